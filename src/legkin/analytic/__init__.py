@@ -1,0 +1,1 @@
+"""Hand-derived analytic kinematics, one module per mechanism (numpy only, vectorised)."""

@@ -1,0 +1,1 @@
+"""Per-mechanism validation: each module's ``run(samples, rng)`` returns ``CheckResult`` rows."""

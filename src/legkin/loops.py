@@ -1,0 +1,159 @@
+"""Closed kinematic loops: their URDF declaration, Pinocchio constraint models, and the loop solver.
+
+A loop is declared inside the xacro (and so inside the generated URDF) with an
+element of legkin's own, which URDF parsers (Pinocchio, yourdfpy) ignore::
+
+    <loop_closure name="B" type="frame" frame1="A_ee" frame2="B_ee"/>
+
+``frame1`` and ``frame2`` are URDF links (or frames of fixed joints) that
+coincide when the loop is closed. ``type="point"`` makes their origins coincide
+(3 rows: a spherical joint at the cut, or a revolute cut on a planar loop);
+``type="frame"`` makes the whole placements coincide (6 rows: a rigid cut).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+
+from .errors import LegkinError, LoopClosureError
+
+__all__ = ["LoopSpec", "LoopSolveInfo", "parse_loops", "build_constraint", "LoopSet"]
+
+_TYPES = ("point", "frame")
+
+
+@dataclass(frozen=True)
+class LoopSpec:
+    """One loop-closure declaration read from the URDF."""
+
+    name: str
+    type: str
+    frame1: str
+    frame2: str
+
+
+@dataclass(frozen=True)
+class LoopSolveInfo:
+    """What :meth:`legkin.Robot.solve_loops` did."""
+
+    iterations: int
+    residual: float
+
+
+def parse_loops(urdf_path: str | Path) -> list[LoopSpec]:
+    """Read every ``<loop_closure>`` element of a URDF file."""
+    root = ET.parse(urdf_path).getroot()
+    loops = []
+    for el in root.iter("loop_closure"):
+        missing = [a for a in ("name", "type", "frame1", "frame2") if a not in el.attrib]
+        if missing:
+            raise LegkinError(f"{urdf_path}: <loop_closure> lacks attribute(s) {', '.join(missing)}")
+        if el.get("type") not in _TYPES:
+            raise LegkinError(
+                f"{urdf_path}: loop {el.get('name')!r} has type {el.get('type')!r}; valid: {', '.join(_TYPES)}"
+            )
+        loops.append(LoopSpec(el.get("name"), el.get("type"), el.get("frame1"), el.get("frame2")))
+    return loops
+
+
+def build_constraint(model: pin.Model, loop: LoopSpec):
+    """The Pinocchio constraint model closing ``loop`` (PointAnchor or FrameAnchor)."""
+    anchors = []
+    for frame in (loop.frame1, loop.frame2):
+        if not model.existFrame(frame):
+            raise LegkinError(f"loop {loop.name!r} names frame {frame!r}, which the model does not have")
+        f = model.frames[model.getFrameId(frame)]
+        anchors += [f.parentJoint, f.placement]
+    cls = pin.PointAnchorConstraintModel if loop.type == "point" else pin.FrameAnchorConstraintModel
+    cm = cls(model, *anchors)
+    cm.name = loop.name
+    return cm
+
+
+class LoopSet:
+    """The stacked loop constraints of a model: residual, Jacobian, mobility and solver."""
+
+    def __init__(self, model: pin.Model, loops: list[LoopSpec]):
+        self.model = model
+        self.data = model.createData()
+        self.loops = list(loops)
+        self.models = [build_constraint(model, lp) for lp in self.loops]
+        self.datas = [cm.createData() for cm in self.models]
+        self.rows = sum(3 if lp.type == "point" else 6 for lp in self.loops)
+        self._v0 = np.zeros(model.nv)
+
+    def residual_and_jacobian(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Stacked residual (rows,) and Jacobian (rows, nv) at ``q``."""
+        model, data = self.model, self.data
+        pin.forwardKinematics(model, data, q, self._v0, self._v0)
+        pin.computeJointJacobians(model, data, q)
+        rs, js = [], []
+        for cm, cd in zip(self.models, self.datas):
+            cm.calc(model, data, cd)
+            rs.append(np.array(cd.constraint_position_error).ravel())
+            js.append(np.array(cm.jacobian(model, data, cd)))
+        if not rs:
+            return np.zeros(0), np.zeros((0, model.nv))
+        return np.concatenate(rs), np.vstack(js)
+
+    def residual(self, q: np.ndarray) -> np.ndarray:
+        return self.residual_and_jacobian(q)[0]
+
+    def mobility(self, q: np.ndarray, free: np.ndarray, tol: float) -> int:
+        """Number of free velocity coordinates minus the rank of the constraint Jacobian on them.
+
+        The rank counts singular values above ``tol`` times the largest one (relative tolerance).
+        """
+        _, jac = self.residual_and_jacobian(q)
+        jac = jac[:, free]
+        if jac.size == 0:
+            return int(free.sum())
+        s = np.linalg.svd(jac, compute_uv=False)
+        rank = int(np.sum(s > tol * max(s[0], 1e-300)))
+        return int(free.sum()) - rank
+
+    def solve(
+        self, q: np.ndarray, free: np.ndarray, tol: float, max_iter: int
+    ) -> tuple[np.ndarray, LoopSolveInfo]:
+        """Levenberg-Marquardt on the stacked residual over the velocity coordinates ``free``.
+
+        Each iteration tries the Gauss-Newton step ``dq = -pinv(J_free) r`` (pseudo-inverse:
+        redundant rows of planar loops make the stack rank-deficient); if it does not reduce
+        ``|r|``, damped steps ``-(J^T J + mu I)^-1 J^T r`` with growing ``mu`` are tried.
+        """
+        model = self.model
+        r, jac = self.residual_and_jacobian(q)
+        err = float(np.linalg.norm(r))
+        mu = 1e-6
+        for it in range(max_iter + 1):
+            if err <= tol:
+                return q, LoopSolveInfo(it, err)
+            if it == max_iter:
+                break
+            jf = jac[:, free]
+            steps = [-np.linalg.pinv(jf, rcond=1e-12) @ r]
+            jtj, jtr = jf.T @ jf, jf.T @ r
+            for k in range(12):
+                steps.append(-np.linalg.solve(jtj + mu * 10.0**k * np.eye(jf.shape[1]), jtr))
+            for step in steps:
+                dq = np.zeros(model.nv)
+                dq[free] = step
+                q_new = pin.integrate(model, q, dq)
+                r_new, jac_new = self.residual_and_jacobian(q_new)
+                err_new = float(np.linalg.norm(r_new))
+                if err_new < err:
+                    break
+            else:
+                break  # no step reduces the residual: a local minimum that does not close
+            q, r, jac, err = q_new, r_new, jac_new, err_new
+        raise LoopClosureError(
+            f"could not close the loops: residual {err:.3e} after {it} iterations (tolerance {tol:.1e})",
+            residual=err,
+            iterations=it,
+            q=q,
+        )

@@ -107,7 +107,9 @@ def model_files(spec: ModelSpec, args: Mapping[str, object]) -> tuple[Path, Path
     if dict(args) == _default_args(spec):
         base = root_dir() / "urdf"
     else:
-        key = hashlib.sha256(json.dumps({k: args[k] for k in sorted(args)}, sort_keys=True).encode()).hexdigest()[:16]
+        sources = b"".join(p.read_bytes() for p in sorted((root_dir() / "xacro").glob("*.xacro")))
+        digest = hashlib.sha256(json.dumps({k: args[k] for k in sorted(args)}, sort_keys=True).encode() + sources)
+        key = digest.hexdigest()[:16]  # xacro sources in the key: an edited xacro never reuses a stale cache
         base = _cache_dir() / f"{spec.name}-{key}"
         if not (base / f"{spec.name}.urdf").exists():
             _write(base, render(spec, args))

@@ -59,7 +59,7 @@ class Robot:
         self.actuated_joints = spec.actuated_joints
         if self.srdf_path is not None:
             pin.loadReferenceConfigurations(self.model, str(self.srdf_path), False)
-        self.poses = {k: np.array(v) for k, v in self.model.referenceConfigurations.items()}
+        self.poses = {e.key(): np.array(e.data()) for e in self.model.referenceConfigurations}
         self.q0 = self.poses.get(spec.reference_pose, pin.neutral(self.model)).copy()
 
     def __repr__(self) -> str:

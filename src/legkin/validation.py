@@ -91,3 +91,44 @@ def write_json(results, path: str | Path) -> None:
         },
     }
     Path(path).write_text(json.dumps(doc, indent=2, allow_nan=True) + "\n")
+
+
+def pinocchio_frames(robot, qs, frames: list[str], jacobians: bool = False):
+    """Pinocchio's world placements (and LOCAL_WORLD_ALIGNED Jacobians) of ``frames`` for each row of ``qs``.
+
+    Returns:
+        ``(positions (N, F, 3), rotations (N, F, 3, 3))``, plus ``jacobians (N, F, 6, nv)`` if asked.
+    """
+    import pinocchio as pin
+
+    model, data = robot.model, robot.data
+    ids = [robot.frame_id(f) for f in frames]
+    n = len(qs)
+    pos = np.empty((n, len(ids), 3))
+    rot = np.empty((n, len(ids), 3, 3))
+    jac = np.empty((n, len(ids), 6, model.nv)) if jacobians else None
+    for i, q in enumerate(qs):
+        if jacobians:
+            pin.computeJointJacobians(model, data, q)
+        else:
+            pin.forwardKinematics(model, data, q)
+        pin.updateFramePlacements(model, data)
+        for k, fid in enumerate(ids):
+            pos[i, k] = data.oMf[fid].translation
+            rot[i, k] = data.oMf[fid].rotation
+            if jacobians:
+                jac[i, k] = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+    return (pos, rot, jac) if jacobians else (pos, rot)
+
+
+def sample_within_limits(robot, n: int, rng: np.random.Generator, joints: list[str] | None = None) -> np.ndarray:
+    """``n`` configurations: ``q0`` with the given 1-DOF joints (default: all) drawn uniformly in their limits."""
+    model = robot.model
+    qs = np.tile(robot.q0, (n, 1))
+    for name in joints or robot.joint_names:
+        j = model.joints[robot.joint_id(name)]
+        if j.nq != 1:
+            continue
+        lo, hi = model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q]
+        qs[:, j.idx_q] = rng.uniform(lo, hi, n)
+    return qs

@@ -1,0 +1,315 @@
+"""Closed-form kinematics of the quadruped's legs (seeds 004 and 002).
+
+Conventions (base frame: x forward, y left, z up; metres, radians):
+
+* legs ``"LF"``, ``"LH"``, ``"RF"``, ``"RH"``; ``sx = +1`` front / ``-1`` hind, ``sy = +1`` left / ``-1`` right;
+* joint vector ``q = (q1, q2, q3)`` = (``<LEG>_HAA``, ``<LEG>_HFE``, ``<LEG>_KFE``), the seed's
+  (aile, epaule, coude) angles; the foot frame ``<LEG>_FOOT`` is the seed's "pied";
+* seed 004's transforms with its sign typo resolved: ``T01 = Tr(h) Rx(sy q1)``, ``T12 = Tr(0, sy y12, 0) Ry(-q2)``,
+  ``T23 = Tr(x23, 0, z23) Ry(q3)``, ``T34 = Tr(x34, 0, foot_z)``.
+
+Every function takes arrays with leading batch dimensions. A single input (``q`` or ``p`` of shape (3,))
+returns plain arrays and raises on failure; a batch returns NaN rows where an item fails, and
+``return_mask=True`` also returns the boolean mask of successes.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import InvalidParameterError, JointLimitError, UnreachableError
+from ._batch import as_input, finish
+
+__all__ = [
+    "LEGS",
+    "X01",
+    "Y01",
+    "Z01",
+    "Y12",
+    "X23",
+    "Z23",
+    "X34",
+    "JOINT_LIMITS",
+    "hip_position",
+    "foot_position",
+    "foot_jacobian",
+    "foot_ik",
+    "foot_ik_all",
+    "within_limits",
+    "textbook_ik",
+    "textbook_frame",
+    "textbook_to_joints",
+]
+
+LEGS = ("LF", "LH", "RF", "RH")
+
+# Seed 004 offsets (m): base_aile, aile_epaule, epaule_coude, coude_pied.
+X01, Y01, Z01 = 0.3305, 0.175, -0.051
+Y12 = 0.1077
+X23, Z23 = -0.35192, -0.041509
+X34 = 0.29604
+
+#: Joint limits (POPI's), rows q1, q2, q3: (lower, upper) in rad.
+JOINT_LIMITS = np.array([[-0.4, 0.4], [0.0, math.pi], [0.26, 1.92]])
+
+#: Branch order of :func:`foot_ik_all`: (s_u, k) with s_u = -1 foot below the hip plane, k the knee sign.
+BRANCHES = ((-1, -1), (-1, 1), (1, -1), (1, 1))
+
+
+def _signs(leg: str) -> tuple[float, float]:
+    try:
+        return {"LF": (1.0, 1.0), "LH": (-1.0, 1.0), "RF": (1.0, -1.0), "RH": (-1.0, -1.0)}[leg]
+    except (KeyError, TypeError):
+        raise InvalidParameterError(f"leg must be one of {', '.join(LEGS)}, got {leg!r}") from None
+
+
+def hip_position(leg: str) -> np.ndarray:
+    """Point of the abduction axis ``base_aile`` of ``leg`` in the base frame (seed 004)."""
+    sx, sy = _signs(leg)
+    return np.array([sx * X01, sy * Y01, Z01])
+
+
+def _wrap(a: np.ndarray) -> np.ndarray:
+    """Wrap angles to (-pi, pi]."""
+    return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
+
+
+def _knee_vector(q3: np.ndarray, foot_z: float) -> tuple[np.ndarray, np.ndarray]:
+    """``v = t23 + Ry(q3) t34`` in the thigh's x-z plane (foot from the shoulder, before q2)."""
+    c3, s3 = np.cos(q3), np.sin(q3)
+    return X23 + X34 * c3 + foot_z * s3, Z23 - X34 * s3 + foot_z * c3
+
+
+def _forward(q: np.ndarray, leg: str, foot_z: float):
+    sx, sy = _signs(leg)
+    a = sy * q[..., 0]
+    c1, s1 = np.cos(a), np.sin(a)
+    c2, s2 = np.cos(q[..., 1]), np.sin(q[..., 1])
+    vx, vz = _knee_vector(q[..., 2], foot_z)
+    ux = vx * c2 - vz * s2  # Ry(-q2) v
+    uz = vx * s2 + vz * c2
+    uy = sy * Y12
+    return sx, sy, c1, s1, c2, s2, ux, uy, uz
+
+
+def foot_position(q, leg: str, *, foot_z: float = 0.0) -> np.ndarray:
+    """Foot position in the base frame: the product of seed 004's transforms T01 T12 T23 T34.
+
+    .. math:: p = h + R_x(s_y q_1)\\,\\big[(0, s_y y_{12}, 0) + R_y(-q_2)(t_{23} + R_y(q_3) t_{34})\\big]
+
+    Seed 004 prints T01 with the ``+-`` signs stacked identically in rows 2 and 3 (not a rotation);
+    the consistent reading, used here, is Rx(+q1) for left legs and Rx(-q1) for right legs.
+
+    Args:
+        q: joint angles (..., 3).
+        leg: ``"LF"``, ``"LH"``, ``"RF"`` or ``"RH"``.
+        foot_z: the foot drop below the shank axis (xacro argument ``foot_z``).
+
+    Returns:
+        Positions (..., 3) in metres.
+    """
+    q = as_input(q, "q", (3,))
+    _, _, c1, s1, _, _, ux, uy, uz = _forward(q, leg, foot_z)
+    h = hip_position(leg)
+    return np.stack([h[0] + ux, h[1] + c1 * uy - s1 * uz, h[2] + s1 * uy + c1 * uz], axis=-1)
+
+
+def foot_jacobian(q, leg: str, *, foot_z: float = 0.0) -> np.ndarray:
+    """Closed-form Jacobian d(foot position)/dq, shape (..., 3, 3) (columns q1, q2, q3).
+
+    Differentiates :func:`foot_position` (seed 004's product) factor by factor:
+    ``dp/dq1 = s_y R_x' u``, ``dp/dq2 = R_x (-u_z, 0, u_x)``, ``dp/dq3 = R_x R_y(-q_2) dv/dq_3``.
+    """
+    q = as_input(q, "q", (3,))
+    _, sy, c1, s1, c2, s2, ux, uy, uz = _forward(q, leg, foot_z)
+    c3, s3 = np.cos(q[..., 2]), np.sin(q[..., 2])
+    dvx = -X34 * s3 + foot_z * c3
+    dvz = -X34 * c3 - foot_z * s3
+    dux3, duz3 = dvx * c2 - dvz * s2, dvx * s2 + dvz * c2
+    zero = np.zeros_like(ux)
+    col1 = np.stack([zero, sy * (-s1 * uy - c1 * uz), sy * (c1 * uy - s1 * uz)], axis=-1)
+    col2 = np.stack([-uz, -s1 * ux, c1 * ux], axis=-1)
+    col3 = np.stack([dux3, -s1 * duz3, c1 * duz3], axis=-1)
+    return np.stack([col1, col2, col3], axis=-1)
+
+
+def within_limits(q, tol: float = 1e-9) -> np.ndarray:
+    """Whether joint vectors (..., 3) lie inside :data:`JOINT_LIMITS` (with slack ``tol`` rad)."""
+    q = np.asarray(q, dtype=float)
+    lo, hi = JOINT_LIMITS[:, 0], JOINT_LIMITS[:, 1]
+    return np.all((q >= lo - tol) & (q <= hi + tol), axis=-1)
+
+
+def _ik_all(p: np.ndarray, leg: str, foot_z: float):
+    """All four branches (..., 4, 3) and the diagnostic quantities of the closed form."""
+    sx, sy = _signs(leg)
+    d = p - hip_position(leg)
+    rho2 = d[..., 1] ** 2 + d[..., 2] ** 2 - Y12**2
+    rho = np.sqrt(np.maximum(rho2, 0.0))
+    l1 = math.hypot(X23, Z23)
+    l2 = math.hypot(X34, foot_z)
+    r2 = np.sum(d * d, axis=-1) - Y12**2
+    kk = (r2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)
+    alpha = math.atan2(Z23, X23)
+    beta = math.atan2(foot_z, X34)
+    acos_k = np.arccos(np.clip(kk, -1.0, 1.0))
+    out = np.empty(p.shape[:-1] + (4, 3))
+    for b, (s_u, k) in enumerate(BRANCHES):
+        uz = s_u * rho
+        ux = d[..., 0]
+        q1 = sy * (np.arctan2(d[..., 2], d[..., 1]) - np.arctan2(uz, sy * Y12))
+        q3 = (beta - alpha) + k * acos_k
+        vx, vz = _knee_vector(q3, foot_z)
+        q2 = np.arctan2(uz, ux) - np.arctan2(vz, vx)
+        out[..., b, :] = _wrap(np.stack([q1, q2, q3], axis=-1))
+    reachable = (rho2 >= 0.0) & (np.abs(kk) <= 1.0)
+    return out, reachable, rho2, r2, kk, l1, l2
+
+
+def _unreachable_message(leg, p, rho2, r2, l1, l2) -> str:
+    if rho2 < 0:
+        dist = math.sqrt(max(rho2 + Y12**2, 0.0))
+        return (
+            f"target {p.tolist()} for leg {leg} is inside the abduction cylinder: its distance to the "
+            f"abduction axis is {dist:.6g} m < {Y12} m (by {Y12 - dist:.3g} m)"
+        )
+    r = math.sqrt(r2)
+    if r > l1 + l2:
+        return (
+            f"target {p.tolist()} for leg {leg} is beyond full stretch: the hip-to-foot distance in the "
+            f"leg plane is {r:.6g} m > L1 + L2 = {l1 + l2:.6g} m (by {r - l1 - l2:.3g} m)"
+        )
+    return (
+        f"target {p.tolist()} for leg {leg} is too close to the hip: the hip-to-foot distance in the leg "
+        f"plane is {r:.6g} m < |L1 - L2| = {abs(l1 - l2):.6g} m (by {abs(l1 - l2) - r:.3g} m)"
+    )
+
+
+def foot_ik_all(p, leg: str, *, foot_z: float = 0.0, return_mask: bool = False):
+    """Every closed-form IK branch of a foot target: shape (..., 4, 3), branches in :data:`BRANCHES` order.
+
+    The closed form for this geometry (knee offset included), checked against Pinocchio:
+
+    1. ``d = p - h``; ``rho^2 = d_y^2 + d_z^2 - y12^2`` (< 0: inside the abduction cylinder);
+    2. ``u_z = s_u rho``, ``u_x = d_x``; ``q1 = s_y [atan2(d_z, d_y) - atan2(u_z, s_y y12)]``;
+    3. ``K = (|d|^2 - y12^2 - L1^2 - L2^2) / (2 L1 L2)`` (|K| > 1: out of reach);
+       ``q3 = (beta - alpha) + k acos K`` with ``alpha = atan2(z23, x23)``, ``beta = atan2(z34, x34)``;
+    4. ``q2 = atan2(u_z, u_x) - atan2(v_z, v_x)`` with ``v = t23 + Ry(q3) t34``; every angle wrapped to (-pi, pi].
+
+    Joint limits are not applied (see :func:`within_limits`); rows are NaN where the target is unreachable.
+
+    Raises:
+        UnreachableError: single target out of reach (message says why and by how much).
+    """
+    p = as_input(p, "p", (3,))
+    q, ok, rho2, r2, kk, l1, l2 = _ik_all(p, leg, foot_z)
+    q[~ok] = np.nan
+
+    def error():
+        return UnreachableError(_unreachable_message(leg, p, float(rho2), float(r2), l1, l2), target=p)
+
+    q = finish(q, ok, p.ndim == 1, False, error)
+    return (q, np.repeat(ok[..., None], 4, axis=-1)) if return_mask else q
+
+
+def foot_ik(p, leg: str, q_ref=None, *, foot_z: float = 0.0, return_mask: bool = False) -> np.ndarray:
+    """Joint angles (..., 3) placing the foot at ``p``: the branch inside the joint limits.
+
+    Among the four branches of :func:`foot_ik_all`, keeps those inside :data:`JOINT_LIMITS`; picks the one
+    nearest ``q_ref`` (wrapped angular distance) when given, else the first in branch order (foot below
+    the hip plane first). Inside POPI's limits only the k = -1 knee branch occurs, but both s_u
+    branches do (s_u = +1 for large q2), so the choice is made here, not assumed.
+
+    Args:
+        p: foot targets (..., 3) in the base frame.
+        leg: ``"LF"``, ``"LH"``, ``"RF"`` or ``"RH"``.
+        q_ref: configurations (..., 3) to stay near (broadcast against ``p``).
+        return_mask: also return the boolean mask of targets solved inside the limits.
+
+    Raises:
+        UnreachableError: single target out of reach.
+        JointLimitError: single target reachable only outside the joint limits.
+    """
+    p = as_input(p, "p", (3,))
+    q_all, ok, rho2, r2, kk, l1, l2 = _ik_all(p, leg, foot_z)
+    inside = within_limits(q_all) & ok[..., None]
+    if q_ref is None:
+        cost = np.broadcast_to(np.arange(4.0), inside.shape)
+    else:
+        q_ref = as_input(q_ref, "q_ref", (3,))
+        cost = np.linalg.norm(_wrap(q_all - q_ref[..., None, :]), axis=-1)
+    cost = np.where(inside, cost, np.inf)
+    best = np.argmin(cost, axis=-1)
+    q = np.take_along_axis(q_all, best[..., None, None], axis=-2)[..., 0, :]
+    solved = np.any(inside, axis=-1)
+    q = np.where(solved[..., None], q, np.nan)
+
+    def error():
+        if not bool(ok):
+            return UnreachableError(_unreachable_message(leg, p, float(rho2), float(r2), l1, l2), target=p)
+        return JointLimitError(
+            f"target {p.tolist()} for leg {leg} is reachable only outside the joint limits "
+            f"{JOINT_LIMITS.tolist()}: branches {np.round(q_all, 4).tolist()}",
+            target=p,
+        )
+
+    return finish(q, solved, p.ndim == 1, return_mask, error)
+
+
+# ----------------------------------------------------------------------------- seed 002
+def textbook_frame(p, leg: str) -> np.ndarray:
+    """Express base-frame foot targets in seed 002's frame for ``leg``.
+
+    Seed 002 works from the abduction axis with x lateral (towards the hip offset, so mirrored on right
+    legs: x_f -> -x_f), y forward and z down: ``(x_f, y_f, z_f) = (s_y d_y, d_x, -d_z)`` with ``d = p - h``.
+    """
+    _, sy = _signs(leg)
+    d = as_input(p, "p", (3,)) - hip_position(leg)
+    return np.stack([sy * d[..., 1], d[..., 0], -d[..., 2]], axis=-1)
+
+
+def textbook_ik(p, a: float, b: float, c: float, *, literal: bool = False) -> np.ndarray:
+    """Seed 002's law-of-cosines IK: (theta_abad, theta_hip, theta_knee), shape (..., 3).
+
+    .. math::
+        \\theta_{abad} = \\operatorname{atan2}(x_f, z_f) + \\arccos\\frac{a}{\\sqrt{x_f^2 + z_f^2}}, \\quad
+        \\theta_{hip} = \\frac{\\pi}{2} - \\arcsin\\frac{-y_f}{\\sqrt{L - a^2}}
+            - \\arccos\\frac{b^2 - a^2 - c^2 + L}{2 b \\sqrt{L - a^2}}, \\quad
+        \\theta_{knee} = \\arccos\\frac{a^2 + b^2 + c^2 - L}{2 b c}
+
+    with ``L = x_f^2 + y_f^2 + z_f^2`` and ``p = (x_f, y_f, z_f)`` in seed 002's frame (:func:`textbook_frame`).
+    Two fixes to the seed as printed: "90" is pi/2 (radians), and ``atan(x_f / z_f)`` is ``atan2(x_f, z_f)``
+    (the literal atan is wrong for every z_f < 0 and divides by zero at z_f = 0). ``literal=True`` keeps the
+    printed atan, to show that failure. Only one branch (knee k = -1, foot below the hip) is returned.
+    ``theta_adab`` and ``theta_abd`` in the seed are typos for theta_abad. NaN where acos/asin are out of range.
+    """
+    p = as_input(p, "p", (3,))
+    xf, yf, zf = p[..., 0], p[..., 1], p[..., 2]
+    big_l = xf * xf + yf * yf + zf * zf
+    m = np.sqrt(big_l - a * a)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        first = np.arctan(xf / zf) if literal else np.arctan2(xf, zf)
+        abad = first + np.arccos(a / np.sqrt(xf * xf + zf * zf))
+        hip = np.pi / 2 - np.arcsin(-yf / m) - np.arccos((b * b - a * a - c * c + big_l) / (2 * b * m))
+        knee = np.arccos((a * a + b * b + c * c - big_l) / (2 * b * c))
+    return np.stack([abad, hip, knee], axis=-1)
+
+
+#: Angle of the thigh offset: atan(|z23| / |x23|) = 0.1174 rad, the seed-002 servo zero offset.
+KNEE_OFFSET = math.atan2(-Z23, -X23)
+
+
+def textbook_to_joints(theta, leg: str) -> np.ndarray:
+    """Map seed 002's (theta_abad, theta_hip, theta_knee) onto the quadruped's (q1, q2, q3) of ``leg``.
+
+    With a = y12, b = L1, c = L2 (foot_z = 0): ``q1 = theta_abad - pi/2``, ``q2 = theta_hip - 0.1174``,
+    ``q3 = theta_knee - 0.1174`` (0.1174 = atan(0.041509 / 0.35192), the thigh's offset angle); this is
+    foot_ik's branch (s_u, k) = (-1, -1). The same formulas hold on both sides because seed 002's frame is
+    mirrored on right legs (see :func:`textbook_frame`).
+    """
+    _signs(leg)
+    theta = as_input(theta, "theta", (3,), allow_nan=True)
+    q = theta - np.array([np.pi / 2, KNEE_OFFSET, KNEE_OFFSET])
+    return _wrap(q)

@@ -1,0 +1,104 @@
+"""Meshcat views of legkin models through Pinocchio's ``MeshcatVisualizer`` (live or as a static page)."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+from pathlib import Path
+from typing import Iterator, Sequence
+
+import numpy as np
+
+from .robot import Robot
+
+__all__ = ["open_viewer", "show", "write_html", "write_animation_html"]
+
+#: Camera position in three.js coordinates (y up), looking at the origin.
+DEFAULT_CAMERA = (1.2, 0.7, 1.2)
+
+
+@contextlib.contextmanager
+def open_viewer(robot: Robot, camera: Sequence[float] | None = None) -> Iterator[object]:
+    """A ``pinocchio.visualize.MeshcatVisualizer`` with ``robot`` loaded; its zmq server is always stopped.
+
+    meshcat 0.3.2 starts the server as a child process and has no working ``close``: the context
+    manager terminates it on exit, whatever happens inside.
+    """
+    import meshcat
+    from pinocchio.visualize import MeshcatVisualizer
+
+    with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; callers decide what to show
+        viewer = meshcat.Visualizer()
+    try:
+        viz = MeshcatVisualizer(robot.model, robot.collision_model, robot.visual_model)
+        viz.initViewer(viewer=viewer, open=False)
+        viz.loadViewerModel(rootNodeName=robot.name)
+        cam = camera if camera is not None else _camera_for(robot)
+        viewer["/Cameras/default/rotated/<object>"].set_property("position", list(map(float, cam)))
+        yield viz
+    finally:
+        proc = getattr(viewer.window, "server_proc", None)
+        if proc is not None:
+            proc.terminate()
+            proc.wait(timeout=10)
+
+
+def _camera_for(robot: Robot) -> tuple[float, float, float]:
+    """A camera distance fitted to the model's extent at ``q0``."""
+    import pinocchio as pin
+
+    pin.framesForwardKinematics(robot.model, robot.data, robot.q0)
+    pts = np.array([f.translation for f in robot.data.oMf])
+    size = float(np.max(np.linalg.norm(pts - pts.mean(axis=0), axis=1))) if len(pts) else 0.5
+    s = max(size, 0.05) * 2.6
+    return (s, 0.6 * s, s)
+
+
+def write_html(robot: Robot, q: np.ndarray, path: str | Path) -> Path:
+    """Write a self-contained static meshcat page showing ``robot`` at ``q``; returns the path."""
+    q = robot.check_q(q)
+    with open_viewer(robot) as viz:
+        viz.display(q)
+        html = viz.viewer.static_html()
+    path = Path(path)
+    path.write_text(html)
+    return path
+
+
+def write_animation_html(robot: Robot, qs: Sequence[np.ndarray], path: str | Path, fps: int = 30) -> Path:
+    """Write a static page with a meshcat animation clip (play/scrub in the page's Animations menu)."""
+    import meshcat.animation
+    import pinocchio as pin
+
+    qs = [robot.check_q(q) for q in qs]
+    with open_viewer(robot) as viz:
+        viz.display(qs[0])
+        anim = meshcat.animation.Animation(default_framerate=fps)
+        model, data = robot.model, robot.data
+        for i, q in enumerate(qs):
+            pin.forwardKinematics(model, data, q)
+            pin.updateGeometryPlacements(model, data, robot.visual_model, viz.visual_data)
+            with anim.at_frame(viz.viewer, i) as frame:
+                for g, geom in enumerate(robot.visual_model.geometryObjects):
+                    transform = viz.visual_data.oMg[g].homogeneous @ np.diag([*geom.meshScale, 1.0])
+                    frame[viz.getViewerNodeName(geom, pin.VISUAL)].set_transform(transform)
+        viz.viewer.set_animation(anim, play=True, repetitions=0)
+        html = viz.viewer.static_html()
+    path = Path(path)
+    path.write_text(html)
+    return path
+
+
+def show(robot: Robot, q: np.ndarray) -> None:
+    """Serve a live meshcat view of ``robot`` at ``q``; prints the URL and blocks until Ctrl-C."""
+    import time
+
+    q = robot.check_q(q)
+    with open_viewer(robot) as viz:
+        viz.display(q)
+        print(f"meshcat viewer: {viz.viewer.url()}  (Ctrl-C to stop)", flush=True)
+        try:
+            while True:
+                time.sleep(1.0)
+        except KeyboardInterrupt:
+            pass

@@ -54,6 +54,9 @@ X34 = 0.29604
 #: Joint limits (POPI's), rows q1, q2, q3: (lower, upper) in rad.
 JOINT_LIMITS = np.array([[-0.4, 0.4], [0.0, math.pi], [0.26, 1.92]])
 
+#: Distance (m) by which a target may lie outside the reachable set and still be solved (on the boundary).
+REACH_TOL = 1e-12
+
 #: Branch order of :func:`foot_ik_all`: (s_u, k) with s_u = -1 foot below the hip plane, k the knee sign.
 BRANCHES = ((-1, -1), (-1, 1), (1, -1), (1, 1))
 
@@ -164,18 +167,24 @@ def _ik_all(p: np.ndarray, leg: str, foot_z: float):
         vx, vz = _knee_vector(q3, foot_z)
         q2 = np.arctan2(uz, ux) - np.arctan2(vz, vx)
         out[..., b, :] = _wrap(np.stack([q1, q2, q3], axis=-1))
-    reachable = (rho2 >= 0.0) & (np.abs(kk) <= 1.0)
+    # Targets on the workspace boundary, built in floating point, may land a rounding error outside it:
+    # accept them within REACH_TOL metres (then the clipped acos / zero rho give the boundary solution).
+    r = np.sqrt(np.maximum(r2, 0.0))
+    axis_dist = np.sqrt(d[..., 1] ** 2 + d[..., 2] ** 2)
+    reachable = (
+        (axis_dist >= Y12 - REACH_TOL) & (r <= l1 + l2 + REACH_TOL) & (r >= abs(l1 - l2) - REACH_TOL)
+    )
     return out, reachable, rho2, r2, kk, l1, l2
 
 
 def _unreachable_message(leg, p, rho2, r2, l1, l2) -> str:
-    if rho2 < 0:
+    if rho2 < 0 and math.sqrt(max(rho2 + Y12**2, 0.0)) < Y12 - REACH_TOL:
         dist = math.sqrt(max(rho2 + Y12**2, 0.0))
         return (
             f"target {p.tolist()} for leg {leg} is inside the abduction cylinder: its distance to the "
             f"abduction axis is {dist:.6g} m < {Y12} m (by {Y12 - dist:.3g} m)"
         )
-    r = math.sqrt(r2)
+    r = math.sqrt(max(r2, 0.0))
     if r > l1 + l2:
         return (
             f"target {p.tolist()} for leg {leg} is beyond full stretch: the hip-to-foot distance in the "

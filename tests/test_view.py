@@ -1,0 +1,67 @@
+"""The meshcat pages render in a real browser (headless Chromium) and show the mechanism."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import legkin
+from legkin._registry import MODELS
+from legkin.viewer import write_html
+
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+
+pytestmark = pytest.mark.skipif(
+    CHROMIUM is None and not os.environ.get("CI"),
+    reason="headless Chromium not installed (apt-get install chromium); required on CI",
+)
+
+
+def screenshot(page: Path, png: Path) -> np.ndarray:
+    from PIL import Image
+
+    assert CHROMIUM is not None, "CI must install Debian's chromium (see .ci/run)"
+    cmd = [
+        CHROMIUM, "--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+        "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic",
+        f"--user-data-dir={png.parent / 'chrome-profile'}", "--window-size=800,600",
+        "--virtual-time-budget=15000", f"--screenshot={png}", page.resolve().as_uri(),
+    ]
+    subprocess.run(cmd, check=True, timeout=120, capture_output=True)
+    return np.asarray(Image.open(png).convert("RGB"), dtype=float)
+
+
+@pytest.fixture(scope="module")
+def empty_scene(tmp_path_factory) -> np.ndarray:
+    import meshcat
+
+    tmp = tmp_path_factory.mktemp("empty")
+    vis = meshcat.Visualizer()
+    try:
+        html = vis.static_html()
+    finally:
+        vis.window.server_proc.terminate()
+        vis.window.server_proc.wait(timeout=10)
+    page = tmp / "empty.html"
+    page.write_text(html)
+    return screenshot(page, tmp / "empty.png")
+
+
+def assert_shows_something(img: np.ndarray, empty: np.ndarray) -> None:
+    assert img.std() > 5, "blank page"
+    changed = np.abs(img - empty).max(axis=-1) > 30
+    assert changed.mean() > 0.01, f"only {changed.mean():.2%} of the pixels differ from the empty scene"
+
+
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_model_page_renders(name, tmp_path, empty_scene):
+    robot = legkin.load(name)
+    page = write_html(robot, robot.q0, tmp_path / f"{name}.html")
+    assert page.stat().st_size > 10_000
+    img = screenshot(page, tmp_path / f"{name}.png")
+    assert_shows_something(img, empty_scene)

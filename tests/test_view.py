@@ -65,3 +65,12 @@ def test_model_page_renders(name, tmp_path, empty_scene):
     assert page.stat().st_size > 10_000
     img = screenshot(page, tmp_path / f"{name}.png")
     assert_shows_something(img, empty_scene)
+
+
+def test_animation_page_renders(tmp_path, empty_scene):
+    from legkin.__main__ import main
+
+    page = tmp_path / "anim.html"
+    assert main(["view", "quadruped", "--animate", "foot_circles", "--html", str(page)]) == 0
+    img = screenshot(page, tmp_path / "anim.png")
+    assert_shows_something(img, empty_scene)

@@ -71,11 +71,27 @@ def _cmd_view(args) -> int:
         q = robot.poses[args.pose]
     else:
         q = robot.q0
+    if args.animate:
+        from .animations import frames
+        from .viewer import write_animation_html
+
+        qs = frames(robot, args.animate)
+        if args.html:
+            print(f"wrote {write_animation_html(robot, qs, args.html)}")
+            return 0
+        show(robot, qs[0], animation=qs)
+        return 0
     if args.html:
         print(f"wrote {write_html(robot, q, args.html)}")
         return 0
     show(robot, q)
     return 0
+
+
+def _cmd_bench(args) -> int:
+    from .bench import run_bench_cli
+
+    return run_bench_cli(args)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -103,8 +119,16 @@ def build_parser() -> argparse.ArgumentParser:
     g = p.add_mutually_exclusive_group()
     g.add_argument("--pose", help="a named pose from the SRDF")
     g.add_argument("--q", type=float, nargs="+", help="a configuration vector")
+    p.add_argument("--animate", metavar="NAME", help="play an animation clip (see legkin.animations)")
     p.add_argument("--html", metavar="PATH", help="write a static page and exit")
     p.set_defaults(func=_cmd_view)
+    p = sub.add_parser("bench", help="time analytic kinematics against iterative solvers")
+    p.add_argument("models", nargs="*", help="models (default: all)")
+    p.add_argument("--n", type=int, default=None, help="targets per method (default: per model)")
+    p.add_argument("--json", metavar="PATH", help="also write the results as JSON")
+    p.add_argument("--quick", action="store_true", help="small run for smoke tests (under a minute)")
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.set_defaults(func=_cmd_bench)
     return parser
 
 

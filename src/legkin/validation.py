@@ -5,7 +5,7 @@ from __future__ import annotations
 import importlib
 import json
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
@@ -33,17 +33,22 @@ class CheckResult:
     p99_error: float
     tolerance: float
     passed: bool
+    errors: np.ndarray = field(default=None, repr=False, compare=False)
+
+    def as_dict(self) -> dict:
+        """The JSON row (per-sample errors left out)."""
+        return {k: getattr(self, k) for k in ("name", "samples", "max_error", "p99_error", "tolerance", "passed")}
 
 
 def compare(name: str, errors, tolerance: float) -> CheckResult:
     """Summarise per-sample errors (any shape; NaN counts as a failure) into a row."""
     e = np.abs(np.asarray(errors, dtype=float)).ravel()
     if e.size == 0:
-        return CheckResult(name, 0, float("nan"), float("nan"), tolerance, False)
+        return CheckResult(name, 0, float("nan"), float("nan"), tolerance, False, e)
     finite = bool(np.all(np.isfinite(e)))
     emax = float(np.max(e)) if finite else float("nan")
     p99 = float(np.percentile(e, 99)) if finite else float("nan")
-    return CheckResult(name, int(e.size), emax, p99, tolerance, finite and emax <= tolerance)
+    return CheckResult(name, int(e.size), emax, p99, tolerance, finite and emax <= tolerance, e)
 
 
 def per_sample(diff, axis=-1):
@@ -86,7 +91,7 @@ def write_json(results, path: str | Path) -> None:
     doc = {
         "passed": all_passed(results),
         "models": {
-            name: {"seconds": seconds, "checks": [asdict(r) for r in rows]}
+            name: {"seconds": seconds, "checks": [r.as_dict() for r in rows]}
             for name, (rows, seconds) in results.items()
         },
     }

@@ -65,37 +65,43 @@ def write_html(robot: Robot, q: np.ndarray, path: str | Path) -> Path:
     return path
 
 
-def write_animation_html(robot: Robot, qs: Sequence[np.ndarray], path: str | Path, fps: int = 30) -> Path:
-    """Write a static page with a meshcat animation clip (play/scrub in the page's Animations menu)."""
+def _animation(robot: Robot, viz, qs: Sequence[np.ndarray], fps: int):
+    """A meshcat clip moving every visual geometry through the configurations ``qs``."""
     import meshcat.animation
     import pinocchio as pin
 
-    qs = [robot.check_q(q) for q in qs]
+    anim = meshcat.animation.Animation(default_framerate=fps)
+    model, data = robot.model, robot.data
+    for i, q in enumerate(qs):
+        pin.forwardKinematics(model, data, robot.check_q(q))
+        pin.updateGeometryPlacements(model, data, robot.visual_model, viz.visual_data)
+        with anim.at_frame(viz.viewer, i) as frame:
+            for g, geom in enumerate(robot.visual_model.geometryObjects):
+                transform = viz.visual_data.oMg[g].homogeneous @ np.diag([*geom.meshScale, 1.0])
+                frame[viz.getViewerNodeName(geom, pin.VISUAL)].set_transform(transform)
+    return anim
+
+
+def write_animation_html(robot: Robot, qs: Sequence[np.ndarray], path: str | Path, fps: int = 30) -> Path:
+    """Write a static page that plays a meshcat clip of ``qs`` (loops; scrub it in the Animations menu)."""
     with open_viewer(robot) as viz:
-        viz.display(qs[0])
-        anim = meshcat.animation.Animation(default_framerate=fps)
-        model, data = robot.model, robot.data
-        for i, q in enumerate(qs):
-            pin.forwardKinematics(model, data, q)
-            pin.updateGeometryPlacements(model, data, robot.visual_model, viz.visual_data)
-            with anim.at_frame(viz.viewer, i) as frame:
-                for g, geom in enumerate(robot.visual_model.geometryObjects):
-                    transform = viz.visual_data.oMg[g].homogeneous @ np.diag([*geom.meshScale, 1.0])
-                    frame[viz.getViewerNodeName(geom, pin.VISUAL)].set_transform(transform)
-        viz.viewer.set_animation(anim, play=True, repetitions=0)
+        viz.display(robot.check_q(qs[0]))
+        viz.viewer.set_animation(_animation(robot, viz, qs, fps), play=True, repetitions=0)
         html = viz.viewer.static_html()
     path = Path(path)
     path.write_text(html)
     return path
 
 
-def show(robot: Robot, q: np.ndarray) -> None:
-    """Serve a live meshcat view of ``robot`` at ``q``; prints the URL and blocks until Ctrl-C."""
+def show(robot: Robot, q: np.ndarray, animation: Sequence[np.ndarray] | None = None) -> None:
+    """Serve a live meshcat view of ``robot`` at ``q`` (playing ``animation`` if given) until Ctrl-C."""
     import time
 
     q = robot.check_q(q)
     with open_viewer(robot) as viz:
         viz.display(q)
+        if animation is not None:
+            viz.viewer.set_animation(_animation(robot, viz, animation, 30), play=True, repetitions=0)
         print(f"meshcat viewer: {viz.viewer.url()}  (Ctrl-C to stop)", flush=True)
         try:
             while True:

@@ -165,3 +165,11 @@ def test_check_json(tmp_path):
     assert doc["passed"] is True
     rows = doc["models"]["quadruped"]["checks"]
     assert rows and {"name", "samples", "max_error", "p99_error", "tolerance", "passed"} <= set(rows[0])
+
+
+def test_readme_model_table_lists_every_model():
+    text = (ROOT / "README.md").read_text()
+    table = text[text.index("<!-- legkin:models -->") : text.index("<!-- /legkin:models -->")]
+    for name in MODEL_NAMES:
+        assert f"[`{name}`]" in table, f"README model table lacks {name}: run scripts/make_docs.py"
+        assert (ROOT / "docs" / f"{name}.md").exists()

@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import os
-import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
@@ -12,9 +10,10 @@ import pytest
 
 import legkin
 from legkin._registry import MODELS
-from legkin.viewer import write_html
+from legkin.viewer import chromium_path, write_html
+from legkin.viewer import screenshot as render_png
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+CHROMIUM = chromium_path()
 
 pytestmark = pytest.mark.skipif(
     CHROMIUM is None and not os.environ.get("CI"),
@@ -26,13 +25,7 @@ def screenshot(page: Path, png: Path) -> np.ndarray:
     from PIL import Image
 
     assert CHROMIUM is not None, "CI must install Debian's chromium (see .ci/run)"
-    cmd = [
-        CHROMIUM, "--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic",
-        f"--user-data-dir={png.parent / 'chrome-profile'}", "--window-size=800,600",
-        "--virtual-time-budget=15000", f"--screenshot={png}", page.resolve().as_uri(),
-    ]
-    subprocess.run(cmd, check=True, timeout=120, capture_output=True)
+    render_png(page, png)
     return np.asarray(Image.open(png).convert("RGB"), dtype=float)
 
 

@@ -108,3 +108,30 @@ def show(robot: Robot, q: np.ndarray, animation: Sequence[np.ndarray] | None = N
                 time.sleep(1.0)
         except KeyboardInterrupt:
             pass
+
+
+def chromium_path() -> str | None:
+    """Path of a Chromium executable, or None (Debian: ``apt-get install chromium``)."""
+    import shutil
+
+    return shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+def screenshot(page: str | Path, png: str | Path, size: tuple[int, int] = (800, 600), budget_ms: int = 15000) -> Path:
+    """Render a page with headless Chromium into a PNG (a real browser, with WebGL in software)."""
+    import subprocess
+    import tempfile
+
+    exe = chromium_path()
+    if exe is None:
+        raise RuntimeError("headless Chromium is not installed (Debian: apt-get install chromium)")
+    png = Path(png)
+    with tempfile.TemporaryDirectory(prefix="legkin-chromium-") as profile:
+        cmd = [
+            exe, "--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+            "--disable-component-update", "--disable-sync", "--no-first-run", "--disable-quic",
+            f"--user-data-dir={profile}", f"--window-size={size[0]},{size[1]}",
+            f"--virtual-time-budget={budget_ms}", f"--screenshot={png.resolve()}", Path(page).resolve().as_uri(),
+        ]
+        subprocess.run(cmd, check=True, timeout=180, capture_output=True)
+    return png

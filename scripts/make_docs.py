@@ -1,0 +1,123 @@
+#!/usr/bin/env python3
+"""Regenerate the README's pictures and tables: ``python scripts/make_docs.py [--skip-bench] [--samples N]``.
+
+Writes ``docs/img/<model>.png`` (a meshcat page of each model rendered by headless Chromium),
+``docs/img/plots/*.png`` (``legkin check --plots``), ``docs/check.json`` and ``docs/bench.json``, then
+rewrites the README sections between ``<!-- legkin:NAME -->`` and ``<!-- /legkin:NAME -->`` markers
+(NAME = models, pictures, check, bench). Needs the ``plots`` and ``bench`` extras and Chromium.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import tempfile
+from pathlib import Path
+
+import legkin
+from legkin._registry import get_spec
+from legkin.validation import run_checks, write_json
+from legkin.viewer import screenshot, write_html
+
+ROOT = Path(__file__).resolve().parents[1]
+DOCS = ROOT / "docs"
+IMG = DOCS / "img"
+
+
+def _replace_section(text: str, name: str, body: str) -> str:
+    pattern = re.compile(rf"(<!-- legkin:{name} -->\n).*?(<!-- /legkin:{name} -->)", re.S)
+    if not pattern.search(text):
+        raise SystemExit(f"README.md lacks the <!-- legkin:{name} --> ... <!-- /legkin:{name} --> markers")
+    return pattern.sub(lambda m: m.group(1) + body + m.group(2), text)
+
+
+def model_table() -> str:
+    lines = ["| name | DOF | loops | actuated joints | source seed |", "| --- | --- | --- | --- | --- |"]
+    for name in legkin.list_models():
+        spec = get_spec(name)
+        robot = legkin.load(name)
+        mobility = robot.mobility(robot.q0)
+        dof = f"{mobility} (tree nv = {robot.model.nv})" if robot.loops else str(mobility)
+        if spec.floating:
+            dof += ", +6 with `floating=True`"
+        joints = ", ".join(f"`{j}`" for j in spec.actuated_joints)
+        if len(spec.actuated_joints) > 6:
+            joints = ", ".join(f"`{j}`" for j in spec.actuated_joints[:4]) + f", ... ({len(spec.actuated_joints)})"
+        lines.append(f"| [`{name}`](docs/{name}.md) | {dof} | {len(robot.loops)} | {joints} | {spec.seed} |")
+    return "\n".join(lines) + "\n"
+
+
+def pictures() -> str:
+    IMG.mkdir(parents=True, exist_ok=True)
+    cells = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name in legkin.list_models():
+            robot = legkin.load(name)
+            page = write_html(robot, robot.q0, Path(tmp) / f"{name}.html")
+            screenshot(page, IMG / f"{name}.png", size=(480, 360))
+            cells.append(f'<img src="docs/img/{name}.png" width="240" alt="{name}"/>')
+    names = " | ".join(f"`{n}`" for n in legkin.list_models())
+    return f"| {names} |\n|{' --- |' * len(cells)}\n| {' | '.join(cells)} |\n"
+
+
+def check_tables(samples: int) -> str:
+    from legkin.plots import write_check_plots
+
+    results = run_checks(samples=samples)
+    write_json(results, DOCS / "check.json")
+    write_check_plots(results, IMG / "plots")
+    out = []
+    for name, (rows, seconds) in results.items():
+        out.append(f"**{name}** ({rows[0].samples if rows else 0}+ samples per row, {seconds:.1f} s)\n")
+        out.append("| check | samples | max error | p99 error | tolerance | result |")
+        out.append("| --- | ---: | ---: | ---: | ---: | --- |")
+        for r in rows:
+            out.append(
+                f"| {r.name} | {r.samples} | {r.max_error:.1e} | {r.p99_error:.1e} | {r.tolerance:.0e} | "
+                f"{'pass' if r.passed else '**FAIL**'} |"
+            )
+        out.append("")
+    return "\n".join(out)
+
+
+def bench_tables() -> str:
+    from legkin.__main__ import main
+
+    path = DOCS / "bench.json"
+    main(["bench", "--json", str(path)])
+    doc = json.loads(path.read_text())
+    out = [f"Machine: {doc['machine'].get('cpu', '?')}, Python {doc['machine'].get('python', '?')}.\n"]
+    for name, entry in doc["models"].items():
+        out.append(f"**{name}**\n")
+        out.append("| method | targets | solved | median error | max error | time per target | ratio to fastest |")
+        out.append("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
+        fastest = min(m["time_per_target_s"] for m in entry["methods"] if m["time_per_target_s"])
+        for m in entry["methods"]:
+            t = m["time_per_target_s"]
+            out.append(
+                f"| {m['name']} | {m['targets']} | {m['solved']:.1%} | {m['median_error']:.1e} | "
+                f"{m['max_error']:.1e} | {t:.2e} s | {t / fastest:.3g}x |"
+            )
+        out.append("")
+    return "\n".join(out)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__)
+    parser.add_argument("--samples", type=int, default=10_000)
+    parser.add_argument("--skip-bench", action="store_true")
+    args = parser.parse_args()
+    readme = ROOT / "README.md"
+    text = readme.read_text()
+    text = _replace_section(text, "models", model_table())
+    text = _replace_section(text, "pictures", pictures())
+    text = _replace_section(text, "check", check_tables(args.samples))
+    if not args.skip_bench:
+        text = _replace_section(text, "bench", bench_tables())
+    readme.write_text(text)
+    print("README.md, docs/img/, docs/check.json updated")
+
+
+if __name__ == "__main__":
+    main()

@@ -67,3 +67,47 @@ def test_animation_page_renders(tmp_path, empty_scene):
     assert main(["view", "quadruped", "--animate", "foot_circles", "--html", str(page)]) == 0
     img = screenshot(page, tmp_path / "anim.png")
     assert_shows_something(img, empty_scene)
+
+
+def _meshcat_servers() -> set[int]:
+    pids = set()
+    for proc in Path("/proc").iterdir():
+        if proc.name.isdigit():
+            try:
+                cmd = (proc / "cmdline").read_bytes()
+            except OSError:
+                continue
+            if b"meshcat" in cmd and b"pytest" not in cmd:
+                pids.add(int(proc.name))
+    return pids
+
+
+def test_html_export_leaves_no_server(tmp_path):
+    from legkin.__main__ import main
+
+    before = _meshcat_servers()
+    assert main(["view", "quadruped", "--pose", "crouching", "--html", str(tmp_path / "p.html")]) == 0
+    assert _meshcat_servers() - before == set()
+
+
+def test_live_view_serves_until_interrupted():
+    import signal
+    import subprocess
+    import sys
+
+    before = _meshcat_servers()
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "legkin", "view", "quadruped"], stdout=subprocess.PIPE, text=True
+    )
+    try:
+        line = proc.stdout.readline()
+        assert "http://127.0.0.1:" in line
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=30) == 0
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    import time
+
+    time.sleep(0.5)
+    assert _meshcat_servers() - before == set()

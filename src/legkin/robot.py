@@ -9,8 +9,8 @@ import numpy as np
 import pinocchio as pin
 
 from ._generate import model_files
-from ._registry import get_spec
-from .errors import InvalidInputError, LegkinError
+from ._registry import MODELS, get_spec
+from .errors import InvalidInputError, InvalidParameterError, LegkinError
 from .loops import LoopSet, LoopSolveInfo, parse_loops
 
 __all__ = ["Robot", "load"]
@@ -194,5 +194,8 @@ def load(name: str, *, floating: bool = False, **params) -> Robot:
     spec = get_spec(name)
     args = spec.resolve_params(params)
     if floating and not spec.floating:
-        raise LegkinError(f"model {name!r} is fixed-base: floating=True is not available for it")
+        floating_models = ", ".join(n for n, s in MODELS.items() if s.floating)
+        raise InvalidParameterError(
+            f"model {name!r} is fixed-base: floating=True is available only for {floating_models}"
+        )
     return Robot(name, args, floating=floating)

@@ -69,45 +69,55 @@ def test_animation_page_renders(tmp_path, empty_scene):
     assert_shows_something(img, empty_scene)
 
 
-def _meshcat_servers() -> set[int]:
-    pids = set()
-    for proc in Path("/proc").iterdir():
-        if proc.name.isdigit():
-            try:
-                cmd = (proc / "cmdline").read_bytes()
-            except OSError:
-                continue
-            if b"meshcat" in cmd and b"pytest" not in cmd:
-                pids.add(int(proc.name))
-    return pids
+def _children(pid: int) -> set[int]:
+    """Direct child processes of ``pid`` (Linux /proc)."""
+    out = set()
+    for task in Path(f"/proc/{pid}/task").glob("*"):
+        try:
+            out |= {int(c) for c in (task / "children").read_text().split()}
+        except OSError:
+            pass
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().split(")")[-1].split()[0]
+    except OSError:
+        return False
+    return state != "Z"
 
 
 def test_html_export_leaves_no_server(tmp_path):
+    import os
+
     from legkin.__main__ import main
 
-    before = _meshcat_servers()
+    before = _children(os.getpid())
     assert main(["view", "quadruped", "--pose", "crouching", "--html", str(tmp_path / "p.html")]) == 0
-    assert _meshcat_servers() - before == set()
+    assert {p for p in _children(os.getpid()) - before if _alive(p)} == set()
 
 
 def test_live_view_serves_until_interrupted():
     import signal
     import subprocess
     import sys
+    import time
 
-    before = _meshcat_servers()
     proc = subprocess.Popen(
         [sys.executable, "-m", "legkin", "view", "quadruped"], stdout=subprocess.PIPE, text=True
     )
     try:
         line = proc.stdout.readline()
         assert "http://127.0.0.1:" in line
+        servers = _children(proc.pid)
+        assert servers, "the viewer runs a meshcat server process"
         proc.send_signal(signal.SIGINT)
         assert proc.wait(timeout=30) == 0
     finally:
         if proc.poll() is None:
             proc.kill()
-    import time
-
-    time.sleep(0.5)
-    assert _meshcat_servers() - before == set()
+    deadline = time.time() + 10
+    while any(_alive(p) for p in servers) and time.time() < deadline:
+        time.sleep(0.2)
+    assert not any(_alive(p) for p in servers)

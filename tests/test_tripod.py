@@ -1,0 +1,251 @@
+"""Tests of the tripod: model, loops, analytic kinematics (legkin.analytic.tripod) and its checks."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import legkin
+from legkin import InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
+from legkin.analytic import tripod as at
+from legkin.checks import tripod as ct
+
+ALPHAS = (math.pi / 4, math.pi / 3, math.pi / 2)
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return legkin.load("tripod")
+
+
+def _tilt_u(theta, phi):
+    r = np.stack([np.cos(theta), np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi)], axis=-1)
+    return at.orientation_from_axis(r)
+
+
+# ------------------------------------------------------------------------------------------ model and checks
+def test_check_rows_pass():
+    rows = ct.run(150, np.random.default_rng(1))
+    assert len(rows) >= 45
+    failed = [r for r in rows if not r.passed]
+    assert not failed, failed
+
+
+def test_committed_urdf_matches_xacro():
+    from legkin._generate import check_all
+
+    assert check_all(["tripod"]) == []
+
+
+def test_model_structure(robot):
+    assert robot.model.nq == 12 and len(robot.loops) == 2
+    assert {lp.type for lp in robot.loops} == {"frame"}
+    assert robot.actuated_joints == ("A_q1", "B_q1", "C_q1")
+    assert set(robot.poses) >= {"home", "tilt_y", "tilt_z", "tilt_diag"}
+    q0 = robot.q0
+    for leg in at.LEGS:
+        assert q0[robot.idx_q(f"{leg}_q1")] == pytest.approx(-math.pi / 6, abs=1e-15)
+        assert q0[robot.idx_q(f"{leg}_q2")] == pytest.approx(math.pi / 2, abs=1e-15)
+    m = robot.frame_placement(q0, "platform")
+    assert np.allclose(m.rotation, np.eye(3), atol=1e-15)
+    assert np.allclose(m.translation, [-0.05, 0, 0], atol=1e-15)  # L = d at alpha = pi/3
+
+
+@pytest.mark.parametrize("alpha", [math.pi / 3, math.pi / 2, 2.5])
+def test_srdf_poses_close_loops_and_match_orientation(alpha):
+    robot = legkin.load("tripod") if alpha == math.pi / 3 else legkin.load("tripod", alpha=alpha, d=0.08)
+    theta = 2 * math.asin(0.6 * math.cos(alpha / 2))
+    phis = {"home": None, "tilt_y": -math.pi / 2, "tilt_z": 0.0, "tilt_diag": 3 * math.pi / 4}
+    for name, phi in phis.items():
+        q = robot.poses[name]
+        assert np.linalg.norm(robot.constraint_residual(q)) < 1e-12, name
+        assert robot.mobility(q) == 2
+        ay, az = (0.0, 0.0) if phi is None else _tilt_u(theta, phi)
+        rot = robot.frame_placement(q, "platform").rotation
+        assert np.abs(rot - at.platform_rotation(ay, az)).max() < 1e-12, name
+        assert np.abs(q - at.ik(ay, az, d=robot.params["d"], alpha=alpha)).max() < 1e-12, name
+
+
+def test_point_closures_would_not_suffice(robot):
+    """Documented design choice: with 3-D point cuts the platform copies could spin (mobility 8, not 2)."""
+    import pinocchio as pin
+
+    from legkin.loops import LoopSet, LoopSpec
+
+    ls = LoopSet(robot.model, [LoopSpec("B", "point", "A_ee", "B_ee"), LoopSpec("C", "point", "A_ee", "C_ee")])
+    assert ls.mobility(robot.q0, np.ones(12, bool), 1e-9) == 8
+    assert robot.mobility(robot.q0) == 2
+    assert robot.mobility(robot.q0, locked=["A_q1", "B_q1"]) == 0
+    assert pin.__version__.startswith("4.")
+
+
+def test_solve_loops_from_home_reaches_tilted_pose(robot):
+    qt = robot.poses["tilt_diag"]
+    fixed = {"A_q1": qt[0], "B_q1": qt[4]}
+    q, info = robot.solve_loops(robot.q0, fixed, return_info=True)
+    assert info.residual <= 1e-12 and info.iterations < 20
+    assert np.abs(q - qt).max() < 1e-10
+
+
+# ------------------------------------------------------------------------------------------ properties
+@settings(max_examples=60, deadline=None)
+@given(
+    st.floats(-math.pi / 2 + 1e-3, math.pi / 2 - 1e-3),
+    st.floats(-math.pi, math.pi),
+    st.sampled_from(ALPHAS),
+)
+def test_ik_fk_round_trip(ay, az, alpha):
+    q, ok = at.ik(np.array([ay]), np.array([az]), alpha=alpha, return_mask=True)
+    if not ok[0] or 1 + math.cos(ay) * math.cos(az) < 1e-2:
+        return
+    y, z, inc = at.fk(q[0, 0], q[0, 4], q[0, 8], alpha=alpha)
+    assert inc < 1e-11
+    assert np.abs(at.platform_rotation(y, z) - at.platform_rotation(ay, az)).max() < 1e-11
+    assert -math.pi / 2 <= y <= math.pi / 2
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(-math.pi, math.pi), st.floats(-10, -3), st.sampled_from(ALPHAS), st.integers(0, 2))
+def test_round_trip_near_boundary(phi, log_gap, alpha, k):
+    """Tilts where leg k has 1 - |cos q_k2| = 10**log_gap (just inside the workspace)."""
+    s = abs(math.sin(phi - at.ETA[k]))
+    arg = (1 - 10**log_gap) * math.cos(alpha / 2) / max(s, 1e-300)
+    if arg >= 1 or arg < 0.05:
+        return
+    ay, az = _tilt_u(2 * math.asin(arg), phi)
+    q, ok = at.ik(np.array([ay]), np.array([az]), alpha=alpha, return_mask=True)
+    if not ok[0] or 1 + math.cos(ay) * math.cos(az) < 1e-2:
+        return
+    assert 1 - abs(math.cos(q[0, 4 * k + 1])) == pytest.approx(10**log_gap, rel=1e-3)
+    y, z, inc = at.fk(q[0, 0], q[0, 4], q[0, 8], alpha=alpha, max_inconsistency=1e-8)
+    assert np.abs(at.platform_rotation(y, z) - at.platform_rotation(ay, az)).max() < 1e-9
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.floats(-math.pi, math.pi), min_size=4, max_size=4), st.sampled_from(range(3)))
+def test_leg_transform_is_eq10_on_cv_branch_and_general_position(q, k):
+    q = np.array(q)
+    t = at.leg_transform(q, at.ETA[k])
+    assert np.allclose(t[:3, :3] @ t[:3, :3].T, np.eye(3), atol=1e-14)
+    assert np.allclose(t[:3, 3], at.leg_transform_cv(q[0], q[1], at.ETA[k])[:3, 3], atol=1e-16)
+    qcv = np.array([q[0], q[1], q[1], q[0]])
+    assert np.abs(at.leg_transform(qcv, at.ETA[k]) - at.leg_transform_cv(q[0], q[1], at.ETA[k])).max() < 1e-15
+
+
+def test_seed_t33_sign_and_eq15_atan_are_wrong():
+    """The corrections are needed: the printed forms disagree with the mechanism."""
+    q1, q2, eta = 0.3, 1.1, at.ETA[1]
+    t = at.leg_transform_cv(q1, q2, eta)
+    c1, s1, c2, s2 = math.cos(q1), math.sin(q1), math.cos(q2), math.sin(q2)
+    ca, sa, ce, se = math.cos(at.ALPHA), math.sin(at.ALPHA), math.cos(eta), math.sin(eta)
+    g4 = c2 * (c1 * sa + s1 * s2 * (1 + ca))
+    printed = t[2, 2] - 4 * ce * se * g4  # T33 with -2 c s g4 instead of +2 c s g4
+    assert abs(printed - t[2, 2]) > 0.1
+    ay, az = 1.2, 2.0  # c_y + c_z < 0: one-argument atan lands on the wrong branch
+    wrong = math.atan(math.sin(ay) * math.sin(az) / (math.cos(ay) + math.cos(az)))
+    assert abs(wrong - float(at.alpha_x(ay, az))) == pytest.approx(math.pi, abs=1e-12)
+    q = at.ik(ay, az)
+    robot = legkin.load("tripod")
+    rot = robot.frame_placement(q, "platform").rotation
+    assert np.abs(rot - at.platform_rotation(ay, az)).max() < 1e-13
+
+
+def test_batch_shapes_and_scalar_wrapper():
+    ay = np.linspace(-0.5, 0.5, 6).reshape(2, 3)
+    q = at.ik(ay, 0.2)
+    assert q.shape == (2, 3, 12)
+    assert np.array_equal(at.ik(float(ay[1, 2]), 0.2), q[1, 2])
+    assert at.actuation_jacobian(ay, 0.2).shape == (2, 3, 3, 2)
+    y, z, inc = at.fk(q[..., 0], q[..., 4], q[..., 8])
+    assert y.shape == (2, 3) and np.allclose(y, ay, atol=1e-12)
+
+
+def test_workspace_matches_ik():
+    for alpha in ALPHAS:
+        ws = at.workspace(alpha=alpha, n=61)
+        gy, gz = np.meshgrid(ws.alpha_y, ws.alpha_z, indexing="ij")
+        _, ok = at.ik(gy, gz, alpha=alpha, return_mask=True)
+        assert np.array_equal(ok, ws.reachable)
+        b = ws.boundary[np.all(np.isfinite(ws.boundary), axis=1)]
+        if len(b):
+            _, c2, _ = at._ik_core(b[:, 0], b[:, 1], at.D, alpha, np.array(at.ETA))
+            c2 = c2[np.all(np.isfinite(c2), axis=-1)]  # points at the flip (tilt pi) have no E
+            assert len(c2) > 100 and np.allclose(np.abs(c2).max(axis=-1), 1.0, atol=1e-9)
+    assert at.workspace(alpha=math.pi / 2).reachable.mean() < at.workspace(alpha=math.pi / 4).reachable.mean()
+
+
+# ------------------------------------------------------------------------------------------ error paths
+@pytest.mark.parametrize("params", [{"d": 0.0}, {"d": -0.1}, {"alpha": 0.0}, {"alpha": math.pi}, {"alpha": 4.0},
+                                    {"alpha": float("nan")}, {"foo": 1.0}])
+def test_bad_params_refused_before_writing(params, tmp_path, monkeypatch):
+    monkeypatch.setenv("LEGKIN_CACHE", str(tmp_path))
+    with pytest.raises(InvalidParameterError):
+        legkin.load("tripod", **params)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_xacro_refuses_bad_alpha_directly():
+    from legkin._generate import render
+    from legkin._registry import get_spec
+
+    spec = get_spec("tripod")
+    args = {k: p.default for k, p in spec.params.items()}
+    with pytest.raises(Exception, match="alpha"):
+        render(spec, {**args, "alpha": 4.0})
+    with pytest.raises(Exception, match="d="):
+        render(spec, {**args, "d": -1.0})
+
+
+@pytest.mark.parametrize("kw", [{"d": 0}, {"alpha": -1}, {"alpha": math.pi}, {"eta": (0.0, 1.0)}])
+def test_analytic_bad_params(kw):
+    with pytest.raises(InvalidParameterError):
+        at.ik(0.1, 0.2, **kw)
+
+
+def test_bad_inputs():
+    with pytest.raises(InvalidInputError):
+        at.ik(float("nan"), 0.2)
+    with pytest.raises(ValueError):
+        at.ik(np.zeros(3), np.zeros(2))
+    with pytest.raises(InvalidInputError):
+        at.leg_transform(np.zeros(3), 0.0)
+    with pytest.raises(InvalidInputError):
+        at.fk(0.1, np.inf, 0.2)
+    with pytest.raises(InvalidInputError):
+        at.platform_rotation("a", 1.0)
+
+
+def test_unreachable_and_singular():
+    alpha = math.pi / 2  # workspace: tilt <= 2 asin(cos(pi/4) / max |sin(phi - eta)|)
+    ay, az = _tilt_u(2.6, 0.0)  # tilt 2.6 rad towards +y: beyond legs B and C
+    with pytest.raises(UnreachableError, match="leg B"):
+        at.ik(ay, az, alpha=alpha)
+    q, ok = at.ik(np.array([ay, 0.1]), np.array([az, 0.1]), alpha=alpha, return_mask=True)
+    assert ok.tolist() == [False, True] and np.isnan(q[0]).all() and np.isfinite(q[1]).all()
+    with pytest.raises(UnreachableError):
+        at.actuation_jacobian(ay, az, alpha=alpha)
+    with pytest.raises(SingularityError, match="1 \\+ cos"):
+        at.ik(0.0, math.pi)
+    # exactly on the boundary of leg A: sin q_A2 = 0
+    phi = math.pi / 2
+    ay, az = _tilt_u(2 * math.asin(math.cos(alpha / 2)), phi)
+    with pytest.raises(SingularityError, match="leg A"):
+        at.ik(ay, az, alpha=alpha)
+    a, m = at.actuation_jacobian(np.array([ay]), np.array([az]), alpha=alpha, return_mask=True)
+    assert not m[0] and np.isnan(a).all()
+
+
+def test_fk_reports_inconsistent_motors():
+    q = at.ik(0.3, -0.4)
+    with pytest.raises(UnreachableError, match="inconsistent") as exc:
+        at.fk(q[0], q[4], q[8] + 1e-3)
+    assert exc.value.closest is not None
+    y, z, inc = at.fk(q[0], q[4], q[8] + 1e-3, max_inconsistency=np.inf)
+    assert 1e-5 < inc < 1e-3
+    ys, zs, incs, mask = at.fk(np.array([q[0], q[0]]), np.array([q[4], q[4]]), np.array([q[8], q[8] + 1e-3]),
+                               return_mask=True)
+    assert mask.tolist() == [True, False] and np.isnan(ys[1]) and incs[0] < 1e-12

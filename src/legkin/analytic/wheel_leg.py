@@ -31,7 +31,7 @@ from typing import Mapping, NamedTuple
 import numpy as np
 
 from ..errors import InvalidInputError, InvalidParameterError, UnreachableError
-from ._batch import as_input, finish
+from ._batch import as_angles, as_input, finish
 
 __all__ = [
     "LEGS",
@@ -285,20 +285,11 @@ def linkage_points(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict
         dict name -> array (..., 3) of (x, y, w = 0) in {L}; names in :data:`POINTS`.
     """
     geo = geometry or Geometry()
-    theta, beta = _angles(theta, beta, names=("theta", "beta"))
+    theta, beta = as_angles(theta, beta, names=("theta", "beta"))
     _check_theta(theta)
     pts, _ = _closed_form(theta, _constants(geo.R), geo.R + FOOT_OFFSET)
     rot = _rot(beta)
     return {k: _xyw(rot * v, 0.0) for k, v in _both_halves(pts).items()}
-
-
-def _angles(*xs, names):
-    arrs = [as_input(x, n) for x, n in zip(xs, names)]
-    try:
-        return tuple(np.broadcast_arrays(*arrs))
-    except ValueError as exc:
-        shapes = ", ".join(f"{n}{a.shape}" for n, a in zip(names, arrs))
-        raise InvalidInputError(f"inputs do not broadcast together: {shapes}") from exc
 
 
 def _link_angles(pts: dict) -> dict:
@@ -333,7 +324,7 @@ def passive_angles(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict
         dict joint name (without the ``<leg>_`` prefix, see :data:`PASSIVE_JOINTS`) -> array.
     """
     geo = geometry or Geometry()
-    theta, beta = _angles(theta, beta, names=("theta", "beta"))
+    theta, beta = as_angles(theta, beta, names=("theta", "beta"))
     _check_theta(theta)
     c = _constants(geo.R)
     now = _link_angles(_closed_form(theta, c, geo.R)[0])
@@ -350,7 +341,7 @@ def passive_angles(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict
 
 def motor_angles(theta, beta) -> tuple[np.ndarray, np.ndarray]:
     """(phi_L, phi_R) = (beta + theta - theta0, beta - theta + theta0) (reference, motor mapping)."""
-    theta, beta = _angles(theta, beta, names=("theta", "beta"))
+    theta, beta = as_angles(theta, beta, names=("theta", "beta"))
     return beta + (theta - THETA0), beta - (theta - THETA0)
 
 
@@ -359,7 +350,7 @@ def theta_beta(phi_L, phi_R) -> tuple[np.ndarray, np.ndarray]:
 
     theta is not range-checked here (the motors can be commanded anywhere; the linkage cannot).
     """
-    phi_L, phi_R = _angles(phi_L, phi_R, names=("phi_L", "phi_R"))
+    phi_L, phi_R = as_angles(phi_L, phi_R, names=("phi_L", "phi_R"))
     return (phi_L - phi_R) / 2 + THETA0, (phi_L + phi_R) / 2
 
 
@@ -430,7 +421,7 @@ def _rim_seed(theta, beta, alpha, geo: Geometry, radius: float, want_der: bool):
 
 
 def _rim_inputs(theta, beta, alpha, w, geo):
-    theta, beta, alpha, w = _angles(theta, beta, alpha, w, names=("theta", "beta", "alpha", "w"))
+    theta, beta, alpha, w = as_angles(theta, beta, alpha, w, names=("theta", "beta", "alpha", "w"))
     _check_theta(theta)
     _check_alpha(alpha)
     _check_w(w, geo)

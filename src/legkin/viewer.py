@@ -44,13 +44,16 @@ def open_viewer(robot: Robot, camera: Sequence[float] | None = None) -> Iterator
 
 
 def _camera_for(robot: Robot) -> tuple[float, float, float]:
-    """A camera distance fitted to the model's extent at ``q0``."""
+    """A camera distance fitted to the visual geometry at ``q0`` (the camera looks at the origin)."""
     import pinocchio as pin
 
-    pin.framesForwardKinematics(robot.model, robot.data, robot.q0)
-    pts = np.array([f.translation for f in robot.data.oMf])
-    size = float(np.max(np.linalg.norm(pts - pts.mean(axis=0), axis=1))) if len(pts) else 0.5
-    s = max(size, 0.05) * 2.6
+    data = pin.GeometryData(robot.visual_model)
+    pin.forwardKinematics(robot.model, robot.data, robot.q0)
+    pin.updateGeometryPlacements(robot.model, robot.data, robot.visual_model, data)
+    pts = np.array([m.translation for m in data.oMg])
+    # 80th percentile, not max: a long thin part (the hybrid leg's virtual-pivot arm) must not shrink the rest
+    size = float(np.percentile(np.linalg.norm(pts, axis=1), 80)) if len(pts) else 0.5
+    s = max(size, 0.05) * 2.2
     return (s, 0.6 * s, s)
 
 

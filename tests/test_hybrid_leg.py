@@ -1,0 +1,426 @@
+"""Tests of the hybrid leg: model, loops, mobility, analytic kinematics (legkin.analytic.hybrid_leg), checks."""
+
+from __future__ import annotations
+
+import math
+import xml.etree.ElementTree as ET
+
+import numpy as np
+import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+import legkin
+from legkin import (
+    ConvergenceError,
+    InvalidInputError,
+    InvalidParameterError,
+    SingularityError,
+    UnreachableError,
+)
+from legkin.analytic import hybrid_leg as ah
+from legkin.checks import hybrid_leg as ch
+
+DEG = math.pi / 180
+ACTUATED = ("MCS1", "MCS2", "LL")
+
+
+@pytest.fixture(scope="module")
+def robot():
+    return legkin.load("hybrid_leg")
+
+
+@pytest.fixture(scope="module")
+def spherical():
+    return legkin.load("hybrid_leg", center="spherical")
+
+
+def _in_mode(roll, pitch, sigma_min=1e-2):
+    r, p = np.atleast_1d(roll), np.atleast_1d(pitch)
+    ok = ch._neutral_mode(r, p)
+    return bool(ok[0]) and float(ch._sigma_min(r, p)[0]) >= sigma_min
+
+
+# ------------------------------------------------------------------------------------------ model and checks
+def test_check_rows_pass():
+    rows = ch.run(150, np.random.default_rng(3))
+    assert len(rows) >= 20
+    failed = [r for r in rows if not r.passed]
+    assert not failed, failed
+
+
+def test_committed_urdf_matches_xacro():
+    from legkin._generate import check_all
+
+    assert check_all(["hybrid_leg"]) == []
+
+
+def test_model_structure(robot, spherical):
+    assert robot.model.nq == robot.model.nv == 11
+    assert spherical.model.nq == spherical.model.nv == 12
+    assert [(lp.name, lp.type, lp.frame1, lp.frame2) for lp in robot.loops] == [
+        ("rod_1", "point", "rod_1_end", "P_sph_1"),
+        ("rod_2", "point", "rod_2_end", "P_sph_2"),
+    ]
+    assert robot.actuated_joints == ACTUATED
+    assert set(robot.poses) == {"neutral", "zero_motors", "extended"}
+    assert "LCS_z" not in robot.joint_names and "LCS_z" in spherical.joint_names
+    # the base transforms of eqs 5, 12, re-orthonormalised (the seed prints 0.9306 / 0.3661)
+    for i, sy in ((1, 1), (2, -1)):
+        m = robot.model.jointPlacements[robot.joint_id(f"MCS{i}")]
+        rot = m.rotation
+        assert abs(np.linalg.det(rot) - 1) < 1e-15
+        assert np.abs(rot.T @ rot - np.eye(3)).max() < 1e-15
+        assert rot[0, 0] == pytest.approx(0.9306, abs=5e-5) and rot[1, 0] == pytest.approx(sy * 0.3661, abs=5e-5)
+        assert np.allclose(m.translation, [0.139807669447128, sy * 0.0549998406976098, -0.051], atol=1e-15)
+    # LL origin and the foot (eqs 18, 20), LCS centre (eq 2)
+    assert np.allclose(robot.frame_placement(robot.q0, "FCS").translation, [0.405, 0, -0.023], atol=1e-15)
+    assert np.allclose(robot.frame_placement(robot.q0, "P").translation, ah.CENTER, atol=1e-15)
+
+
+def test_transmission_carries_eq19(robot, tmp_path, monkeypatch):
+    def transmission(path):
+        el = ET.parse(path).getroot().find("transmission")
+        return float(el.find("joint/offset").text), float(el.find("actuator/mechanicalReduction").text)
+
+    offset, reduction = transmission(robot.urdf_path)
+    assert offset == 0.0
+    # SimpleTransmission: joint = actuator / reduction + offset == eq 19
+    assert 1.0 / reduction == pytest.approx(ah.ll_angle(1.0) - ah.ll_angle(0.0), rel=1e-15)
+    monkeypatch.setenv("LEGKIN_CACHE", str(tmp_path))
+    shifted = legkin.load("hybrid_leg", starting_value=0.25)
+    assert transmission(shifted.urdf_path)[0] == 0.25
+
+
+@pytest.mark.parametrize("center", ["universal", "spherical"])
+def test_srdf_poses_close_loops(center, robot, spherical):
+    rob = robot if center == "universal" else spherical
+    for name, q in rob.poses.items():
+        assert np.linalg.norm(rob.constraint_residual(q)) < 1e-15, name
+    q = rob.poses["neutral"]
+    th = ah.motor_angles(0.0, 0.0)
+    assert q[rob.idx_q("MCS1")] == th[0] and q[rob.idx_q("MCS2")] == th[1]  # full precision in the SRDF
+    sph = ah.sphere_joint_angles(np.eye(3))
+    for i in (1, 2):
+        for k, ax in enumerate("zyx"):
+            assert q[rob.idx_q(f"Sph_{i}_1_{ax}")] == sph[i - 1, k]
+    assert np.allclose(rob.frame_placement(q, "P").rotation, np.eye(3), atol=0)
+    qz = rob.poses["zero_motors"]
+    assert qz[rob.idx_q("LCS_y")] == pytest.approx(float(ah.platform_orientation(0.0, 0.0)[1]), abs=1e-15)
+    qe = rob.poses["extended"]
+    assert qe[rob.idx_q("LL")] == pytest.approx(float(ah.ll_angle(8 * math.pi)), abs=1e-16)
+
+
+# ------------------------------------------------------------------------------------------ reference facts
+def test_rod_span_at_zero_motors_does_not_close(robot):
+    assert np.allclose(ah.rod_spans(0.0, 0.0), 0.0839, atol=5e-5)
+    # the same span measured in Pinocchio: lever tip (sphere joint centre) to the platform point
+    q = robot.configuration({"MCS1": 0.0, "MCS2": 0.0, "LCS_x": 0.0, "LCS_y": 0.0})
+    for i in (1, 2):
+        tip = robot.frame_placement(q, f"Sph_{i}_1_a").translation
+        att = robot.frame_placement(q, f"P_sph_{i}").translation
+        assert np.linalg.norm(att - tip) == pytest.approx(float(ah.rod_spans(0.0, 0.0)[i - 1]), abs=1e-15)
+    # and the zero-motor pose closes with the platform pitched -20.48 deg
+    assert np.allclose(ah.platform_orientation(0.0, 0.0) / DEG, [0.0, -20.48], atol=5e-3)
+
+
+def test_neutral_motor_angles():
+    assert np.allclose(ah.motor_angles(0.0, 0.0) / DEG, [18.255, -18.255], atol=5e-4)
+    assert np.allclose(ah.motor_angles(0.0, 0.0, (-1, -1)) / DEG, [-82.22, 82.22], atol=5e-3)
+    th = ah.motor_angles(0.0, 0.0)
+    assert th[0] == -th[1]  # mirror symmetry of the two chains
+    # lever at 86.8 deg to the rod at the neutral pose
+    tip, _ = ah._lever_tips(th)
+    rod = ah._attach_world(np.eye(3)) - tip
+    lever_x = np.stack([np.cos(th + ah.MOTOR_YAW), np.sin(th + ah.MOTOR_YAW), np.zeros(2)], -1)
+    ang = np.arccos(np.sum(rod * lever_x, -1) / ah.ROD_LENGTH) / DEG
+    assert np.allclose(ang, 86.8, atol=0.05)
+
+
+def test_neutral_sensitivity():
+    inv = np.linalg.inv(ah.motor_jacobian(0.0, 0.0))
+    assert np.allclose(inv, [[0.586, 0.586], [0.655, -0.655]], atol=5e-4)
+    assert np.linalg.cond(inv) == pytest.approx(1.12, abs=5e-3)
+
+
+def test_spherical_free_axis_reference(spherical):
+    axis = ah.spherical_free_axis(np.eye(3))
+    assert np.allclose(axis, [-0.39, 0.0, 0.92], atol=5e-3)
+    dof, measured = ch.platform_dof(spherical, spherical.q0)
+    assert dof == 1
+    assert np.abs(measured - axis).max() < 1e-12
+
+
+def test_extension_four_turns():
+    tll = ah.ll_angle(4 * 2 * math.pi)
+    p = ah.foot_position_from_platform(0.0, 0.0, tll)
+    p0 = ah.foot_position_from_platform(0.0, 0.0, 0.0)
+    assert p[2] == pytest.approx(-0.301, abs=5e-4)
+    assert p[0] - p0[0] == pytest.approx(0.026, abs=5e-4)
+    # ~70 mm per revolution, almost straight down, at the start
+    d1 = ah.foot_position_from_platform(0.0, 0.0, ah.ll_angle(2 * math.pi)) - p0
+    assert np.linalg.norm(d1) == pytest.approx(0.07, abs=1e-4)
+
+
+# ------------------------------------------------------------------------------------------ mobility
+def test_mobility_counts(robot, spherical):
+    spins = ["Sph_1_1_x", "Sph_2_1_x"]
+    for rob, expected in ((robot, 0), (spherical, 1)):
+        q = rob.q0
+        free = rob.model.nv - 6
+        assert rob.mobility(q) == free  # 6 independent rows: two point closures
+        assert rob.mobility(q, locked=ACTUATED) == 2 + expected  # + 2 rod spins
+        assert rob.mobility(q, locked=ACTUATED + tuple(spins)) == expected
+        assert ch.platform_dof(rob, q)[0] == expected
+        # the two extra DOF with motors locked are the rod spins: they move no other joint
+        jc = rob.constraint_jacobian(q)
+        for s in spins:
+            v = np.zeros(rob.model.nv)
+            v[rob.idx_v(s)] = 1.0
+            assert np.abs(jc @ v).max() < 1e-15
+
+
+# ------------------------------------------------------------------------------------------ round trips
+workspace = st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.1))
+
+
+@settings(max_examples=150, deadline=None)
+@given(workspace)
+def test_motor_angles_platform_orientation_round_trip(x):
+    roll, pitch = x
+    assume(_in_mode(roll, pitch))
+    th = ah.motor_angles(roll, pitch)
+    assert np.allclose(ah.rod_spans(th[0], th[1], roll, pitch), ah.ROD_LENGTH, atol=1e-15, rtol=0)
+    back = ah.platform_orientation(th[0], th[1])
+    assert np.abs(back - [roll, pitch]).max() < 1e-12
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(-0.9, 0.9), st.floats(-7.0, -2.0))
+def test_platform_orientation_near_forward_singularity(roll, log_dist):
+    """Just inside the forward-singularity curve: converges in the neutral mode, error ~ eps / sigma_min."""
+    lo, hi = 0.0, 1.1
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ch._neutral_mode(np.array([roll]), np.array([mid]))[0] else (lo, mid)
+    pitch = lo - 10.0**log_dist
+    th = ah.motor_angles(roll, pitch)
+    back = ah.platform_orientation(th[0], th[1])
+    sigma = float(ch._sigma_min(np.array([roll]), np.array([pitch]))[0])
+    assert np.abs(back - [roll, pitch]).max() * sigma < ch.TOL_SCALED
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(-math.pi, math.pi), st.floats(-1.0, 1.0))
+def test_motor_angles_at_reach_boundary(direction, log_gap):
+    """Points just inside the reach boundary (|k| -> 1) still close the loops to 1e-15 m."""
+    lo, hi = 0.0, 3.0
+    d = np.array([math.cos(direction), math.sin(direction)])
+    for _ in range(80):
+        mid = 0.5 * (lo + hi)
+        _, ok = ah.motor_angles(*(mid * d)[:, None], return_mask=True)
+        lo, hi = (mid, hi) if ok[0] else (lo, mid)
+    roll, pitch = lo * d
+    assert ah.motor_angles(roll, pitch, return_mask=True)[1]
+    th = ah.motor_angles(roll, pitch)
+    assert np.allclose(ah.rod_spans(th[0], th[1], roll, pitch), ah.ROD_LENGTH, atol=1e-14, rtol=0)
+    # just outside: the scalar call raises, the batch returns NaN and a False mask
+    out = hi * d * (1 + 1e-9) + 1e-12 * np.sign(d)
+    with pytest.raises(UnreachableError):
+        ah.motor_angles(out[0], out[1])
+    val, ok = ah.motor_angles(out[:1], out[1:], return_mask=True)
+    assert not ok[0] and np.all(np.isnan(val))
+
+
+@settings(max_examples=150, deadline=None)
+@given(workspace, st.floats(-0.3, 0.125), st.floats(-0.5, 0.5))
+def test_foot_ik_round_trip(x, tll, starting_value):
+    roll, pitch = x
+    assume(_in_mode(roll, pitch))
+    th = ah.motor_angles(roll, pitch)
+    t0 = ah.extension_motor_angle(tll, starting_value)
+    p = ah.foot_position(th[0], th[1], t0, starting_value=starting_value)
+    assert np.abs(p - ah.foot_position_from_platform(roll, pitch, tll)).max() < 1e-12
+    kappa = float(ch.foot_ik_condition(p, np.array(tll), np.array(roll), np.array(pitch)))
+    llb = -1 if tll <= ah.LL_DELTA else 1
+    sol = ah.foot_ik(p, starting_value=starting_value, ll_branch=llb)
+    err = max(np.abs(sol[:2] - th).max(), abs(ah.ll_angle(sol[2], starting_value) - tll))
+    assert err < max(1e-12, kappa * ch.TOL_KAPPA)
+    # the target is reached whatever the conditioning of the angles
+    plat = ah.foot_platform_ik(p, ll_branch=llb)
+    assert np.abs(ah.foot_position_from_platform(*plat[1:], plat[0]) - p).max() < 1e-14
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.floats(-1.0, 1.0), st.floats(-8.0, -1.0), st.sampled_from([-1, 1]))
+def test_foot_ik_near_ll_branch_merge(roll, log_alpha, side):
+    """Near theta_LL = LL_DELTA the LL branches merge; both still reach the target."""
+    tll = ah.LL_DELTA + side * 10.0**log_alpha
+    p = ah.foot_position_from_platform(roll * 0.5, 0.2, tll)
+    for llb in (-1, 1):
+        plat = ah.foot_platform_ik(p, ll_branch=llb)
+        assert np.abs(ah.foot_position_from_platform(*plat[1:], plat[0]) - p).max() < 1e-14
+    plat = ah.foot_platform_ik(p, ll_branch=side)
+    assert abs(plat[0] - tll) < 1e-15 / 10.0**log_alpha + 1e-15
+
+
+def test_foot_ik_all_branches():
+    p = ah.foot_position_from_platform(0.1, 0.2, -0.1)
+    allb, ok = ah.foot_ik(p, all_branches=True, return_mask=True)
+    assert allb.shape == (16, 3) and ok.shape == (16,)
+    assert ok.sum() >= 2 and ok[0]
+    assert np.all(np.isnan(allb[~ok]))
+    for (llb, rb, b1, b2), sol, good in zip(ah.FOOT_IK_BRANCHES, allb, ok):
+        if good:
+            x = ah.foot_platform_ik(p, ll_branch=llb, roll_branch=rb)
+            assert np.allclose(ah.motor_angles(x[1], x[2], (b1, b2)), sol[:2], atol=0)
+            assert abs(ah.ll_angle(sol[2]) - x[0]) < 1e-15
+    assert np.array_equal(ah.foot_ik(p), allb[0])
+
+
+def test_batch_shapes_and_scalar_wrapper():
+    rng = np.random.default_rng(0)
+    r, p = ch.sample_workspace(12, rng)
+    r, p = r.reshape(3, 4), p.reshape(3, 4)
+    th = ah.motor_angles(r, p)
+    assert th.shape == (3, 4, 2)
+    assert np.array_equal(ah.motor_angles(r[1, 2], p[1, 2]), th[1, 2])
+    x = ah.platform_orientation(th[..., 0], th[..., 1])
+    assert x.shape == (3, 4, 2) and np.abs(x - np.stack([r, p], -1)).max() < 1e-12
+    t0 = np.zeros((3, 4))
+    foot = ah.foot_position(th[..., 0], th[..., 1], t0)
+    assert foot.shape == (3, 4, 3)
+    jac = ah.foot_jacobian(th[..., 0], th[..., 1], t0)
+    assert jac.shape == (3, 4, 3, 3)
+    assert np.array_equal(ah.foot_jacobian(th[1, 2, 0], th[1, 2, 1], 0.0), jac[1, 2])
+    sol = ah.foot_ik(foot)
+    assert sol.shape == (3, 4, 3)
+    assert ah.foot_ik(foot, all_branches=True).shape == (3, 4, 16, 3)
+    assert ah.sphere_joint_angles(ah.platform_rotation(r, p)).shape == (3, 4, 2, 3)
+
+
+def test_foot_jacobian_matches_finite_differences():
+    th = ah.motor_angles(0.1, 0.15)
+    t0 = 3.0
+    jac = ah.foot_jacobian(th[0], th[1], t0)
+    h = 1e-6
+    num = np.empty((3, 3))
+    for k in range(3):
+        e = np.zeros(3)
+        e[k] = h
+        args_p, args_m = np.array([*th, t0]) + e, np.array([*th, t0]) - e
+        num[:, k] = (ah.foot_position(*args_p) - ah.foot_position(*args_m)) / (2 * h)
+    assert np.abs(num - jac).max() < 1e-8
+
+
+def test_ll_transmission_round_trip():
+    t0 = np.linspace(-50, 50, 11)
+    assert np.allclose(ah.extension_motor_angle(ah.ll_angle(t0, 0.3), 0.3), t0, atol=1e-12)
+    assert ah.ll_angle(0.0, 0.3) == 0.3
+    assert ah.ll_angle(2 * math.pi) == pytest.approx(-0.07 / 1.5, rel=1e-15)  # 70 mm of arc per turn
+
+
+# ------------------------------------------------------------------------------------------ error paths
+@pytest.mark.parametrize(
+    "params",
+    [{"center": "ball"}, {"center": 1.0}, {"starting_value": float("nan")}, {"starting_value": 4.0}, {"foo": 1}],
+)
+def test_bad_params_raise_before_writing(params, tmp_path, monkeypatch):
+    cache = tmp_path / "cache"
+    monkeypatch.setenv("LEGKIN_CACHE", str(cache))
+    with pytest.raises(InvalidParameterError) as info:
+        legkin.load("hybrid_leg", **params)
+    assert list(params)[0] in str(info.value)
+    assert not cache.exists()
+
+
+def test_floating_is_refused():
+    with pytest.raises(legkin.LegkinError):
+        legkin.load("hybrid_leg", floating=True)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: ah.motor_angles(float("nan"), 0.0),
+        lambda: ah.motor_angles([0.0, 1.0], [0.0, 0.1, 0.2]),
+        lambda: ah.motor_angles(0.0, 0.0, branch=(1, 0)),
+        lambda: ah.motor_angles(0.0, 0.0, branch=1),
+        lambda: ah.motor_angles_from_rotation(np.eye(3)[:2]),
+        lambda: ah.motor_angles_from_rotation(2 * np.eye(3)),
+        lambda: ah.motor_angles_from_rotation(np.diag([1.0, 1.0, -1.0])),
+        lambda: ah.platform_orientation(0.3, float("inf")),
+        lambda: ah.platform_orientation(0.3, -0.3, guess=[0.0]),
+        lambda: ah.foot_position(0.3, -0.3, float("nan")),
+        lambda: ah.foot_ik([0.4, 0.0]),
+        lambda: ah.foot_ik([0.4, float("nan"), 0.0]),
+        lambda: ah.foot_ik([0.4, 0.0, -0.2], ll_branch=0),
+        lambda: ah.foot_ik([0.4, 0.0, -0.2], starting_value=float("nan")),
+        lambda: ah.foot_platform_ik([0.4, 0.0, -0.2], roll_branch=2),
+        lambda: ah.ll_angle("x"),
+        lambda: ah.sphere_joint_angles(np.ones((3, 3))),
+        lambda: ah.foot_jacobian(0.3, -0.3, [0.0, float("nan")]),
+    ],
+)
+def test_invalid_input_raises_value_error(call):
+    with pytest.raises(InvalidInputError) as info:
+        call()
+    assert isinstance(info.value, ValueError)
+
+
+def test_unreachable_platform():
+    with pytest.raises(UnreachableError, match="chain"):
+        ah.motor_angles(0.0, -1.0)
+    th, ok = ah.motor_angles([0.0, 0.0], [0.0, -1.0], return_mask=True)
+    assert ok.tolist() == [True, False]
+    assert np.all(np.isfinite(th[0])) and np.all(np.isnan(th[1]))
+    rot = ah.platform_rotation(0.0, -1.0)
+    with pytest.raises(UnreachableError):
+        ah.motor_angles_from_rotation(rot)
+    with pytest.raises(UnreachableError):
+        ah.sphere_joint_angles(rot)
+    with pytest.raises(UnreachableError):
+        ah.spherical_free_axis(rot)
+    with pytest.raises(UnreachableError):
+        ah.motor_jacobian(0.0, -1.0)
+
+
+def test_unreachable_foot():
+    far = ah.CENTER + [0.0, 0.0, -3.5]
+    near = ah.CENTER + [0.0, 0.0, -0.1]
+    for p in (far, near):
+        with pytest.raises(UnreachableError, match="LL arc"):
+            ah.foot_ik(p)
+        with pytest.raises(UnreachableError):
+            ah.foot_platform_ik(p)
+        with pytest.raises(UnreachableError):
+            ah.foot_ik(p, all_branches=True)
+    # on the LL arc but beyond the motors: needs the platform pitched ~ -90 deg
+    beyond = ah.foot_position_from_platform(0.0, -1.5, -0.2)
+    with pytest.raises(UnreachableError, match="roll, pitch"):
+        ah.foot_ik(beyond)
+    sol, ok = ah.foot_ik(np.stack([ah.foot_position_from_platform(0.0, 0.0, -0.1), far, beyond]), return_mask=True)
+    assert ok.tolist() == [True, False, False]
+    assert np.all(np.isnan(sol[1:])) and np.all(np.isfinite(sol[0]))
+
+
+def test_singular_foot_on_roll_axis():
+    on_axis = ah.CENTER + [0.3, 0.0, 0.0]
+    with pytest.raises(SingularityError, match="roll axis"):
+        ah.foot_platform_ik(on_axis)
+    with pytest.raises(SingularityError):
+        ah.foot_ik(on_axis)
+    x, ok = ah.foot_platform_ik(np.stack([on_axis, on_axis + [0, 0, -0.1]]), return_mask=True)
+    assert ok.tolist() == [False, True] and np.all(np.isnan(x[0]))
+
+
+def test_forward_kinematics_does_not_assemble():
+    # motor angles no platform pose of the neutral mode reaches
+    with pytest.raises(ConvergenceError):
+        ah.platform_orientation(3.0, 3.0)
+    with pytest.raises(ConvergenceError):
+        ah.foot_position(3.0, 3.0, 0.0)
+    with pytest.raises(ConvergenceError):
+        ah.foot_jacobian(3.0, 3.0, 0.0)
+    x, ok = ah.platform_orientation([0.3, 3.0], [-0.3, 3.0], return_mask=True)
+    assert ok.tolist() == [True, False] and np.all(np.isnan(x[1]))

@@ -1,0 +1,487 @@
+"""``legkin bench``: analytic kinematics timed side by side with iterative solvers, on the same targets.
+
+How a model is benchmarked: its module ``legkin.benches.<model>`` defines
+``build(n, rng, quick) -> ModelBench``, a list of :class:`Method` records, each with its inputs (the
+same random reachable targets for every method of a group), a ``run`` callable (the timed part) and a
+``score`` callable (untimed: turns the output into per-target errors measured the same way for every
+method, by Pinocchio). This module times each method (median of ``repeats`` runs over the same inputs,
+in one process), scores it, and prints one table per model; ``--json`` writes the same numbers.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+import platform
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from ._registry import get_spec, list_models
+
+__all__ = [
+    "Method",
+    "Score",
+    "ModelBench",
+    "MethodResult",
+    "run_model",
+    "run_bench",
+    "format_table",
+    "machine_info",
+    "to_json",
+    "run_bench_cli",
+]
+
+
+@dataclass
+class Score:
+    """Per-target outcome of one method (arrays of length = number of targets; NaN marks a failure).
+
+    Attributes:
+        error: primary error per target (position in m, or orientation in rad; see ``ModelBench.units``).
+        solved: boolean mask: the target was reached within the model's tolerance (and joint limits).
+        orientation: secondary error per target (rad), when the task has one.
+        iterations: iterations per target, for iterative methods.
+        fk_evals: forward-kinematics evaluations per target, for iterative methods.
+        reached: error within tolerance, whatever the joint limits (when ``solved`` also asks for limits).
+    """
+
+    error: np.ndarray
+    solved: np.ndarray
+    orientation: np.ndarray | None = None
+    iterations: np.ndarray | None = None
+    fk_evals: np.ndarray | None = None
+    reached: np.ndarray | None = None
+
+
+@dataclass
+class Method:
+    """One way of solving a model's task.
+
+    Attributes:
+        name: row label (the batch closed form's contains "batch", Pinocchio's contains "pinocchio").
+        inputs: targets, first axis = targets (shared with the other methods of the group).
+        run: ``run(inputs) -> output``; the timed part (everything a user would call).
+        score: ``score(inputs, output) -> Score``; not timed.
+        group: methods are compared (ratio to fastest) within their group.
+        max_targets: solve only the first ``max_targets`` inputs (slow per-target methods).
+        repeats: timed runs; the time reported is their median.
+        skip: if set, the method is not run and this reason is printed instead.
+        note: printed under the table.
+    """
+
+    name: str
+    inputs: Any = None
+    run: Callable[[Any], Any] | None = None
+    score: Callable[[Any, Any], Score] | None = None
+    group: str = "ik"
+    max_targets: int | None = None
+    repeats: int = 5
+    skip: str | None = None
+    note: str = ""
+
+
+@dataclass
+class ModelBench:
+    """What a bench module returns for one model.
+
+    Attributes:
+        methods: the rows, in display order.
+        units: unit of ``Score.error`` per group (e.g. ``{"ik": "m"}``).
+        tolerance: the ``solved`` threshold, same for every method (stated in the table).
+        notes: lines printed under the table (how the targets were made, what each peer was given).
+        summary: ``summary(results) -> lines``: derived figures (speed-ups, IK/FK), printed and in the JSON.
+        secondary: column label of ``Score.orientation`` (e.g. "rot" in rad, or "loop |r|").
+    """
+
+    methods: list[Method]
+    units: dict[str, str] = field(default_factory=lambda: {"ik": "m"})
+    tolerance: str = ""
+    notes: list[str] = field(default_factory=list)
+    summary: Callable[[list], list[str]] | None = None
+    secondary: str = "rot"
+
+
+@dataclass
+class MethodResult:
+    """A timed and scored method (one table row)."""
+
+    name: str
+    group: str
+    unit: str
+    targets: int
+    solved: float  # percent
+    solved_count: int
+    median_error: float
+    max_error: float
+    time_per_target_s: float
+    repeats: int
+    ratio: float = float("nan")
+    median_orientation_error: float | None = None
+    max_orientation_error: float | None = None
+    iterations_median: float | None = None
+    fk_evals_mean: float | None = None
+    reached: float | None = None  # percent
+    note: str = ""
+
+    def as_dict(self) -> dict:
+        d = {
+            "name": self.name,
+            "targets": self.targets,
+            "solved": self.solved,
+            "median_error": self.median_error,
+            "max_error": self.max_error,
+            "time_per_target_s": self.time_per_target_s,
+            "group": self.group,
+            "error_unit": self.unit,
+            "solved_count": self.solved_count,
+            "repeats": self.repeats,
+            "ratio_to_fastest": self.ratio,
+        }
+        for key in ("reached", "iterations_median", "fk_evals_mean"):
+            if getattr(self, key) is not None:
+                d[key] = getattr(self, key)
+        if self.median_orientation_error is not None:
+            d["median_secondary_error"] = self.median_orientation_error
+            d["max_secondary_error"] = self.max_orientation_error
+        if self.note:
+            d["note"] = self.note
+        return d
+
+
+# ------------------------------------------------------------------------------------------- progress
+class _Progress:
+    """A one-line progress bar on stderr (only when stderr is a terminal)."""
+
+    def __init__(self, total: int, label: str):
+        self.total, self.done, self.label = max(total, 1), 0, label
+        self.enabled = sys.stderr.isatty()
+        self.t0 = time.perf_counter()
+
+    def show(self, what: str) -> None:
+        if not self.enabled:
+            return
+        width = 24
+        k = int(width * self.done / self.total)
+        bar = "#" * k + "-" * (width - k)
+        line = f"\r{self.label} [{bar}] {self.done}/{self.total} {what} ({time.perf_counter() - self.t0:.0f} s)"
+        sys.stderr.write(line[:120].ljust(120))
+        sys.stderr.flush()
+
+    def step(self, what: str) -> None:
+        self.done += 1
+        self.show(what)
+
+    def close(self) -> None:
+        if self.enabled:
+            sys.stderr.write("\r" + " " * 120 + "\r")
+            sys.stderr.flush()
+
+
+# ------------------------------------------------------------------------------------------- running
+def _median_or_none(x) -> float | None:
+    if x is None:
+        return None
+    x = np.asarray(x, dtype=float)
+    return float(np.nanmedian(x)) if x.size and np.any(np.isfinite(x)) else float("nan")
+
+
+def _mean_or_none(x) -> float | None:
+    if x is None:
+        return None
+    x = np.asarray(x, dtype=float)
+    return float(np.nanmean(x)) if x.size and np.any(np.isfinite(x)) else float("nan")
+
+
+def _stats(err: np.ndarray) -> tuple[float, float]:
+    """Median and worst error; a target with no result (NaN) makes the worst error NaN-free but counted."""
+    err = np.asarray(err, dtype=float)
+    finite = err[np.isfinite(err)]
+    if finite.size == 0:
+        return float("nan"), float("nan")
+    return float(np.median(finite)), float(np.max(finite))
+
+
+def _time_method(m: Method, inputs, progress: _Progress) -> tuple[float, Any]:
+    times, out = [], None
+    for r in range(m.repeats):
+        progress.show(f"{m.name} (run {r + 1}/{m.repeats})")
+        t0 = time.perf_counter()
+        out = m.run(inputs)
+        times.append(time.perf_counter() - t0)
+    progress.step(m.name)
+    return float(np.median(times)), out
+
+
+def _subset(inputs, k: int | None):
+    if k is None:
+        return inputs
+    if isinstance(inputs, tuple):
+        return tuple(x[:k] for x in inputs)
+    return inputs[:k]
+
+
+def _count(inputs) -> int:
+    return len(inputs[0]) if isinstance(inputs, tuple) else len(inputs)
+
+
+def run_model(bench: ModelBench, label: str = "", progress: _Progress | None = None) -> list[MethodResult]:
+    """Time and score every method of a model; fills the ratio to the fastest method of each group."""
+    runnable = [m for m in bench.methods if m.skip is None]
+    own = progress is None
+    progress = progress or _Progress(len(runnable), label)
+    results: list[MethodResult] = []
+    for m in runnable:
+        inputs = _subset(m.inputs, m.max_targets)
+        k = _count(inputs)
+        seconds, out = _time_method(m, inputs, progress)
+        s = m.score(inputs, out)
+        solved = np.asarray(s.solved, dtype=bool)
+        med, worst = _stats(s.error)
+        # a target without any result counts as a failure and its error as infinite in "worst"
+        if not np.all(np.isfinite(np.asarray(s.error, dtype=float))):
+            worst = float("inf")
+        r = MethodResult(
+            name=m.name,
+            group=m.group,
+            unit=bench.units.get(m.group, ""),
+            targets=k,
+            solved=100.0 * float(solved.sum()) / k,
+            solved_count=int(solved.sum()),
+            median_error=med,
+            max_error=worst,
+            time_per_target_s=seconds / k,
+            repeats=m.repeats,
+            iterations_median=_median_or_none(s.iterations),
+            fk_evals_mean=_mean_or_none(s.fk_evals),
+            note=m.note,
+        )
+        if s.reached is not None:
+            r.reached = 100.0 * float(np.sum(s.reached)) / k
+        if s.orientation is not None:
+            omed, oworst = _stats(s.orientation)
+            if not np.all(np.isfinite(np.asarray(s.orientation, dtype=float))):
+                oworst = float("inf")
+            r.median_orientation_error, r.max_orientation_error = omed, oworst
+        results.append(r)
+    for g in {r.group for r in results}:
+        fastest = min(r.time_per_target_s for r in results if r.group == g)
+        for r in results:
+            if r.group == g:
+                r.ratio = r.time_per_target_s / fastest
+    if own:
+        progress.close()
+    return results
+
+
+def _load_bench_module(name: str):
+    """The bench module of ``name``, or None if there is none."""
+    modname = f"legkin.benches.{name}"
+    try:
+        return importlib.import_module(modname)
+    except ModuleNotFoundError as exc:
+        if exc.name == modname:
+            return None
+        raise
+
+
+def run_bench(
+    models: list[str] | None = None, n: int | None = None, seed: int = 0, quick: bool = False
+) -> dict:
+    """Build and run the benches of ``models`` (default: all registered).
+
+    Returns:
+        ``{"models": {name: (ModelBench, [MethodResult])}, "skipped": {name: reason}}``.
+    """
+    names = models or list_models()
+    for name in names:
+        get_spec(name)  # unknown names raise UnknownModelError
+    out: dict = {"models": {}, "skipped": {}}
+    for name in names:
+        module = _load_bench_module(name)
+        if module is None:
+            out["skipped"][name] = f"no bench module legkin.benches.{name}"
+            continue
+        rng = np.random.default_rng(seed)
+        bench = module.build(n, rng, quick)
+        out["models"][name] = (bench, run_model(bench, label=name))
+    return out
+
+
+# ------------------------------------------------------------------------------------------- output
+def _fmt_err(x: float | None) -> str:
+    if x is None:
+        return "-"
+    if np.isnan(x):
+        return "nan"
+    if np.isinf(x):
+        return "fail"
+    return f"{x:.1e}"
+
+
+def _fmt_time(t: float) -> str:
+    if t >= 1e-3:
+        return f"{t * 1e3:.3g} ms"
+    if t >= 1e-6:
+        return f"{t * 1e6:.3g} us"
+    return f"{t * 1e9:.3g} ns"
+
+
+def _summary(bench: ModelBench, results: list[MethodResult]) -> list[str]:
+    return list(bench.summary(results)) if bench.summary is not None else []
+
+
+def format_table(name: str, bench: ModelBench, results: list[MethodResult]) -> str:
+    """One model's table: method, targets, solved, errors, time per target, ratio to the fastest."""
+    lines = [f"{name}" + (f"  (solved: {bench.tolerance})" if bench.tolerance else "")]
+    has_ori = any(r.median_orientation_error is not None for r in results)
+    has_it = any(r.iterations_median is not None for r in results)
+    has_fk = any(r.fk_evals_mean is not None for r in results)
+    width = max([len(r.name) for r in results] + [len(m.name) for m in bench.methods] + [6])
+    has_reach = any(r.reached is not None for r in results)
+    head = f"  {'method':<{width}}  {'targets':>7}  {'solved':>7}"
+    if has_reach:
+        head += f"  {'reached':>7}"
+    head += f"  {'err med':>8}  {'err max':>8}"
+    if has_ori:
+        head += f"  {bench.secondary[:4] + ' med':>8}  {bench.secondary[:4] + ' max':>8}"
+    if has_it:
+        head += f"  {'iters':>5}"
+    if has_fk:
+        head += f"  {'FK/solve':>8}"
+    head += f"  {'time/target':>11}  {'ratio':>8}"
+    groups = list(dict.fromkeys(m.group for m in bench.methods))
+    for g in groups:
+        rows = [r for r in results if r.group == g]
+        unit = bench.units.get(g, "")
+        lines.append(f"  [{g}] err in {unit}" + (f", {bench.secondary}" if has_ori else ""))
+        lines.append(head)
+        for r in rows:
+            line = f"  {r.name:<{width}}  {r.targets:>7d}  {r.solved:>6.1f}%"
+            if has_reach:
+                line += f"  {'-' if r.reached is None else f'{r.reached:.1f}%':>7}"
+            line += f"  {_fmt_err(r.median_error):>8}  {_fmt_err(r.max_error):>8}"
+            if has_ori:
+                line += f"  {_fmt_err(r.median_orientation_error):>8}  {_fmt_err(r.max_orientation_error):>8}"
+            if has_it:
+                line += f"  {'-' if r.iterations_median is None else f'{r.iterations_median:g}':>5}"
+            if has_fk:
+                line += f"  {'-' if r.fk_evals_mean is None else f'{r.fk_evals_mean:.3g}':>8}"
+            line += f"  {_fmt_time(r.time_per_target_s):>11}  {r.ratio:>7.1f}x"
+            lines.append(line)
+        for m in bench.methods:
+            if m.group == g and m.skip is not None:
+                lines.append(f"  {m.name:<{width}}  skipped: {m.skip}")
+    for text in _summary(bench, results):
+        lines.append(f"  = {text}")
+    notes = [f"{r.name}: {r.note}" for r in results if r.note] + list(bench.notes)
+    for text in notes:
+        lines.append(f"  * {text}")
+    return "\n".join(lines) + "\n"
+
+
+def _version(dist: str) -> str | None:
+    try:
+        from importlib.metadata import version
+
+        return version(dist)
+    except Exception:
+        return None
+
+
+def _cpu_model() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def machine_info() -> dict:
+    """CPU, core count, OS, and the versions of Python and of every library the bench touches."""
+    return {
+        "cpu": _cpu_model(),
+        "cpu_count": os.cpu_count(),
+        "platform": platform.platform(),
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "pin": _version("pin"),
+        "legkin": _version("legkin"),
+        "ikpy": _version("ikpy"),
+        "pytracik": _version("pytracik"),
+        "scipy": _version("scipy"),
+        "load_average_1min": _loadavg(),
+    }
+
+
+def _loadavg() -> float | None:
+    """1-minute load average: other processes on the machine make every timing slower."""
+    try:
+        return os.getloadavg()[0]
+    except (AttributeError, OSError):
+        return None
+
+
+def to_json(run: dict, settings: dict | None = None, machine: dict | None = None) -> dict:
+    """The ``--json`` document: ``{"machine", "settings", "models": {name: {"methods": [...]}}, "skipped"}``."""
+    models = {}
+    for name, (bench, results) in run["models"].items():
+        models[name] = {
+            "methods": [r.as_dict() for r in results],
+            "skipped_methods": {m.name: m.skip for m in bench.methods if m.skip is not None},
+            "tolerance": bench.tolerance,
+            "units": bench.units,
+            "secondary_error": bench.secondary,
+            "notes": list(bench.notes),
+            "summary": _summary(bench, results),
+        }
+    return {
+        "machine": machine or machine_info(),
+        "settings": settings or {},
+        "models": models,
+        "skipped": run["skipped"],
+    }
+
+
+def _finite(obj):
+    """Replace NaN and infinities by None (strict JSON): null means "no finite value" (a failed target)."""
+    if isinstance(obj, float):
+        return obj if np.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [_finite(v) for v in obj]
+    return obj
+
+
+def run_bench_cli(args) -> int:
+    """Entry point of ``legkin bench`` (arguments: models, n, json, quick, seed)."""
+    if args.n is not None and args.n < 1:
+        print(f"legkin: error: --n must be a positive integer, got {args.n}", file=sys.stderr)
+        return 2
+    t0 = time.perf_counter()
+    info = machine_info()  # before the run: the load average then is the other processes'
+    run = run_bench(args.models or None, n=args.n, seed=args.seed, quick=args.quick)
+    print(
+        f"legkin bench on {info['cpu']} ({info['cpu_count']} cores), Python {info['python']}, "
+        f"numpy {info['numpy']}, pin {info['pin']}, load average {info['load_average_1min']:.2f}"
+        + ("  [--quick]" if args.quick else "")
+    )
+    print("time/target = median over repeats of (wall time of the whole call) / targets\n")
+    for name, (bench, results) in run["models"].items():
+        print(format_table(name, bench, results))
+    for name, reason in run["skipped"].items():
+        print(f"{name}: skipped ({reason})")
+    print(f"total {time.perf_counter() - t0:.1f} s")
+    if args.json:
+        doc = to_json(run, {"n": args.n, "seed": args.seed, "quick": bool(args.quick)}, machine=info)
+        Path(args.json).write_text(json.dumps(_finite(doc), indent=2, allow_nan=False) + "\n")
+        print(f"wrote {args.json}")
+    return 0

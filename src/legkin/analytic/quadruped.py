@@ -16,6 +16,7 @@ returns plain arrays and raises on failure; a batch returns NaN rows where an it
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numpy as np
 
@@ -145,36 +146,77 @@ def within_limits(q, tol: float = 1e-9) -> np.ndarray:
     return np.all((q >= lo - tol) & (q <= hi + tol), axis=-1)
 
 
-def _ik_all(p: np.ndarray, leg: str, foot_z: float):
-    """All four branches (..., 4, 3) and the diagnostic quantities of the closed form."""
-    sx, sy = _signs(leg)
-    d = p - hip_position(leg)
-    rho2 = d[..., 1] ** 2 + d[..., 2] ** 2 - Y12**2
+class _Solution(NamedTuple):
+    q: np.ndarray  # (..., n_branches, 3) in the order of ``branches``
+    branches: tuple[tuple[int, int], ...]
+    reachable: np.ndarray
+    rho2: np.ndarray
+    r2: np.ndarray
+    l1: float
+    l2: float
+
+
+def _inside(x: np.ndarray, row: int, tol: float = 1e-9) -> np.ndarray:
+    lo, hi = JOINT_LIMITS[row]
+    return (x >= lo - tol) & (x <= hi + tol)
+
+
+def _toward_limits(x: np.ndarray, row: int, tol: float = 1e-9) -> np.ndarray:
+    """The representative of angle ``x`` (mod 2 pi) inside the limits of joint ``row`` when one is.
+
+    Needed where a limit is +-pi (q2's upper limit): rounding can return -pi + eps for pi - eps.
+    """
+    lo, hi = JOINT_LIMITS[row]
+    x = np.where((x < lo - tol) & (x + 2 * np.pi <= hi + tol), x + 2 * np.pi, x)
+    return np.where((x > hi + tol) & (x - 2 * np.pi >= lo - tol), x - 2 * np.pi, x)
+
+
+def _solve(p: np.ndarray, leg: str, foot_z: float, limited: bool = False) -> _Solution:
+    """The closed form, branch by branch.
+
+    Angle differences are taken in one ``atan2`` (``atan2(a) - atan2(b) = atan2(a x b, a . b)``), which is
+    also wrapped to (-pi, pi] already. With ``limited=True`` a knee branch is computed only if its q3 is
+    inside the limits for some target (q3 depends on the knee sign alone): inside POPI's limits the k = +1
+    branch never is, which halves the work of :func:`foot_ik`.
+    """
+    _, sy = _signs(leg)
+    h = hip_position(leg)
+    dx, dy, dz = p[..., 0] - h[0], p[..., 1] - h[1], p[..., 2] - h[2]
+    axis2 = dy * dy + dz * dz
+    rho2 = axis2 - Y12**2
     rho = np.sqrt(np.maximum(rho2, 0.0))
+    r2 = dx * dx + rho2
     l1 = math.hypot(X23, Z23)
     l2 = math.hypot(X34, foot_z)
-    r2 = np.sum(d * d, axis=-1) - Y12**2
-    kk = (r2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)
-    alpha = math.atan2(Z23, X23)
-    beta = math.atan2(foot_z, X34)
-    acos_k = np.arccos(np.clip(kk, -1.0, 1.0))
-    out = np.empty(p.shape[:-1] + (4, 3))
-    for b, (s_u, k) in enumerate(BRANCHES):
-        uz = s_u * rho
-        ux = d[..., 0]
-        q1 = sy * (np.arctan2(d[..., 2], d[..., 1]) - np.arctan2(uz, sy * Y12))
-        q3 = (beta - alpha) + k * acos_k
-        vx, vz = _knee_vector(q3, foot_z)
-        q2 = np.arctan2(uz, ux) - np.arctan2(vz, vx)
-        out[..., b, :] = _wrap(np.stack([q1, q2, q3], axis=-1))
+    kk = np.minimum(np.maximum((r2 - l1 * l1 - l2 * l2) * (0.5 / (l1 * l2)), -1.0), 1.0)
+    sk = np.sqrt(1.0 - kk * kk)
     # Targets on the workspace boundary, built in floating point, may land a rounding error outside it:
-    # accept them within REACH_TOL metres (then the clipped acos / zero rho give the boundary solution).
-    r = np.sqrt(np.maximum(r2, 0.0))
-    axis_dist = np.sqrt(d[..., 1] ** 2 + d[..., 2] ** 2)
+    # accept them within REACH_TOL metres (the clipped K / zero rho then give the boundary solution).
     reachable = (
-        (axis_dist >= Y12 - REACH_TOL) & (r <= l1 + l2 + REACH_TOL) & (r >= abs(l1 - l2) - REACH_TOL)
+        (axis2 >= (Y12 - REACH_TOL) ** 2)
+        & (r2 <= (l1 + l2 + REACH_TOL) ** 2)
+        & (r2 >= (abs(l1 - l2) - REACH_TOL) ** 2)
     )
-    return out, reachable, rho2, r2, kk, l1, l2
+    offset = math.atan2(foot_z, X34) - math.atan2(Z23, X23)  # q3 = offset + k acos K
+    co, so = math.cos(offset), math.sin(offset)
+    acos_k = np.arccos(kk)
+    knees = {}
+    for k in (-1, 1):
+        q3 = offset + k * acos_k  # within 3 pi of 0: one shift wraps it (cheaper than a modulo)
+        q3 = np.where(q3 > np.pi, q3 - 2 * np.pi, np.where(q3 <= -np.pi, q3 + 2 * np.pi, q3))
+        if limited and not np.any(_inside(q3, 2) & reachable):
+            continue
+        c3, s3 = co * kk - k * so * sk, so * kk + k * co * sk  # cos, sin of q3 without trig calls
+        knees[k] = (q3, X23 + X34 * c3 + foot_z * s3, Z23 - X34 * s3 + foot_z * c3)
+    branches = tuple((s_u, k) for s_u, k in BRANCHES if k in knees)
+    out = np.empty(p.shape[:-1] + (len(branches), 3))
+    for b, (s_u, k) in enumerate(branches):
+        uz = s_u * rho
+        q3, vx, vz = knees[k]
+        out[..., b, 0] = sy * np.arctan2(sy * Y12 * dz - dy * uz, sy * Y12 * dy + dz * uz)
+        out[..., b, 1] = np.arctan2(uz * vx - dx * vz, dx * vx + uz * vz)
+        out[..., b, 2] = q3
+    return _Solution(out, branches, reachable, rho2, r2, l1, l2)
 
 
 def _unreachable_message(leg, p, rho2, r2, l1, l2) -> str:
@@ -213,11 +255,12 @@ def foot_ik_all(p, leg: str, *, foot_z: float = 0.0, return_mask: bool = False):
         UnreachableError: single target out of reach (message says why and by how much).
     """
     p = as_input(p, "p", (3,))
-    q, ok, rho2, r2, kk, l1, l2 = _ik_all(p, leg, foot_z)
-    q[~ok] = np.nan
+    sol = _solve(p, leg, foot_z)
+    ok = sol.reachable
+    q = np.where(ok[..., None, None], sol.q, np.nan)
 
     def error():
-        return UnreachableError(_unreachable_message(leg, p, float(rho2), float(r2), l1, l2), target=p)
+        return UnreachableError(_unreachable_message(leg, p, float(sol.rho2), float(sol.r2), sol.l1, sol.l2), target=p)
 
     q = finish(q, ok, p.ndim == 1, False, error)
     return (q, np.repeat(ok[..., None], 4, axis=-1)) if return_mask else q
@@ -242,22 +285,31 @@ def foot_ik(p, leg: str, q_ref=None, *, foot_z: float = 0.0, return_mask: bool =
         JointLimitError: single target reachable only outside the joint limits.
     """
     p = as_input(p, "p", (3,))
-    q_all, ok, rho2, r2, kk, l1, l2 = _ik_all(p, leg, foot_z)
-    inside = within_limits(q_all) & ok[..., None]
-    if q_ref is None:
-        cost = np.broadcast_to(np.arange(4.0), inside.shape)
-    else:
+    if q_ref is not None:
         q_ref = as_input(q_ref, "q_ref", (3,))
-        cost = np.linalg.norm(_wrap(q_all - q_ref[..., None, :]), axis=-1)
-    cost = np.where(inside, cost, np.inf)
-    best = np.argmin(cost, axis=-1)
-    q = np.take_along_axis(q_all, best[..., None, None], axis=-2)[..., 0, :]
-    solved = np.any(inside, axis=-1)
-    q = np.where(solved[..., None], q, np.nan)
+    sol = _solve(p, leg, foot_z, limited=True)
+    ok = sol.reachable
+    # Walk the candidate branches keeping, per target, the first inside the limits (or the nearest q_ref).
+    q = np.full(np.broadcast_shapes(p.shape, () if q_ref is None else q_ref.shape), np.nan)
+    best = np.full(q.shape[:-1], np.inf)
+    for b in range(len(sol.branches)):
+        qb = sol.q[..., b, :].copy()
+        qb[..., 1] = _toward_limits(qb[..., 1], 1)  # q1 and q3 limits are far from +-pi
+        inside = ok & _inside(qb[..., 0], 0) & _inside(qb[..., 1], 1) & _inside(qb[..., 2], 2)
+        if q_ref is None:
+            take = inside & np.isinf(best)
+            best = np.where(take, 0.0, best)
+        else:
+            cost = np.linalg.norm(_wrap(qb - q_ref), axis=-1)
+            take = inside & (cost < best)
+            best = np.where(take, cost, best)
+        q = np.where(take[..., None], qb, q)
+    solved = np.isfinite(best)
 
     def error():
         if not bool(ok):
-            return UnreachableError(_unreachable_message(leg, p, float(rho2), float(r2), l1, l2), target=p)
+            return UnreachableError(_unreachable_message(leg, p, float(sol.rho2), float(sol.r2), sol.l1, sol.l2), target=p)
+        q_all = _solve(p, leg, foot_z).q
         return JointLimitError(
             f"target {p.tolist()} for leg {leg} is reachable only outside the joint limits "
             f"{JOINT_LIMITS.tolist()}: branches {np.round(q_all, 4).tolist()}",

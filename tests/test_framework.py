@@ -173,3 +173,12 @@ def test_readme_model_table_lists_every_model():
     for name in MODEL_NAMES:
         assert f"[`{name}`]" in table, f"README model table lacks {name}: run scripts/make_docs.py"
         assert (ROOT / "docs" / f"{name}.md").exists()
+
+
+def test_readme_python_examples_run():
+    text = (ROOT / "README.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, re.S)
+    assert len(blocks) >= 2
+    namespace: dict = {}
+    for block in blocks:
+        exec(compile(block, "README.md", "exec"), namespace)  # noqa: S102 - the README's own examples

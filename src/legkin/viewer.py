@@ -89,7 +89,9 @@ def write_animation_html(robot: Robot, qs: Sequence[np.ndarray], path: str | Pat
     """Write a static page that plays a meshcat clip of ``qs`` (loops; scrub it in the Animations menu)."""
     with open_viewer(robot) as viz:
         viz.display(robot.check_q(qs[0]))
-        viz.viewer.set_animation(_animation(robot, viz, qs, fps), play=True, repetitions=0)
+        # three.js setLoop(LoopRepeat, n) plays n times, then meshcat pauses and resets to frame 0:
+        # repetitions=0 plays the clip ONCE; Infinity (msgpack float) loops for ever.
+        viz.viewer.set_animation(_animation(robot, viz, qs, fps), play=True, repetitions=float("inf"))
         html = viz.viewer.static_html()
     path = Path(path)
     path.write_text(html)
@@ -104,7 +106,7 @@ def show(robot: Robot, q: np.ndarray, animation: Sequence[np.ndarray] | None = N
     with open_viewer(robot) as viz:
         viz.display(q)
         if animation is not None:
-            viz.viewer.set_animation(_animation(robot, viz, animation, 30), play=True, repetitions=0)
+            viz.viewer.set_animation(_animation(robot, viz, animation, 30), play=True, repetitions=float("inf"))
         print(f"meshcat viewer: {viz.viewer.url()}  (Ctrl-C to stop)", flush=True)
         try:
             while True:

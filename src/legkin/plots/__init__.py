@@ -35,10 +35,11 @@ def error_histograms(model: str, rows, outdir: Path) -> Path:
         e = e[np.isfinite(e)]
         floor = 1e-18
         logs = np.log10(np.maximum(e, floor)) if e.size else np.array([])
-        lo = min(float(logs.min()) if logs.size else -17, math.log10(row.tolerance)) - 0.5
-        hi = max(float(logs.max()) if logs.size else -12, math.log10(row.tolerance)) + 0.5
+        log_tol = math.log10(max(row.tolerance, floor))  # exact rows (e.g. mobility counts) have tolerance 0
+        lo = min(float(logs.min()) if logs.size else -17, log_tol) - 0.5
+        hi = max(float(logs.max()) if logs.size else -12, log_tol) + 0.5
         ax.hist(logs, bins=np.linspace(lo, hi, 50), color="tab:blue" if row.passed else "tab:red")
-        ax.axvline(math.log10(row.tolerance), color="k", ls="--", lw=1, label="tolerance")
+        ax.axvline(log_tol, color="k", ls="--", lw=1, label="tolerance")
         ax.set_yscale("log")
         ax.set_title(row.name, fontsize=8)
         ax.set_xlabel("log10(error)", fontsize=8)

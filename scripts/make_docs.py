@@ -81,23 +81,35 @@ def check_tables(samples: int) -> str:
     return "\n".join(out)
 
 
+def _num(x, fmt: str = ".1e") -> str:
+    """A JSON number for a table cell (``-`` for missing, ``fail`` for NaN/inf: some targets unsolved)."""
+    if x is None:
+        return "-"
+    return format(x, fmt) if x == x and abs(x) != float("inf") else "fail"
+
+
 def bench_tables() -> str:
     from legkin.__main__ import main
 
     path = DOCS / "bench.json"
     main(["bench", "--json", str(path)])
     doc = json.loads(path.read_text())
-    out = [f"Machine: {doc['machine'].get('cpu', '?')}, Python {doc['machine'].get('python', '?')}.\n"]
+    mach = doc["machine"]
+    out = [
+        f"Measured in one run on {mach.get('cpu', '?')} ({mach.get('cpu_count', '?')} cores, 1-min load "
+        f"{mach.get('load_average_1min', float('nan')):.2f}), Python {mach.get('python', '?')}, numpy "
+        f"{mach.get('numpy', '?')}, pin {mach.get('pin', '?')}. Ratios are within a group of methods solving "
+        "the same problem; 'fail' in an error column means some targets were not solved.\n"
+    ]
     for name, entry in doc["models"].items():
         out.append(f"**{name}**\n")
         out.append("| method | targets | solved | median error | max error | time per target | ratio to fastest |")
         out.append("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
-        fastest = min(m["time_per_target_s"] for m in entry["methods"] if m["time_per_target_s"])
         for m in entry["methods"]:
-            t = m["time_per_target_s"]
             out.append(
-                f"| {m['name']} | {m['targets']} | {m['solved']:.1%} | {m['median_error']:.1e} | "
-                f"{m['max_error']:.1e} | {t:.2e} s | {t / fastest:.3g}x |"
+                f"| {m['name']} | {m['targets']} | {m['solved']:.1f}% | {_num(m['median_error'])} | "
+                f"{_num(m['max_error'])} | {_num(m['time_per_target_s'], '.2e')} s | "
+                f"{_num(m.get('ratio_to_fastest'), '.3g')}x |"
             )
         out.append("")
     return "\n".join(out)

@@ -194,4 +194,6 @@ def test_animation_page_plays_in_chromium(model, robots, tmp_path, empty_scene):
     still = _shot(static, tmp_path / "static.png")
     assert anim.std() > 5, "blank page"
     assert _changed(anim, empty_scene) > 0.01, "the mechanism is shown"
-    assert _changed(anim, still) > 0.01, "the clip has moved the mechanism away from q0"
+    # relative to the mechanism's own footprint on screen (the hybrid leg is small in its view)
+    footprint = _changed(still, empty_scene)
+    assert _changed(anim, still) > 0.1 * footprint, "the clip has moved the mechanism away from q0"

@@ -107,8 +107,8 @@ def show(robot: Robot, q: np.ndarray, animation: Sequence[np.ndarray] | None = N
         viz.display(q)
         if animation is not None:
             viz.viewer.set_animation(_animation(robot, viz, animation, 30), play=True, repetitions=float("inf"))
-        print(f"meshcat viewer: {viz.viewer.url()}  (Ctrl-C to stop)", flush=True)
         try:
+            print(f"meshcat viewer: {viz.viewer.url()}  (Ctrl-C to stop)", flush=True)
             while True:
                 time.sleep(1.0)
         except KeyboardInterrupt:

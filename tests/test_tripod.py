@@ -249,3 +249,95 @@ def test_fk_reports_inconsistent_motors():
     ys, zs, incs, mask = at.fk(np.array([q[0], q[0]]), np.array([q[4], q[4]]), np.array([q[8], q[8] + 1e-3]),
                                return_mask=True)
     assert mask.tolist() == [True, False] and np.isnan(ys[1]) and incs[0] < 1e-12
+
+
+# ------------------------------------------------------------------------------------------ fk internals (closed forms)
+def _exact_lstsq(a: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """-pinv(A) r in exact rational arithmetic (A is 3 x 2 of full rank): the reference for the closed form."""
+    from fractions import Fraction
+
+    m = [[Fraction(float(x)) for x in row] for row in a]
+    v = [Fraction(float(x)) for x in r]
+    g11, g22 = (sum(m[i][j] ** 2 for i in range(3)) for j in (0, 1))
+    g12 = sum(m[i][0] * m[i][1] for i in range(3))
+    b1, b2 = (sum(m[i][j] * v[i] for i in range(3)) for j in (0, 1))
+    det = g11 * g22 - g12 * g12
+    return np.array([-float((g22 * b1 - g12 * b2) / det), -float((g11 * b2 - g12 * b1) / det)])
+
+
+def _random_a(rng, cond: float) -> np.ndarray:
+    u, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    v, _ = np.linalg.qr(rng.normal(size=(2, 2)))
+    return (u[:, :2] * np.array([1.0, 1.0 / cond])) @ v.T
+
+
+def _step(a: np.ndarray, r: np.ndarray) -> np.ndarray:
+    with np.errstate(invalid="ignore", divide="ignore"):  # as fk calls it (0/0 on the rank-1 branch, replaced)
+        s0, s1 = at._gauss_newton_step(a[None, :, 0], a[None, :, 1], r[None])
+    return np.array([s0[0, 0], s1[0, 0]])
+
+
+@pytest.mark.parametrize("cond", [1.0, 1e4, 1e8])
+def test_gauss_newton_step_error_grows_like_cond_not_cond_squared(cond):
+    """Consistent r = A x: the closed-form step errs ~1e-16 cond (naive normal equations: ~1e-16 cond^2)."""
+    rng = np.random.default_rng(int(math.log10(cond)))
+    worst = 0.0
+    for _ in range(100):
+        a = _random_a(rng, cond)
+        r = a @ rng.normal(size=2)
+        ref = _exact_lstsq(a, r)
+        worst = max(worst, np.abs(_step(a, r) - ref).max() / np.abs(ref).max())
+    assert worst <= 1e-15 * cond + 1e-15
+
+
+def test_gauss_newton_step_matches_pinv_including_rank_deficient():
+    rng = np.random.default_rng(7)
+    for _ in range(200):  # inconsistent r (both differ from the exact step by ~1e-16 cond^2 here): same as pinv
+        a, r = _random_a(rng, 10.0 ** rng.uniform(0, 1)), rng.normal(size=3)
+        ref = -np.linalg.pinv(a, rcond=at.STEP_RCOND) @ r
+        assert np.abs(_step(a, r) - ref).max() <= 1e-13 * np.abs(ref).max()
+    a1 = rng.normal(size=3)
+    for a2 in (np.zeros(3), 1e-14 * rng.normal(size=3), 3.0 * a1):  # sigma_2 <= 1e-12 sigma_1: rank-1 pinv
+        a, r = np.stack([a1, a2], axis=-1), rng.normal(size=3)
+        ref = -np.linalg.pinv(a, rcond=at.STEP_RCOND) @ r
+        assert np.abs(_step(a, r) - ref).max() <= 1e-12 * np.abs(ref).max()
+    assert np.array_equal(_step(np.zeros((3, 2)), rng.normal(size=3)), [0.0, 0.0])
+
+
+def _planes_lstsq_u(q):
+    """The motor planes' least-squares intersection -> (alpha_y, alpha_z), with the SVD pseudo-inverse (oracle)."""
+    s, c = np.sin(q), np.cos(q)
+    m = np.stack([s, -c * np.cos(at.ETA), -c * np.sin(at.ETA)], axis=-1)
+    e = np.linalg.pinv(m, rcond=1e-10) @ np.full(3, at.D * (1 - math.cos(at.ALPHA)))
+    e = e / np.linalg.norm(e) if np.linalg.norm(e) > 0 else np.array([-1.0, 0.0, 0.0])
+    return at.orientation_from_axis(2 * e[0] * e - np.array([1.0, 0.0, 0.0]))
+
+
+def test_initial_guess_adjugate_and_parallel_planes_fallback():
+    geo = at._geometry(at.D, at.ALPHA, np.array(at.ETA))
+    h = math.pi / 2
+    motors = [(0.3, -1.0, 2.0), (-2.5, 0.4, 1.1), (h, h, h), (h, -h, h), (0.0, 0.0, 0.0), (h + 1e-5, h - 2e-5, h)]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ay, az = at._initial_guess(np.array(motors), geo)
+    for k, q in enumerate(motors):  # the last four have |det M| <= PLANES_DET_MIN: pinv fallback
+        ry, rz = _planes_lstsq_u(np.array(q))
+        assert np.abs(at.platform_rotation(ay[k, 0], az[k, 0]) - at.platform_rotation(ry, rz)).max() < 1e-12, q
+    u = np.array([[0.4, -2.0], [-1.2, 0.7], [1.5, 3.0]])  # consistent motors: the start is already the pose
+    q = at.ik(u[:, 0], u[:, 1])[:, [0, 4, 8]]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ay, az = at._initial_guess(q, geo)
+    assert np.abs(at.platform_rotation(ay[:, 0], az[:, 0]) - at.platform_rotation(u[:, 0], u[:, 1])).max() < 1e-13
+
+
+def test_fk_scalar_is_a_batch_of_one():
+    u = [(0.3, -0.4), (math.pi / 2, 0.3), (-1.2, 2.9)]  # alpha_y = pi/2: A_u has rank 1 (rank-1 step)
+    for ay, az in u:
+        q = at.ik(ay, az)
+        single = at.fk(q[0], q[4], q[8])
+        batch = at.fk(q[[0]], q[[4]], q[[8]])
+        assert all(np.array_equal(np.asarray(s), b[0]) for s, b in zip(single, batch))
+        assert np.abs(at.platform_rotation(*single[:2]) - at.platform_rotation(ay, az)).max() < 1e-13
+        assert np.array_equal(at.actuation_jacobian(ay, az), at.actuation_jacobian([ay], [az])[0])
+    q = at.ik(0.3, -0.4)
+    y, z, inc, ok = at.fk(q[[0]], q[[4]], q[[8]] + 1e-3, return_mask=True)
+    assert not ok[0] and np.isnan(y[0]) and np.isnan(inc[0])

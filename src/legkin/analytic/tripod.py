@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Sequence
+from typing import NamedTuple, Sequence
 
 import numpy as np
 
@@ -264,23 +264,81 @@ def platform_position(alpha_y, alpha_z, d: float = D, alpha: float = ALPHA) -> n
 
 
 # ------------------------------------------------------------------------------------------ inverse kinematics
+#: Cyclic index shifts K -> K+1 and K -> K+2 (mod 3) over the legs: cross products without np.cross.
+_NEXT = np.array([1, 2, 0])
+_PREV = np.array([2, 0, 1])
+
+
+class _Geometry(NamedTuple):
+    """Constants of one geometry, computed once per public call (not per iteration / per item)."""
+
+    d: float
+    ce: np.ndarray  # cos eta_K, (3,)
+    se: np.ndarray  # sin eta_K, (3,)
+    ca: float  # cos alpha
+    sa: float  # sin alpha
+    k: float  # 1 - cos alpha
+    k2: float  # (1 - cos alpha)^2
+    opc: float  # 1 + cos alpha
+    dsa: float  # d sin alpha
+    minus_l: float  # -L = -d sqrt(2 (1 - cos alpha)) (eq 18)
+    tan_half: float  # tan(alpha / 2)
+    ce_n: np.ndarray  # cos eta_{K+1} (legs cyclic: A -> B -> C -> A), (3,)
+    ce_p: np.ndarray  # cos eta_{K+2}
+    se_n: np.ndarray  # sin eta_{K+1}
+    se_p: np.ndarray  # sin eta_{K+2}
+    w: np.ndarray  # sin(eta_{K+2} - eta_{K+1})
+
+
+def _geometry(d: float, alpha: float, eta: np.ndarray) -> _Geometry:
+    """The constants of an already validated geometry (see :func:`_params`)."""
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    ce, se = np.cos(eta), np.sin(eta)
+    return _Geometry(
+        d, ce, se, ca, sa, 1 - ca, (1 - ca) ** 2, 1 + ca, d * sa, -d * math.sqrt(2.0 * (1.0 - ca)),
+        math.tan(alpha / 2.0), ce[_NEXT], ce[_PREV], se[_NEXT], se[_PREV], np.sin(eta[_PREV] - eta[_NEXT]),
+    )
+
+
+def _ik_eval(cy, sy, cz, sz, g: _Geometry):
+    """Unchecked seed eqs (98), (102) on a trailing leg axis (call under ``np.errstate(invalid, divide)``).
+
+    Args:
+        cy, sy, cz, sz: cos / sin of alpha_y, alpha_z, shape (..., 1).
+        g: the geometry's constants.
+
+    Returns:
+        ``(q1, q2, cos q2, sin q2)`` per leg (..., 3) and ``1 + c_y c_z`` (..., 1); NaN where undefined.
+        The platform centre E is :func:`platform_position` (same operations, so the same bits).
+    """
+    nb2 = 1.0 + cy * cz
+    scale = np.where(nb2 > SINGULAR_TOL, g.minus_l / np.sqrt(2.0 * nb2), np.nan)
+    x, y, z = nb2 * scale, sz * cy * scale, -sy * scale  # E = -L b / |b|, b = (1 + c_y c_z, s_z c_y, -s_y)
+    c2 = (g.ce * z - g.se * y) / g.dsa  # eq (98)
+    q2 = np.arccos(c2)  # branch q2 in (0, pi); NaN where |c2| > 1
+    s2 = np.sin(q2)
+    w = -(g.ce * y + g.se * z)
+    s2sa = s2 * g.sa
+    det = g.d * (g.k2 + s2sa**2)  # corrected determinant (d^2 (...) with 1/d folded in)
+    q1 = np.arctan2((g.k * x + s2sa * w) / det, (-s2sa * x + g.k * w) / det)  # eq (102)
+    return q1, q2, c2, s2, nb2
+
+
+def _inside(c2: np.ndarray, nb2: np.ndarray) -> np.ndarray:
+    """Success mask (..., 1) of :func:`_ik_eval`: not singular, every leg reached and 1 - |cos q_K2| > BOUNDARY_TOL.
+
+    Equal to ``~sing & ~unreachable.any(-1) & ~leg_sing.any(-1)`` of :func:`_ik_status` (c2 is finite off
+    the singular set), in fewer operations.
+    """
+    return (nb2 > SINGULAR_TOL) & (1.0 - np.maximum.reduce(np.abs(c2), axis=-1, keepdims=True) > BOUNDARY_TOL)
+
+
 def _ik_core(ay: np.ndarray, az: np.ndarray, d: float, alpha: float, eta: np.ndarray):
     """Unchecked vectorised IK: joints (..., 3, 4), cos q_K2 (..., 3), 1 + c_y c_z (...)."""
-    e = platform_position(ay, az, d, alpha)  # (..., 3), NaN on the singular set
-    x, y, z = e[..., 0:1], e[..., 1:2], e[..., 2:3]
-    ce, se = np.cos(eta), np.sin(eta)  # (3,)
-    ca, sa = math.cos(alpha), math.sin(alpha)
-    c2 = (ce * z - se * y) / (d * sa)  # eq (98)
-    with np.errstate(invalid="ignore"):
-        q2 = np.arccos(c2)  # branch q2 in (0, pi); NaN where |c2| > 1
-    s2 = np.sin(q2)
-    w = -(ce * y + se * z)
-    det = d * ((1 - ca) ** 2 + (s2 * sa) ** 2)  # corrected determinant (d^2 (...) with 1/d folded in)
-    s1 = ((1 - ca) * x + s2 * sa * w) / det  # eq (102)
-    c1 = (-s2 * sa * x + (1 - ca) * w) / det
-    q1 = np.arctan2(s1, c1)
-    joints = np.stack([q1, q2, q2, q1], axis=-1)
-    return joints, c2, 1.0 + np.cos(ay) * np.cos(az)
+    ay, az = np.asarray(ay)[..., None], np.asarray(az)[..., None]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        q1, q2, c2, _, nb2 = _ik_eval(np.cos(ay), np.sin(ay), np.cos(az), np.sin(az), _geometry(d, alpha, eta))
+    return np.stack([q1, q2, q2, q1], axis=-1), c2, nb2[..., 0]
 
 
 def _ik_status(c2: np.ndarray, one_cc: np.ndarray):
@@ -316,6 +374,14 @@ def _ik_error(ay, az, c2, sing, unreachable, leg_sing) -> Exception:
     return SingularityError(f"{where}: inverse kinematics failed")  # pragma: no cover
 
 
+def _checked_u(alpha_y, alpha_z, d, alpha, eta):
+    """Validate once at a public entry point: (alpha_y, alpha_z) broadcast, their cos/sin (..., 1), geometry."""
+    d, alpha, eta_arr = _params(d, alpha, eta)
+    ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))
+    yc, zc = ay[..., None], az[..., None]
+    return ay, az, (np.cos(yc), np.sin(yc), np.cos(zc), np.sin(zc)), _geometry(d, alpha, eta_arr)
+
+
 def ik(
     alpha_y,
     alpha_z,
@@ -349,36 +415,36 @@ def ik(
         SingularityError: (scalar) ``sin q_K2 = 0`` (workspace boundary) or ``1 + c_y c_z = 0``.
         InvalidInputError: non-finite or non-broadcastable angles; InvalidParameterError: bad geometry.
     """
-    d, alpha, eta_arr = _params(d, alpha, eta)
-    ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))
-    joints, c2, one_cc = _ik_core(ay, az, d, alpha, eta_arr)
-    sing, unreachable, leg_sing = _ik_status(c2, one_cc)
-    ok = ~sing & ~unreachable.any(axis=-1) & ~leg_sing.any(axis=-1)
-    out = np.where(ok[..., None, None], joints, np.nan).reshape(ok.shape + (12,))
+    ay, az, trig, g = _checked_u(alpha_y, alpha_z, d, alpha, eta)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        q1, q2, c2, _, nb2 = _ik_eval(*trig, g)
+    ok = _inside(c2, nb2)[..., 0]
+    out = np.where(ok[..., None, None], np.stack([q1, q2, q2, q1], axis=-1), np.nan).reshape(ok.shape + (12,))
     return finish(
-        out, ok, ay.ndim == 0, return_mask, lambda: _ik_error(ay, az, c2, sing, unreachable, leg_sing)
+        out, ok, ay.ndim == 0, return_mask, lambda: _ik_error(ay, az, c2, *_ik_status(c2, nb2[..., 0]))
     )
 
 
-def _jacobian_core(ay: np.ndarray, az: np.ndarray, joints: np.ndarray, alpha: float, eta: np.ndarray) -> np.ndarray:
-    """Unchecked eqs (103)-(105) from the IK joints (..., 3, 4); (..., 3, 2)."""
-    eta_arr = eta
-    cy, sy, cz, sz = (f(a)[..., None] for f, a in ((np.cos, ay), (np.sin, ay), (np.cos, az), (np.sin, az)))
-    ck, sk = np.cos(eta_arr), np.sin(eta_arr)
-    s2 = np.sin(joints[..., 1])
-    ca = math.cos(alpha)
-    n = 1.0 + cy * cz
-    f = math.tan(alpha / 2.0) * (ck * sy + sk * cy * sz)  # eq (105)
-    m = (1 + ca) * s2**2 + 1 - ca
-    p = n**2 + (ck * cy * sz - sk * sy) ** 2
-    with np.errstate(invalid="ignore", divide="ignore"):
-        a1 = -f * (ck * (cy + cz) - sk * sy * sz + (ck * cy - sk * sy * sz) * n) / (2 * s2 * n**2 * m) - (
-            ck * sy * sz + sk * (cy + cz)
-        ) / p
-        a2 = -f * cy * (sk * (cy + cz) + ck * sy * sz + sk * cz * n) / (2 * s2 * n**2 * m) + cy * (
-            ck * (cy + cz) - sk * sy * sz
-        ) / p
-    return np.stack([a1, a2], axis=-1)
+def _jac_eval(cy, sy, cz, sz, s2, nb2, g: _Geometry) -> tuple[np.ndarray, np.ndarray]:
+    """Unchecked eqs (103)-(105): the two columns of A_u, (..., 3) each, from the trig of u (..., 1),
+    sin q_K2 (..., 3) and 1 + c_y c_z (..., 1) of :func:`_ik_eval` (call under ``np.errstate``).
+
+    The expressions of :func:`actuation_jacobian`'s docstring, evaluated in the same order (repeated
+    sub-expressions are computed once).
+    """
+    ck, sk, n = g.ce, g.se, nb2
+    cpc = cy + cz
+    ck_cpc, sk_cpc = ck * cpc, sk * cpc
+    ck_sy, sk_sy, ck_cy = ck * sy, sk * sy, ck * cy
+    ck_sy_sz, sk_sy_sz = ck_sy * sz, sk_sy * sz
+    f = g.tan_half * (ck_sy + sk * cy * sz)  # eq (105)
+    m = g.opc * s2**2 + 1 - g.ca
+    p = n**2 + (ck_cy * sz - sk_sy) ** 2
+    den = 2 * s2 * n**2 * m
+    mf = -f
+    a1 = mf * (ck_cpc - sk_sy_sz + (ck_cy - sk_sy_sz) * n) / den - (ck_sy_sz + sk_cpc) / p
+    a2 = mf * cy * (sk_cpc + ck_sy_sz + sk * cz * n) / den + cy * (ck_cpc - sk_sy_sz) / p
+    return a1, a2
 
 
 def actuation_jacobian(
@@ -405,38 +471,127 @@ def actuation_jacobian(
     and central differences of :func:`ik`, on the branch q_K2 in (0, pi)). A_u does not depend on d.
     Undefined where :func:`ik` fails (NaN / same exceptions).
     """
-    d, alpha, eta_arr = _params(d, alpha, eta)
-    ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))
-    joints, c2, one_cc = _ik_core(ay, az, d, alpha, eta_arr)
-    sing, unreachable, leg_sing = _ik_status(c2, one_cc)
-    ok = ~sing & ~unreachable.any(axis=-1) & ~leg_sing.any(axis=-1)
-    jac = _jacobian_core(ay, az, joints, alpha, eta_arr)
-    out = np.where(ok[..., None, None], jac, np.nan)
+    ay, az, trig, g = _checked_u(alpha_y, alpha_z, d, alpha, eta)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        _, _, c2, s2, nb2 = _ik_eval(*trig, g)
+        a1, a2 = _jac_eval(*trig, s2, nb2, g)
+    ok = _inside(c2, nb2)[..., 0]
+    out = np.where(ok[..., None, None], np.stack([a1, a2], axis=-1), np.nan)
     return finish(
-        out, ok, ay.ndim == 0, return_mask, lambda: _ik_error(ay, az, c2, sing, unreachable, leg_sing)
+        out, ok, ay.ndim == 0, return_mask, lambda: _ik_error(ay, az, c2, *_ik_status(c2, nb2[..., 0]))
     )
 
 
 # ------------------------------------------------------------------------------------------ forward kinematics
-def _initial_guess(qm: np.ndarray, d: float, alpha: float, eta: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Closed-form start for :func:`fk` from the motor angles (..., 3).
+#: :func:`_initial_guess` intersects the motor planes with the adjugate of M (rows: their unit normals) where
+#: |det M| > PLANES_DET_MIN: there sigma_3 = |det M| / (sigma_1 sigma_2) > |det M| / 1.5 > 6.7e-9 (unit rows:
+#: sigma_1 <= sqrt 3, sigma_1 sigma_2 <= 3/2), above the 1e-10 sigma_1 cut-off of the pseudo-inverse; below it
+#: (nearly parallel planes) the SVD pseudo-inverse with rcond = 1e-10 gives the least-squares intersection.
+PLANES_DET_MIN = 1e-8
+#: Relative singular-value cut-off of the Gauss-Newton step (that of ``np.linalg.pinv(A_u, rcond=1e-12)``).
+STEP_RCOND = 1e-12
+
+
+def _initial_guess(qm: np.ndarray, g: _Geometry) -> tuple[np.ndarray, np.ndarray]:
+    """Closed-form start for :func:`fk` from the motor angles (n, 3); returns alpha_y, alpha_z as (n, 1).
 
     Eliminating s_K2 from the two rows of eq (101) leaves one linear equation per motor,
-    ``s_K1 x - c_K1 (c_K y + s_K z) = d (1 - c_alpha)``: E lies on three planes. Their least-squares
-    intersection, pushed onto the sphere |E| = L (eq 64a), gives the platform axis
-    ``R e_x = 2 (e_x . e) e - e_x`` (e = E / |E|: E is on the bisector, see :func:`platform_position`).
+    ``s_K1 x - c_K1 (c_K y + s_K z) = d (1 - c_alpha)``: E lies on three planes with unit normals
+    ``n_K = (s_K1, -c_K1 c_K, -c_K1 s_K)``, the rows of M. Their intersection is
+    ``E = d (1 - c_alpha) M^-1 (1, 1, 1)`` with ``M^-1 = [n_B x n_C, n_C x n_A, n_A x n_B] / det M``; for
+    ``(J, K) = (K+1, K+2)`` the cross product is ``n_J x n_K = (c_J1 c_K1 sin(eta_K - eta_J),
+    s_J1 c_K1 s_K - c_J1 s_K1 s_J, c_J1 s_K1 c_J - s_J1 c_K1 c_K)``. Nearly parallel planes
+    (``|det M| <= PLANES_DET_MIN``) take the least-squares intersection ``pinv(M)`` instead. Pushed onto the
+    sphere |E| = L (eq 64a), E gives the platform axis ``r = R e_x = 2 (e_x . e) e - e_x`` (e = E / |E|: E is
+    on the bisector, see :func:`platform_position`), i.e. ``r = (2 E_x^2 - |E|^2, 2 E_x E_y, 2 E_x E_z) / |E|^2``
+    (invariant under E -> -E and scaling, so only the direction of ``adj(M) (1, 1, 1)`` is needed), and
+    ``(alpha_y, alpha_z) = (-asin(r_z), atan2(r_y, r_x))`` as in :func:`orientation_from_axis`.
     """
-    s1, c1 = np.sin(qm), np.cos(qm)
-    ce, se = np.cos(eta), np.sin(eta)
-    normals = np.stack([s1, -c1 * ce, -c1 * se], axis=-1)  # (..., 3, 3)
-    rhs = np.full(qm.shape, d * (1 - math.cos(alpha)))
-    pinv = np.linalg.pinv(normals, rcond=1e-10)
-    e = (pinv @ rhs[..., None])[..., 0]
-    norm = np.linalg.norm(e, axis=-1, keepdims=True)
-    e = np.where(norm > 0, e / np.where(norm > 0, norm, 1.0), np.array([-1.0, 0.0, 0.0]))
-    axis = 2.0 * e[..., 0:1] * e
-    axis[..., 0] -= 1.0
-    return orientation_from_axis(axis)
+    s, c = np.sin(qm), np.cos(qm)
+    cn, cp, sn, sp = c[:, _NEXT], c[:, _PREV], s[:, _NEXT], s[:, _PREV]
+    p, q = cn * sp, sn * cp
+    x = cn * cp * g.w  # row K: n_{K+1} x n_{K+2}, components (x, y, z)
+    y = q * g.se_p - p * g.se_n
+    z = p * g.ce_n - q * g.ce_p
+    det3 = np.add.reduce(s * x - c * (g.ce * y + g.se * z), axis=-1)  # sum_K n_K . (n_{K+1} x n_{K+2}) = 3 det M
+    ex, ey, ez = (np.add.reduce(v, axis=-1, keepdims=True) for v in (x, y, z))  # adj(M) (1, 1, 1)
+    weak = ~(np.abs(det3) > 3.0 * PLANES_DET_MIN) | (g.k == 0.0)
+    if weak.any():
+        m = np.stack([s[weak], -c[weak] * g.ce, -c[weak] * g.se], axis=-1)  # (k, 3, 3), rows n_K
+        rhs = np.full(m.shape[:-1] + (1,), g.d * g.k)
+        e = (np.linalg.pinv(m, rcond=1e-10) @ rhs)[..., 0]
+        norm = np.linalg.norm(e, axis=-1, keepdims=True)
+        e = np.where(norm > 0, e / np.where(norm > 0, norm, 1.0), np.array([-1.0, 0.0, 0.0]))
+        ex[weak], ey[weak], ez[weak] = e[:, 0:1], e[:, 1:2], e[:, 2:3]
+    ee = ex * ex + ey * ey + ez * ez
+    t = ex + ex
+    ay = -np.arcsin(np.minimum(np.maximum(t * ez / ee, -1.0), 1.0))
+    az = np.arctan2(t * ey, t * ex - ee)
+    return ay, az
+
+
+def _gauss_newton_step(a1: np.ndarray, a2: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``-pinv(A) r`` for ``A = [a1 a2]`` (n, 3, 2) given as its columns (n, 3), without an SVD; (n, 1) each.
+
+    Least squares in closed form: with ``n = a1 x a2``, ``|n|^2 = det(A^T A)`` (Lagrange's identity) and the
+    normal equations solved by Cramer's rule, ``x = ((r x a2) . n, (a1 x r) . n) / |n|^2``. Written with cross
+    products, no entry of ``A^T A`` is formed, so the error grows like cond(A), not cond(A)^2. Where
+    ``sigma_2 <= STEP_RCOND sigma_1`` (i.e. ``|n|^2 <= STEP_RCOND^2 |A|_F^4``: ``alpha_y`` at +-pi/2 makes
+    the second column vanish), the rank-1 pseudo-inverse ``A^T r / |A|_F^2`` is used, as ``np.linalg.pinv``
+    with that rcond would (``0`` for ``A = 0``).
+    """
+    a1i, a1j, a2i, a2j, ri, rj = a1[:, _NEXT], a1[:, _PREV], a2[:, _NEXT], a2[:, _PREV], r[:, _NEXT], r[:, _PREV]
+    n = a1i * a2j - a1j * a2i  # a1 x a2
+    nn = np.add.reduce(n * n, axis=-1, keepdims=True)
+    s0 = np.add.reduce((a2i * rj - a2j * ri) * n, axis=-1, keepdims=True) / nn  # -((r x a2) . n) / |n|^2
+    s1 = np.add.reduce((ri * a1j - rj * a1i) * n, axis=-1, keepdims=True) / nn  # -((a1 x r) . n) / |n|^2
+    f = np.add.reduce(a1 * a1 + a2 * a2, axis=-1, keepdims=True)
+    rank1 = nn <= (STEP_RCOND * STEP_RCOND) * f * f
+    if rank1.any():
+        fs = np.where(f > 0, f, 1.0)
+        s0 = np.where(rank1, -np.add.reduce(a1 * r, axis=-1, keepdims=True) / fs, s0)
+        s1 = np.where(rank1, -np.add.reduce(a2 * r, axis=-1, keepdims=True) / fs, s1)
+    return s0, s1
+
+
+def _fk_core(qm: np.ndarray, g: _Geometry, tol: float, max_iter: int):
+    """Unchecked :func:`fk` on motors (n, 3) (call under ``np.errstate(invalid, divide)``).
+
+    Returns:
+        alpha_y, alpha_z, inconsistency, converged, active: (n, 1) each.
+    """
+    ay, az = _initial_guess(qm, g)
+    converged = np.zeros(ay.shape, dtype=bool)
+    active = np.ones(ay.shape, dtype=bool)
+    rn_prev = np.full(ay.shape, np.inf)
+    for _ in range(max_iter):
+        cy, sy, cz, sz = np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
+        q1, _, c2, s2, nb2 = _ik_eval(cy, sy, cz, sz, g)
+        a1, a2 = _jac_eval(cy, sy, cz, sz, s2, nb2, g)
+        r = _wrap(q1 - qm)
+        rn = np.sqrt(np.add.reduce(r * r, axis=-1, keepdims=True))
+        stalled = rn >= rn_prev  # no progress: at the (least-squares) minimum to rounding
+        finite = np.isfinite(rn)
+        rn_prev = np.where(finite, rn, np.inf)
+        active &= _inside(c2, nb2) & finite  # A_u and r are finite exactly there
+        s0, s1 = _gauss_newton_step(a1, a2, r)
+        # converged when the step, or its effect on the motors (the step is ill-determined near the
+        # parametrisation singularity c_y = 0 and near 1 + c_y c_z = 0), is below tol
+        motor_step = np.maximum.reduce(np.abs(a1 * s0 + a2 * s1), axis=-1, keepdims=True)
+        small = (np.maximum(np.abs(s0), np.abs(s1)) <= tol) | (motor_step <= tol) | stalled
+        upd = active & ~converged
+        ay = np.where(upd, ay + s0, ay)
+        az = np.where(upd, az + s1, az)
+        converged |= active & small
+        if (converged | ~active).all():
+            break
+    # report alpha_y in [-pi/2, pi/2], alpha_z in [-pi, pi)
+    flip = np.cos(ay) < 0
+    ay = _wrap(np.where(flip, np.pi - ay, ay))
+    az = _wrap(np.where(flip, az + np.pi, az))
+    q1 = _ik_eval(np.cos(ay), np.sin(ay), np.cos(az), np.sin(az), g)[0]
+    r = _wrap(q1 - qm)
+    return ay, az, np.sqrt(np.add.reduce(r * r, axis=-1, keepdims=True)), converged, active
 
 
 def fk(
@@ -455,9 +610,12 @@ def fk(
     """Platform orientation from the three motor angles: Gauss-Newton on :func:`ik` with :func:`actuation_jacobian`.
 
     Solves ``min_u |wrap(ik_motors(u) - q_m)|`` over u = (alpha_y, alpha_z) (three equations, two unknowns):
-    ``u <- u - pinv(A_u) r``, from the closed-form start of :func:`_initial_guess` (the motor planes; not in
-    the seed), until the step (or its image ``A_u du`` in the motors) is below ``tol``; it typically takes 1-3 iterations. The result is reported
-    with ``alpha_y`` in [-pi/2, pi/2] (``(pi - alpha_y, alpha_z + pi)`` is the same orientation).
+    ``u <- u - pinv(A_u) r`` (the 3 x 2 least-squares step in closed form, see :func:`_gauss_newton_step`),
+    from the closed-form start of :func:`_initial_guess` (the motor planes; not in the seed), until the step
+    (or its image ``A_u du`` in the motors) is below ``tol``; from consistent motors the start is already
+    exact to rounding and one iteration confirms it. The result is reported with ``alpha_y`` in
+    [-pi/2, pi/2] (``(pi - alpha_y, alpha_z + pi)`` is the same orientation). Inputs are checked once here;
+    the iteration runs on the unchecked private functions (a single call is a batch of one).
 
     Redundant actuation: three motor angles produced by no pose are not averaged silently. The
     inconsistency ``|r|`` (rad) at the least-squares solution is returned; above ``max_inconsistency`` the
@@ -481,50 +639,20 @@ def fk(
     """
     d, alpha, eta_arr = _params(d, alpha, eta)
     a1, b1, c1 = as_angles(q_A1, q_B1, q_C1, names=("q_A1", "q_B1", "q_C1"))
-    qm = np.stack([a1, b1, c1], axis=-1)
-    ay, az = _initial_guess(qm, d, alpha, eta_arr)
-    converged = np.zeros(ay.shape, dtype=bool)
-    active = np.ones(ay.shape, dtype=bool)
-    rn_prev = np.full(ay.shape, np.inf)
-    for _ in range(max_iter):
-        joints, c2, one_cc = _ik_core(ay, az, d, alpha, eta_arr)
-        sing, unreachable, leg_sing = _ik_status(c2, one_cc)
-        inside = ~sing & ~unreachable.any(axis=-1) & ~leg_sing.any(axis=-1)
-        jac = np.where(inside[..., None, None], _jacobian_core(ay, az, joints, alpha, eta_arr), np.nan)
-        r = _wrap(joints[..., 0] - qm)
-        rn = np.linalg.norm(r, axis=-1)
-        stalled = rn >= rn_prev  # no progress: at the (least-squares) minimum to rounding
-        rn_prev = np.where(np.isfinite(rn), rn, np.inf)
-        with np.errstate(invalid="ignore"):
-            step = -(np.linalg.pinv(np.nan_to_num(jac), rcond=1e-12) @ np.nan_to_num(r)[..., None])[..., 0]
-        bad = ~np.all(np.isfinite(jac), axis=(-1, -2)) | ~np.all(np.isfinite(r), axis=-1)
-        active &= ~bad
-        # converged when the step, or its effect on the motors (the step is ill-determined near the
-        # parametrisation singularity c_y = 0 and near 1 + c_y c_z = 0), is below tol
-        motor_step = np.abs(np.nan_to_num(jac) @ step[..., None])[..., 0]
-        small = (np.max(np.abs(step), axis=-1) <= tol) | (np.max(motor_step, axis=-1) <= tol) | stalled
-        upd = active & ~converged
-        ay = np.where(upd, ay + step[..., 0], ay)
-        az = np.where(upd, az + step[..., 1], az)
-        converged |= active & small
-        if np.all(converged | ~active):
-            break
-    # report alpha_y in [-pi/2, pi/2], alpha_z in [-pi, pi)
-    flip = np.cos(ay) < 0
-    ay = np.where(flip, np.pi - ay, ay)
-    az = np.where(flip, az + np.pi, az)
-    ay, az = _wrap(ay), _wrap(az)
-    joints, c2, one_cc = _ik_core(ay, az, d, alpha, eta_arr)
-    r = _wrap(joints[..., 0] - qm)
-    inconsistency = np.linalg.norm(r, axis=-1)
-    consistent = inconsistency <= max_inconsistency
-    ok = converged & active & consistent
+    shape = a1.shape
+    qm = np.stack([a1, b1, c1], axis=-1).reshape(-1, 3)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ay, az, inconsistency, converged, active = _fk_core(qm, _geometry(d, alpha, eta_arr), tol, max_iter)
+    ay, az, inconsistency = ay.reshape(shape), az.reshape(shape), inconsistency.reshape(shape)
+    converged, active = converged.reshape(shape), active.reshape(shape)
+    ok = converged & active & (inconsistency <= max_inconsistency)
     nan = np.where(ok, 0.0, np.nan)
 
     def error() -> Exception:
         motors = f"(q_A1, q_B1, q_C1) = ({float(a1):.17g}, {float(b1):.17g}, {float(c1):.17g})"
+        target = qm.reshape(shape + (3,))
         if not active:
-            return UnreachableError(f"{motors}: the solver left the workspace; no pose was found", target=qm)
+            return UnreachableError(f"{motors}: the solver left the workspace; no pose was found", target=target)
         if not converged:
             return ConvergenceError(
                 f"{motors}: Gauss-Newton did not converge in {max_iter} iterations (singular A_u?)"
@@ -533,7 +661,7 @@ def fk(
             f"{motors} are inconsistent: no pose produces all three; the least-squares pose "
             f"(alpha_y, alpha_z) = ({float(ay):.17g}, {float(az):.17g}) misses them by {float(inconsistency):.3e} rad "
             f"(max_inconsistency = {max_inconsistency:.1e})",
-            target=qm,
+            target=target,
             closest=(float(ay), float(az)),
         )
 

@@ -31,7 +31,7 @@ def as_input(x, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = Fals
         raise InvalidInputError(
             f"{name} must have shape (..., {', '.join(map(str, core))}), got shape {arr.shape}"
         )
-    if not allow_nan and not np.all(np.isfinite(arr)):
+    if not allow_nan and not np.isfinite(arr).all():
         bad = arr[~np.isfinite(arr)].ravel()[0]
         raise InvalidInputError(f"{name} must be finite, got a {bad} entry")
     return arr

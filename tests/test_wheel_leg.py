@@ -27,7 +27,7 @@ def robot():
 # ---------------------------------------------------------------- checks and model
 def test_check_rows_pass():
     rows = checks.run(40, np.random.default_rng(7))
-    assert len(rows) >= 13
+    assert len(rows) >= 18
     failed = [(r.name, r.max_error, r.tolerance) for r in rows if not r.passed]
     assert not failed, failed
 
@@ -237,6 +237,123 @@ def test_ik_at_the_theta_bounds(theta):
     assert q[0] == pytest.approx(theta, abs=1e-9)
     q_seed = wl.ik(target, 0.0, 0.01, "RR", method="seed", rim="continuous")
     assert np.linalg.norm(wl.contact_point(q_seed, 0.0, 0.01, "RR") - target) <= 1e-12
+    q_rad = wl.ik(target, 0.0, 0.01, "RR", method="radial")
+    assert q_rad == pytest.approx([theta, 0.3, -0.2], abs=1e-9)
+    assert np.linalg.norm(wl.contact_point(q_rad, 0.0, 0.01, "RR") - target) <= 1e-12
+
+
+# ---------------------------------------------------------------- radial IK
+def _solution_error(sols, alpha, w, leg, rim, target):
+    """Contact error of every listed solution (NaN rows dropped)."""
+    sols = sols[~np.isnan(sols[:, 0])]
+    return np.linalg.norm(wl.contact_point(sols, alpha, w, leg, rim=rim) - target, axis=-1), sols
+
+
+@given(st.one_of(st.floats(17 * DEG, 160 * DEG), st.sampled_from([17 * DEG, 160 * DEG])), st.floats(-math.pi, math.pi),
+       st.floats(-0.6, 0.6),
+       st.one_of(st.floats(-math.pi, math.pi),
+                 st.sampled_from([-math.pi, -50 * DEG, -40 * DEG, 0.0, 40 * DEG, 50 * DEG, math.pi])),
+       st.one_of(st.floats(-0.02, 0.02), st.sampled_from([-0.02, 0.02])), st.sampled_from(wl.LEGS),
+       st.sampled_from(["continuous", "seed"]))
+@settings(max_examples=120, deadline=None)
+def test_radial_ik_finds_every_solution(theta, beta, gamma, alpha, w, leg, rim):
+    q_true = np.array([theta, beta, gamma])
+    target = wl.contact_point(q_true, alpha, w, leg, rim=rim)
+    q, info = wl.ik(target, alpha, w, leg, method="radial", rim=rim, return_info=True)
+    assert wl.THETA_MIN <= q[0] <= wl.THETA_MAX
+    assert np.linalg.norm(wl.contact_point(q, alpha, w, leg, rim=rim) - target) <= 1e-12
+    assert info.error <= 1e-12 and info.solutions.ndim == 2 and info.solutions.shape[1] == 3
+    # every listed solution reaches the target, the returned one is the first, the sampled q is among them
+    err, sols = _solution_error(info.solutions, alpha, w, leg, rim, target)
+    assert err.max() <= 1e-12 and np.array_equal(sols[0], q)
+    d = sols - q_true
+    d[:, 1:] = np.angle(np.exp(1j * d[:, 1:]))
+    sigma = np.linalg.svd(wl.contact_jacobian(q_true, alpha, w, leg, rim=rim), compute_uv=False)[-1]
+    assert np.abs(d).max(axis=1).min() * sigma <= 1e-12  # q distance scaled by the conditioning: metres
+    # the other methods' answer (when they converge) is one of the solutions too
+    q_d = wl.ik(target, alpha, w, leg, rim=rim)
+    d = sols - q_d
+    d[:, 1:] = np.angle(np.exp(1j * d[:, 1:]))
+    assert np.abs(d).max(axis=1).min() * sigma <= 1e-12
+
+
+def test_radial_ik_batch_matches_scalar_and_other_methods():
+    rng = np.random.default_rng(11)
+    q = checks.sample_leg_q(300, rng)
+    alpha, w = rng.uniform(-math.pi, math.pi, 300), rng.uniform(-0.02, 0.02, 300)
+    for rim in ("continuous", "seed"):
+        t = wl.contact_point(q, alpha, w, "RL", rim=rim)
+        qs, ok, info = wl.ik(t, alpha, w, "RL", method="radial", rim=rim, return_mask=True, return_info=True)
+        assert ok.all() and info.error.max() <= 1e-12 and info.iterations.shape == (300,)
+        assert np.linalg.norm(wl.contact_point(qs, alpha, w, "RL", rim=rim) - t, axis=-1).max() <= 1e-12
+        for i in range(0, 300, 37):  # the scalar call is the batch path on one item
+            assert np.abs(wl.ik(t[i], alpha[i], w[i], "RL", method="radial", rim=rim) - qs[i]).max() <= 1e-12
+        qd, okd = wl.ik(t, alpha, w, "RL", rim=rim, return_mask=True)
+        same = np.abs(np.angle(np.exp(1j * (qd - qs)))).max(axis=1) <= 1e-9
+        assert same[okd].mean() > 0.9  # both take the branch y_L <= 0; they differ only where several theta exist
+        assert np.all(np.isnan(info.solutions[:, :, 0]).sum(axis=1) < info.solutions.shape[1])
+    # leading dimensions kept
+    q2, info2 = wl.ik(t.reshape(3, 100, 3), alpha.reshape(3, 100), w.reshape(3, 100), "RL", method="radial",
+                      rim="seed", return_info=True)
+    assert q2.shape == (3, 100, 3) and info2.solutions.shape[:2] == (3, 100) and info2.error.shape == (3, 100)
+    assert wl.ik(t[0], alpha[0], w[0], "RL", rim="seed", return_info=True)[1].solutions is None
+
+
+def test_radial_ik_two_roots_near_a_fold():
+    # alpha = 120 deg: |c(theta)| has a maximum near theta = 154.5 deg; a target just below it has two close roots
+    alpha = 120 * DEG
+    th = np.linspace(150 * DEG, 159 * DEG, 90001)
+    r = np.linalg.norm(wl.rim_point(th, 0.0, alpha)[:, :2], axis=-1)
+    k = int(np.argmax(r))
+    assert 0 < k < th.size - 1  # an interior maximum
+    for dth in (3e-2, 1e-3, 2e-5):
+        q_true = np.array([th[k] - dth, 0.2, 0.1])
+        target = wl.contact_point(q_true, alpha, 0.0, "FL")
+        q, info = wl.ik(target, alpha, 0.0, "FL", method="radial", return_info=True)
+        err, sols = _solution_error(info.solutions, alpha, 0.0, "FL", "continuous", target)
+        assert err.max() <= 1e-12
+        lower = sols[: len(sols) // 2]  # branch y_L <= 0
+        assert len(lower) == 2 and lower[0, 0] < th[k] < lower[1, 0]
+        assert abs(lower[0, 0] - q_true[0]) <= 1e-6 and q[0] == lower[0, 0]
+    # exactly at the top: one (double) root, reached within tolerance
+    target = wl.contact_point([th[k], 0.2, 0.1], alpha, 0.0, "FL")
+    q, info = wl.ik(target, alpha, 0.0, "FL", method="radial", return_info=True)
+    assert np.linalg.norm(wl.contact_point(q, alpha, 0.0, "FL") - target) <= 1e-12
+    # above the top: unreachable for this alpha
+    above = wl.leg_frame_to_robot(wl.rim_point(th[k], 0.2, alpha) * [1.001, 1.001, 1.0], 0.1, "FL")
+    with pytest.raises(legkin.UnreachableError):
+        wl.ik(above, alpha, 0.0, "FL", method="radial")
+
+
+def test_radial_ik_q0_picks_the_nearest_solution():
+    q_true = np.array([1.4, 0.4, -0.3])
+    target = wl.contact_point(q_true, 0.3, 0.01, "FR")
+    q, info = wl.ik(target, 0.3, 0.01, "FR", method="radial", return_info=True)
+    assert q == pytest.approx(q_true, abs=1e-12)
+    other = info.solutions[1]  # the same theta on the other out-of-plane branch (y_L > 0)
+    assert other[0] == pytest.approx(q_true[0], abs=1e-12) and abs(other[2] - q_true[2]) > 1.0
+    assert np.linalg.norm(wl.contact_point(other, 0.3, 0.01, "FR") - target) <= 1e-12
+    q0 = other + [0.05, 2 * math.pi, -2 * math.pi]
+    q1 = wl.ik(target, 0.3, 0.01, "FR", method="radial", q0=q0)
+    assert q1 == pytest.approx(other + [0.0, 2 * math.pi, -2 * math.pi], abs=1e-12)  # within pi of q0's angles
+    q2 = wl.ik(target, 0.3, 0.01, "FR", method="radial", q0=q_true + 0.1)
+    assert q2 == pytest.approx(q_true, abs=1e-12)
+
+
+def test_radial_ik_unreachable():
+    far = np.array([0.3, 0.2, -0.6])
+    with pytest.raises(legkin.UnreachableError) as info:
+        wl.ik(far, 0.0, 0.0, "FL", method="radial")
+    assert info.value.closest is not None and np.linalg.norm(info.value.closest - far) > 0.2
+    assert "radial" in str(info.value) and "closest" in str(info.value)
+    near = wl.leg_frame_to_robot([0.0, -0.03, 0.0], 0.0, "FL")  # inside the wheel radius
+    inside = wl.contact_point([1.0, 0.1, 0.0], 0.0, 0.0, "FL")
+    on_axis = wl.module_origin("FL") + [-0.05, 0.0, 0.0]  # closer to the ABAD axis than d_wheel
+    qs, ok, info = wl.ik(np.stack([far, inside, near, on_axis]), 0.0, 0.0, "FL", method="radial", return_mask=True,
+                         return_info=True)
+    assert ok.tolist() == [False, True, False, False]
+    assert np.all(np.isnan(qs[~ok])) and np.all(np.isfinite(qs[1]))
+    assert np.all(np.isnan(info.solutions[[0, 2, 3]])) and np.all(info.error[~ok] > 1e-3)
 
 
 def test_ik_batch_and_methods():
@@ -245,11 +362,11 @@ def test_ik_batch_and_methods():
     alpha = rng.uniform(-math.pi, math.pi, 200)
     for rim in ("continuous", "seed"):
         t = wl.contact_point(q, alpha, 0.0, "FR", rim=rim)
-        for method in ("damped", "seed"):
+        for method in ("damped", "seed", "radial"):
             qs, ok, info = wl.ik(t, alpha, 0.0, "FR", method=method, rim=rim, return_mask=True, return_info=True)
             assert qs.shape == (200, 3) and ok.shape == (200,) and info.iterations.shape == (200,)
             assert np.all(np.isnan(qs[~ok]))
-            assert ok.mean() > (0.999 if method == "damped" else 0.95)
+            assert ok.mean() > {"damped": 0.999, "seed": 0.95, "radial": 0.9999}[method]
             err = np.linalg.norm(wl.contact_point(qs[ok], alpha[ok], 0.0, "FR", rim=rim) - t[ok], axis=-1)
             assert err.max() <= 1e-12
 
@@ -290,6 +407,10 @@ def test_ik_unreachable():
         lambda: wl.ik([0.1, 0.1], 0.0, 0.0, "FL"),
         lambda: wl.ik([0.1, 0.1, -0.2], 0.0, 0.05, "FL"),
         lambda: wl.ik([0.1, 0.1, -0.2], 0.0, 0.0, "FL", q0=[0.1, 0.0, 0.0]),
+        lambda: wl.ik([0.1, 0.1, -0.2], 0.0, 0.0, "FL", method="radial", q0=[0.1, 0.0, 0.0]),
+        lambda: wl.ik([0.1, np.nan, -0.2], 0.0, 0.0, "FL", method="radial"),
+        lambda: wl.ik([0.1, 0.1, -0.2], 3.5, 0.0, "FL", method="radial"),
+        lambda: wl.ik(np.zeros((2, 3)), np.zeros(3), 0.0, "FL", method="radial"),
         lambda: wl.rim_jump_seed(np.nan),
     ],
 )
@@ -305,6 +426,8 @@ def test_invalid_choices():
         lambda: wl.contact_point([1.0, 0.0, 0.0], 0.0, 0.0, 4),
         lambda: wl.contact_point([1.0, 0.0, 0.0], 0.0, 0.0, "FL", rim="five_arcs"),
         lambda: wl.ik([0.1, 0.1, -0.2], 0.0, 0.0, "FL", method="newton"),
+        lambda: wl.ik([0.1, 0.1, -0.2], 0.0, 0.0, "FL", method="radial", rim="five_arcs"),
+        lambda: wl.ik([0.1, 0.1, -0.2], 0.0, 0.0, "XX", method="radial"),
     ):
         with pytest.raises(legkin.InvalidParameterError):
             call()

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, fields
+from functools import lru_cache
 from typing import Mapping, NamedTuple
 
 import numpy as np
@@ -132,6 +133,7 @@ def linkage_constants(R: float = 0.1) -> dict[str, float]:
     return _constants(float(R))._asdict()
 
 
+@lru_cache(maxsize=16)
 def _constants(R: float) -> _Const:
     l1 = 0.8 * R
     l3 = 2.0 * R * math.sin(_ARC_BC / 2)
@@ -165,59 +167,84 @@ PASSIVE_JOINTS = (
 )  # fmt: skip
 
 
-def _closed_form(theta: np.ndarray, c: _Const, foot_radius: float) -> tuple[dict, dict]:
+def _cis(x) -> np.ndarray:
+    """``exp(i x)`` for real ``x``, built from cos and sin (bitwise the same as ``np.exp(1j * x)``, ~2x faster)."""
+    x = np.asarray(x, dtype=float)
+    out = np.empty(x.shape, dtype=complex)
+    out.real = np.cos(x)
+    out.imag = np.sin(x)
+    return out
+
+
+@lru_cache(maxsize=16)
+def _factors(c: _Const, foot_radius: float) -> tuple[complex, ...]:
+    """Constant complex factors of :func:`_closed_form` (computed once per geometry instead of per call)."""
+    R = c.R
+    return (
+        complex(np.exp(-1j * c.ang_BCF) * c.l7 / c.l3),  # kF
+        complex(np.exp(1j * c.ang_UBC) * R / c.l3),  # kU
+        complex(np.exp(1j * c.ang_LFG) * R / c.l8),  # kL
+        complex(np.exp(-1j * THETA0)),  # e0
+        complex(np.exp(1j * _J_ANGLE) * foot_radius / R),  # kJ (|H - U| = R)
+    )
+
+
+def _closed_form(theta: np.ndarray, c: _Const, foot_radius: float, want_der: bool = True,
+                 full: bool = True) -> tuple[dict, dict | None]:
     """Left-half points (complex, leg axis +x, before the beta rotation) and their theta-derivatives.
 
     Implements the closed form of the design notes (reference "Closed form of the left half"),
     differentiated by hand (forward mode). ``foot_radius`` only scales J (whose direction alone is used).
+    ``want_der=False`` skips the derivatives (``der`` is None); ``full=False`` skips H, J and O_r (the seed
+    rim's points), which the continuous rim does not use.
     """
     R = c.R
-    eth = np.exp(1j * theta)
-    A, dA = c.l1 * eth, 1j * c.l1 * eth
-    B, dB = R * eth, 1j * R * eth
-    s = c.l1 * np.sin(theta) / c.l_AE  # sin(OEA)
-    ds = c.l1 * np.cos(theta) / c.l_AE
+    kF, kU, kL, e0, kJ = _factors(c, foot_radius)
+    eth = _cis(theta)
+    A = c.l1 * eth
+    B = R * eth
+    s = c.l1 * eth.imag / c.l_AE  # sin(OEA)
     cs = np.sqrt(1.0 - s * s)
     E = A.real - c.l_AE * cs
-    dE = dA.real + c.l_AE * s * ds / cs
     eo = cs + 1j * s  # exp(i OEA)
     D = E + c.l6 * eo
-    dD = dE + 1j * c.l6 * eo * (ds / cs)
-    BD, dBD = D - B, dD - dB
+    BD = D - B
     lBD = np.abs(BD)
-    dlBD = (np.conj(BD) * dBD).real / lBD
     cosg = (lBD**2 + c.l3**2 - c.l4**2) / (2 * lBD * c.l3)  # cos(DBC)
-    dcosg = (1.0 / (2 * c.l3) - (c.l3**2 - c.l4**2) / (2 * c.l3 * lBD**2)) * dlBD
     sing = np.sqrt(1.0 - cosg * cosg)
-    dg = -dcosg / sing
     eg = cosg - 1j * sing  # exp(-i DBC)
     u = BD / lBD
-    du = (dBD - u * dlBD) / lBD
     C = B + c.l3 * u * eg
-    dC = dB + c.l3 * eg * (du - 1j * dg * u)
-    kF = np.exp(-1j * c.ang_BCF) * c.l7 / c.l3
     F = C + (B - C) * kF
-    dF = dC + (dB - dC) * kF
     t = F.imag / c.l8  # sin(OGF)
     ct = np.sqrt(1.0 - t * t)
     G = F.real - c.l8 * ct + 0j
-    dG = dF.real + t * dF.imag / ct + 0j
-    kU = np.exp(1j * c.ang_UBC) * R / c.l3
     U = B + (C - B) * kU
-    dU = dB + (dC - dB) * kU
-    kL = np.exp(1j * c.ang_LFG) * R / c.l8
     L = F + (G - F) * kL
+    pts = dict(O=np.zeros_like(A), A=A, B=B, C=C, D=D, E=E + 0j, F=F, G=G, U=U, L=L)
+    if full:
+        H = U + (B - U) * e0
+        pts.update(H=H, O_r=G + R, J=U + (H - U) * kJ)
+    if not want_der:
+        return pts, None
+    dA, dB = 1j * A, 1j * B
+    ds = c.l1 * eth.real / c.l_AE
+    dE = dA.real + c.l_AE * s * ds / cs
+    dD = dE + 1j * c.l6 * eo * (ds / cs)
+    dBD = dD - dB
+    dlBD = (np.conj(BD) * dBD).real / lBD
+    dcosg = (1.0 / (2 * c.l3) - (c.l3**2 - c.l4**2) / (2 * c.l3 * lBD**2)) * dlBD
+    dg = -dcosg / sing
+    du = (dBD - u * dlBD) / lBD
+    dC = dB + c.l3 * eg * (du - 1j * dg * u)
+    dF = dC + (dB - dC) * kF
+    dG = dF.real + t * dF.imag / ct + 0j
+    dU = dB + (dC - dB) * kU
     dL = dF + (dG - dF) * kL
-    e0 = np.exp(-1j * THETA0)
-    H = U + (B - U) * e0
-    dH = dU + (dB - dU) * e0
-    Or, dOr = G + R, dG
-    kJ = np.exp(1j * _J_ANGLE) * foot_radius / R  # |H - U| = R
-    J = U + (H - U) * kJ
-    dJ = dU + (dH - dU) * kJ
-    zero = np.zeros_like(A)
-    pts = dict(O=zero, A=A, B=B, C=C, D=D, E=E + 0j, F=F, G=G, H=H, U=U, L=L, O_r=Or, J=J)
-    der = dict(O=zero, A=dA, B=dB, C=dC, D=dD, E=dE + 0j, F=dF, G=dG, H=dH, U=dU, L=dL, O_r=dOr, J=dJ)
+    der = dict(O=pts["O"], A=dA, B=dB, C=dC, D=dD, E=dE + 0j, F=dF, G=dG, U=dU, L=dL)
+    if full:
+        dH = dU + (dB - dU) * e0
+        der.update(H=dH, O_r=dG, J=dU + (dH - dU) * kJ)
     return pts, der
 
 
@@ -260,7 +287,7 @@ def _check_w(w: np.ndarray, geo: Geometry) -> None:
 
 
 def _rot(beta: np.ndarray) -> np.ndarray:
-    return np.exp(1j * (beta + math.pi / 2))
+    return _cis(beta + math.pi / 2)
 
 
 def _xyw(z: np.ndarray, w) -> np.ndarray:
@@ -287,7 +314,7 @@ def linkage_points(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict
     geo = geometry or Geometry()
     theta, beta = as_angles(theta, beta, names=("theta", "beta"))
     _check_theta(theta)
-    pts, _ = _closed_form(theta, _constants(geo.R), geo.R + FOOT_OFFSET)
+    pts, _ = _closed_form(theta, _constants(geo.R), geo.R + FOOT_OFFSET, want_der=False)
     rot = _rot(beta)
     return {k: _xyw(rot * v, 0.0) for k, v in _both_halves(pts).items()}
 
@@ -327,8 +354,8 @@ def passive_angles(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict
     theta, beta = as_angles(theta, beta, names=("theta", "beta"))
     _check_theta(theta)
     c = _constants(geo.R)
-    now = _link_angles(_closed_form(theta, c, geo.R)[0])
-    ref = _link_angles(_closed_form(np.array(THETA0), c, geo.R)[0])
+    now = _link_angles(_closed_form(theta, c, geo.R, want_der=False, full=False)[0])
+    ref = _link_angles(_closed_form(np.array(THETA0), c, geo.R, want_der=False, full=False)[0])
     d = {k: np.angle(now[k] * np.conj(ref[k])) for k in now}
     out = {"phi_L": beta + (theta - THETA0), "phi_R": beta - (theta - THETA0)}
     for hinge, child, parent in (
@@ -375,49 +402,87 @@ def rim_segment(alpha) -> np.ndarray:
     return np.where(a < -_ARC_FG, 0, np.where(a < 0.0, 1, np.where(a <= _ARC_FG, 2, 3)))
 
 
-def _rim_continuous(theta, beta, alpha, geo: Geometry, radius: float, want_der: bool):
-    pts, der = _closed_form(theta, _constants(geo.R), geo.R + FOOT_OFFSET)
-    P, dP = _both_halves(pts), _both_halves(der)
-    seg = np.broadcast_to(rim_segment(alpha), np.broadcast(theta, alpha).shape)
-    z = np.zeros(np.broadcast(theta, alpha).shape, dtype=complex)
-    dz = np.zeros_like(z)
-    for k, (_, _, _, cen, ref) in enumerate(_SEGMENTS):
-        m = seg == k
-        if not np.any(m):
-            continue
-        ctr, q = np.broadcast_to(P[cen], z.shape)[m], np.broadcast_to(P[ref], z.shape)[m]
-        e = np.exp(1j * (np.broadcast_to(alpha, z.shape)[m] - _SEG_A0[k])) * radius / geo.R
-        z[m] = ctr + e * (q - ctr)
+class _Sel(NamedTuple):
+    """Per-item choice of rim arc for fixed alpha: the arc is ``y = ctr + e (ref - ctr)`` (continuous rim) or
+    ``y = ctr + e (ref - ctr) / |ref - ctr|`` (seed rim) on left-half points, conjugated on the right half.
+
+    ``upper``: the arc's (ctr, ref) are (U, F) (continuous) / (U, J) (seed), else (L, G) / (O_r, G).
+    ``right``: right half: the point is ``conj(y)``, and ``e`` is stored conjugated so that
+    ``conj(y) = conj(ctr) + e_true conj(ref - ctr)`` (the formula of :func:`rim_point` on right-half points).
+    """
+
+    seed: bool
+    upper: np.ndarray
+    right: np.ndarray
+    e: np.ndarray
+
+    def take(self, idx) -> "_Sel":
+        return _Sel(self.seed, self.upper[idx], self.right[idx], self.e[idx])
+
+
+def _select(alpha: np.ndarray, seed: bool, radius: float, R: float) -> _Sel:
+    """The arc of every alpha (:data:`_SEGMENTS` for the continuous rim; seed 1.1's three arcs)."""
+    alpha = np.asarray(alpha, dtype=float)
+    if seed:
+        up_r, up_l = alpha > PSI_FG, alpha < -PSI_FG
+        a0 = np.where(up_r, PSI_FG, np.where(up_l, -PSI_FG, 0.0))
+        e = _cis(alpha - a0) * radius
+        upper, right = up_r | up_l, up_r
+    else:
+        seg = rim_segment(alpha)
+        a0 = np.asarray(_SEG_A0)[seg]
+        e = _cis(alpha - a0) * radius / R
+        upper, right = (seg == 0) | (seg == 3), seg >= 2
+    return _Sel(seed, upper, right, np.where(right, np.conj(e), e))
+
+
+def _plane(pts: dict, der: dict | None, sel: _Sel, want_der: bool, conj: bool = True):
+    """Contact point z (complex, leg plane, before the beta rotation) and dz/dtheta from the closed form.
+
+    With ``conj=False`` the right-half points are left unconjugated (same modulus: what the radial IK uses).
+    """
+    up = sel.upper
+    lo_c, lo_r = ("O_r", "G") if sel.seed else ("L", "G")
+    hi_r = "J" if sel.seed else "F"
+    ctr = np.where(up, pts["U"], pts[lo_c])
+    v = np.where(up, pts[hi_r], pts[lo_r]) - ctr
+    if sel.seed:
+        nv = np.abs(v)
+        y = ctr + sel.e * v / nv
+    else:
+        y = ctr + sel.e * v
+    dy = None
+    if want_der:
+        dc = np.where(up, der["U"], der[lo_c])
+        dv = np.where(up, der[hi_r], der[lo_r]) - dc
+        if sel.seed:
+            dnv = (np.conj(v) * dv).real / nv
+            dy = dc + sel.e * (dv - v * dnv / nv) / nv
+        else:
+            dy = dc + sel.e * dv
+    if conj:
+        y = np.where(sel.right, np.conj(y), y)
         if want_der:
-            dc, dq = np.broadcast_to(dP[cen], z.shape)[m], np.broadcast_to(dP[ref], z.shape)[m]
-            dz[m] = dc + e * (dq - dc)
+            dy = np.where(sel.right, np.conj(dy), dy)
+    return y, dy
+
+
+def _rim(theta, beta, alpha, geo: Geometry, radius: float, want_der: bool, seed: bool):
+    sel = _select(alpha, seed, radius, geo.R)
+    pts, der = _closed_form(theta, _constants(geo.R), geo.R + FOOT_OFFSET, want_der, full=seed)
+    z, dz = _plane(pts, der, sel, want_der)
     rot = _rot(beta)
-    return rot * z, rot * dz
+    return rot * z, (rot * dz if want_der else None)
+
+
+def _rim_continuous(theta, beta, alpha, geo: Geometry, radius: float, want_der: bool):
+    """:func:`rim_point`'s arcs in the leg plane (complex, rotated by beta) and their theta-derivatives."""
+    return _rim(theta, beta, alpha, geo, radius, want_der, False)
 
 
 def _rim_seed(theta, beta, alpha, geo: Geometry, radius: float, want_der: bool):
-    pts, der = _closed_form(theta, _constants(geo.R), geo.R + FOOT_OFFSET)
-    P, dP = _both_halves(pts), _both_halves(der)
-    shape = np.broadcast(theta, alpha).shape
-    a = np.broadcast_to(alpha, shape)
-    z = np.zeros(shape, dtype=complex)
-    dz = np.zeros_like(z)
-    up_r, up_l = a > PSI_FG, a < -PSI_FG
-    toe = ~(up_r | up_l)
-    for m, cen, ref, a0 in ((up_r, "U_R", "J_R", PSI_FG), (up_l, "U_L", "J_L", -PSI_FG), (toe, "O_r", "G", 0.0)):
-        if not np.any(m):
-            continue
-        ctr, q = np.broadcast_to(P[cen], shape)[m], np.broadcast_to(P[ref], shape)[m]
-        dc, dq = np.broadcast_to(dP[cen], shape)[m], np.broadcast_to(dP[ref], shape)[m]
-        v = q - ctr
-        nv = np.abs(v)
-        e = np.exp(1j * (a[m] - a0)) * radius
-        z[m] = ctr + e * v / nv
-        if want_der:
-            dnv = (np.conj(v) * (dq - dc)).real / nv
-            dz[m] = dc + e * ((dq - dc) - v * dnv / nv) / nv
-    rot = _rot(beta)
-    return rot * z, rot * dz
+    """:func:`rim_point_seed`'s arcs in the leg plane (complex, rotated by beta) and their theta-derivatives."""
+    return _rim(theta, beta, alpha, geo, radius, want_der, True)
 
 
 def _rim_inputs(theta, beta, alpha, w, geo):
@@ -549,30 +614,73 @@ def leg_frame_to_robot(p_L, gamma, leg, *, geometry: Geometry | None = None) -> 
     return module_origin(leg, geo) + np.einsum("...ij,...j->...i", rot, p_M)
 
 
-def _contact(q, alpha, w, leg, rim, geo, want_jac, radius):
-    _, side, _ = _leg(leg)
-    theta, beta, gamma = q[..., 0], q[..., 1], q[..., 2]
+class _Ctx(NamedTuple):
+    """Everything the contact FK needs besides q, prepared once per call (the IK iterates on it)."""
+
+    sel: _Sel
+    w: np.ndarray
+    c: _Const
+    geo: Geometry
+    origin: np.ndarray  # module origin in {R}
+    s: float  # +1 left legs, -1 right legs
+    seed: bool
+
+    def take(self, idx) -> "_Ctx":
+        return self._replace(sel=self.sel.take(idx), w=self.w[idx])
+
+
+def _rim_kind(rim: str) -> bool:
     if rim == "continuous":
-        rho = geo.R if radius is None else float(radius)
-        z, dz = _rim_continuous(theta, beta, alpha, geo, rho, want_jac)
-    elif rim == "seed":
-        rho = geo.R + FOOT_OFFSET if radius is None else float(radius)
-        z, dz = _rim_seed(theta, beta, alpha, geo, rho, want_jac)
+        return False
+    if rim == "seed":
+        return True
+    raise InvalidParameterError(f"rim must be 'continuous' or 'seed', got {rim!r}")
+
+
+def _context(alpha, w, leg, rim, geo, radius) -> _Ctx:
+    seed = _rim_kind(rim)
+    _, side, _ = _leg(leg)
+    if radius is None:
+        rho = geo.R + FOOT_OFFSET if seed else geo.R
     else:
-        raise InvalidParameterError(f"rim must be 'continuous' or 'seed', got {rim!r}")
-    w = np.broadcast_to(w, z.shape)
-    p_L = _xyw(z, w)
-    p_M = p_L @ _R_LM[side].T + np.array([geo.d_wheel, 0.0, 0.0])
-    rot = _R_0[side] @ _rz(np.broadcast_to(gamma, z.shape))
-    p = module_origin(leg, geo) + np.einsum("...ij,...j->...i", rot, p_M)
+        rho = float(radius)
+    sel = _select(alpha, seed, rho, geo.R)
+    return _Ctx(sel, np.asarray(w, dtype=float), _constants(geo.R), geo, module_origin(leg, geo),
+                1.0 if side == "L" else -1.0, seed)
+
+
+def _fk(q: np.ndarray, ctx: _Ctx, want_jac: bool):
+    """Contact point in {R} (..., 3) and, if asked, d/d(theta, beta, gamma) (..., 3, 3).
+
+    Same map as :func:`leg_frame_to_robot` written out for the signed permutation ``R0``: with the rotated
+    leg-plane point ``x + i y``, ``a = d_wheel + s w`` (s = +1 left, -1 right), ``m0 = cos(gamma) a -
+    sin(gamma) y``, ``m1 = sin(gamma) a + cos(gamma) y``: ``p = o + (-x, s m0, m1)``.
+    """
+    theta, beta, gamma = q[..., 0], q[..., 1], q[..., 2]
+    pts, der = _closed_form(theta, ctx.c, ctx.geo.R + FOOT_OFFSET, want_jac, full=ctx.seed)
+    z, dz = _plane(pts, der, ctx.sel, want_jac)
+    rot = _rot(beta)
+    zr = rot * z
+    x, y = zr.real, zr.imag
+    cg, sg = np.cos(gamma), np.sin(gamma)
+    s, o = ctx.s, ctx.origin
+    a = ctx.geo.d_wheel + s * ctx.w
+    m0 = cg * a - sg * y
+    m1 = sg * a + cg * y
+    p = np.stack(np.broadcast_arrays(o[0] - x, o[1] + s * m0, o[2] + m1), axis=-1)
     if not want_jac:
         return p, None
-    zero = np.zeros(z.shape)
-    d_theta = np.stack([dz.real, dz.imag, zero], -1) @ _R_LM[side].T
-    d_beta = np.stack([-z.imag, z.real, zero], -1) @ _R_LM[side].T  # d/dbeta = i z
-    d_gamma = np.stack([-p_M[..., 1], p_M[..., 0], zero], -1)  # e_z x p_M
-    cols = [np.einsum("...ij,...j->...i", rot, d) for d in (d_theta, d_beta, d_gamma)]
-    return p, np.stack(cols, -1)
+    dzr = rot * dz
+    dx, dy = dzr.real, dzr.imag
+    ssg = s * sg
+    zero = np.zeros(p.shape[:-1])
+    cols = (-dx, y, zero, -ssg * dy, -ssg * x, -s * m1, cg * dy, cg * x, m0)
+    J = np.stack(np.broadcast_arrays(*cols), axis=-1).reshape(p.shape[:-1] + (3, 3))
+    return p, J
+
+
+def _contact(q, alpha, w, leg, rim, geo, want_jac, radius):
+    return _fk(q, _context(alpha, w, leg, rim, geo, radius), want_jac)
 
 
 def _q_inputs(q, alpha, w, geo):
@@ -628,10 +736,97 @@ def contact_jacobian(q, alpha, w, leg, *, rim: str = "continuous", radius: float
 
 # ---------------------------------------------------------------- inverse kinematics
 class IKInfo(NamedTuple):
-    """What :func:`ik` did, per target: iterations used and final position error (m)."""
+    """What :func:`ik` did, per target: iterations used and final position error (m).
+
+    ``solutions`` (``method="radial"`` only, else None): shape (..., S, 3), every solution found for each
+    target, NaN-padded (see :func:`ik`).
+    """
 
     iterations: np.ndarray
     error: np.ndarray
+    solutions: np.ndarray | None = None
+
+
+@lru_cache(maxsize=32)
+def _arc_table(R: float, seed: bool, nodes: int) -> tuple[np.ndarray, np.ndarray]:
+    """``|c(theta, alpha)|^2`` and its theta-derivative on a theta grid, as a matrix for all alpha at once.
+
+    For an arc ``c = ctr + e v`` (``v = ref - ctr``, made unit for the seed rim; :func:`_plane`),
+    ``|c|^2 = A + |e|^2 V + 2 Re(W e)`` with ``A = |ctr|^2``, ``V = |v|^2``, ``W = conj(ctr) v``: functions
+    of theta alone, tabulated once per geometry. Returns ``grid`` (K,) and ``table`` (9, 2K) such that
+    :func:`_arc_coefficients` ``@ table`` is ``[f(grid), f'(grid)]``, ``f = |c|^2 - r^2``.
+    """
+    grid = np.linspace(THETA_MIN, THETA_MAX, nodes)
+    coef = _arc_terms(grid, R, seed)
+    table = np.zeros((9, 2 * nodes))
+    for kind in range(2):
+        for row in range(4):
+            table[4 * kind + row, :nodes] = coef[kind, row]
+            table[4 * kind + row, nodes:] = coef[kind, row + 4]
+    table[8, :nodes] = 1.0
+    grid.setflags(write=False)
+    table.setflags(write=False)
+    return grid, table
+
+
+def _arc_terms(theta: np.ndarray, R: float, seed: bool) -> np.ndarray:
+    """(2 arc kinds, 8, ...): A, V, Re W, Im W and their theta-derivatives (see :func:`_arc_table`)."""
+    pts, der = _closed_form(theta, _constants(R), R + FOOT_OFFSET, True, full=seed)
+    rows = []
+    for ctr_name, ref_name in ((("U", "J"), ("O_r", "G")) if seed else (("U", "F"), ("L", "G"))):
+        ctr, dctr = pts[ctr_name], der[ctr_name]
+        v, dv = pts[ref_name] - ctr, der[ref_name] - dctr
+        if seed:
+            nv = np.abs(v)
+            dnv = (np.conj(v) * dv).real / nv
+            v, dv = v / nv, (dv - v * dnv / nv) / nv
+        W, dW = np.conj(ctr) * v, np.conj(dctr) * v + np.conj(ctr) * dv
+        rows.append([np.abs(ctr) ** 2, np.abs(v) ** 2, W.real, W.imag,
+                     2 * (np.conj(ctr) * dctr).real, 2 * (np.conj(v) * dv).real, dW.real, dW.imag])
+    return np.array(rows)
+
+
+def _arc_coefficients(sel: _Sel, r2) -> np.ndarray:
+    """(n, 9) rows ``[u, u |e|^2, 2 u Re e, -2 u Im e, l, l |e|^2, 2 l Re e, -2 l Im e, -r^2]`` (u = 1 on the
+    upper rim, l = 1 - u) that turn :func:`_arc_table`'s table into ``f, f'`` for each item."""
+    e = sel.e
+    ee = e.real * e.real + e.imag * e.imag
+    coef = np.empty(e.shape + (9,))
+    for base, on in ((0, sel.upper), (4, ~sel.upper)):
+        w8 = on.astype(float)
+        coef[..., base] = w8
+        coef[..., base + 1] = w8 * ee
+        coef[..., base + 2] = w8 * 2.0 * e.real
+        coef[..., base + 3] = w8 * -2.0 * e.imag
+    coef[..., 8] = -r2
+    return coef
+
+
+_GUESS_NODES = 64
+
+
+@lru_cache(maxsize=16)
+def _guess_grid(R: float, seed: bool) -> tuple[np.ndarray, dict]:
+    """The closed form on the start grid (theta only: computed once per geometry, not per call)."""
+    grid = np.linspace(THETA_MIN, THETA_MAX, _GUESS_NODES)
+    pts, _ = _closed_form(grid, _constants(R), R + FOOT_OFFSET, want_der=False, full=seed)
+    return grid, pts
+
+
+def _out_of_plane(target: np.ndarray, ctx: _Ctx):
+    """The target's in-plane coordinates for the out-of-plane branch ``y_L <= 0``, and gamma.
+
+    In {M} (before the ABAD rotation) the contact point is ``(a, y_L, -+x_L)`` with ``a = d_wheel + s w``;
+    ``Rz(gamma)`` keeps the coordinate along z_M (so ``x_L = -(target - o)_x``) and the distance from
+    that axis, ``|(a, y_L)| = |(x_M, y_M)|``, so ``y_L = -+sqrt(x_M^2 + y_M^2 - a^2)`` and gamma is the angle
+    from ``(a, y_L)`` to ``(x_M, y_M)``. Returns ``(x_L, |y_L|, a, x_M + i y_M)``; ``|y_L|`` is clipped at 0
+    when the target is closer to the ABAD axis than ``a``.
+    """
+    d = target - ctx.origin
+    a = ctx.geo.d_wheel + ctx.s * ctx.w
+    m = ctx.s * d[..., 1] + 1j * d[..., 2]
+    yabs = np.sqrt(np.maximum(m.real**2 + m.imag**2 - a * a, 0.0))
+    return -d[..., 0], yabs, a, m
 
 
 def _initial_guesses(target, alpha, w, leg, rim, geo, radius, count: int = 3):
@@ -642,28 +837,42 @@ def _initial_guesses(target, alpha, w, leg, rim, geo, radius, count: int = 3):
     local minima over a 64-point theta grid of ``| |z(theta, alpha)| - |target in plane| |`` (several
     theta can give the same radius), best first; beta rotates z onto the target.
     """
-    _, side, _ = _leg(leg)
-    t_M = np.einsum("ji,...j->...i", _R_0[side], target - module_origin(leg, geo))
-    sw, sx = (1.0, -1.0) if side == "L" else (-1.0, 1.0)
-    a = geo.d_wheel + sw * w
-    r2 = t_M[..., 0] ** 2 + t_M[..., 1] ** 2
-    y = -np.sqrt(np.maximum(r2 - a * a, 0.0))
-    gamma = np.angle(np.exp(1j * (np.arctan2(t_M[..., 1], t_M[..., 0]) - np.arctan2(y, a))))
-    tgt = sx * t_M[..., 2] + 1j * y
-    grid = np.linspace(THETA_MIN, THETA_MAX, 64)
+    return _guesses(target, _context(alpha, w, leg, rim, geo, radius), count)
+
+
+def _guesses(target, ctx: _Ctx, count: int):
     shape = target.shape[:-1]
-    th = grid.reshape((64,) + (1,) * len(shape))
-    if rim == "continuous":
-        z, _ = _rim_continuous(th, 0.0, alpha[None], geo, geo.R if radius is None else radius, False)
-    else:
-        z, _ = _rim_seed(th, 0.0, alpha[None], geo, geo.R + FOOT_OFFSET if radius is None else radius, False)
-    res = np.abs(np.abs(z) - np.abs(tgt)[None])
-    pad = np.concatenate([np.full((1,) + res.shape[1:], np.inf), res, np.full((1,) + res.shape[1:], np.inf)])
-    local = (res <= pad[:-2]) & (res <= pad[2:])
-    order = np.argsort(np.where(local, res, np.inf + res), axis=0, kind="stable")[:count]
+    x_L, yabs, a, m = _out_of_plane(target, ctx)
+    y = -yabs
+    gamma = np.angle(_cis(np.arctan2(m.imag, m.real) - np.arctan2(y, a)))
+    tgt = x_L + 1j * y
+    grid, table = _arc_table(ctx.geo.R, ctx.seed, _GUESS_NODES)
+    K = grid.size
+    # | |z(theta_k)| - |target| | on the grid, |z|^2 from the tabulated coefficients (one small matrix product)
+    # (in place: fresh (n, 64) temporaries cost more in page faults than the arithmetic)
+    coef = _arc_coefficients(ctx.sel, 0.0).reshape(-1, 9)
+    res = coef @ table[:, :K]
+    np.maximum(res, 0.0, out=res)
+    np.sqrt(res, out=res)
+    res -= np.abs(tgt).reshape(-1, 1)
+    np.abs(res, out=res)
+    local = np.ones(res.shape, dtype=bool)
+    np.less_equal(res[:, 1:], res[:, :-1], out=local[:, 1:])
+    local[:, :-1] &= res[:, :-1] <= res[:, 1:]
+    # local minima by increasing residual, then the other nodes in grid order (a stable sort of the key)
+    key = res
+    np.putmask(key, ~local, 1e300 * (1.0 + np.arange(K) / K))
+    rows = np.arange(res.shape[0])
+    order = []
+    for _ in range(count):
+        k = np.argmin(key, axis=1)
+        key[rows, k] = np.inf
+        order.append(k)
+    pts = _guess_grid(ctx.geo.R, ctx.seed)[1]
     out = []
     for k in order:
-        zk = np.take_along_axis(z, k[None], 0)[0]
+        k = k.reshape(shape)
+        zk = _rot(0.0) * _plane({name: v[k] for name, v in pts.items()}, None, ctx.sel, False)[0]
         out.append(np.stack([grid[k], np.angle(tgt / zk), gamma], -1))
     return np.stack(out)
 
@@ -682,21 +891,32 @@ def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "damped", r
         Levenberg-Marquardt damping when a full step does not reduce ``|E|``, and theta projected onto
         [17 deg, 160 deg] (default ``max_iter`` 60); once ``|E| <= tol`` one more step is taken if it
         lowers ``|E|`` (so the result is usually at rounding level, not just under ``tol``).
+        ``"radial"``: not an iteration on the 3x3 system at all: gamma and beta in closed form and a
+        1-D bracketed Newton for theta (:func:`_ik_radial` states the math). It finds every theta in
+        [17 deg, 160 deg] that reaches the target; ``info.solutions`` lists them (for both signs of the
+        out-of-plane square root). Without ``q0`` it returns the smallest theta on the branch ``y_L <= 0``
+        (the branch of the geometric start of the other methods); with ``q0`` the solution nearest ``q0``
+        (distance ``sqrt(dtheta^2 + dbeta^2 + dgamma^2)``, angle differences wrapped), with beta and
+        gamma shifted by multiples of 2 pi to lie within pi of ``q0``'s. ``max_iter`` (default 60)
+        bounds the Newton iterations per root; ``delta`` is not used.
 
-    Both start from ``q0`` if given, else from a geometric guess (gamma exact, theta from a grid; not the
-    lab's beta = 90 deg default): the seed method from the best guess only, the damped method restarts
-    a failed target from the next two local minima of the grid (several theta can give the same radius).
-    Converged means ``|E| <= tol`` (m). ``info.iterations`` counts every iteration, restarts included.
+    The iterative methods start from ``q0`` if given, else from a geometric guess (gamma exact, theta from a
+    grid; not the lab's beta = 90 deg default): the seed method from the best guess only, the damped method
+    restarts a failed target from the next two local minima of the grid (several theta can give the same
+    radius). Converged means ``|E| <= tol`` (m), ``E`` the contact point (:func:`contact_point`) minus the
+    target. ``info.iterations`` counts every iteration, restarts included (radial: Newton and bracketing
+    steps summed over the target's roots).
 
     Args:
         target: (..., 3) points in {R}; alpha (rad), w (m) broadcast with its leading shape.
-        q0: (..., 3) start (theta, beta, gamma).
+        q0: (..., 3) start (theta, beta, gamma) (radial: the configuration to stay near).
         return_mask: also return the mask of converged targets (batch).
-        return_info: also return an :class:`IKInfo` (iterations, final error per target).
+        return_info: also return an :class:`IKInfo` (iterations, final error per target; radial: solutions).
 
     Raises:
         UnreachableError: single target not reached (``closest`` = the point reached).
         InvalidInputError: NaN/inf or wrong shapes, alpha or w out of range.
+        InvalidParameterError: unknown ``method``, ``rim`` or ``leg``.
     """
     geo = geometry or Geometry()
     target = as_input(target, "target", (3,))
@@ -710,30 +930,34 @@ def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "damped", r
     alpha, w = np.broadcast_to(alpha, shape).astype(float), np.broadcast_to(w, shape).astype(float)
     _check_alpha(alpha)
     _check_w(w, geo)
-    if rim not in ("continuous", "seed"):
-        raise InvalidParameterError(f"rim must be 'continuous' or 'seed', got {rim!r}")
-    if method not in ("seed", "damped"):
-        raise InvalidParameterError(f"method must be 'seed' or 'damped', got {method!r}")
+    _rim_kind(rim)
+    if method not in _METHODS:
+        raise InvalidParameterError(f"method must be one of {', '.join(map(repr, _METHODS))}, got {method!r}")
     _leg(leg)
-    if q0 is None:
-        starts = _initial_guesses(target, alpha, w, leg, rim, geo, radius, 1 if method == "seed" else 3)
-    else:
-        starts = np.array(np.broadcast_to(as_input(q0, "q0", (3,)), shape + (3,)), dtype=float)[None]
-        _check_theta(starts[..., 0], "theta (q0[..., 0])")
     n = int(np.prod(shape, dtype=int))
-    starts = starts.reshape(-1, n, 3)
-    target, alpha, w = target.reshape(n, 3), alpha.reshape(n), w.reshape(n)
-    solver = _ik_seed if method == "seed" else _ik_damped
-    q, it, err, ok = solver(starts[0].copy(), target, alpha, w, leg, rim, geo, radius, tol, max_iter, delta)
-    for start in starts[1:]:  # restart the failures from the next geometric guess
-        f = np.flatnonzero(~ok)
-        if f.size == 0:
-            break
-        qf, itf, errf, okf = solver(start[f].copy(), target[f], alpha[f], w[f], leg, rim, geo, radius, tol,
-                                    max_iter, delta)
-        it[f] += itf
-        take = okf | (errf < err[f])
-        q[f[take]], err[f[take]], ok[f] = qf[take], errf[take], okf
+    if q0 is not None:
+        q0 = np.array(np.broadcast_to(as_input(q0, "q0", (3,)), shape + (3,)), dtype=float)
+        _check_theta(q0[..., 0], "theta (q0[..., 0])")
+        q0 = q0.reshape(n, 3)
+    ctx = _context(alpha.reshape(n), w.reshape(n), leg, rim, geo, radius)  # validated once; the solvers iterate on it
+    flat = target.reshape(n, 3)
+    solutions = None
+    if method == "radial":
+        q, it, err, ok, solutions = _ik_radial(flat, ctx, tol, max_iter, q0, want_solutions=return_info)
+        if solutions is not None:
+            solutions = solutions.reshape(shape + solutions.shape[1:])
+    else:
+        starts = _guesses(flat, ctx, 1 if method == "seed" else 3) if q0 is None else q0[None]
+        solver = _ik_seed if method == "seed" else _ik_damped
+        q, it, err, ok = solver(starts[0].copy(), flat, ctx, tol, max_iter, delta)
+        for start in starts[1:]:  # restart the failures from the next geometric guess
+            f = np.flatnonzero(~ok)
+            if f.size == 0:
+                break
+            qf, itf, errf, okf = solver(start[f].copy(), flat[f], ctx.take(f), tol, max_iter, delta)
+            it[f] += itf
+            take = okf | (errf < err[f])
+            q[f[take]], err[f[take]], ok[f] = qf[take], errf[take], okf
     with np.errstate(invalid="ignore"):
         inside = (q[:, 0] >= THETA_MIN - 1e-12) & (q[:, 0] <= THETA_MAX + 1e-12)
     ok &= inside & np.all(np.isfinite(q), axis=1)
@@ -744,14 +968,14 @@ def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "damped", r
         with np.errstate(invalid="ignore"):
             qc = q.copy()
             qc[0] = np.clip(qc[0], THETA_MIN, THETA_MAX)
-            closest = _contact(qc, alpha.reshape(()), w.reshape(()), leg, rim, geo, False, radius)[0] if np.all(np.isfinite(qc)) else None
+            closest = _fk(qc, ctx.take(0), False)[0] if np.all(np.isfinite(qc)) else None
     q_out = np.where(ok[..., None], q, np.nan)
-    info = IKInfo(it, err)
+    info = IKInfo(it, err, solutions)
 
     def error():
         return UnreachableError(
-            f"target {np.asarray(target).reshape(3).tolist()} not reached for leg {leg!r} (alpha={float(alpha[0])!r}, "
-            f"w={float(w[0])!r}) with method {method!r}: final error {float(err):.3e} m after {int(it)} iterations "
+            f"target {np.asarray(target).reshape(3).tolist()} not reached for leg {leg!r} (alpha={float(alpha)!r}, "
+            f"w={float(w)!r}) with method {method!r}: final error {float(err):.3e} m after {int(it)} iterations "
             f"(tolerance {tol:.1e} m, theta in [17, 160] deg); closest point reached {None if closest is None else closest.tolist()}",
             target=np.asarray(target).reshape(3),
             closest=closest,
@@ -763,18 +987,22 @@ def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "damped", r
     return out
 
 
-def _fk_flat(q, alpha, w, leg, rim, geo, radius, jac):
-    return _contact(q, alpha, w, leg, rim, geo, jac, radius)
+_METHODS = ("damped", "seed", "radial")
 
 
-def _ik_seed(q, target, alpha, w, leg, rim, geo, radius, tol, max_iter, delta):
+def _fk_flat(q, ctx: _Ctx, jac: bool):
+    """The IK solvers' forward kinematics (one place, so the bench can count its rows)."""
+    return _fk(q, ctx, jac)
+
+
+def _ik_seed(q, target, ctx, tol, max_iter, delta):
     max_iter = 100 if max_iter is None else max_iter
     n = q.shape[0]
     it = np.zeros(n, dtype=int)
     active = np.ones(n, dtype=bool)
     ok = np.zeros(n, dtype=bool)
     with np.errstate(invalid="ignore", divide="ignore"):
-        p = _fk_flat(q, alpha, w, leg, rim, geo, radius, False)[0]
+        p = _fk_flat(q, ctx, False)[0]
         err = np.linalg.norm(p - target, axis=1)
         for _ in range(max_iter + 1):
             ok |= active & (err <= tol)
@@ -782,13 +1010,14 @@ def _ik_seed(q, target, alpha, w, leg, rim, geo, radius, tol, max_iter, delta):
             if not np.any(active) or np.all(it[active] >= max_iter):
                 break
             a = np.flatnonzero(active & (it < max_iter))
+            ctx_a = ctx if a.size == n else ctx.take(a)
             qa, pa = q[a], p[a]
             E = pa - target[a]
             J = np.empty((a.size, 3, 3))
             for k in range(3):
                 qk = qa.copy()
                 qk[:, k] += delta
-                J[:, :, k] = (_fk_flat(qk, alpha[a], w[a], leg, rim, geo, radius, False)[0] - pa) / delta
+                J[:, :, k] = (_fk_flat(qk, ctx_a, False)[0] - pa) / delta
             JtJ = np.einsum("nji,njk->nik", J, J)
             JtE = np.einsum("nji,nj->ni", J, E)
             good = np.abs(np.linalg.det(JtJ)) > 1e-300
@@ -797,26 +1026,28 @@ def _ik_seed(q, target, alpha, w, leg, rim, geo, radius, tol, max_iter, delta):
                 dq[good] = -np.linalg.solve(JtJ[good], JtE[good][..., None])[..., 0]
             q[a] = qa + dq
             it[a] += 1
-            p[a] = _fk_flat(q[a], alpha[a], w[a], leg, rim, geo, radius, False)[0]
+            p[a] = _fk_flat(q[a], ctx_a, False)[0]
             err[a] = np.linalg.norm(p[a] - target[a], axis=1)
     return q, it, err, ok
 
 
-def _ik_damped(q, target, alpha, w, leg, rim, geo, radius, tol, max_iter, delta):
+def _ik_damped(q, target, ctx, tol, max_iter, delta):
     max_iter = 60 if max_iter is None else max_iter
     n = q.shape[0]
     q = q.copy()
     q[:, 0] = np.clip(q[:, 0], THETA_MIN, THETA_MAX)
     it = np.zeros(n, dtype=int)
     mu = np.full(n, 1e-16)
-    p, J = _fk_flat(q, alpha, w, leg, rim, geo, radius, True)
+    p, J = _fk_flat(q, ctx, True)
     err = np.linalg.norm(p - target, axis=1)
     active = err > tol
     polish = ~active  # one more (kept only if it helps) Gauss-Newton step after reaching tol
+    eye = np.eye(3)
     for _ in range(max_iter):
         a = np.flatnonzero(active)
         if a.size == 0:
             break
+        ctx_a = ctx if a.size == n else ctx.take(a)
         E = p[a] - target[a]
         Ja = J[a]
         JtJ = np.einsum("nji,njk->nik", Ja, Ja)
@@ -831,11 +1062,11 @@ def _ik_damped(q, target, alpha, w, leg, rim, geo, radius, tol, max_iter, delta)
             if not np.any(todo):
                 break
             t = np.flatnonzero(todo)
-            M = JtJ[t] + (lam[t] * scale[t])[:, None, None] * np.eye(3)
+            M = JtJ[t] + (lam[t] * scale[t])[:, None, None] * eye
             dq = -np.linalg.solve(M, JtE[t][..., None])[..., 0]
             qn = q[a[t]] + dq
             qn[:, 0] = np.clip(qn[:, 0], THETA_MIN, THETA_MAX)
-            pn = _fk_flat(qn, alpha[a[t]], w[a[t]], leg, rim, geo, radius, False)[0]
+            pn = _fk_flat(qn, ctx_a if t.size == a.size else ctx_a.take(t), False)[0]
             en = np.linalg.norm(pn - target[a[t]], axis=1)
             better = en < err[a[t]]
             improved[t[better]] = True
@@ -844,8 +1075,393 @@ def _ik_damped(q, target, alpha, w, leg, rim, geo, radius, tol, max_iter, delta)
             lam[t[better]] = np.maximum(lam[t[better]] / 10.0, 1e-16)
         q[a], err[a], mu[a] = best_q, best_err, lam
         it[a] += 1
-        p[a], J[a] = _fk_flat(q[a], alpha[a], w[a], leg, rim, geo, radius, True)
+        p[a], J[a] = _fk_flat(q[a], ctx_a, True)
         done = err[a] <= tol
         active[a] = (~done | ~polish[a]) & improved
         polish[a] |= done
     return q, it, err, err <= tol
+
+
+# ---------------------------------------------------------------- radial IK (method="radial")
+#: Nodes of the theta grid that brackets the roots of the radial equation (8.9 deg cells).
+_RADIAL_NODES = 17
+#: Sub-cells per cell of the fine coefficient table that refines the Newton start (0.14 deg).
+_RADIAL_SUB = 64
+_EPS = float(np.finfo(float).eps)
+
+
+@lru_cache(maxsize=16)
+def _radial_table(R: float, seed: bool):
+    """The radial IK's tables: :func:`_arc_table` on a coarse and a fine grid, and curvature bounds.
+
+    Returns ``grid`` (K,), ``table`` (9, 2K) (coarse: brackets every root of every target with one small
+    matrix product), ``m2`` (2, 3, K - 1): bounds of ``|A''|, |V''|, |W''|`` in each cell (finite
+    differences of the exact first derivatives on 256 sub-intervals per cell, times 1.25), so
+    ``|f''| <= m2[k, 0, j] + |e|^2 m2[k, 1, j] + 2 |e| m2[k, 2, j]`` in cell j for arc kind k; and ``fine``
+    (Kf,), ``fine_rows`` (2 Kf, 9) (the fine table transposed: rows are gathered per root to refine its
+    start).
+    """
+    grid, table = _arc_table(R, seed, _RADIAL_NODES)
+    k = grid.size
+    per = 256
+    fine = np.linspace(THETA_MIN, THETA_MAX, (k - 1) * per + 1)
+    d = _arc_terms(fine, R, seed)[:, 4:]
+    d2 = np.abs(np.diff(d, axis=-1)) / (fine[1] - fine[0])  # (2, 4, fine intervals): A'', V'', Re W'', Im W''
+    d2 = d2.reshape(2, 4, k - 1, per).max(axis=-1)
+    m2 = 1.25 * np.stack([d2[:, 0], d2[:, 1], np.hypot(d2[:, 2], d2[:, 3])], 1)  # (2, 3, cells)
+    fine, fine_table = _arc_table(R, seed, (k - 1) * _RADIAL_SUB + 1)
+    fine_rows = np.ascontiguousarray(fine_table.T)
+    for arr in (m2, fine_rows):
+        arr.setflags(write=False)
+    return grid, table, m2, fine, fine_rows
+
+
+def _radial_eval(theta: np.ndarray, sel: _Sel, ctx: _Ctx) -> tuple[np.ndarray, np.ndarray]:
+    """The contact point ``c(theta, alpha)`` in the leg plane (right halves left unconjugated: same modulus)
+    and ``dc/dtheta``, from the closed form: the radial IK's only evaluation of the linkage (kept apart so
+    the bench can count its rows)."""
+    pts, der = _closed_form(theta, ctx.c, ctx.geo.R + FOOT_OFFSET, True, full=ctx.seed)
+    return _plane(pts, der, sel, True, conj=False)
+
+
+def _f_and_slope(y, dy, r2):
+    """``f = |y|^2 - r2`` and ``f' = 2 Re(conj(y) dy)``."""
+    return y.real * y.real + y.imag * y.imag - r2, 2.0 * (y.real * dy.real + y.imag * dy.imag)
+
+
+def _lower_bound(Fa, Fb, Ga, Gb, h, M):
+    """Lower bound of f on a cell of width h from its ends (f oriented positive there: Fa, Fb > 0; slopes
+    Ga, Gb) and a bound M of |f''|: the larger of the Taylor bounds from the two ends,
+    ``Fa + Ga t - M t^2/2`` and ``Fb - Gb (h - t) - M (h - t)^2/2``, at the t where they cross."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        tc = np.clip((Fa - Fb + Gb * h + M * h * h / 2) / (Gb - Ga + M * h), 0.0, h)
+    tc = np.where(np.isfinite(tc), tc, 0.5 * h)
+    return np.maximum(Fa + Ga * tc - M * tc * tc / 2, Fb - Gb * (h - tc) - M * (h - tc) ** 2 / 2)
+
+
+def _hermite_root(h, flo, fhi, glo, ghi):
+    """Root (offset from the lower end, in [0, h]) of the cubic Hermite model of f on a bracket of width h
+    (values flo, fhi of opposite signs, slopes glo, ghi): four Newton steps on the cubic from the regula
+    falsi point, clipped to the bracket."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        df = fhi - flo
+        c2 = (3 * df / h - 2 * glo - ghi) / h
+        c3 = (glo + ghi - 2 * df / h) / (h * h)
+        t = np.clip(-flo / df, 0.0, 1.0) * h
+        for _ in range(4):
+            t = np.clip(t - (flo + t * (glo + t * (c2 + t * c3))) / (glo + t * (2 * c2 + 3 * t * c3)), 0.0, h)
+    return t
+
+
+def _radial_extremum(lo, hi, flo, fhi, glo, ghi, M, sel, ctx, r2, ftol, max_iter):
+    """Decide whether f (of one sign at both ends of [lo, hi]) reaches 0 near the extremum inside.
+
+    Regula falsi (Illinois) on f' from the extremum of the cubic Hermite model, until: f changes sign at
+    the new point (two roots: split the bracket there), ``|f| <= 4 eps r^2`` (a double root at rounding
+    level), :func:`_lower_bound` on the shrunk bracket is above ftol (no root), or the bracket is 1e-11
+    wide (the extremum: a double root if ``|f| <= ftol`` there, else none). Returns (theta, f and f'
+    there, status: 1 split / 2 double root / 0 none, f'' estimated by the secant of f' over the last
+    bracket, iterations).
+    """
+    m = lo.size
+    sig = np.where(flo > 0, 1.0, -1.0)
+    Fa, Fb, Ga, Gb = sig * flo, sig * fhi, sig * glo, sig * ghi  # oriented: Fa, Fb > 0, Ga < 0 < Gb
+    h = hi - lo
+    with np.errstate(divide="ignore", invalid="ignore"):  # extremum of the cubic model p'(t) = 0
+        c2 = (3 * (Fb - Fa) / h - 2 * Ga - Gb) / h
+        c3 = (Ga + Gb - 2 * (Fb - Fa) / h) / (h * h)
+        disc = np.sqrt(np.maximum(c2 * c2 - 3 * c3 * Ga, 0.0))
+        t0 = -Ga / (c2 + disc)  # the root of Ga + 2 c2 t + 3 c3 t^2 between the slopes' sign change
+    th = np.where((t0 > 0) & (t0 < h), lo + t0, lo - Ga * h / (Gb - Ga))
+    ga, gb = Ga.copy(), Gb.copy()  # Illinois-modified slopes
+    f_out, g_out = np.full(m, np.nan), np.full(m, np.nan)
+    status = np.zeros(m, dtype=int)
+    its = np.zeros(m, dtype=int)
+    kept = np.zeros(m, dtype=int)  # +1: the upper end was kept last time, -1: the lower end
+    act = np.arange(m)
+    for _ in range(max_iter):
+        if act.size == 0:
+            break
+        t = th[act]
+        f, g = _f_and_slope(*_radial_eval(t, sel.take(act), ctx), r2[act])
+        its[act] += 1
+        s_ = sig[act]
+        F, G = s_ * f, s_ * g
+        f_out[act], g_out[act] = f, g
+        split = F < 0
+        double = ~split & (F <= 4 * _EPS * r2[act])  # at rounding level: a double root
+        left = G < 0  # t replaces the lower end
+        k = kept[act]
+        lo[act], hi[act] = np.where(left, t, lo[act]), np.where(left, hi[act], t)
+        Fa[act], Fb[act] = np.where(left, F, Fa[act]), np.where(left, Fb[act], F)
+        Ga[act], Gb[act] = np.where(left, G, Ga[act]), np.where(left, Gb[act], G)
+        ga[act] = np.where(left, G, np.where(k == -1, 0.5 * ga[act], ga[act]))
+        gb[act] = np.where(left, np.where(k == 1, 0.5 * gb[act], gb[act]), G)
+        kept[act] = np.where(left, 1, -1)
+        a_lo, a_hi = lo[act], hi[act]
+        none = _lower_bound(Fa[act], Fb[act], Ga[act], Gb[act], a_hi - a_lo, M[act]) > ftol[act]
+        narrow = (a_hi - a_lo <= 1e-11) | (G == 0)  # the extremum found: a double root if within tolerance
+        double |= ~split & narrow & (F <= ftol[act])
+        status[act] = np.where(split, 1, np.where(double, 2, 0))
+        done = split | double | none | narrow
+        with np.errstate(divide="ignore", invalid="ignore"):
+            nxt = (a_lo * gb[act] - a_hi * ga[act]) / (gb[act] - ga[act])
+        th[act] = np.where((nxt > a_lo) & (nxt < a_hi), nxt, 0.5 * (a_lo + a_hi))
+        th[act[done]] = t[done]
+        act = act[~done]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        curv = sig * (Gb - Ga) / (hi - lo)
+    return th, f_out, g_out, status, curv, its
+
+
+def _radial_newton(lo, hi, flo, fhi, glo, ghi, guess, coef, sel, ctx, r2, mb, max_iter):
+    """Safeguarded Newton on ``f(theta) = |c(theta)|^2 - r2`` in brackets [lo, hi] where f changes sign.
+
+    Start (no linkage evaluation): the root of the cubic Hermite model of f on the bracket
+    (:func:`_hermite_root`) picks a sub-cell of the fine table (0.14 deg); if f (from the table and
+    ``coef`` (m, 9), each bracket's :func:`_arc_coefficients`) does not change sign there, bisection on the
+    table's nodes inside the bracket finds one; the start is then the root of the cubic model on that
+    sub-cell, which becomes the bracket (if the table's signs do not bracket the root, e.g. a root at a
+    node, the start on the whole bracket is kept). ``guess`` (NaN: none) overrides the start (the
+    parabola start of the brackets split at an extremum). Each step ``-f/f'`` stays inside the
+    (shrinking) bracket, else bisects. Stops when the predicted radius error after the step,
+    ``|f''| step^2 / (4 r)`` with ``mb`` bounding ``|f''|``, is below one ulp of r, when
+    ``|f| <= 4 eps r^2``, or when the bracket is ~eps wide.
+
+    Returns (theta, c(theta) (complex, conjugated on right halves: the contact point before the beta
+    rotation, from the last evaluation's Taylor step ``c + (theta - t) dc``, at rounding level since
+    the last step is), iterations, converged).
+    """
+    m = lo.size
+    _, _, _, fine, fine_rows = _radial_table(ctx.geo.R, ctx.seed)
+    kf = fine.size
+    hf = fine[1] - fine[0]
+
+    def fine_f(i, c=coef):  # f (and f' at column kf + i) from the fine table
+        return np.einsum("mk,mk->m", fine_rows[i], c)
+
+    # the sub-cell of the fine table where f changes sign: the one holding the cubic model's root on the
+    # bracket if f changes sign there, else bisection on the table's nodes inside the bracket
+    start = lo + _hermite_root(hi - lo, flo, fhi, glo, ghi)
+    i_lo = np.clip(((start - THETA_MIN) / hf).astype(int), 0, kf - 2)
+    i_hi = i_lo + 1
+    f_lo, f_hi = fine_f(i_lo), fine_f(i_hi)
+    ok = ((f_lo > 0) != (f_hi > 0)) & (fine[i_lo] >= lo) & (fine[i_hi] <= hi)
+    miss = np.flatnonzero(~ok & np.isnan(guess))
+    if miss.size:
+        coef_m = coef[miss]
+        b_lo = np.clip(np.ceil((lo[miss] - THETA_MIN) / hf - 1e-6).astype(int), 0, kf - 1)
+        b_hi = np.clip(np.floor((hi[miss] - THETA_MIN) / hf + 1e-6).astype(int), 0, kf - 1)
+        b_p = fine_f(b_lo, coef_m) > 0
+        b_ok = (b_p != (fine_f(b_hi, coef_m) > 0)) & (b_lo < b_hi)
+        while True:
+            wide = b_ok & (b_hi - b_lo > 1)
+            if not wide.any():
+                break
+            mid = (b_lo + b_hi) // 2
+            left = (fine_f(mid, coef_m) > 0) == b_p
+            b_lo, b_hi = np.where(wide & left, mid, b_lo), np.where(wide & ~left, mid, b_hi)
+        i_lo[miss], i_hi[miss], ok[miss] = b_lo, b_hi, b_ok
+        f_lo[miss], f_hi[miss] = fine_f(b_lo, coef_m), fine_f(b_hi, coef_m)
+    lo, hi = np.where(ok, fine[i_lo], lo), np.where(ok, fine[i_hi], hi)
+    flo, fhi = np.where(ok, f_lo, flo), np.where(ok, f_hi, fhi)
+    glo, ghi = np.where(ok, fine_f(kf + i_lo), glo), np.where(ok, fine_f(kf + i_hi), ghi)
+    start = np.where(ok, lo + _hermite_root(hi - lo, flo, fhi, glo, ghi), start)  # the cubic model on the sub-cell
+    start = np.where(np.isnan(guess), start, guess)
+    th = np.where((start > lo) & (start < hi), start, 0.5 * (lo + hi))
+    root = np.full(m, np.nan)
+    z = np.full(m, np.nan, dtype=complex)
+    its = np.zeros(m, dtype=int)
+    conv = np.zeros(m, dtype=bool)
+    pos_lo = flo > 0
+    tol_step = 4 * _EPS * r2 / mb  # step^2 below this: the Newton update is at rounding level
+    tol_f = 4 * _EPS * r2
+    act = np.arange(m)
+    for _ in range(max_iter):
+        if act.size == 0:
+            break
+        t = th[act]
+        y, dy = _radial_eval(t, sel if act.size == m else sel.take(act), ctx)
+        f, g = _f_and_slope(y, dy, r2[act])
+        its[act] += 1
+        left = (f > 0) == pos_lo[act]
+        a_lo = lo[act] = np.where(left, t, lo[act])
+        a_hi = hi[act] = np.where(left, hi[act], t)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            step = f / g
+        new = t - step
+        newton = (new > a_lo) & (new < a_hi)
+        new = np.where(newton, new, 0.5 * (a_lo + a_hi))
+        small = np.abs(f) <= tol_f[act]
+        done = small | (newton & (step * step <= tol_step[act])) | (a_hi - a_lo <= 4 * _EPS * a_hi)
+        new = np.where(small, t, new)
+        root[act], z[act] = new, y + (new - t) * dy
+        conv[act] = done
+        th[act] = new
+        act = act[~done]
+    return root, np.where(sel.right, np.conj(z), z), its, conv
+
+
+def _ik_radial(target, ctx, tol, max_iter, q0, want_solutions=True):
+    """The radial IK: gamma and beta in closed form, theta from the 1-D equation ``|c(theta, alpha)| = r``.
+
+    Not in the seed, which iterates Gauss-Newton on all three unknowns with a forward-difference Jacobian
+    (seed 2.2-2.3). This uses the structure of the map q -> contact point:
+
+    * For fixed (alpha, w) the contact point is a fixed point of one rim link; in the leg plane {L} it is
+      ``exp(i (beta + pi/2)) c(theta, alpha)`` (:func:`rim_point`; ``c`` depends on theta alone), at
+      lateral coordinate w.
+    * gamma rotates the module about z_M, the robot's x axis through the module origin o, so the target's
+      coordinate along that axis and its distance from it do not depend on gamma. With ``d = target - o``
+      and ``a = d_wheel + s w`` (s = +1 left, -1 right), the contact point in {M} before the ABAD rotation
+      is ``(a, y_L, -+x_L)``, so ``x_L = -d_x`` and ``a^2 + y_L^2 = d_y^2 + d_z^2``: ``y_L = -+sqrt(d_y^2 +
+      d_z^2 - a^2)`` (two branches; clipped at 0 if negative: then the FK check decides), and
+      ``gamma = arg((s d_y + i d_z) / (a + i y_L))``.
+    * beta rotates the leg plane about the motor axis O, so ``r = |x_L + i y_L|`` must equal ``|c|``, which
+      depends on theta alone. The equation solved is ``f(theta) = |c(theta, alpha)|^2 - r^2 = 0`` on
+      [17 deg, 160 deg], with the exact ``f' = 2 Re(conj(c) dc/dtheta)`` (the closed form's forward-mode
+      derivatives, as in :func:`contact_jacobian`). Then ``beta = arg((x_L + i y_L) / c) - pi/2``.
+
+    Roots: f and f' on a 17-node grid come from tabulated theta-coefficients (:func:`_arc_table`: one
+    small matrix product for the batch). Every cell where f changes sign holds a root, found by
+    :func:`_radial_newton` (usually one evaluation of the closed form, from a start refined on a fine
+    table). A cell where f keeps its sign while f' changes sign holds an extremum of f: unless a
+    curvature bound shows that f stays above ``2 r tol`` in it, :func:`_radial_extremum` decides whether f
+    reaches 0 there (then the cell is split into two brackets, or the extremum taken as a double root if
+    ``|f| <= 2 r tol`` at it). An end of the range with ``|f| <= 2 r tol`` is a root too. This finds every
+    root if each cell holds at most one extremum of f. For the default geometry ``|c|^2`` has at most one
+    extremum in theta for any alpha, both rims (checked on 1441 alpha x 20001 theta). At alpha = +-163 deg
+    the contact point is the crank hinge B, ``|c| = R`` for every theta: f is rounding noise, every theta
+    solves the IK and the grid reports many roots.
+
+    Returns ``(q, iterations, error, converged, solutions)``; ``solutions`` (n, S, 3), NaN-padded (None
+    unless ``want_solutions``): for each root by increasing theta the branch ``y_L <= 0``, then the same
+    roots on the branch ``y_L > 0`` (absent when ``y_L = 0``). The returned solution is checked with the
+    forward kinematics (:func:`_fk_flat`): converged means ``|contact_point(q) - target| <= tol``. A target
+    without a root gets, as its (unconverged) q, the grid node of smallest ``|f|`` with beta, gamma from the
+    branch ``y_L <= 0``.
+    """
+    max_iter = 60 if max_iter is None else max_iter
+    n = target.shape[0]
+    x_L, yabs, a, m = _out_of_plane(target, ctx)
+    r2 = x_L * x_L + yabs * yabs
+    ftol = 2.0 * np.sqrt(r2) * tol
+    grid, table, m2, _, _ = _radial_table(ctx.geo.R, ctx.seed)
+    K = grid.size
+    coef = _arc_coefficients(ctx.sel, r2)
+    fg = coef @ table
+    f, g = fg[:, :K], fg[:, K:]
+    kind = ctx.sel.upper.astype(int) ^ 1  # 0: upper rim, 1: lower rim / toe
+    e = ctx.sel.e
+    ee = e.real * e.real + e.imag * e.imag
+    ea = np.sqrt(ee)
+
+    def curvature(t, cell):  # bound of |f''| in that cell for target t
+        kt = kind[t]
+        return m2[kt, 0, cell] + ee[t] * m2[kt, 1, cell] + 2.0 * ea[t] * m2[kt, 2, cell]
+
+    h = grid[1] - grid[0]
+    pos = f > 0
+    change = pos[:, 1:] != pos[:, :-1]
+    jt, jk = divmod(np.flatnonzero(change), K - 1)  # a sign change: one root (at most one extremum per cell)
+    jobs = [(jt, grid[jk], grid[jk + 1], f[jt, jk], f[jt, jk + 1], g[jt, jk], g[jt, jk + 1], curvature(jt, jk),
+             np.full(jt.size, np.nan))]
+    its = np.zeros(n, dtype=int)
+    extra_t, extra_th = [], []  # roots found without Newton (ends of the range, double roots)
+    for col in (0, -1):
+        end = np.flatnonzero((np.abs(f[:, col]) <= ftol) & ~change[:, col])
+        if end.size:
+            extra_t.append(end)
+            extra_th.append(np.full(end.size, grid[col]))
+    gpos = g > 0
+    et, ek = divmod(np.flatnonzero((gpos[:, 1:] != gpos[:, :-1]) & ~change), K - 1)  # extremum, no sign change
+    if et.size:
+        sig = np.where(pos[et, ek], 1.0, -1.0)
+        Fa, Fb, Ga, Gb = sig * f[et, ek], sig * f[et, ek + 1], sig * g[et, ek], sig * g[et, ek + 1]
+        M = curvature(et, ek)
+        # |f| falls into the cell from both ends and the curvature bound allows it to reach 0
+        r = np.flatnonzero((Ga < 0) & (Gb > 0) & (_lower_bound(Fa, Fb, Ga, Gb, h, M) <= ftol[et]))
+        if r.size:
+            rt, rk = et[r], ek[r]
+            th_e, f_e, g_e, status, k_e, its_e = _radial_extremum(
+                grid[rk], grid[rk + 1], f[rt, rk], f[rt, rk + 1], g[rt, rk], g[rt, rk + 1], M[r],
+                ctx.sel.take(rt), ctx, r2[rt], ftol[rt], max_iter)
+            its += np.bincount(rt, weights=its_e, minlength=n).astype(int)
+            double = status == 2
+            if double.any():
+                extra_t.append(rt[double])
+                extra_th.append(th_e[double])
+            split = status == 1
+            st, sk, se, sf, sg, mc = rt[split], rk[split], th_e[split], f_e[split], g_e[split], M[r][split]
+            # start both roots from the parabola f_s + f'_s d + k d^2 / 2 through the split point
+            with np.errstate(divide="ignore", invalid="ignore"):
+                ks = k_e[split]
+                sq = np.sqrt(np.maximum(sg * sg - 2 * ks * sf, 0.0))
+                d1, d2 = (-sg - sq) / ks, (-sg + sq) / ks
+            jobs.append((st, grid[sk], se, f[st, sk], sf, g[st, sk], sg, mc, se + np.minimum(d1, d2)))
+            jobs.append((st, se, grid[sk + 1], sf, f[st, sk + 1], sg, g[st, sk + 1], mc, se + np.maximum(d1, d2)))
+    if len(jobs) > 1:
+        jt, lo, hi, flo, fhi, glo, ghi, mb, guess = (np.concatenate(col) for col in zip(*jobs))
+    else:
+        jt, lo, hi, flo, fhi, glo, ghi, mb, guess = jobs[0]
+    sel_j = ctx.sel.take(jt)
+    roots, zr, its_n, conv = _radial_newton(lo, hi, flo, fhi, glo, ghi, guess, coef[jt], sel_j, ctx, r2[jt],
+                                            mb, max_iter)
+    its += np.bincount(jt, weights=its_n, minlength=n).astype(int)
+    rt, rth, rz = jt, roots, zr
+    if not conv.all():
+        rt, rth, rz = jt[conv], roots[conv], zr[conv]
+    if extra_t:  # roots without a Newton evaluation: the contact point from the closed form
+        xt, xth = np.concatenate(extra_t), np.concatenate(extra_th)
+        pts, _ = _closed_form(xth, ctx.c, ctx.geo.R + FOOT_OFFSET, False, full=ctx.seed)
+        xz, _ = _plane(pts, None, ctx.sel.take(xt), False)
+        rt, rth, rz = np.concatenate([rt, xt]), np.concatenate([rth, xth]), np.concatenate([rz, xz])
+    want_solutions = want_solutions or q0 is not None
+    if want_solutions and (extra_t or len(jobs) > 1):  # else already by target, then theta
+        order = np.lexsort((rth, rt))
+        rt, rth, rz = rt[order], rth[order], rz[order]
+    counts = np.bincount(rt, minlength=n)
+    if want_solutions or not (extra_t or len(jobs) > 1):
+        first = np.cumsum(counts) - counts  # index of each target's first root (sorted)
+    else:  # index of each target's smallest root, without sorting
+        best = np.full(n, np.inf)
+        np.minimum.at(best, rt, rth)
+        at_best = np.flatnonzero(rth == best[rt])
+        first = np.zeros(n, dtype=int)
+        first[rt[at_best]] = at_best
+    tau = x_L[rt] - 1j * yabs[rt]  # branch y_L <= 0; exp(i (beta + pi/2)) c = tau
+    ccz = np.conj(rz) * -1j
+    beta1 = np.angle(tau * ccz)
+    gamma1 = np.angle(m * (a + 1j * yabs))
+    has = counts > 0
+    q = np.full((n, 3), np.nan)
+    sols = None
+    if want_solutions:
+        rank = np.arange(rt.size) - first[rt]
+        S = int((counts * np.where(yabs > 0, 2, 1)).max()) if n else 0
+        sols = np.full((n, S, 3), np.nan)
+        sols[rt, rank] = np.stack([rth, beta1, gamma1[rt]], -1)
+        two = np.flatnonzero(yabs[rt] > 0)
+        if two.size:
+            t2 = rt[two]
+            sols[t2, counts[t2] + rank[two]] = np.stack(
+                [rth[two], np.angle(np.conj(tau[two]) * ccz[two]), np.angle(m[t2] * (a[t2] - 1j * yabs[t2]))], -1)
+    if q0 is None:
+        k = first[has]
+        q[has] = np.stack([rth[k], beta1[k], gamma1[has]], -1)
+    elif sols.shape[1]:
+        diff = sols - q0[:, None, :]
+        diff[..., 1:] = np.angle(_cis(diff[..., 1:]))  # wrapped angle differences
+        d2 = np.where(np.isnan(diff[..., 0]), np.inf, np.sum(diff * diff, axis=-1))
+        k = np.argmin(d2, axis=1)[:, None, None]
+        q[has] = np.take_along_axis(sols, k, 1)[has, 0]
+        q[has, 1:] = (q0[:, 1:] + np.take_along_axis(diff, k, 1)[:, 0, 1:])[has]  # within pi of q0's
+    miss = np.flatnonzero(~has)
+    if miss.size:  # no root: the grid node of smallest |f|, as the point reached
+        k = np.argmin(np.abs(f[miss]), axis=1)
+        pts, _ = _closed_form(grid[k], ctx.c, ctx.geo.R + FOOT_OFFSET, False, full=ctx.seed)
+        cz, _ = _plane(pts, None, ctx.sel.take(miss), False)
+        q[miss] = np.stack([grid[k], np.angle((x_L[miss] - 1j * yabs[miss]) * np.conj(cz) * -1j), gamma1[miss]], -1)
+    p = _fk_flat(q, ctx, False)[0]
+    err = np.linalg.norm(p - target, axis=1)
+    return q, its, err, has & (err <= tol), sols

@@ -1,4 +1,4 @@
-"""Wheel-leg rim-contact IK: analytic-Jacobian ``ik`` vs the seed's finite-difference Gauss-Newton vs Pinocchio.
+"""Wheel-leg rim-contact IK: legkin's ``ik`` (analytic Jacobian; radial) vs the seed's finite differences vs Pinocchio.
 
 Targets: Pinocchio's contact point (the rim link's placement times the contact point's fixed local
 coordinates, as in ``checks.wheel_leg``) for random (theta, beta, gamma) of leg FL, rim parameter alpha and
@@ -37,18 +37,25 @@ def _sizes(n: int | None, quick: bool) -> tuple[int, int, int]:
 
 @contextlib.contextmanager
 def _count_fk(counter: list):
-    """Count the rows of every forward-kinematics call of :mod:`legkin.analytic.wheel_leg`'s IK (untimed runs)."""
-    original = wl._fk_flat
+    """Count the rows of every linkage evaluation of :mod:`legkin.analytic.wheel_leg`'s IK (untimed runs): the
+    contact FK (``_fk_flat``, with or without the Jacobian) and the radial method's evaluation of the leg-plane
+    closed form with its theta-derivative (``_radial_eval``), each row counted as one evaluation."""
+    originals = {name: getattr(wl, name) for name in ("_fk_flat", "_radial_eval")}
 
-    def counting(q, *args, **kwargs):
-        counter[0] += len(q)
-        return original(q, *args, **kwargs)
+    def counting(original):
+        def wrapped(q, *args, **kwargs):
+            counter[0] += len(q)
+            return original(q, *args, **kwargs)
 
-    wl._fk_flat = counting
+        return wrapped
+
+    for name, original in originals.items():
+        setattr(wl, name, counting(original))
     try:
         yield
     finally:
-        wl._fk_flat = original
+        for name, original in originals.items():
+            setattr(wl, name, original)
 
 
 def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
@@ -167,13 +174,17 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
 
     run_d, score_d = analytic("damped")
     run_s, score_s = analytic("seed")
+    run_r, score_r = analytic("radial")
     run_d1, score_d1 = analytic("damped", scalar=True)
     run_s1, score_s1 = analytic("seed", scalar=True)
+    run_r1, score_r1 = analytic("radial", scalar=True)
     methods = [
         Method(f"legkin batch ik, analytic Jacobian (method='damped'; {n_batch} at once)", inputs, run_d, score_d,
                repeats=5),
+        Method(f"legkin batch ik, radial (method='radial'; {n_batch} at once)", inputs, run_r, score_r, repeats=5),
         Method(f"seed Gauss-Newton, forward differences (method='seed'; batch)", inputs, run_s, score_s, repeats=5),
         Method("legkin scalar ik (damped), Python loop", inputs, run_d1, score_d1, max_targets=n_scalar, repeats=3),
+        Method("legkin scalar ik (radial), Python loop", inputs, run_r1, score_r1, max_targets=n_scalar, repeats=3),
         Method("seed forward-difference Gauss-Newton, scalar calls in a loop", inputs, run_s1, score_s1,
                max_targets=n_scalar, repeats=3),
         Method("pinocchio closed-loop IK (LM on loops + contact point)", inputs, pin_ik, pin_score,
@@ -187,26 +198,44 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         "err = Pinocchio contact point of the answer vs target (m); loop |r| = Pinocchio loop residual; "
         "solved also needs theta in [17, 160] deg; iters = median; FK/solve = mean forward-kinematics "
         "evaluations per target (legkin: rows passed to the contact FK, counted in an untimed rerun; the damped "
-        "method's FK also returns the Jacobian; Pinocchio: residual + Jacobian evaluations)",
-        f"every method is given tolerance {TOL:g} m; both legkin methods are vectorised over the batch and start "
-        "from the same geometric guess; the damped method restarts failures from two more guesses and takes one "
-        "polishing step; the Pinocchio IK starts from the configuration of the same first guess",
+        "method's FK also returns the Jacobian; radial: rows of its leg-plane closed form with theta-derivative "
+        "(Newton steps) plus the final contact FK that checks the answer, its 17-node grid and start table "
+        "look-ups are not counted; Pinocchio: residual + Jacobian evaluations)",
+        f"every method is given tolerance {TOL:g} m; the legkin methods are vectorised over the batch; damped "
+        "and seed start from the same geometric guess, the damped method restarts failures from two more "
+        "guesses and takes one polishing step; radial solves gamma and beta in closed form and theta by a "
+        "bracketed 1-D Newton (no start needed, every root found, the first returned); the Pinocchio IK starts "
+        "from the configuration of the damped/seed first guess",
         "pinocchio closed-loop IK: the Levenberg-Marquardt of Robot.solve_loops on [16 loop residuals; contact "
         "point - target] with the 11 joints of the leg free, contact Jacobian from getFrameJacobian",
     ]
 
     def summary(results: list[MethodResult]) -> list[str]:
-        d = next(r for r in results if "batch ik" in r.name)
+        d = next(r for r in results if "batch ik, analytic" in r.name)
+        r = next(r for r in results if "batch ik, radial" in r.name)
         s = next(r for r in results if "forward differences" in r.name)
-        d1 = next(r for r in results if "scalar ik" in r.name)
+        d1 = next(r for r in results if "scalar ik (damped)" in r.name)
+        r1 = next(r for r in results if "scalar ik (radial)" in r.name)
         s1 = next(r for r in results if "scalar calls" in r.name)
         p = next(r for r in results if "pinocchio" in r.name)
+
+        def acc(x):
+            if not np.isfinite(x.max_error):
+                return f"{x.solved:.1f}% solved, some targets unsolved"
+            worst = f"max error {x.max_error:.1e} m"
+            return f"{x.solved:.1f}% solved, {worst}"
+
         return [
-            "analytic-Jacobian ik vs the finite-difference iteration: "
-            f"{s.time_per_target_s / d.time_per_target_s:.2f}x "
-            f"(batch), {s1.time_per_target_s / d1.time_per_target_s:.2f}x (scalar calls) (target >= 10x)",
-            f"batch ik is {p.time_per_target_s / d.time_per_target_s:,.0f}x and the scalar call "
-            f"{p.time_per_target_s / d1.time_per_target_s:,.1f}x faster than the Pinocchio closed-loop IK",
+            "speed-up over the seed's finite-difference iteration (target >= 10x at equal or better accuracy): "
+            f"damped (analytic Jacobian) {s.time_per_target_s / d.time_per_target_s:.2f}x batch, "
+            f"{s1.time_per_target_s / d1.time_per_target_s:.2f}x scalar calls; radial "
+            f"{s.time_per_target_s / r.time_per_target_s:.2f}x batch, "
+            f"{s1.time_per_target_s / r1.time_per_target_s:.2f}x scalar calls",
+            f"accuracy (batch): damped {acc(d)}; radial {acc(r)}; seed {acc(s)}",
+            f"batch ik is {p.time_per_target_s / d.time_per_target_s:,.0f}x (damped) / "
+            f"{p.time_per_target_s / r.time_per_target_s:,.0f}x (radial) and the scalar call "
+            f"{p.time_per_target_s / d1.time_per_target_s:,.1f}x / {p.time_per_target_s / r1.time_per_target_s:,.1f}x "
+            "faster than the Pinocchio closed-loop IK",
         ]
 
     return ModelBench(

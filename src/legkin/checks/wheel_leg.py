@@ -204,11 +204,12 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
                         jerr, TOL))
 
     # ---------------------------------------------------------------- IK round trips
-    for method in ("damped", "seed"):
+    for method in ("damped", "seed", "radial"):
         for rim in ("continuous", "seed"):
             errs = np.full(n, np.nan)
             its = np.zeros(n, dtype=int)
             ok_all = np.zeros(n, dtype=bool)
+            found = np.full(n, np.nan)
             for k, leg in enumerate(wl.LEGS):
                 m = legs == k
                 if rim == "seed":
@@ -220,6 +221,9 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
                 reached = wl.contact_point(np.where(ok[:, None], qk, q3[m]), alpha[m], w[m], leg, rim=rim, geometry=geo)
                 errs[m] = np.where(ok, per_sample(reached - target), np.nan)
                 its[m], ok_all[m] = info.iterations, ok
+                if method == "radial":
+                    found[m] = solution_distance(info.solutions, q3[m]) * np.linalg.svd(
+                        wl.contact_jacobian(q3[m], alpha[m], w[m], leg, rim=rim, geometry=geo), compute_uv=False)[:, -1]
             name = (f"ik(method='{method}', rim='{rim}') round trip: {ok_all.sum()}/{n} converged in [17, 160] deg, "
                     f"iterations mean {its.mean():.2f} max {its.max()}")
             if method == "seed":
@@ -227,4 +231,32 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
                 rows.append(compare(name + " (converged targets)", errs[ok_all], TOL))
             else:
                 rows.append(compare(name, errs, TOL))
+            if method == "radial":
+                # Every root found: the sampled q is one of info.solutions. Its distance in q is scaled by the
+                # smallest singular value of the contact Jacobian at the sample (near folds theta is
+                # ill-conditioned: a position error e moves the root by ~e / sigma_min), giving metres.
+                rows.append(compare(f"ik(method='radial', rim='{rim}'): sampled q among info.solutions "
+                                    "(q distance x sigma_min(J), m)", found, TOL))
+
+    # radial IK against Pinocchio: targets are the rim link placements oMf times the local contact point,
+    # the answers are scored by Pinocchio on the configuration closing every loop
+    q_rad = leg_q.copy()
+    ok_rad = np.zeros(n, dtype=bool)
+    for k, leg in enumerate(wl.LEGS):
+        m = np.flatnonzero(legs == k)
+        qk, ok_rad[m] = wl.ik(pin_p[m], alpha[m], w[m], leg, method="radial", geometry=geo, return_mask=True)
+        q_rad[m[ok_rad[m]], k] = qk[ok_rad[m]]
+    fpos_r, frot_r = pinocchio_frames(robot, configuration(robot, q_rad), seg_frames)
+    pin_r = fpos_r[np.arange(n), idx] + np.einsum("nij,nj->ni", frot_r[np.arange(n), idx], local)
+    rows.append(compare(f"ik(method='radial') vs Pinocchio: target = rim link oMf * local point, answer's contact "
+                        f"point by Pinocchio (closed configuration), {ok_rad.sum()}/{n} solved",
+                        np.where(ok_rad, per_sample(pin_r - pin_p), np.nan), TOL))
     return rows
+
+
+def solution_distance(solutions: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Distance (max-norm, angles wrapped) from each q (n, 3) to the nearest of its solutions (n, S, 3)."""
+    d = solutions - q[:, None, :]
+    d[..., 1:] = np.angle(np.exp(1j * d[..., 1:]))
+    d = np.abs(d).max(axis=-1)
+    return np.min(np.where(np.isnan(d), np.inf, d), axis=1)

@@ -81,10 +81,10 @@ def check_tables(samples: int) -> str:
     return "\n".join(out)
 
 
-def _num(x, fmt: str = ".1e") -> str:
-    """A JSON number for a table cell (``-`` for missing, ``fail`` for NaN/inf: some targets unsolved)."""
+def _num(x, fmt: str = ".1e", missing: str = "-") -> str:
+    """A JSON number for a table cell; ``missing`` for null, ``fail`` for NaN/inf."""
     if x is None:
-        return "-"
+        return missing
     return format(x, fmt) if x == x and abs(x) != float("inf") else "fail"
 
 
@@ -108,7 +108,7 @@ def bench_tables() -> str:
         for m in entry["methods"]:
             out.append(
                 f"| {m['name']} | {m['targets']} | {m['solved']:.1f}% | {_num(m['median_error'])} | "
-                f"{_num(m['max_error'])} | {_num(m['time_per_target_s'], '.2e')} s | "
+                f"{_num(m['max_error'], missing='fail')} | {_num(m['time_per_target_s'], '.2e')} s | "
                 f"{_num(m.get('ratio_to_fastest'), '.3g')}x |"
             )
         out.append("")

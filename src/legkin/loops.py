@@ -22,7 +22,7 @@ import pinocchio as pin
 
 from .errors import LegkinError, LoopClosureError
 
-__all__ = ["LoopSpec", "LoopSolveInfo", "parse_loops", "build_constraint", "LoopSet"]
+__all__ = ["LoopSpec", "LoopSolveInfo", "parse_loops", "build_constraint", "LoopSet", "levenberg_marquardt"]
 
 _TYPES = ("point", "frame")
 
@@ -120,40 +120,57 @@ class LoopSet:
     def solve(
         self, q: np.ndarray, free: np.ndarray, tol: float, max_iter: int
     ) -> tuple[np.ndarray, LoopSolveInfo]:
-        """Levenberg-Marquardt on the stacked residual over the velocity coordinates ``free``.
-
-        Each iteration tries the Gauss-Newton step ``dq = -pinv(J_free) r`` (pseudo-inverse:
-        redundant rows of planar loops make the stack rank-deficient); if it does not reduce
-        ``|r|``, damped steps ``-(J^T J + mu I)^-1 J^T r`` with growing ``mu`` are tried.
-        """
-        model = self.model
-        r, jac = self.residual_and_jacobian(q)
-        err = float(np.linalg.norm(r))
-        mu = 1e-6
-        for it in range(max_iter + 1):
-            if err <= tol:
-                return q, LoopSolveInfo(it, err)
-            if it == max_iter:
-                break
-            jf = jac[:, free]
-            steps = [-np.linalg.pinv(jf, rcond=1e-12) @ r]
-            jtj, jtr = jf.T @ jf, jf.T @ r
-            for k in range(12):
-                steps.append(-np.linalg.solve(jtj + mu * 10.0**k * np.eye(jf.shape[1]), jtr))
-            for step in steps:
-                dq = np.zeros(model.nv)
-                dq[free] = step
-                q_new = pin.integrate(model, q, dq)
-                r_new, jac_new = self.residual_and_jacobian(q_new)
-                err_new = float(np.linalg.norm(r_new))
-                if err_new < err:
-                    break
-            else:
-                break  # no step reduces the residual: a local minimum that does not close
-            q, r, jac, err = q_new, r_new, jac_new, err_new
+        """:func:`levenberg_marquardt` on the stacked loop residual; raises if the loops do not close."""
+        q, it, _, converged, err = levenberg_marquardt(self.model, self.residual_and_jacobian, q, free, tol, max_iter)
+        if converged:
+            return q, LoopSolveInfo(it, err)
         raise LoopClosureError(
             f"could not close the loops: residual {err:.3e} after {it} iterations (tolerance {tol:.1e})",
             residual=err,
             iterations=it,
             q=q,
         )
+
+
+def levenberg_marquardt(model: pin.Model, residual_and_jacobian, q: np.ndarray, free: np.ndarray, tol: float, max_iter: int):
+    """Levenberg-Marquardt on a stacked residual over the velocity coordinates ``free`` of ``model``.
+
+    Each iteration tries the Gauss-Newton step ``dq = -pinv(J_free) r`` (pseudo-inverse: redundant rows of
+    planar loops make the stack rank-deficient); if it does not reduce ``|r|``, damped steps
+    ``-(J^T J + mu I)^-1 J^T r`` with growing ``mu`` are tried; configurations are updated with
+    ``pin.integrate``. Stops at ``|r| <= tol``, after ``max_iter`` iterations, or when no step reduces ``|r|``.
+
+    Args:
+        residual_and_jacobian: ``q -> (r (rows,), J (rows, nv))``.
+
+    Returns:
+        ``(q, iterations, residual evaluations, converged, |r|)``.
+    """
+    r, jac = residual_and_jacobian(q)
+    evals = 1
+    err = float(np.linalg.norm(r))
+    mu = 1e-6
+    it = 0
+    for it in range(max_iter + 1):
+        if err <= tol:
+            return q, it, evals, True, err
+        if it == max_iter:
+            break
+        jf = jac[:, free]
+        steps = [-np.linalg.pinv(jf, rcond=1e-12) @ r]
+        jtj, jtr = jf.T @ jf, jf.T @ r
+        for k in range(12):
+            steps.append(-np.linalg.solve(jtj + mu * 10.0**k * np.eye(jf.shape[1]), jtr))
+        for step in steps:
+            dq = np.zeros(model.nv)
+            dq[free] = step
+            q_new = pin.integrate(model, q, dq)
+            r_new, jac_new = residual_and_jacobian(q_new)
+            evals += 1
+            err_new = float(np.linalg.norm(r_new))
+            if err_new < err:
+                break
+        else:
+            break  # no step reduces the residual: a local minimum that does not close
+        q, r, jac, err = q_new, r_new, jac_new, err_new
+    return q, it, evals, False, err

@@ -63,43 +63,22 @@ def pinocchio_positions(model, data, frame_id: int, qs: np.ndarray) -> tuple[np.
 
 
 def levenberg_marquardt(model, residual_and_jacobian, q: np.ndarray, free: np.ndarray, tol: float, max_iter: int):
-    """The iteration of :meth:`legkin.Robot.solve_loops` on any stacked residual (Pinocchio-only solvers).
-
-    Each iteration tries the Gauss-Newton step ``dq = -pinv(J_free) r``, then damped steps
-    ``-(J^T J + mu I)^-1 J^T r`` with growing ``mu`` until ``|r|`` decreases; stops at ``|r| <= tol``.
+    """:func:`legkin.loops.levenberg_marquardt` (the iteration of ``Robot.solve_loops``) on any residual.
 
     Returns:
         ``(q, iterations, residual evaluations, converged)``.
     """
-    import pinocchio as pin
+    from ..loops import levenberg_marquardt as lm
 
-    r, jac = residual_and_jacobian(q)
-    evals = 1
-    err = float(np.linalg.norm(r))
-    mu = 1e-6
-    for it in range(max_iter + 1):
-        if err <= tol:
-            return q, it, evals, True
-        if it == max_iter:
-            break
-        jf = jac[:, free]
-        steps = [-np.linalg.pinv(jf, rcond=1e-12) @ r]
-        jtj, jtr = jf.T @ jf, jf.T @ r
-        for k in range(12):
-            steps.append(-np.linalg.solve(jtj + mu * 10.0**k * np.eye(jf.shape[1]), jtr))
-        for step in steps:
-            dq = np.zeros(model.nv)
-            dq[free] = step
-            q_new = pin.integrate(model, q, dq)
-            r_new, jac_new = residual_and_jacobian(q_new)
-            evals += 1
-            err_new = float(np.linalg.norm(r_new))
-            if err_new < err:
-                break
-        else:
-            break
-        q, r, jac, err = q_new, r_new, jac_new, err_new
-    return q, it, evals, False
+    return lm(model, residual_and_jacobian, q, free, tol, max_iter)[:4]
+
+
+def sizes(n: int | None, quick: bool, full: tuple[int, int, int], small: tuple[int, int, int]) -> tuple[int, int, int]:
+    """(batch targets, scalar-loop targets, iterative-solver targets): ``full`` or, with ``quick``, ``small``;
+    ``n`` overrides the batch size and caps the others."""
+    batch, scalar, iterative = small if quick else full
+    n = n or batch
+    return n, min(n, scalar), min(n, iterative)
 
 
 def rotation_error(r1: np.ndarray, r2: np.ndarray) -> np.ndarray:

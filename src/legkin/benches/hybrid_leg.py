@@ -16,18 +16,15 @@ from ..analytic import hybrid_leg as ah
 from ..bench import Method, MethodResult, ModelBench, Score
 from ..checks.hybrid_leg import LL_RANGE, closed_configuration, sample_workspace
 from ..errors import LegkinError
-from . import SOLVE_TOL, levenberg_marquardt, pinocchio_positions
+from . import SOLVE_TOL, levenberg_marquardt, pinocchio_positions, sizes
 
 TOL = 1e-12
 MAX_ITER = 100
 
 
 def _sizes(n: int | None, quick: bool) -> tuple[int, int, int]:
-    if quick:
-        n = n or 1_000
-        return n, min(n, 100), min(n, 10)
-    n = n or 20_000
-    return n, min(n, 2_000), min(n, 200)
+    """(batch targets, scalar-loop targets, iterative-solver targets)."""
+    return sizes(n, quick, full=(20_000, 2_000, 200), small=(1_000, 100, 10))
 
 
 def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:

@@ -17,7 +17,7 @@ from .. import load
 from ..analytic import quadruped as aq
 from ..bench import Method, MethodResult, ModelBench, Score
 from ..errors import UnreachableError
-from . import SOLVE_TOL, missing, pinocchio_positions, quiet_stdout
+from . import SOLVE_TOL, missing, pinocchio_positions, quiet_stdout, sizes
 
 LEG = "LF"
 #: CLIK settings of Pinocchio's examples/inverse-kinematics.py, with the issue's tolerance 1e-10.
@@ -28,11 +28,7 @@ TRACIK_EPS = 1e-10
 
 def _sizes(n: int | None, quick: bool) -> tuple[int, int, int]:
     """(batch targets, scalar-loop targets, iterative-solver targets)."""
-    if quick:
-        n = n or 2_000
-        return n, min(n, 200), min(n, 10)
-    n = n or 100_000
-    return n, min(n, 5_000), min(n, 300)
+    return sizes(n, quick, full=(100_000, 5_000, 300), small=(2_000, 200, 10))
 
 
 def _into_limits(q: np.ndarray) -> np.ndarray:

@@ -15,7 +15,7 @@ from ..analytic import tripod as at
 from ..bench import Method, MethodResult, ModelBench, Score
 from ..checks.tripod import sample_workspace
 from ..errors import LegkinError, LoopClosureError
-from . import SOLVE_TOL, levenberg_marquardt, rotation_error
+from . import SOLVE_TOL, levenberg_marquardt, rotation_error, sizes
 
 #: The tolerance every iterative method is given (fk's step tolerance, solve_loops' residual tolerance).
 TOL = 1e-12
@@ -23,11 +23,8 @@ MAX_ITER = 100
 
 
 def _sizes(n: int | None, quick: bool) -> tuple[int, int, int]:
-    if quick:
-        n = n or 1_000
-        return n, min(n, 100), min(n, 10)
-    n = n or 20_000
-    return n, min(n, 2_000), min(n, 200)
+    """(batch targets, scalar-loop targets, iterative-solver targets)."""
+    return sizes(n, quick, full=(20_000, 2_000, 200), small=(1_000, 100, 10))
 
 
 def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:

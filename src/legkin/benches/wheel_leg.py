@@ -18,7 +18,7 @@ from ..analytic import wheel_leg as wl
 from ..bench import Method, MethodResult, ModelBench, Score
 from ..checks.wheel_leg import SEGMENT_LINKS, configuration, leg_joint_names, local_contact_point, sample_leg_q
 from ..errors import UnreachableError
-from . import SOLVE_TOL, levenberg_marquardt
+from . import SOLVE_TOL, levenberg_marquardt, sizes
 
 LEG = "FL"
 #: Every iterative method is asked for the same position tolerance (m) (wl.ik's default).
@@ -27,12 +27,8 @@ MAX_ITER = 100
 
 
 def _sizes(n: int | None, quick: bool) -> tuple[int, int, int]:
-    """(batch targets, scalar-loop targets, Pinocchio targets)."""
-    if quick:
-        n = n or 300
-        return n, min(n, 20), min(n, 5)
-    n = n or 5_000
-    return n, min(n, 300), min(n, 100)
+    """(batch targets, scalar-loop targets, iterative-solver targets)."""
+    return sizes(n, quick, full=(5_000, 300, 100), small=(300, 20, 5))
 
 
 @contextlib.contextmanager

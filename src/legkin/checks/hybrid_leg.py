@@ -220,12 +220,23 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     # start the solver near the sample's assembly: passive joints perturbed by N(0, 0.1 sigma_min) rad (the
     # other assembly mode is ~sigma_min away near the forward singularity, and the solver would find it)
     scale = 0.1 * _sigma_min(roll[:ns], pitch[:ns])
+    other_mode = np.zeros(ns, dtype=bool)
     for k in range(ns):
         q_init = qs[k].copy()
         q_init[pas] += rng.normal(0.0, scale[k], len(pas))
         q = robot.solve_loops(q_init, fixed=list(ACTUATED), tol=1e-15, max_iter=50)
-        err[k] = np.abs(q[[robot.idx_q("LCS_x"), robot.idx_q("LCS_y")]] - x[k]).max()
-    rows.append(compare(f"platform_orientation vs Robot.solve_loops (motors held, {ns} samples)", err, TOL))
+        x_solver = q[[robot.idx_q("LCS_x"), robot.idx_q("LCS_y")]]
+        err[k] = np.abs(x_solver - x[k]).max()
+        if err[k] > 1e-6:
+            # The forward kinematics of the closed chain is multi-valued: the solver may close the loops in
+            # another assembly mode, a different platform pose whose motor angles (on some motor branch) are
+            # the held ones. Such samples are counted, not compared; anything else stays an error.
+            th_other = np.stack([ah.motor_angles(x_solver[0], x_solver[1], b, return_mask=True)[0]
+                                 for b in ah.MOTOR_BRANCHES])
+            other_mode[k] = bool(np.any(np.abs(th_other - th[k]).max(-1) < 1e-9))
+    rows.append(compare(
+        f"platform_orientation vs Robot.solve_loops (motors held, {ns} samples; {int(other_mode.sum())} "
+        "closed in another assembly mode, skipped)", err[~other_mode], TOL))
 
     # -- foot position (Newton FK + eq 19 + eqs 17-20) vs Pinocchio FCS
     pos = pinocchio_frames(robot, qs, ["FCS"])[0][:, 0]

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import shot
 
 import legkin
 from legkin import animations
@@ -150,33 +151,8 @@ browser = pytest.mark.skipif(
 )
 
 
-def _shot(page: Path, png: Path, budget_ms: int = 15000) -> np.ndarray:
-    from PIL import Image
-
-    from legkin.viewer import screenshot
-
-    assert CHROMIUM is not None, "CI must install Debian's chromium (see .ci/run)"
-    screenshot(page, png, budget_ms=budget_ms)
-    return np.asarray(Image.open(png).convert("RGB"), dtype=float)
-
-
 def _changed(a: np.ndarray, b: np.ndarray) -> float:
     return float((np.abs(a - b).max(axis=-1) > 30).mean())
-
-
-@pytest.fixture(scope="module")
-def empty_scene(tmp_path_factory) -> np.ndarray:
-    import meshcat
-
-    tmp = tmp_path_factory.mktemp("empty")
-    vis = meshcat.Visualizer()
-    try:
-        html = vis.static_html()
-    finally:
-        vis.window.server_proc.terminate()
-        vis.window.server_proc.wait(timeout=10)
-    (tmp / "empty.html").write_text(html)
-    return _shot(tmp / "empty.html", tmp / "empty.png")
 
 
 @browser
@@ -190,8 +166,8 @@ def test_animation_page_plays_in_chromium(model, robots, tmp_path, empty_scene):
     assert main(["view", model, "--animate", CLIPS[model], "--html", str(page)]) == 0
     static = write_html(robots[model], robots[model].q0, tmp_path / f"{model}.html")
     # 1.5 s is mid-clip for every clip here (90-150 frames at 30 fps), whether or not the page loops
-    anim = _shot(page, tmp_path / "anim.png", budget_ms=1500)
-    still = _shot(static, tmp_path / "static.png")
+    anim = shot(page, tmp_path / "anim.png", budget_ms=1500)
+    still = shot(static, tmp_path / "static.png")
     assert anim.std() > 5, "blank page"
     assert _changed(anim, empty_scene) > 0.01, "the mechanism is shown"
     # relative to the mechanism's own footprint on screen (the hybrid leg is small in its view)

@@ -11,7 +11,7 @@ import pytest
 import legkin
 from legkin._registry import MODELS
 from legkin.viewer import chromium_path, write_html
-from legkin.viewer import screenshot as render_png
+from conftest import shot
 
 CHROMIUM = chromium_path()
 
@@ -19,30 +19,6 @@ pytestmark = pytest.mark.skipif(
     CHROMIUM is None and not os.environ.get("CI"),
     reason="headless Chromium not installed (apt-get install chromium); required on CI",
 )
-
-
-def screenshot(page: Path, png: Path) -> np.ndarray:
-    from PIL import Image
-
-    assert CHROMIUM is not None, "CI must install Debian's chromium (see .ci/run)"
-    render_png(page, png)
-    return np.asarray(Image.open(png).convert("RGB"), dtype=float)
-
-
-@pytest.fixture(scope="module")
-def empty_scene(tmp_path_factory) -> np.ndarray:
-    import meshcat
-
-    tmp = tmp_path_factory.mktemp("empty")
-    vis = meshcat.Visualizer()
-    try:
-        html = vis.static_html()
-    finally:
-        vis.window.server_proc.terminate()
-        vis.window.server_proc.wait(timeout=10)
-    page = tmp / "empty.html"
-    page.write_text(html)
-    return screenshot(page, tmp / "empty.png")
 
 
 def assert_shows_something(img: np.ndarray, empty: np.ndarray) -> None:
@@ -56,7 +32,7 @@ def test_model_page_renders(name, tmp_path, empty_scene):
     robot = legkin.load(name)
     page = write_html(robot, robot.q0, tmp_path / f"{name}.html")
     assert page.stat().st_size > 10_000
-    img = screenshot(page, tmp_path / f"{name}.png")
+    img = shot(page, tmp_path / f"{name}.png")
     assert_shows_something(img, empty_scene)
 
 
@@ -65,7 +41,7 @@ def test_animation_page_renders(tmp_path, empty_scene):
 
     page = tmp_path / "anim.html"
     assert main(["view", "quadruped", "--animate", "foot_circles", "--html", str(page)]) == 0
-    img = screenshot(page, tmp_path / "anim.png")
+    img = shot(page, tmp_path / "anim.png")
     assert_shows_something(img, empty_scene)
 
 

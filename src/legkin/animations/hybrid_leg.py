@@ -26,28 +26,17 @@ def tilt_path(frames: int = 400) -> tuple[np.ndarray, np.ndarray]:
 def configurations(robot, roll, pitch, theta_ll, branch=BRANCH) -> np.ndarray:
     """Configurations (n, nq) closing both loops: universal centre at (roll, pitch), LL at ``theta_ll``.
 
-    Motors from :func:`~legkin.analytic.hybrid_leg.motor_angles` (the rod-length equations in closed form),
-    the lever-tip spherical joints from :func:`~legkin.analytic.hybrid_leg.sphere_joint_angles`.
-    For the spherical-centre model, its third centre joint ``LCS_z`` keeps its ``q0`` value (0).
+    Built by :func:`legkin.checks.hybrid_leg.closed_configuration` (motors and lever-tip spherical joints in
+    closed form). For the spherical-centre model, its third centre joint ``LCS_z`` keeps its ``q0`` value.
     """
-    roll, pitch = np.asarray(roll, dtype=float), np.asarray(pitch, dtype=float)
-    rot = ah.platform_rotation(roll, pitch)
+    from ..checks.hybrid_leg import closed_configuration
+
+    angles = [np.ravel(roll), np.ravel(pitch)]
     if robot.model.existJointName("LCS_z"):
-        cz = robot.q0[robot.idx_q("LCS_z")]
-        rz = np.array([[math.cos(cz), -math.sin(cz), 0.0], [math.sin(cz), math.cos(cz), 0.0], [0.0, 0.0, 1.0]])
-        rot = rot @ rz
-    theta = ah.motor_angles_from_rotation(rot, branch)
-    sph = ah.sphere_joint_angles(rot, branch)
-    if not (np.all(np.isfinite(theta)) and np.all(np.isfinite(sph))):
+        angles.append(np.full(angles[0].shape, robot.q0[robot.idx_q("LCS_z")]))
+    qs = closed_configuration(robot, np.stack(angles, axis=-1), np.ravel(theta_ll), branch)
+    if not np.all(np.isfinite(qs)):
         raise RuntimeError("hybrid_leg clip: a pose of the path is out of the motors' reach")  # pragma: no cover
-    qs = np.tile(robot.q0, (roll.size, 1))
-    qs[:, robot.idx_q("LCS_x")] = roll
-    qs[:, robot.idx_q("LCS_y")] = pitch
-    for i in (1, 2):
-        qs[:, robot.idx_q(f"MCS{i}")] = theta[:, i - 1]
-        for k, axis in enumerate("zyx"):
-            qs[:, robot.idx_q(f"Sph_{i}_1_{axis}")] = sph[:, i - 1, k]
-    qs[:, robot.idx_q("LL")] = theta_ll
     return qs
 
 

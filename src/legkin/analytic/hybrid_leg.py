@@ -244,6 +244,15 @@ def _unreachable(what: str, k: np.ndarray) -> UnreachableError:
     )
 
 
+def _levers_at(rotation, branch):
+    """Checked rotation, motor angles, chain flags, success mask and lever tips for a platform rotation."""
+    rot = _check_rotation(rotation)
+    theta, k, ok2 = _chains(rot, _check_branch(branch))
+    ok = np.all(ok2, axis=-1)
+    tip, _ = _lever_tips(np.where(ok[..., None], theta, 0.0))
+    return rot, theta, k, ok, tip
+
+
 def motor_angles_from_rotation(rotation, branch: Sequence[int] = (1, 1), *, return_mask: bool = False):
     """Motor angles (..., 2) = (theta1, theta2) for platform rotations (..., 3, 3) (any centre joint).
 
@@ -348,11 +357,7 @@ def sphere_joint_angles(rotation, branch: Sequence[int] = (1, 1), *, return_mask
     Raises:
         UnreachableError: single rotation out of reach.
     """
-    rot = _check_rotation(rotation)
-    b = _check_branch(branch)
-    theta, k, ok2 = _chains(rot, b)
-    ok = np.all(ok2, axis=-1)
-    tip, _ = _lever_tips(np.where(ok[..., None], theta, 0.0))
+    rot, theta, k, ok, tip = _levers_at(rotation, branch)
     d = _attach_world(rot) - tip
     rz = _rotz(theta + MOTOR_YAW)
     u = np.einsum("...ji,...j->...i", rz, d) / ROD_LENGTH
@@ -769,11 +774,7 @@ def spherical_free_axis(rotation, branch: Sequence[int] = (1, 1), *, return_mask
     Raises:
         UnreachableError: single rotation out of reach.
     """
-    rot = _check_rotation(rotation)
-    b = _check_branch(branch)
-    theta, k, ok2 = _chains(rot, b)
-    ok = np.all(ok2, axis=-1)
-    tip, _ = _lever_tips(np.where(ok[..., None], theta, 0.0))
+    rot, theta, k, ok, tip = _levers_at(rotation, branch)
     ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
     d = CENTER + ra - tip
     g = np.cross(ra, d)

@@ -2,6 +2,7 @@
 
 from ._registry import list_models
 from .errors import (
+    AssemblyModeError,
     ConvergenceError,
     InvalidInputError,
     InvalidParameterError,
@@ -26,6 +27,7 @@ __all__ = [
     "InvalidInputError",
     "UnreachableError",
     "JointLimitError",
+    "AssemblyModeError",
     "SingularityError",
     "LoopClosureError",
     "ConvergenceError",

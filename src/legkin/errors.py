@@ -9,6 +9,7 @@ __all__ = [
     "InvalidInputError",
     "UnreachableError",
     "JointLimitError",
+    "AssemblyModeError",
     "SingularityError",
     "LoopClosureError",
     "ConvergenceError",
@@ -50,6 +51,18 @@ class UnreachableError(LegkinError):
 
 class JointLimitError(UnreachableError):
     """A target that is geometrically reachable, but only outside the joint limits."""
+
+
+class AssemblyModeError(UnreachableError):
+    """A target that is reachable, but only in another assembly mode (or branch) than the one asked for.
+
+    Attributes:
+        modes: the mode arguments under which the target is reachable, e.g. ``[{"ll_branch": 1}]``.
+    """
+
+    def __init__(self, message: str, target=None, closest=None, modes=None):
+        super().__init__(message, target=target, closest=closest)
+        self.modes = modes or []
 
 
 class SingularityError(LegkinError):

@@ -12,7 +12,16 @@ import numpy as np
 
 from ._registry import get_spec, list_models
 
-__all__ = ["CheckResult", "compare", "run_checks", "format_table", "write_json"]
+__all__ = [
+    "CheckResult",
+    "compare",
+    "run_checks",
+    "format_table",
+    "write_json",
+    "IKRobustness",
+    "classify_failures",
+    "robustness_row",
+]
 
 
 @dataclass(frozen=True)
@@ -34,10 +43,15 @@ class CheckResult:
     tolerance: float
     passed: bool
     errors: np.ndarray = field(default=None, repr=False, compare=False)
+    #: the counts of an IK robustness row (:class:`IKRobustness`), else None.
+    counts: object = field(default=None, repr=False, compare=False)
 
     def as_dict(self) -> dict:
         """The JSON row (per-sample errors left out)."""
-        return {k: getattr(self, k) for k in ("name", "samples", "max_error", "p99_error", "tolerance", "passed")}
+        row = {k: getattr(self, k) for k in ("name", "samples", "max_error", "p99_error", "tolerance", "passed")}
+        if self.counts is not None:
+            row["counts"] = dict(vars(self.counts))
+        return row
 
 
 def compare(name: str, errors, tolerance: float) -> CheckResult:
@@ -56,14 +70,31 @@ def per_sample(diff, axis=-1):
     return np.linalg.norm(np.asarray(diff, dtype=float), axis=axis)
 
 
-def run_checks(models: list[str] | None = None, samples: int = 10_000, seed: int = 0):
-    """Run every check of each model; returns ``{model: (rows, seconds)}``."""
+def run_checks(
+    models: list[str] | None = None,
+    samples: int = 10_000,
+    seed: int = 0,
+    *,
+    ik_targets: int | None = None,
+    classify: int | None = 2000,
+):
+    """Run every check of each model; returns ``{model: (rows, seconds)}``.
+
+    A model's checks module may define ``ik_robustness(n, rng, *, classify) -> CheckResult`` (the IK contract
+    row on ``n`` random targets in and around the workspace, see :func:`robustness_row`); it runs on
+    ``ik_targets`` targets (default ``samples``), classifying at most ``classify`` unsolved ones (None: all)
+    by single calls.
+    """
     out = {}
     for name in models or list_models():
         spec = get_spec(name)
         rng = np.random.default_rng(seed)
         t0 = time.perf_counter()
-        rows = importlib.import_module(spec.checks).run(samples, rng)
+        module = importlib.import_module(spec.checks)
+        rows = list(module.run(samples, rng))
+        if hasattr(module, "ik_robustness"):
+            n = samples if ik_targets is None else ik_targets
+            rows.append(module.ik_robustness(n, np.random.default_rng(seed + 1), classify=classify))
         out[name] = (rows, time.perf_counter() - t0)
     return out
 
@@ -137,3 +168,109 @@ def sample_within_limits(robot, n: int, rng: np.random.Generator, joints: list[s
         lo, hi = model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q]
         qs[:, j.idx_q] = rng.uniform(lo, hi, n)
     return qs
+
+
+# ---------------------------------------------------------------- the IK contract row
+#: Reasons a default IK may give for leaving a target unsolved, by the legkin error a single call raises.
+REASONS = ("out of reach", "out of limits", "other mode")
+
+
+@dataclass(frozen=True)
+class IKRobustness:
+    """Counts of one IK robustness run (see :func:`robustness_row`)."""
+
+    targets: int
+    made: int
+    solved: int
+    wrong: int
+    missed: int
+    reasons: dict
+    exceptions: int
+    max_error: float
+
+    def summary(self) -> str:
+        why = ", ".join(f"{k} {v}" for k, v in self.reasons.items() if v) or "none"
+        return (
+            f"{self.targets} targets ({self.made} made by FK from in-limit joints): {self.solved} solved, "
+            f"{self.wrong} not reproduced, {self.missed} FK-made targets missed, unsolved by reason: {why}; "
+            f"{self.exceptions} foreign exceptions"
+        )
+
+
+def classify_failures(call, indices) -> tuple[dict, int]:
+    """Classify unsolved targets by the legkin error that a single call on each raises.
+
+    ``call(i)`` runs the default IK on target ``i`` as a single call. Returns ``(reasons, exceptions)``:
+    counts per reason (:data:`REASONS`; another legkin error counts under its class name, a single call that
+    succeeds where the batch failed under ``"solved by a single call"``) and the number of non-legkin
+    exceptions (each one a defect).
+    """
+    from .errors import AssemblyModeError, JointLimitError, LegkinError, UnreachableError
+
+    reasons = {k: 0 for k in REASONS}
+    exceptions = 0
+    for i in indices:
+        try:
+            call(int(i))
+        except AssemblyModeError:
+            reasons["other mode"] += 1
+        except JointLimitError:
+            reasons["out of limits"] += 1
+        except UnreachableError:
+            reasons["out of reach"] += 1
+        except LegkinError as exc:
+            key = type(exc).__name__
+            reasons[key] = reasons.get(key, 0) + 1
+        except Exception:  # noqa: BLE001 - counting foreign exceptions is the point
+            exceptions += 1
+        else:
+            reasons["solved by a single call"] = reasons.get("solved by a single call", 0) + 1
+    return reasons, exceptions
+
+
+def robustness_row(
+    mechanism: str,
+    *,
+    made: np.ndarray,
+    solved: np.ndarray,
+    error: np.ndarray,
+    reasons: dict,
+    classified: int,
+    exceptions: int,
+    tolerance: float = 1e-9,
+) -> CheckResult:
+    """The IK contract row: "IK on N random targets in and around the workspace".
+
+    Args:
+        made: (N,) True for targets made by the default forward kinematics from in-limit joints (each must
+            be solved).
+        solved: (N,) the default batch IK's mask.
+        error: (N,) ``|FK(IK(x)) - x|`` (default FK options) for the solved targets (ignored elsewhere).
+        reasons: counts of the classified unsolved targets (:func:`classify_failures`).
+        classified: how many unsolved targets were classified.
+        exceptions: non-legkin exceptions seen (batch call included).
+
+    Passes when every solved answer reproduces its target within ``tolerance``, every FK-made target is
+    solved, no single call succeeds where the batch failed, and no foreign exception was raised.
+    """
+    made, solved = np.asarray(made, bool), np.asarray(solved, bool)
+    err = np.abs(np.asarray(error, dtype=float))[solved]
+    wrong = int(np.sum(~(err <= tolerance)))
+    missed = int(np.sum(made & ~solved))
+    counts = IKRobustness(
+        targets=int(made.size), made=int(made.sum()), solved=int(solved.sum()), wrong=wrong, missed=missed,
+        reasons=dict(reasons), exceptions=int(exceptions), max_error=float(err.max()) if err.size else 0.0,
+    )
+    unsolved = int(made.size - solved.sum())
+    why = ", ".join(f"{k} {v}" for k, v in reasons.items() if v) or "none"
+    name = (
+        f"IK on {made.size} random targets in and around the workspace: {counts.solved} solved "
+        f"({wrong} not reproduced), {unsolved} unsolved ({missed} of them FK-made; {classified} classified: "
+        f"{why}), {exceptions} exceptions"
+    )
+    passed = (
+        wrong == 0 and missed == 0 and exceptions == 0 and reasons.get("solved by a single call", 0) == 0
+    )
+    emax = counts.max_error
+    p99 = float(np.percentile(err, 99)) if err.size else 0.0
+    return CheckResult(name, int(made.size), emax, p99, tolerance, bool(passed), err, counts)

@@ -2,10 +2,24 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
 
 import legkin
+
+# Property tests: reproducible on CI (derandomized: the same examples on every run, no example database,
+# failures print the blob that replays them with @reproduce_failure); random exploration locally.
+# Pick one with HYPOTHESIS_PROFILE=ci|dev; CI=true selects "ci". Every example that ever failed is kept
+# as an explicit @example beside its test.
+settings.register_profile(
+    "ci", derandomize=True, database=None, print_blob=True, deadline=None,
+    suppress_health_check=[HealthCheck.too_slow],
+)
+settings.register_profile("dev", print_blob=True, deadline=None)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci" if os.environ.get("CI") else "dev"))
 
 
 @pytest.fixture(scope="session")

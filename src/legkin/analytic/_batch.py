@@ -21,12 +21,18 @@ def as_input(x, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = Fals
     """Return ``x`` as a float array whose trailing shape is ``core``.
 
     Raises:
-        InvalidInputError: (a ``ValueError``) wrong trailing shape, or NaN/inf entries.
+        InvalidInputError: (a ``ValueError``) wrong trailing shape, NaN/inf entries, complex or non-numeric
+            input (a complex array is refused, never cut to its real part).
     """
     try:
-        arr = np.asarray(x, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InvalidInputError(f"{name} must be numeric, got {x!r}") from exc
+        raw = np.asarray(x)
+    except (TypeError, ValueError) as exc:  # ragged nested sequences
+        raise InvalidInputError(f"{name} must be a numeric array, got {x!r}") from exc
+    if raw.dtype.kind == "c":
+        raise InvalidInputError(f"{name} must be real, got a complex array ({raw.dtype})")
+    if raw.dtype.kind not in "biuf":
+        raise InvalidInputError(f"{name} must be numeric, got {x!r}")
+    arr = raw if raw.dtype == np.float64 else raw.astype(float)
     if core and (arr.ndim < len(core) or arr.shape[arr.ndim - len(core):] != core):
         raise InvalidInputError(
             f"{name} must have shape (..., {', '.join(map(str, core))}), got shape {arr.shape}"

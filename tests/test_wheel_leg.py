@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import legkin
@@ -256,6 +256,11 @@ def _solution_error(sols, alpha, w, leg, rim, target):
        st.one_of(st.floats(-0.02, 0.02), st.sampled_from([-0.02, 0.02])), st.sampled_from(wl.LEGS),
        st.sampled_from(["continuous", "seed"]))
 @settings(max_examples=120, deadline=None)
+# issue 15: a root at theta = THETA_MAX lost when the end cell also holds an interior root
+@example(theta=160 * DEG, beta=0.0, gamma=0.0, alpha=2.0, w=0.0, leg="FL", rim="continuous")
+@example(theta=160 * DEG, beta=0.0, gamma=0.0, alpha=1.6, w=0.0, leg="FL", rim="seed")
+@example(theta=17 * DEG, beta=0.0, gamma=0.0, alpha=2.0, w=0.0, leg="FR", rim="continuous")
+@example(theta=17 * DEG, beta=0.3, gamma=-0.2, alpha=1.6, w=0.01, leg="RL", rim="seed")
 def test_radial_ik_finds_every_solution(theta, beta, gamma, alpha, w, leg, rim):
     q_true = np.array([theta, beta, gamma])
     target = wl.contact_point(q_true, alpha, w, leg, rim=rim)
@@ -275,6 +280,29 @@ def test_radial_ik_finds_every_solution(theta, beta, gamma, alpha, w, leg, rim):
     d = sols - q_d
     d[:, 1:] = np.angle(np.exp(1j * d[:, 1:]))
     assert np.abs(d).max(axis=1).min() * sigma <= 1e-12
+
+
+@pytest.mark.parametrize("rim", ["continuous", "seed"])
+def test_radial_ik_lists_the_sampled_configuration_at_the_theta_ends(rim):
+    """theta drawn from {17 deg, 160 deg} (two thirds) and uniform in between: the sampled configuration is
+    always among ``info.solutions`` (issue 15: 1.3 % of end samples were missing before the fix)."""
+    rng = np.random.default_rng(15)
+    n = 4000
+    for leg in wl.LEGS:
+        theta = rng.choice([wl.THETA_MIN, wl.THETA_MAX, np.nan], n)
+        mid = np.isnan(theta)
+        theta[mid] = rng.uniform(wl.THETA_MIN, wl.THETA_MAX, mid.sum())
+        q = np.stack([theta, rng.uniform(-math.pi, math.pi, n), rng.uniform(-math.pi / 2, math.pi / 2, n)], -1)
+        alpha, w = rng.uniform(-math.pi, math.pi, n), rng.uniform(-0.02, 0.02, n)
+        target = wl.contact_point(q, alpha, w, leg, rim=rim)
+        _, ok, info = wl.ik(target, alpha, w, leg, method="radial", rim=rim, return_mask=True, return_info=True)
+        assert ok.all()
+        d = info.solutions - q[:, None, :]
+        d[..., 1:] = np.angle(np.exp(1j * d[..., 1:]))
+        dist = np.nanmin(np.abs(d).max(axis=-1), axis=1)
+        sigma = np.linalg.svd(wl.contact_jacobian(q, alpha, w, leg, rim=rim), compute_uv=False)[:, -1]
+        missing = np.flatnonzero(~(dist * sigma <= 1e-12))
+        assert missing.size == 0, (leg, q[missing[:3]], alpha[missing[:3]], w[missing[:3]])
 
 
 def test_radial_ik_batch_matches_scalar_and_other_methods():

@@ -1368,8 +1368,14 @@ def _ik_radial(target, ctx, tol, max_iter, q0, want_solutions=True):
              np.full(jt.size, np.nan))]
     its = np.zeros(n, dtype=int)
     extra_t, extra_th = [], []  # roots found without Newton (ends of the range, double roots)
-    for col in (0, -1):
-        end = np.flatnonzero((np.abs(f[:, col]) <= ftol) & ~change[:, col])
+    for col, inward in ((0, 1.0), (-1, -1.0)):
+        # An end of [17, 160] deg with |f| <= ftol is a root within rounding. The Newton bracket of the end
+        # cell finds it only when f really crosses zero there: if f approaches the end from the side that
+        # the rounded end value has (slope sign: inward * g == sign f), the cell's sign change belongs to an
+        # interior root and the end root must be added here (issue 15: theta = 160 deg, alpha = 2).
+        near = np.abs(f[:, col]) <= ftol
+        same_side = (inward * g[:, col] > 0) == (f[:, col] > 0)
+        end = np.flatnonzero(near & (~change[:, col] | same_side))
         if end.size:
             extra_t.append(end)
             extra_th.append(np.full(end.size, grid[col]))
@@ -1420,6 +1426,11 @@ def _ik_radial(target, ctx, tol, max_iter, q0, want_solutions=True):
     if want_solutions and (extra_t or len(jobs) > 1):  # else already by target, then theta
         order = np.lexsort((rth, rt))
         rt, rth, rz = rt[order], rth[order], rz[order]
+        # one root found twice (an end root that a split bracket also reaches) is listed once
+        dup = np.zeros(rt.size, dtype=bool)
+        dup[1:] = (rt[1:] == rt[:-1]) & (np.abs(rth[1:] - rth[:-1]) <= 1e-10)
+        if dup.any():
+            rt, rth, rz = rt[~dup], rth[~dup], rz[~dup]
     counts = np.bincount(rt, minlength=n)
     if want_solutions or not (extra_t or len(jobs) > 1):
         first = np.cumsum(counts) - counts  # index of each target's first root (sorted)

@@ -270,7 +270,8 @@ def test_radial_ik_finds_every_solution(theta, beta, gamma, alpha, w, leg, rim):
     assert info.error <= 1e-12 and info.solutions.ndim == 2 and info.solutions.shape[1] == 3
     # every listed solution reaches the target, the returned one is the first, the sampled q is among them
     err, sols = _solution_error(info.solutions, alpha, w, leg, rim, target)
-    assert err.max() <= 1e-12 and np.array_equal(sols[0], q)
+    first_in_limits = sols[np.abs(sols[:, 2]) <= wl.ABAD_LIMIT + 1e-12][0]
+    assert err.max() <= 1e-12 and np.abs(q - first_in_limits).max() <= 1e-12 and abs(q[2]) <= wl.ABAD_LIMIT
     d = sols - q_true
     d[:, 1:] = np.angle(np.exp(1j * d[:, 1:]))
     sigma = np.linalg.svd(wl.contact_jacobian(q_true, alpha, w, leg, rim=rim), compute_uv=False)[-1]
@@ -324,7 +325,7 @@ def test_radial_ik_batch_matches_scalar_and_other_methods():
     q2, info2 = wl.ik(t.reshape(3, 100, 3), alpha.reshape(3, 100), w.reshape(3, 100), "RL", method="radial",
                       rim="seed", return_info=True)
     assert q2.shape == (3, 100, 3) and info2.solutions.shape[:2] == (3, 100) and info2.error.shape == (3, 100)
-    assert wl.ik(t[0], alpha[0], w[0], "RL", rim="seed", return_info=True)[1].solutions is None
+    assert wl.ik(t[0], alpha[0], w[0], "RL", method="damped", rim="seed", return_info=True)[1].solutions is None
 
 
 def test_radial_ik_two_roots_near_a_fold():
@@ -362,8 +363,12 @@ def test_radial_ik_q0_picks_the_nearest_solution():
     assert other[0] == pytest.approx(q_true[0], abs=1e-12) and abs(other[2] - q_true[2]) > 1.0
     assert np.linalg.norm(wl.contact_point(other, 0.3, 0.01, "FR") - target) <= 1e-12
     q0 = other + [0.05, 2 * math.pi, -2 * math.pi]
-    q1 = wl.ik(target, 0.3, 0.01, "FR", method="radial", q0=q0)
+    q1 = wl.ik(target, 0.3, 0.01, "FR", method="radial", q0=q0, limits=False)
     assert q1 == pytest.approx(other + [0.0, 2 * math.pi, -2 * math.pi], abs=1e-12)  # within pi of q0's angles
+    # with the ABAD limits (default) the other branch's gamma is out of [-pi/2, pi/2]: the in-limit answer
+    assert abs(other[2]) > wl.ABAD_LIMIT
+    q1 = wl.ik(target, 0.3, 0.01, "FR", method="radial", q0=q0)
+    assert q1 == pytest.approx(q_true + [0.0, 2 * math.pi, 0.0], abs=1e-12)
     q2 = wl.ik(target, 0.3, 0.01, "FR", method="radial", q0=q_true + 0.1)
     assert q2 == pytest.approx(q_true, abs=1e-12)
 

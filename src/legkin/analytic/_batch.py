@@ -12,9 +12,9 @@ from typing import Callable
 
 import numpy as np
 
-from ..errors import InvalidInputError
+from ..errors import InvalidInputError, InvalidParameterError
 
-__all__ = ["as_input", "as_angles", "finish"]
+__all__ = ["as_input", "as_angles", "finish", "check_number", "check_integer", "check_flag", "check_choice"]
 
 
 def as_input(x, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = False) -> np.ndarray:
@@ -76,4 +76,63 @@ def finish(
         if isinstance(value, tuple):
             return (*value, ok)
         return value, ok
+    return value
+
+
+def _range_text(low, high, low_open: bool, high_open: bool) -> str:
+    lo = "-inf" if low is None else f"{low:g}"
+    hi = "inf" if high is None else f"{high:g}"
+    return f"{'(' if low_open or low is None else '['}{lo}, {hi}{')' if high_open or high is None else ']'}"
+
+
+def check_number(
+    value, name: str, low: float | None = None, high: float | None = None, *,
+    low_open: bool = False, high_open: bool = False,
+) -> float:
+    """A keyword parameter that must be one finite real number in a range; returns it as a float.
+
+    Raises:
+        InvalidParameterError: (a ``ValueError``) not a real number, NaN/inf, or outside the range; the
+            message names the value and the range.
+    """
+    rng = _range_text(low, high, low_open, high_open)
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
+        if not (isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf"):
+            raise InvalidParameterError(f"{name} must be a real number in {rng}, got {value!r}")
+    v = float(value)
+    bad = not np.isfinite(v)
+    if low is not None:
+        bad |= v <= low if low_open else v < low
+    if high is not None:
+        bad |= v >= high if high_open else v > high
+    if bad:
+        raise InvalidParameterError(f"{name}={v!r} is out of range: must be a finite number in {rng}")
+    return v
+
+
+def check_integer(value, name: str, low: int | None = None, high: int | None = None) -> int:
+    """A keyword parameter that must be an integer in ``[low, high]``."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise InvalidParameterError(f"{name} must be an integer in {_range_text(low, high, False, False)}, got {value!r}")
+    v = int(value)
+    if (low is not None and v < low) or (high is not None and v > high):
+        raise InvalidParameterError(f"{name}={v} is out of range: must be an integer in {_range_text(low, high, False, False)}")
+    return v
+
+
+def check_flag(value, name: str) -> bool:
+    """A keyword parameter that must be a bool."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise InvalidParameterError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def check_choice(value, name: str, choices) -> object:
+    """A keyword parameter that must be one of ``choices`` (compared with ==, hashable values only)."""
+    try:
+        ok = value in tuple(choices)
+    except Exception:  # noqa: BLE001 - an unhashable or array value is simply not a valid choice
+        ok = False
+    if isinstance(value, np.ndarray) or not ok:
+        raise InvalidParameterError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
     return value

@@ -31,8 +31,8 @@ from typing import Mapping, NamedTuple
 
 import numpy as np
 
-from ..errors import InvalidInputError, InvalidParameterError, UnreachableError
-from ._batch import as_angles, as_input, finish
+from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
+from ._batch import as_angles, as_input, check_flag, check_integer, check_number, finish
 
 __all__ = [
     "LEGS",
@@ -99,13 +99,31 @@ class Geometry:
     d_wheel: float = 0.091675
     T: float = 0.04
 
+    def __post_init__(self) -> None:
+        from ..models.wheel_leg import SPEC  # the model's parameter ranges, one source
+
+        for f in fields(self):
+            object.__setattr__(self, f.name, float(SPEC.params[f.name].check(f.name, getattr(self, f.name))))
+
     @classmethod
     def from_params(cls, params: Mapping[str, object] | None) -> "Geometry":
         """Build from a mapping (e.g. ``Robot.params``); keys that are not kinematic are ignored."""
         if params is None:
             return cls()
         names = {f.name for f in fields(cls)}
-        return cls(**{k: float(v) for k, v in params.items() if k in names})
+        return cls(**{k: v for k, v in params.items() if k in names})
+
+
+def _geometry(geometry) -> Geometry:
+    """``geometry`` or the default; anything but a :class:`Geometry` is refused."""
+    if geometry is None:
+        return _DEFAULT_GEOMETRY
+    if not isinstance(geometry, Geometry):
+        raise InvalidParameterError(f"geometry must be a wheel_leg.Geometry, got {type(geometry).__name__}")
+    return geometry
+
+
+_DEFAULT_GEOMETRY = Geometry()
 
 
 class _Const(NamedTuple):
@@ -311,7 +329,7 @@ def linkage_points(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict
     Returns:
         dict name -> array (..., 3) of (x, y, w = 0) in {L}; names in :data:`POINTS`.
     """
-    geo = geometry or Geometry()
+    geo = _geometry(geometry)
     theta, beta = as_angles(theta, beta, names=("theta", "beta"))
     _check_theta(theta)
     pts, _ = _closed_form(theta, _constants(geo.R), geo.R + FOOT_OFFSET, want_der=False)
@@ -350,7 +368,7 @@ def passive_angles(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict
     Returns:
         dict joint name (without the ``<leg>_`` prefix, see :data:`PASSIVE_JOINTS`) -> array.
     """
-    geo = geometry or Geometry()
+    geo = _geometry(geometry)
     theta, beta = as_angles(theta, beta, names=("theta", "beta"))
     _check_theta(theta)
     c = _constants(geo.R)
@@ -520,7 +538,7 @@ def rim_point(theta, beta, alpha, w=0.0, *, radius: float | None = None, geometr
     Returns:
         array (..., 3): (x, y, w) in {L}.
     """
-    geo = geometry or Geometry()
+    geo = _geometry(geometry)
     theta, beta, alpha, w = _rim_inputs(theta, beta, alpha, w, geo)
     z, _ = _rim_continuous(theta, beta, alpha, geo, geo.R if radius is None else float(radius), False)
     return _xyw(z, w)
@@ -541,7 +559,7 @@ def rim_point_seed(theta, beta, alpha, w=0.0, *, radius: float | None = None, ge
     leaves out the lower-rim arcs: it is discontinuous at alpha = +-psi_FG once theta > theta0
     (:func:`rim_jump_seed`), and the toe arc about O_r is not attached to any link.
     """
-    geo = geometry or Geometry()
+    geo = _geometry(geometry)
     theta, beta, alpha, w = _rim_inputs(theta, beta, alpha, w, geo)
     rho = geo.R + FOOT_OFFSET if radius is None else float(radius)
     z, _ = _rim_seed(theta, beta, alpha, geo, rho, False)
@@ -553,7 +571,7 @@ def rim_jump_seed(theta, *, radius: float | None = None, geometry: Geometry | No
 
     The distance between the toe-arc point at alpha = psi_FG and the upper-rim point at alpha -> psi_FG+.
     """
-    geo = geometry or Geometry()
+    geo = _geometry(geometry)
     theta = as_input(theta, "theta")
     _check_theta(theta)
     rho = geo.R + FOOT_OFFSET if radius is None else float(radius)
@@ -587,7 +605,7 @@ def _leg(leg) -> tuple[int, str, float]:
 
 def module_origin(leg, geometry: Geometry | None = None) -> np.ndarray:
     """Origin of the module frame {M_i} in {R}: (+-L_body/2, +-W_body/2, d_abad)."""
-    geo = geometry or Geometry()
+    geo = _geometry(geometry)
     _, side, sx = _leg(leg)
     sy = 1.0 if side == "L" else -1.0
     return np.array([sx * geo.L_body / 2, sy * geo.W_body / 2, geo.d_abad])
@@ -605,7 +623,7 @@ def leg_frame_to_robot(p_L, gamma, leg, *, geometry: Geometry | None = None) -> 
     ``p_M = T_L^M p_L`` (the seed's matrices, offset d_wheel), ``p_R = o_i + R0_i Rz(gamma) p_M``; the
     seed does not print ``T_M^R``: this is the module placement of "Coord definitions".
     """
-    geo = geometry or Geometry()
+    geo = _geometry(geometry)
     _, side, _ = _leg(leg)
     p_L = as_input(p_L, "p_L", (3,))
     gamma = as_input(gamma, "gamma")
@@ -643,7 +661,7 @@ def _context(alpha, w, leg, rim, geo, radius) -> _Ctx:
     if radius is None:
         rho = geo.R + FOOT_OFFSET if seed else geo.R
     else:
-        rho = float(radius)
+        rho = check_number(radius, "radius", 0.0, 2.0 * geo.R, low_open=True)
     sel = _select(alpha, seed, rho, geo.R)
     return _Ctx(sel, np.asarray(w, dtype=float), _constants(geo.R), geo, module_origin(leg, geo),
                 1.0 if side == "L" else -1.0, seed)
@@ -716,7 +734,7 @@ def contact_point(q, alpha, w, leg, *, rim: str = "continuous", radius: float | 
     Returns:
         (..., 3) point in {R}.
     """
-    geo = geometry or Geometry()
+    geo = _geometry(geometry)
     q, alpha, w = _q_inputs(q, alpha, w, geo)
     return _contact(q, alpha, w, leg, rim, geo, False, radius)[0]
 
@@ -729,7 +747,7 @@ def contact_jacobian(q, alpha, w, leg, *, rim: str = "continuous", radius: float
     theta-derivatives are carried through every step (forward mode by hand, :func:`_closed_form`),
     d/dbeta is ``i z`` in the leg plane and d/dgamma is ``R0 Rz(gamma) (e_z x p_M)``.
     """
-    geo = geometry or Geometry()
+    geo = _geometry(geometry)
     q, alpha, w = _q_inputs(q, alpha, w, geo)
     return _contact(q, alpha, w, leg, rim, geo, True, radius)[1]
 
@@ -803,6 +821,7 @@ def _arc_coefficients(sel: _Sel, r2) -> np.ndarray:
 
 
 _GUESS_NODES = 64
+_START_MARGIN = 0.5 * (THETA_MAX - THETA_MIN) / (_GUESS_NODES - 1)
 
 
 @lru_cache(maxsize=16)
@@ -840,10 +859,11 @@ def _initial_guesses(target, alpha, w, leg, rim, geo, radius, count: int = 3):
     return _guesses(target, _context(alpha, w, leg, rim, geo, radius), count)
 
 
-def _guesses(target, ctx: _Ctx, count: int):
+def _guesses(target, ctx: _Ctx, count: int, branch: float = -1.0):
+    """(count, ..., 3) starts on the out-of-plane branch ``sign(y_L) = branch`` (see :func:`_initial_guesses`)."""
     shape = target.shape[:-1]
     x_L, yabs, a, m = _out_of_plane(target, ctx)
-    y = -yabs
+    y = branch * yabs
     gamma = np.angle(_cis(np.arctan2(m.imag, m.real) - np.arctan2(y, a)))
     tgt = x_L + 1j * y
     grid, table = _arc_table(ctx.geo.R, ctx.seed, _GUESS_NODES)
@@ -873,58 +893,83 @@ def _guesses(target, ctx: _Ctx, count: int):
     for k in order:
         k = k.reshape(shape)
         zk = _rot(0.0) * _plane({name: v[k] for name, v in pts.items()}, None, ctx.sel, False)[0]
-        out.append(np.stack([grid[k], np.angle(tgt / zk), gamma], -1))
+        # half a grid cell inside the domain: a start on a bound of theta can stall the projected iteration
+        # there (seen: theta = 160 deg start, solution at 158.5 deg, error stuck at 2.8e-5 m)
+        theta = np.clip(grid[k], THETA_MIN + _START_MARGIN, THETA_MAX - _START_MARGIN)
+        out.append(np.stack([theta, np.angle(tgt / zk), gamma], -1))
     return np.stack(out)
 
 
-def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "damped", rim: str = "continuous",
+def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "radial", rim: str = "continuous",
        tol: float = 1e-12, max_iter: int | None = None, delta: float = 1e-6, radius: float | None = None,
-       geometry: Geometry | None = None, return_mask: bool = False, return_info: bool = False):
+       limits: bool = True, geometry: Geometry | None = None, return_mask: bool = False,
+       return_info: bool = False):
     """(theta, beta, gamma) placing the rim point (alpha, w) of ``leg`` at ``target`` in {R} (seed 2).
 
     Methods:
+        ``"radial"`` (default): not an iteration on the 3x3 system at all: gamma and beta in closed form
+        and a 1-D bracketed Newton for theta (:func:`_ik_radial` states the math). It finds every theta in
+        [17 deg, 160 deg] that reaches the target; ``info.solutions`` lists them, for both signs of the
+        out-of-plane square root: the branch ``y_L <= 0`` by increasing theta, then the branch ``y_L > 0``.
+        Without ``q0`` it returns the first solution in that order whose gamma is inside the ABAD limits;
+        with ``q0`` the usable solution nearest ``q0`` (distance ``sqrt(dtheta^2 + dbeta^2 + dgamma^2)``,
+        angle differences wrapped), with beta shifted by a multiple of 2 pi to lie within pi of ``q0``'s.
+        ``max_iter`` (default 60) bounds the Newton iterations per root; ``delta`` is not used.
         ``"seed"``: seed 2.2-2.3 as printed: Gauss-Newton ``dq = -(J^T J)^{-1} J^T E`` with the
         forward-difference Jacobian ``(FK(q + delta e_k) - FK(q)) / delta``, full steps, no bounds
-        (the baseline). Fails if J^T J is singular, theta leaves the linkage's domain, or it does not
+        (the baseline), from the best geometric start of each out-of-plane branch in turn. Fails if J^T J is singular, theta leaves the linkage's domain, or it does not
         converge in ``max_iter`` (default 100) iterations.
-        ``"damped"`` (default): the same iteration with the analytic Jacobian (:func:`contact_jacobian`),
+        ``"damped"``: the same iteration with the analytic Jacobian (:func:`contact_jacobian`),
         Levenberg-Marquardt damping when a full step does not reduce ``|E|``, and theta projected onto
         [17 deg, 160 deg] (default ``max_iter`` 60); once ``|E| <= tol`` one more step is taken if it
         lowers ``|E|`` (so the result is usually at rounding level, not just under ``tol``).
-        ``"radial"``: not an iteration on the 3x3 system at all: gamma and beta in closed form and a
-        1-D bracketed Newton for theta (:func:`_ik_radial` states the math). It finds every theta in
-        [17 deg, 160 deg] that reaches the target; ``info.solutions`` lists them (for both signs of the
-        out-of-plane square root). Without ``q0`` it returns the smallest theta on the branch ``y_L <= 0``
-        (the branch of the geometric start of the other methods); with ``q0`` the solution nearest ``q0``
-        (distance ``sqrt(dtheta^2 + dbeta^2 + dgamma^2)``, angle differences wrapped), with beta and
-        gamma shifted by multiples of 2 pi to lie within pi of ``q0``'s. ``max_iter`` (default 60)
-        bounds the Newton iterations per root; ``delta`` is not used.
 
-    The iterative methods start from ``q0`` if given, else from a geometric guess (gamma exact, theta from a
-    grid; not the lab's beta = 90 deg default): the seed method from the best guess only, the damped method
-    restarts a failed target from the next two local minima of the grid (several theta can give the same
-    radius). Converged means ``|E| <= tol`` (m), ``E`` the contact point (:func:`contact_point`) minus the
-    target. ``info.iterations`` counts every iteration, restarts included (radial: Newton and bracketing
-    steps summed over the target's roots).
+    The iterative methods start from ``q0`` if given, else from geometric guesses (gamma exact, theta from a
+    grid; not the lab's beta = 90 deg default): the seed method from the best guess of each branch, the damped
+    method restarts a failed target from the next local minima of the grid and then from the guesses of the other
+    out-of-plane branch. Converged means ``|E| <= tol`` (m), ``E`` the contact point (:func:`contact_point`)
+    minus the target. ``info.iterations`` counts every iteration, restarts included (radial: Newton and
+    bracketing steps summed over the target's roots).
+
+    The contract (docs/wheel_leg.md): every answer marked solved is reproduced by :func:`contact_point` with
+    the same ``alpha, w, leg, rim, radius`` to ``tol``; with ``limits=True`` (default) its gamma lies inside
+    the ABAD joint's URDF limits [-pi/2, pi/2] (:data:`ABAD_LIMIT`) and theta in [17 deg, 160 deg]; the
+    default method solves every target that :func:`contact_point` makes from such joints.
 
     Args:
-        target: (..., 3) points in {R}; alpha (rad), w (m) broadcast with its leading shape.
+        target: (..., 3) points in {R}; alpha (rad), w (m), q0 broadcast with its leading shape.
         q0: (..., 3) start (theta, beta, gamma) (radial: the configuration to stay near).
+        tol: convergence tolerance (m), in (0, 1e-3].
+        max_iter: iteration bound, an integer >= 1 (None: the method's default).
+        delta: forward-difference step of ``method="seed"`` (rad), in (0, 0.1].
+        radius: rim radius of the contact point (m), in (0, 2 R] (None: the rim's own, see :func:`rim_point`).
+        limits: keep only answers inside the ABAD joint limits (False: any gamma).
         return_mask: also return the mask of converged targets (batch).
         return_info: also return an :class:`IKInfo` (iterations, final error per target; radial: solutions).
 
     Raises:
+        JointLimitError: single target reachable, but only with gamma outside the ABAD limits.
         UnreachableError: single target not reached (``closest`` = the point reached).
-        InvalidInputError: NaN/inf or wrong shapes, alpha or w out of range.
-        InvalidParameterError: unknown ``method``, ``rim`` or ``leg``.
+        InvalidInputError: NaN/inf, complex or wrong shapes, alpha or w out of range.
+        InvalidParameterError: unknown ``method``, ``rim`` or ``leg``; a keyword out of its range.
     """
-    geo = geometry or Geometry()
+    geo = _geometry(geometry)
     target = as_input(target, "target", (3,))
     alpha, w = as_input(alpha, "alpha"), as_input(w, "w")
+    q0 = None if q0 is None else as_input(q0, "q0", (3,))
+    tol = check_number(tol, "tol", 0.0, 1e-3, low_open=True)
+    delta = check_number(delta, "delta", 0.0, 0.1, low_open=True)
+    if max_iter is not None:
+        max_iter = check_integer(max_iter, "max_iter", 1, 100_000)
+    limits = check_flag(limits, "limits")
+    shapes = [target.shape[:-1], alpha.shape, w.shape] + ([] if q0 is None else [q0.shape[:-1]])
     try:
-        shape = np.broadcast_shapes(target.shape[:-1], alpha.shape, w.shape)
+        shape = np.broadcast_shapes(*shapes)
     except ValueError as exc:
-        raise InvalidInputError(f"inputs do not broadcast together: target{target.shape}, alpha{alpha.shape}, w{w.shape}") from exc
+        raise InvalidInputError(
+            f"inputs do not broadcast together: target{target.shape}, alpha{alpha.shape}, w{w.shape}"
+            + ("" if q0 is None else f", q0{q0.shape}")
+        ) from exc
     scalar = shape == ()
     target = np.broadcast_to(target, shape + (3,)).astype(float)
     alpha, w = np.broadcast_to(alpha, shape).astype(float), np.broadcast_to(w, shape).astype(float)
@@ -936,33 +981,19 @@ def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "damped", r
     _leg(leg)
     n = int(np.prod(shape, dtype=int))
     if q0 is not None:
-        q0 = np.array(np.broadcast_to(as_input(q0, "q0", (3,)), shape + (3,)), dtype=float)
+        q0 = np.array(np.broadcast_to(q0, shape + (3,)), dtype=float)
         _check_theta(q0[..., 0], "theta (q0[..., 0])")
         q0 = q0.reshape(n, 3)
     ctx = _context(alpha.reshape(n), w.reshape(n), leg, rim, geo, radius)  # validated once; the solvers iterate on it
     flat = target.reshape(n, 3)
     solutions = None
     if method == "radial":
-        q, it, err, ok, solutions = _ik_radial(flat, ctx, tol, max_iter, q0, want_solutions=return_info)
-        if solutions is not None:
-            solutions = solutions.reshape(shape + solutions.shape[1:])
+        q, it, err, ok, solutions, reason = _ik_radial(flat, ctx, tol, max_iter, q0, limits)
+        solutions = solutions.reshape(shape + solutions.shape[1:]) if return_info else None
     else:
-        starts = _guesses(flat, ctx, 1 if method == "seed" else 3) if q0 is None else q0[None]
-        solver = _ik_seed if method == "seed" else _ik_damped
-        q, it, err, ok = solver(starts[0].copy(), flat, ctx, tol, max_iter, delta)
-        for start in starts[1:]:  # restart the failures from the next geometric guess
-            f = np.flatnonzero(~ok)
-            if f.size == 0:
-                break
-            qf, itf, errf, okf = solver(start[f].copy(), flat[f], ctx.take(f), tol, max_iter, delta)
-            it[f] += itf
-            take = okf | (errf < err[f])
-            q[f[take]], err[f[take]], ok[f] = qf[take], errf[take], okf
-    with np.errstate(invalid="ignore"):
-        inside = (q[:, 0] >= THETA_MIN - 1e-12) & (q[:, 0] <= THETA_MAX + 1e-12)
-    ok &= inside & np.all(np.isfinite(q), axis=1)
+        q, it, err, ok, reason = _ik_iterative(flat, ctx, q0, method, tol, max_iter, delta, limits)
     q = q.reshape(shape + (3,))
-    it, err, ok = it.reshape(shape), err.reshape(shape), ok.reshape(shape)
+    it, err, ok, reason = it.reshape(shape), err.reshape(shape), ok.reshape(shape), reason.reshape(shape)
     closest = None
     if scalar and not bool(ok):
         with np.errstate(invalid="ignore"):
@@ -973,10 +1004,18 @@ def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "damped", r
     info = IKInfo(it, err, solutions)
 
     def error():
+        where = (f"target {np.asarray(target).reshape(3).tolist()} for leg {leg!r} (alpha={float(alpha)!r}, "
+                 f"w={float(w)!r})")
+        if int(reason) == _LIMITS:
+            return JointLimitError(
+                f"{where} is reachable only with the ABAD angle outside its limits [-pi/2, pi/2] "
+                f"(gamma={float(q[2]):.6g} rad); pass limits=False to accept it",
+                target=np.asarray(target).reshape(3), closest=closest,
+            )
         return UnreachableError(
-            f"target {np.asarray(target).reshape(3).tolist()} not reached for leg {leg!r} (alpha={float(alpha)!r}, "
-            f"w={float(w)!r}) with method {method!r}: final error {float(err):.3e} m after {int(it)} iterations "
-            f"(tolerance {tol:.1e} m, theta in [17, 160] deg); closest point reached {None if closest is None else closest.tolist()}",
+            f"{where} not reached with method {method!r}: final error {float(err):.3e} m after {int(it)} "
+            f"iterations (tolerance {tol:.1e} m, theta in [17, 160] deg); closest point reached "
+            f"{None if closest is None else closest.tolist()}",
             target=np.asarray(target).reshape(3),
             closest=closest,
         )
@@ -985,6 +1024,55 @@ def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "damped", r
     if return_info:
         return (*out, info) if isinstance(out, tuple) else (out, info)
     return out
+
+
+#: ABAD joint limit (rad): the URDF's ``<leg>_abad`` joints range over [-ABAD_LIMIT, ABAD_LIMIT].
+ABAD_LIMIT = math.pi / 2
+#: Beyond a limit by at most this (rad) counts as on it (the answer is clipped onto the limit).
+_LIMIT_ROUNDING = 1e-12
+_SOLVED, _UNREACHABLE, _LIMITS = 0, 1, 2
+
+
+def _in_limits(q: np.ndarray, limits: bool) -> np.ndarray:
+    """Mask of answers inside theta's domain and (``limits``) the ABAD limits; clips within-rounding ones."""
+    with np.errstate(invalid="ignore"):
+        inside = (q[:, 0] >= THETA_MIN - 1e-12) & (q[:, 0] <= THETA_MAX + 1e-12) & np.all(np.isfinite(q), axis=1)
+        if limits:
+            inside &= np.abs(q[:, 2]) <= ABAD_LIMIT + _LIMIT_ROUNDING
+            q[inside, 2] = np.clip(q[inside, 2], -ABAD_LIMIT, ABAD_LIMIT)
+    return inside
+
+
+def _ik_iterative(flat, ctx, q0, method, tol, max_iter, delta, limits):
+    """The seed and damped methods: solve from each start in turn, restarting the targets not yet solved
+    (not converged, or converged outside the limits)."""
+    if q0 is not None:
+        starts = q0[None]
+    elif method == "seed":  # the best start of each out-of-plane branch
+        starts = np.concatenate([_guesses(flat, ctx, 1), _guesses(flat, ctx, 1, branch=1.0)])
+    else:  # the grid's three best starts on the branch y_L <= 0, then on y_L > 0
+        starts = np.concatenate([_guesses(flat, ctx, 3), _guesses(flat, ctx, 3, branch=1.0)])
+    solver = _ik_seed if method == "seed" else _ik_damped
+    n = flat.shape[0]
+    q = np.full((n, 3), np.nan)
+    it, err = np.zeros(n, dtype=int), np.full(n, np.inf)
+    ok = np.zeros(n, dtype=bool)
+    converged_outside = np.zeros(n, dtype=bool)
+    for start in starts:
+        f = np.flatnonzero(~ok)
+        if f.size == 0:
+            break
+        qf, itf, errf, okf = solver(start[f].copy(), flat[f], ctx if f.size == n else ctx.take(f), tol, max_iter,
+                                    delta)
+        it[f] += itf
+        inside = _in_limits(qf, limits)
+        good = okf & inside
+        converged_outside[f] |= okf & ~inside
+        take = good | (errf < err[f])
+        q[f[take]], err[f[take]] = qf[take], errf[take]
+        ok[f] = good
+    reason = np.where(ok, _SOLVED, np.where(converged_outside, _LIMITS, _UNREACHABLE))
+    return q, it, err, ok, reason
 
 
 _METHODS = ("damped", "seed", "radial")
@@ -1031,6 +1119,26 @@ def _ik_seed(q, target, ctx, tol, max_iter, delta):
     return q, it, err, ok
 
 
+def _solve3(M: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``M^-1 b`` for a batch of 3x3 systems; NaN rows where ``M`` is singular or not finite (the damped
+    iteration then damps harder), instead of numpy's LinAlgError for the whole batch (issue 10)."""
+    with np.errstate(all="ignore"):
+        det = np.linalg.det(M)
+        good = np.isfinite(det) & (det != 0.0)
+        out = np.full(b.shape, np.nan)
+        if good.all():
+            try:
+                return np.linalg.solve(M, b[..., None])[..., 0]
+            except np.linalg.LinAlgError:  # a zero pivot that the determinant's rounding hid
+                good = np.zeros(good.shape, dtype=bool)
+        for i in np.flatnonzero(good) if not good.all() else ():
+            try:
+                out[i] = np.linalg.solve(M[i], b[i])
+            except np.linalg.LinAlgError:
+                pass
+    return out
+
+
 def _ik_damped(q, target, ctx, tol, max_iter, delta):
     max_iter = 60 if max_iter is None else max_iter
     n = q.shape[0]
@@ -1063,7 +1171,7 @@ def _ik_damped(q, target, ctx, tol, max_iter, delta):
                 break
             t = np.flatnonzero(todo)
             M = JtJ[t] + (lam[t] * scale[t])[:, None, None] * eye
-            dq = -np.linalg.solve(M, JtE[t][..., None])[..., 0]
+            dq = -_solve3(M, JtE[t])
             qn = q[a[t]] + dq
             qn[:, 0] = np.clip(qn[:, 0], THETA_MIN, THETA_MAX)
             pn = _fk_flat(qn, ctx_a if t.size == a.size else ctx_a.take(t), False)[0]
@@ -1302,7 +1410,7 @@ def _radial_newton(lo, hi, flo, fhi, glo, ghi, guess, coef, sel, ctx, r2, mb, ma
     return root, np.where(sel.right, np.conj(z), z), its, conv
 
 
-def _ik_radial(target, ctx, tol, max_iter, q0, want_solutions=True):
+def _ik_radial(target, ctx, tol, max_iter, q0, limits=True):
     """The radial IK: gamma and beta in closed form, theta from the 1-D equation ``|c(theta, alpha)| = r``.
 
     Not in the seed, which iterates Gauss-Newton on all three unknowns with a forward-difference Jacobian
@@ -1334,12 +1442,15 @@ def _ik_radial(target, ctx, tol, max_iter, q0, want_solutions=True):
     the contact point is the crank hinge B, ``|c| = R`` for every theta: f is rounding noise, every theta
     solves the IK and the grid reports many roots.
 
-    Returns ``(q, iterations, error, converged, solutions)``; ``solutions`` (n, S, 3), NaN-padded (None
-    unless ``want_solutions``): for each root by increasing theta the branch ``y_L <= 0``, then the same
-    roots on the branch ``y_L > 0`` (absent when ``y_L = 0``). The returned solution is checked with the
-    forward kinematics (:func:`_fk_flat`): converged means ``|contact_point(q) - target| <= tol``. A target
-    without a root gets, as its (unconverged) q, the grid node of smallest ``|f|`` with beta, gamma from the
-    branch ``y_L <= 0``.
+    Returns ``(q, iterations, error, converged, solutions, reason)``; ``solutions`` (n, S, 3), NaN-padded:
+    for each root by increasing theta the branch ``y_L <= 0``, then the same roots on the branch ``y_L > 0``
+    (absent when ``y_L = 0``). The answer is the first solution in that order whose gamma is inside the ABAD
+    joint's URDF limits ``[-pi/2, pi/2]`` (``limits=False``: the first), or with ``q0`` the usable solution
+    nearest ``q0``. It is checked with the forward kinematics (:func:`_fk_flat`): converged means
+    ``|contact_point(q) - target| <= tol``. ``reason`` per target: 0 solved, 1 no root (out of reach),
+    2 every root outside the ABAD limits. A target without a root gets, as its (unconverged) q, the grid
+    node of smallest ``|f|`` with beta, gamma from the branch ``y_L <= 0``; one reachable only outside the
+    limits, its first solution.
     """
     max_iter = 60 if max_iter is None else max_iter
     n = target.shape[0]
@@ -1422,8 +1533,7 @@ def _ik_radial(target, ctx, tol, max_iter, q0, want_solutions=True):
         pts, _ = _closed_form(xth, ctx.c, ctx.geo.R + FOOT_OFFSET, False, full=ctx.seed)
         xz, _ = _plane(pts, None, ctx.sel.take(xt), False)
         rt, rth, rz = np.concatenate([rt, xt]), np.concatenate([rth, xth]), np.concatenate([rz, xz])
-    want_solutions = want_solutions or q0 is not None
-    if want_solutions and (extra_t or len(jobs) > 1):  # else already by target, then theta
+    if extra_t or len(jobs) > 1:  # else already by target, then theta
         order = np.lexsort((rth, rt))
         rt, rth, rz = rt[order], rth[order], rz[order]
         # one root found twice (an end root that a split bracket also reaches) is listed once
@@ -1432,41 +1542,45 @@ def _ik_radial(target, ctx, tol, max_iter, q0, want_solutions=True):
         if dup.any():
             rt, rth, rz = rt[~dup], rth[~dup], rz[~dup]
     counts = np.bincount(rt, minlength=n)
-    if want_solutions or not (extra_t or len(jobs) > 1):
-        first = np.cumsum(counts) - counts  # index of each target's first root (sorted)
-    else:  # index of each target's smallest root, without sorting
-        best = np.full(n, np.inf)
-        np.minimum.at(best, rt, rth)
-        at_best = np.flatnonzero(rth == best[rt])
-        first = np.zeros(n, dtype=int)
-        first[rt[at_best]] = at_best
+    first = np.cumsum(counts) - counts  # index of each target's first root (sorted)
     tau = x_L[rt] - 1j * yabs[rt]  # branch y_L <= 0; exp(i (beta + pi/2)) c = tau
     ccz = np.conj(rz) * -1j
     beta1 = np.angle(tau * ccz)
     gamma1 = np.angle(m * (a + 1j * yabs))
     has = counts > 0
     q = np.full((n, 3), np.nan)
-    sols = None
-    if want_solutions:
-        rank = np.arange(rt.size) - first[rt]
-        S = int((counts * np.where(yabs > 0, 2, 1)).max()) if n else 0
-        sols = np.full((n, S, 3), np.nan)
-        sols[rt, rank] = np.stack([rth, beta1, gamma1[rt]], -1)
-        two = np.flatnonzero(yabs[rt] > 0)
-        if two.size:
-            t2 = rt[two]
-            sols[t2, counts[t2] + rank[two]] = np.stack(
-                [rth[two], np.angle(np.conj(tau[two]) * ccz[two]), np.angle(m[t2] * (a[t2] - 1j * yabs[t2]))], -1)
-    if q0 is None:
-        k = first[has]
-        q[has] = np.stack([rth[k], beta1[k], gamma1[has]], -1)
-    elif sols.shape[1]:
+    rank = np.arange(rt.size) - first[rt]
+    S = int((counts * np.where(yabs > 0, 2, 1)).max()) if n else 0
+    sols = np.full((n, S, 3), np.nan)
+    sols[rt, rank] = np.stack([rth, beta1, gamma1[rt]], -1)
+    two = np.flatnonzero(yabs[rt] > 0)
+    if two.size:
+        t2 = rt[two]
+        sols[t2, counts[t2] + rank[two]] = np.stack(
+            [rth[two], np.angle(np.conj(tau[two]) * ccz[two]), np.angle(m[t2] * (a[t2] - 1j * yabs[t2]))], -1)
+    usable = ~np.isnan(sols[..., 0])
+    if limits:  # the ABAD joint's URDF limits; within rounding of a limit counts as on it
+        g = sols[..., 2]
+        with np.errstate(invalid="ignore"):
+            usable &= np.abs(g) <= ABAD_LIMIT + _LIMIT_ROUNDING
+            sols[..., 2] = np.where(usable, np.clip(g, -ABAD_LIMIT, ABAD_LIMIT), g)
+    in_lim = usable.any(axis=1)
+    if not S:  # no target has a root
+        pass
+    elif q0 is None:  # the first usable solution in the documented order
+        k = np.argmax(usable, axis=1)
+        q[in_lim] = sols[in_lim, k[in_lim]]
+    else:
         diff = sols - q0[:, None, :]
         diff[..., 1:] = np.angle(_cis(diff[..., 1:]))  # wrapped angle differences
-        d2 = np.where(np.isnan(diff[..., 0]), np.inf, np.sum(diff * diff, axis=-1))
+        d2 = np.where(usable, np.sum(diff * diff, axis=-1), np.inf)
         k = np.argmin(d2, axis=1)[:, None, None]
-        q[has] = np.take_along_axis(sols, k, 1)[has, 0]
-        q[has, 1:] = (q0[:, 1:] + np.take_along_axis(diff, k, 1)[:, 0, 1:])[has]  # within pi of q0's
+        q[in_lim] = np.take_along_axis(sols, k, 1)[in_lim, 0]
+        c = 2 if limits else 3  # beta (and without limits gamma) within pi of q0's
+        q[in_lim, 1:c] = (q0[:, 1:c] + np.take_along_axis(diff, k, 1)[:, 0, 1:c])[in_lim]
+    limited = np.flatnonzero(has & ~in_lim)
+    if limited.size:  # reachable only outside the ABAD limits: the first solution, for the error message
+        q[limited] = sols[limited, 0]
     miss = np.flatnonzero(~has)
     if miss.size:  # no root: the grid node of smallest |f|, as the point reached
         k = np.argmin(np.abs(f[miss]), axis=1)
@@ -1475,4 +1589,7 @@ def _ik_radial(target, ctx, tol, max_iter, q0, want_solutions=True):
         q[miss] = np.stack([grid[k], np.angle((x_L[miss] - 1j * yabs[miss]) * np.conj(cz) * -1j), gamma1[miss]], -1)
     p = _fk_flat(q, ctx, False)[0]
     err = np.linalg.norm(p - target, axis=1)
-    return q, its, err, has & (err <= tol), sols
+    reason = np.where(~has, _UNREACHABLE, np.where(in_lim, _SOLVED, _LIMITS))
+    ok = in_lim & (err <= tol)
+    reason[in_lim & ~ok] = _UNREACHABLE  # (does not happen: each root is checked against tol by the FK)
+    return q, its, err, ok, sols, reason

@@ -468,3 +468,143 @@ def test_invalid_choices():
         wl.rim_point(1.0, 0.0, 0.0, 0.5)
     with pytest.raises(legkin.InvalidInputError, match="17 deg to 160 deg"):
         wl.linkage_points(3.0)
+
+
+# ---------------------------------------------------------------- the IK contract (issue 10)
+#: Slightly unreachable targets on which the damped step's 3x3 solve used to raise numpy's LinAlgError
+#: ("Singular matrix") and abort the whole batch (found by bisection on 10^6 perturbed targets).
+SINGULAR_STEP_TARGETS = [
+    ([0.3671926525548385, 0.1841563765356252, -0.007407738060030997], -0.8674801011446105, 0.0006185796230125488, "FL"),
+    ([0.12458215887018051, -0.17272748123695433, -0.025051981391774794], -0.976671629088858, -0.007639002632478884, "FR"),
+    ([-0.3827757402597827, -0.20401883867890871, 0.10254649552575955], 0.8906034126757216, -0.008245358133955771, "RR"),
+]
+
+
+@pytest.mark.parametrize("target, alpha, w, leg", SINGULAR_STEP_TARGETS)
+@pytest.mark.parametrize("method", ["damped", "radial"])
+def test_ik_singular_step_is_a_legkin_answer(target, alpha, w, leg, method):
+    try:
+        q = wl.ik(target, alpha, w, leg, method=method)
+    except legkin.UnreachableError:
+        pass
+    else:
+        assert np.linalg.norm(wl.contact_point(q, alpha, w, leg) - target) <= 1e-12
+    inside = wl.contact_point([1.0, 0.1, 0.0], 0.0, 0.0, leg)
+    batch = np.array([target, inside])
+    qs, ok = wl.ik(batch, [alpha, 0.0], [w, 0.0], leg, method=method, return_mask=True)
+    assert ok[1] and np.all(np.isnan(qs[~ok]))
+
+
+def _in_limit_joints(n, rng):
+    """(n, 3) (theta, beta, gamma) anywhere inside the joint limits, ends included."""
+    theta = rng.uniform(wl.THETA_MIN, wl.THETA_MAX, n)
+    gamma = rng.uniform(-wl.ABAD_LIMIT, wl.ABAD_LIMIT, n)
+    ends = rng.random(n) < 0.1
+    gamma[ends] = rng.choice([-wl.ABAD_LIMIT, wl.ABAD_LIMIT], ends.sum())
+    return np.stack([theta, rng.uniform(-math.pi, math.pi, n), gamma], -1)
+
+
+def test_abad_limit_matches_the_urdf():
+    robot = legkin.load("wheel_leg")
+    for leg in wl.LEGS:
+        j = robot.model.joints[robot.joint_id(f"{leg}_abad")]
+        assert robot.model.lowerPositionLimit[j.idx_q] == -wl.ABAD_LIMIT
+        assert robot.model.upperPositionLimit[j.idx_q] == wl.ABAD_LIMIT
+
+
+@pytest.mark.parametrize("method", ["radial", "damped"])
+def test_ik_answers_inside_the_abad_limits(method):
+    """FK-made targets from in-limit joints are all solved, inside the limits (24 % of answers had |gamma| >
+    pi/2 before, although an in-limit solution existed); limits=False may leave them."""
+    rng = np.random.default_rng(10)
+    n = 2000
+    for leg in wl.LEGS:
+        q = _in_limit_joints(n, rng)
+        alpha, w = rng.uniform(-math.pi, math.pi, n), rng.uniform(-0.02, 0.02, n)
+        target = wl.contact_point(q, alpha, w, leg)
+        qs, ok = wl.ik(target, alpha, w, leg, method=method, return_mask=True)
+        assert ok.all()
+        assert np.abs(qs[:, 2]).max() <= wl.ABAD_LIMIT
+        assert np.linalg.norm(wl.contact_point(qs, alpha, w, leg) - target, axis=-1).max() <= 1e-12
+
+
+def test_ik_reachable_only_outside_the_abad_limits():
+    q = np.array([0.39896854737191256, 2.6257815016632486, 2.829530947384123])  # foot turned up, gamma ~ 162 deg
+    target = wl.contact_point(q, 0.0, 0.0, "FL")
+    sols = wl.ik(target, 0.0, 0.0, "FL", limits=False, return_info=True)[1].solutions
+    sols = sols[~np.isnan(sols[:, 0])]
+    assert sols.shape[0] >= 1 and np.all(np.abs(sols[:, 2]) > wl.ABAD_LIMIT)  # every solution outside the limits
+    with pytest.raises(legkin.JointLimitError, match=r"ABAD angle outside its limits \[-pi/2, pi/2\]"):
+        wl.ik(target, 0.0, 0.0, "FL")
+    qs, ok = wl.ik(np.stack([target, target]), 0.0, 0.0, "FL", return_mask=True)
+    assert not ok.any() and np.isnan(qs).all()
+    assert np.linalg.norm(wl.contact_point(wl.ik(target, 0.0, 0.0, "FL", limits=False), 0.0, 0.0, "FL")
+                          - target) <= 1e-12
+
+
+def test_ik_scalar_target_with_batch_q0():
+    q = np.array([[1.0, 0.2, 0.1], [1.5, -0.3, -0.2]])
+    target = wl.contact_point(q[0], 0.0, 0.0, "FL")
+    for method in ("radial", "damped"):
+        qs = wl.ik(target, 0.0, 0.0, "FL", q0=q, method=method)
+        assert qs.shape == (2, 3)
+        assert np.linalg.norm(wl.contact_point(qs, 0.0, 0.0, "FL") - target, axis=-1).max() <= 1e-12
+    with pytest.raises(legkin.InvalidInputError, match="q0"):
+        wl.ik(np.zeros((3, 3)), 0.0, 0.0, "FL", q0=q)
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    ({"tol": float("nan")}, "tol"), ({"tol": -1e-9}, "tol"), ({"tol": "1e-9"}, "tol"),
+    ({"max_iter": 0}, "max_iter"), ({"max_iter": 2.5}, "max_iter"), ({"delta": float("inf")}, "delta"),
+    ({"radius": float("nan")}, "radius"), ({"radius": -0.1}, "radius"), ({"limits": "yes"}, "limits"),
+    ({"method": np.array(["radial"])}, "method"), ({"geometry": {"R": 0.1}}, "geometry"),
+])
+def test_ik_keywords_are_validated(kwargs, match):
+    target = wl.contact_point([1.0, 0.1, 0.0], 0.0, 0.0, "FL")
+    with pytest.raises(legkin.InvalidParameterError, match=match):
+        wl.ik(target, 0.0, 0.0, "FL", **kwargs)
+
+
+@pytest.mark.parametrize("fn", [wl.contact_point, wl.contact_jacobian])
+def test_contact_radius_is_validated(fn):
+    with pytest.raises(legkin.InvalidParameterError, match=r"radius=nan .* \(0, 0.2\]"):
+        fn([1.0, 0.1, 0.0], 0.0, 0.0, "FL", radius=float("nan"))
+
+
+@pytest.mark.parametrize("name, value", [("R", float("nan")), ("R", -0.1), ("T", 0.0), ("d_wheel", float("inf")),
+                                         ("L_body", "wide")])
+def test_geometry_is_validated(name, value):
+    with pytest.raises(legkin.InvalidParameterError, match=name):
+        wl.Geometry(**{name: value})
+
+
+@pytest.mark.parametrize("bad", [np.array([1.0 + 1j, 0.2, -0.2]), "abc", [0.1, [0.2]], [np.nan, 0.0, 0.0]])
+def test_ik_bad_targets(bad):
+    with pytest.raises(legkin.InvalidInputError):
+        wl.ik(bad, 0.0, 0.0, "FL")
+
+
+@settings(max_examples=150)
+@given(st.floats(17 * DEG, 160 * DEG), st.floats(-math.pi, math.pi),
+       st.one_of(st.floats(-math.pi / 2, math.pi / 2), st.sampled_from([-math.pi / 2, math.pi / 2])),
+       st.one_of(st.floats(-math.pi, math.pi), st.sampled_from([-math.pi, -40 * DEG, 0.0, 40 * DEG, math.pi])),
+       st.floats(-0.02, 0.02), st.sampled_from(wl.LEGS), st.sampled_from(["continuous", "seed"]),
+       st.one_of(st.just(0.0), st.floats(1e-4, 0.05)), st.integers(0, 2))
+def test_ik_contract_property(theta, beta, gamma, alpha, w, leg, rim, offset, axis):
+    """Targets made by FK from in-limit joints are solved inside the limits; targets pushed off by up to
+    5 cm are either solved and reproduced, or raise a legkin UnreachableError (never another exception)."""
+    q_true = np.array([theta, beta, gamma])
+    target = wl.contact_point(q_true, alpha, w, leg, rim=rim)
+    if offset == 0.0:
+        q = wl.ik(target, alpha, w, leg, rim=rim)
+        assert abs(q[2]) <= wl.ABAD_LIMIT and wl.THETA_MIN <= q[0] <= wl.THETA_MAX
+        assert np.linalg.norm(wl.contact_point(q, alpha, w, leg, rim=rim) - target) <= 1e-12
+        return
+    target = target + offset * np.eye(3)[axis]
+    for method in ("radial", "damped"):
+        try:
+            q = wl.ik(target, alpha, w, leg, rim=rim, method=method)
+        except legkin.UnreachableError:
+            continue
+        assert abs(q[2]) <= wl.ABAD_LIMIT and wl.THETA_MIN <= q[0] <= wl.THETA_MAX
+        assert np.linalg.norm(wl.contact_point(q, alpha, w, leg, rim=rim) - target) <= 1e-12

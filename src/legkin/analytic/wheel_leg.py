@@ -32,7 +32,7 @@ from typing import Mapping, NamedTuple
 import numpy as np
 
 from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
-from ._batch import as_angles, as_input, check_flag, check_integer, check_number, finish
+from ._batch import as_angles, as_input, check_choice, check_flag, check_integer, check_number, finish
 
 __all__ = [
     "LEGS",
@@ -596,7 +596,7 @@ def _leg(leg) -> tuple[int, str, float]:
     """(index, side "L"/"R", sx) of a leg given by name or index."""
     if isinstance(leg, (int, np.integer)) and not isinstance(leg, bool) and 0 <= int(leg) < 4:
         i = int(leg)
-    elif leg in LEGS:
+    elif isinstance(leg, str) and leg in LEGS:
         i = LEGS.index(leg)
     else:
         raise InvalidParameterError(f"leg must be one of {', '.join(LEGS)} or an index 0-3, got {leg!r}")
@@ -648,11 +648,7 @@ class _Ctx(NamedTuple):
 
 
 def _rim_kind(rim: str) -> bool:
-    if rim == "continuous":
-        return False
-    if rim == "seed":
-        return True
-    raise InvalidParameterError(f"rim must be 'continuous' or 'seed', got {rim!r}")
+    return check_choice(rim, "rim", ("continuous", "seed")) == "seed"
 
 
 def _context(alpha, w, leg, rim, geo, radius) -> _Ctx:
@@ -976,8 +972,7 @@ def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "radial", r
     _check_alpha(alpha)
     _check_w(w, geo)
     _rim_kind(rim)
-    if method not in _METHODS:
-        raise InvalidParameterError(f"method must be one of {', '.join(map(repr, _METHODS))}, got {method!r}")
+    check_choice(method, "method", _METHODS)
     _leg(leg)
     n = int(np.prod(shape, dtype=int))
     if q0 is not None:
@@ -1174,8 +1169,9 @@ def _ik_damped(q, target, ctx, tol, max_iter, delta):
             dq = -_solve3(M, JtE[t])
             qn = q[a[t]] + dq
             qn[:, 0] = np.clip(qn[:, 0], THETA_MIN, THETA_MAX)
-            pn = _fk_flat(qn, ctx_a if t.size == a.size else ctx_a.take(t), False)[0]
-            en = np.linalg.norm(pn - target[a[t]], axis=1)
+            with np.errstate(invalid="ignore"):  # NaN steps (singular systems) give NaN errors: not better
+                pn = _fk_flat(qn, ctx_a if t.size == a.size else ctx_a.take(t), False)[0]
+                en = np.linalg.norm(pn - target[a[t]], axis=1)
             better = en < err[a[t]]
             improved[t[better]] = True
             best_q[t[better]], best_err[t[better]] = qn[better], en[better]

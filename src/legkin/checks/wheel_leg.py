@@ -260,3 +260,51 @@ def solution_distance(solutions: np.ndarray, q: np.ndarray) -> np.ndarray:
     d[..., 1:] = np.angle(np.exp(1j * d[..., 1:]))
     d = np.abs(d).max(axis=-1)
     return np.min(np.where(np.isnan(d), np.inf, d), axis=1)
+
+
+def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 2000) -> CheckResult:
+    """The IK contract row: the default :func:`wl.ik` on ``n`` random targets in and around the workspace.
+
+    Half the targets (``made``) are :func:`wl.contact_point` of random joints inside the URDF limits (theta over
+    [17, 160] deg, beta over the circle, gamma over [-pi/2, pi/2], 10 % of them on a limit) at random rim
+    points (alpha, w); a quarter are such targets pushed off by up to 5 cm in a random direction; a quarter are
+    uniform in a 0.8 m box around the module origin. Legs in turn. Each solved answer is scored by the
+    default :func:`wl.contact_point`; up to ``classify`` unsolved targets are classified by single calls.
+    """
+    from ..validation import classify_failures, robustness_row
+
+    legs = np.arange(n) % 4
+    m_made, m_push = n // 2, n // 4
+    kind = np.zeros(n, dtype=int)
+    kind[m_made:m_made + m_push], kind[m_made + m_push:] = 1, 2
+    q = np.stack([rng.uniform(wl.THETA_MIN, wl.THETA_MAX, n), rng.uniform(-np.pi, np.pi, n),
+                  rng.uniform(-wl.ABAD_LIMIT, wl.ABAD_LIMIT, n)], -1)
+    on_limit = rng.random(n) < 0.1
+    q[on_limit, 2] = rng.choice([-wl.ABAD_LIMIT, wl.ABAD_LIMIT], on_limit.sum())
+    alpha, w = rng.uniform(-np.pi, np.pi, n), rng.uniform(-0.02, 0.02, n)
+    target = np.empty((n, 3))
+    solved = np.zeros(n, dtype=bool)
+    error = np.full(n, np.nan)
+    exceptions = 0
+    for k, leg in enumerate(wl.LEGS):
+        m = np.flatnonzero(legs == k)
+        t = wl.contact_point(q[m], alpha[m], w[m], leg)
+        push = kind[m] == 1
+        d = rng.normal(size=(push.sum(), 3))
+        t[push] += d / np.linalg.norm(d, axis=1, keepdims=True) * rng.uniform(0.0, 0.05, (push.sum(), 1))
+        box = kind[m] == 2
+        t[box] = wl.module_origin(leg) + rng.uniform(-0.4, 0.4, (box.sum(), 3))
+        target[m] = t
+        try:
+            qs, ok = wl.ik(t, alpha[m], w[m], leg, return_mask=True)
+        except Exception:  # noqa: BLE001 - a foreign exception from the batch is a defect, counted
+            exceptions += 1
+            continue
+        solved[m] = ok
+        error[m[ok]] = per_sample(wl.contact_point(qs[ok], alpha[m[ok]], w[m[ok]], leg) - t[ok])
+    unsolved = np.flatnonzero(~solved)
+    pick = unsolved if classify is None else unsolved[: max(int(classify), 0)]
+    reasons, single_exc = classify_failures(
+        lambda i: wl.ik(target[i], alpha[i], w[i], wl.LEGS[legs[i]]), pick)
+    return robustness_row("wheel_leg", made=kind == 0, solved=solved, error=error, reasons=reasons,
+                          classified=len(pick), exceptions=exceptions + single_exc)

@@ -152,8 +152,7 @@ def test_cli_list_and_errors(capsys):
     assert "known models" in capsys.readouterr().err
     assert main(["view", "quadruped", "--pose", "no_such_pose", "--html", "/dev/null"]) == 2
     assert main(["view", "quadruped", "--q", "1", "2", "--html", "/dev/null"]) == 2
-    with pytest.raises(SystemExit):
-        main(["check", "--samples", "0"])
+    assert main(["check", "--samples", "0"]) == 2
 
 
 def test_check_json(tmp_path):
@@ -182,3 +181,194 @@ def test_readme_python_examples_run():
     namespace: dict = {}
     for block in blocks:
         exec(compile(block, "README.md", "exec"), namespace)  # noqa: S102 - the README's own examples
+
+
+# ------------------------------------------------------------------------------ bad inputs to Robot and load
+NAN, INF = float("nan"), float("inf")
+
+
+@pytest.fixture(scope="module")
+def tripod():
+    return legkin.load("tripod")
+
+
+def test_solve_loops_nan_held_value_names_the_joint(tripod):
+    # Issue 10: this reached numpy's SVD ("SVD did not converge", LinAlgError).
+    with pytest.raises(legkin.InvalidInputError, match="A_q1") as info:
+        tripod.solve_loops(tripod.q0, fixed={"A_q1": NAN})
+    assert isinstance(info.value, ValueError) and "finite" in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        ({"fixed": {"A_q1": INF}}, ["A_q1", "finite"]),
+        ({"fixed": {"A_q1": 1j}}, ["A_q1", "real"]),
+        ({"fixed": {"A_q1": "x"}}, ["A_q1", "numeric"]),
+        ({"fixed": {"A_q1": [0.1, 0.2]}}, ["A_q1", "nq = 1"]),
+        ({"fixed": {"NO_JOINT": 0.0}}, ["NO_JOINT", "A_q1, A_q2"]),
+        ({"fixed": ["NO_JOINT"]}, ["NO_JOINT", "A_q1, A_q2"]),
+        ({"fixed": {3: 0.0}}, ["string", "3"]),
+        ({"fixed": "A_q1"}, ["string", "['A_q1']"]),
+        ({"fixed": 5}, ["collection of joint names", "5"]),
+        ({"tol": NAN}, ["tol", "(0, inf)", "nan"]),
+        ({"tol": -1e-9}, ["tol", "(0, inf)"]),
+        ({"tol": 0.0}, ["tol", "(0, inf)"]),
+        ({"tol": INF}, ["tol", "(0, inf)", "inf"]),
+        ({"tol": "1e-9"}, ["tol", "real number"]),
+        ({"tol": 1e-9 + 0j}, ["tol", "real number"]),
+        ({"max_iter": -1}, ["max_iter", ">= 0", "-1"]),
+        ({"max_iter": 2.5}, ["max_iter", "integer", "2.5"]),
+        ({"max_iter": True}, ["max_iter", "integer"]),
+        ({"max_iter": NAN}, ["max_iter", "integer"]),
+        ({"damping": 0.0}, ["damping", "(0, inf)"]),
+        ({"damping": NAN}, ["damping", "(0, inf)"]),
+        ({"return_info": "yes"}, ["return_info", "True or False"]),
+    ],
+)
+def test_solve_loops_refuses_bad_keywords(tripod, kwargs, words):
+    with pytest.raises(legkin.InvalidInputError) as info:
+        tripod.solve_loops(tripod.q0, **kwargs)
+    for word in words:
+        assert word in str(info.value), (kwargs, str(info.value))
+
+
+def _q_cases(robot):
+    nq = robot.model.nq
+    q_nan = robot.q0.copy()
+    q_nan[5] = NAN
+    return [
+        (np.zeros(nq - 1), [f"({nq},)", f"({nq - 1},)"]),
+        (np.zeros((2, nq)), [f"({nq},)", f"(2, {nq})"]),
+        (robot.q0 + 0j, ["real", "complex"]),
+        (q_nan, ["finite", "[5] = nan", repr(robot.joint_names[5])]),
+        (np.where(np.arange(nq) == 0, INF, robot.q0), ["finite", "[0] = inf"]),
+        ("abc", ["numeric"]),
+        ([[0.0, 1.0], [2.0]], ["numeric"]),
+        (None, ["numeric"]),
+    ]
+
+
+@pytest.mark.parametrize("case", range(8))
+@pytest.mark.parametrize(
+    "method",
+    ["constraint_residual", "constraint_jacobian", "mobility", "solve_loops", "frame_placement", "frame_jacobian"],
+)
+def test_robot_methods_refuse_bad_q(tripod, method, case):
+    q, words = _q_cases(tripod)[case]
+    if method == "solve_loops" and q is None:
+        pytest.skip("solve_loops(None) starts from q0")
+    call = {
+        "frame_placement": lambda: tripod.frame_placement(q, "A_ee"),
+        "frame_jacobian": lambda: tripod.frame_jacobian(q, "A_ee"),
+    }.get(method, lambda: getattr(tripod, method)(q))
+    with pytest.raises(legkin.InvalidInputError) as info:
+        call()
+    for word in words:
+        assert word in str(info.value), (method, str(info.value))
+
+
+@pytest.mark.parametrize(
+    "kwargs, words",
+    [
+        ({"tol": NAN}, ["tol", "[0, 1)"]),
+        ({"tol": -1.0}, ["tol", "[0, 1)"]),
+        ({"tol": 1.0}, ["tol", "[0, 1)"]),
+        ({"locked": ["NO_JOINT"]}, ["NO_JOINT"]),
+        ({"locked": "A_q1"}, ["string"]),
+    ],
+)
+def test_mobility_refuses_bad_keywords(tripod, kwargs, words):
+    with pytest.raises(legkin.InvalidInputError) as info:
+        tripod.mobility(tripod.q0, **kwargs)
+    for word in words:
+        assert word in str(info.value)
+
+
+def test_robot_names_and_references_checked(tripod):
+    with pytest.raises(legkin.InvalidInputError, match="did you mean A_ee"):
+        tripod.frame_placement(tripod.q0, "A_ee_")
+    with pytest.raises(legkin.InvalidInputError, match="string"):
+        tripod.frame_placement(tripod.q0, 3)
+    with pytest.raises(legkin.InvalidInputError, match="ReferenceFrame"):
+        tripod.frame_jacobian(tripod.q0, "A_ee", reference=5)
+    assert np.array_equal(
+        tripod.frame_jacobian(tripod.q0, "A_ee", reference="WORLD"),
+        tripod.frame_jacobian(tripod.q0, "A_ee", reference=pin_world()),
+    )
+    with pytest.raises(legkin.InvalidInputError, match="string"):
+        tripod.joint_id(None)
+    with pytest.raises(legkin.InvalidInputError, match="A_q1"):
+        tripod.configuration({"A_q1": NAN})
+    with pytest.raises(legkin.InvalidInputError, match="mapping"):
+        tripod.configuration([0.1])
+    with pytest.raises(legkin.InvalidInputError, match="base"):
+        tripod.configuration({"A_q1": 0.1}, base=np.zeros(2))
+    assert tripod.configuration({"A_q1": 0.25})[tripod.idx_q("A_q1")] == 0.25
+
+
+def pin_world():
+    import pinocchio as pin
+
+    return pin.WORLD
+
+
+def test_solve_loops_accepts_its_documented_forms(tripod):
+    q, info = tripod.solve_loops(tripod.q0, fixed={"A_q1": np.float64(-0.4), "B_q1": np.array(-0.5)}, return_info=True)
+    assert q[tripod.idx_q("A_q1")] == -0.4 and info.residual <= 1e-12
+    tripod.solve_loops(q, fixed=("A_q1", "B_q1"), max_iter=np.int64(0))  # already closed: zero iterations
+    tripod.solve_loops(fixed=None, damping=1e-3)
+
+
+@pytest.mark.parametrize(
+    "name, kwargs, words",
+    [
+        ("tripod", {"floating": "yes"}, ["floating", "True or False"]),
+        ("tripod", {"d": True}, ["d=True", "(0, inf)"]),
+        ("tripod", {"d": 0.05 + 0j}, ["d=", "not a number"]),
+        ("tripod", {"d": np.array([0.05])}, ["d=", "not a number"]),
+        ("tripod", {"d": NAN}, ["d=nan", "(0, inf)"]),
+        ("hybrid_leg", {"center": np.array([1, 2])}, ["center", "'universal'"]),
+        ("hybrid_leg", {"center": 1}, ["center", "'universal'"]),
+    ],
+)
+def test_load_refuses_bad_kinds(name, kwargs, words, tmp_path, monkeypatch):
+    monkeypatch.setenv("LEGKIN_CACHE", str(tmp_path))
+    with pytest.raises(legkin.InvalidParameterError) as info:
+        legkin.load(name, **kwargs)
+    for word in words:
+        assert word in str(info.value)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_no_foreign_exception_from_robot_methods(tripod):
+    """Random junk into every Robot method: only legkin errors (or a result) may come out."""
+    junk = [NAN, INF, -1, 0, 1e308, 2.5, True, None, "x", 1j, [], [1, 2], {"A_q1": NAN}, np.zeros(3), object()]
+    q = tripod.q0
+    calls = []
+    for x in junk:
+        calls += [
+            lambda x=x: tripod.solve_loops(x),
+            lambda x=x: tripod.solve_loops(q, fixed=x),
+            lambda x=x: tripod.solve_loops(q, tol=x),
+            lambda x=x: tripod.solve_loops(q, max_iter=x),
+            lambda x=x: tripod.solve_loops(q, damping=x),
+            lambda x=x: tripod.solve_loops(q, fixed={"A_q1": x}),
+            lambda x=x: tripod.mobility(q, locked=x),
+            lambda x=x: tripod.mobility(q, tol=x),
+            lambda x=x: tripod.mobility(x),
+            lambda x=x: tripod.constraint_residual(x),
+            lambda x=x: tripod.frame_placement(q, x),
+            lambda x=x: tripod.frame_jacobian(q, "A_ee", x),
+            lambda x=x: tripod.configuration(x),
+            lambda x=x: tripod.configuration({"A_q1": x}),
+            lambda x=x: tripod.joint_id(x),
+            lambda x=x: tripod.idx_q(x),
+            lambda x=x: legkin.load(x),
+            lambda x=x: legkin.load("tripod", floating=x),
+        ]
+    for call in calls:
+        try:
+            call()
+        except legkin.LegkinError:
+            pass

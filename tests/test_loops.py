@@ -70,3 +70,72 @@ def test_unclosable_raises_with_residual(fourbar):
         loops.solve(q, free, 1e-12, 50)
     assert info.value.residual > 1e-3
     assert "residual" in str(info.value)
+
+
+# ---------------------------------------------------------------- bad inputs
+from legkin import InvalidInputError  # noqa: E402
+from legkin.loops import check_count, check_real  # noqa: E402
+
+FREE = np.array([False, True, True])
+
+
+@pytest.mark.parametrize(
+    "q, free, kwargs, words",
+    [
+        (np.zeros(2), FREE, {}, ["q", "(3,)", "(2,)"]),
+        (np.array([0.3, np.nan, 0.0]), FREE, {}, ["q", "finite", "nan"]),
+        (np.zeros(3) + 0j, FREE, {}, ["q", "real"]),
+        (np.zeros(3), np.array([1, 0, 1]), {}, ["free", "boolean"]),
+        (np.zeros(3), np.ones(2, bool), {}, ["free", "(3,)"]),
+        (np.zeros(3), FREE, {"tol": np.nan}, ["tol", "(0, inf)"]),
+        (np.zeros(3), FREE, {"tol": -1.0}, ["tol", "(0, inf)"]),
+        (np.zeros(3), FREE, {"max_iter": -1}, ["max_iter", ">= 0"]),
+        (np.zeros(3), FREE, {"max_iter": 1.5}, ["max_iter", "integer"]),
+        (np.zeros(3), FREE, {"damping": 0.0}, ["damping", "(0, inf)"]),
+    ],
+)
+def test_solve_refuses_bad_input(fourbar, q, free, kwargs, words):
+    model, loops = fourbar
+    args = {"tol": 1e-12, "max_iter": 50, **kwargs}
+    with pytest.raises(InvalidInputError) as info:
+        loops.solve(q, free, args.pop("tol"), args.pop("max_iter"), **args)
+    for word in words:
+        assert word in str(info.value)
+
+
+def test_mobility_refuses_bad_tolerance(fourbar):
+    model, loops = fourbar
+    for tol in (np.nan, -1e-9, 1.0, "1e-9"):
+        with pytest.raises(InvalidInputError, match=r"tol"):
+            loops.mobility(closed_fourbar(0.7), np.ones(3, bool), tol)
+
+
+def test_damping_is_used(fourbar):
+    model, loops = fourbar
+    q_true = closed_fourbar(1.0)
+    start = q_true + np.array([0.0, 0.2, -0.15])
+    for damping in (1e-9, 1e-6, 1e-1):
+        q, info = loops.solve(start, FREE, 1e-12, 100, damping=damping)
+        np.testing.assert_allclose(q, q_true, atol=1e-10)
+
+
+def test_breakdown_becomes_loop_closure_error(fourbar, monkeypatch):
+    # A non-finite Jacobian on the way (overflow) must not escape as numpy's LinAlgError.
+    model, loops = fourbar
+    q = closed_fourbar(0.5) + np.array([0.0, 0.3, 0.0])
+    r, j = loops.residual_and_jacobian(q)
+    monkeypatch.setattr(loops, "residual_and_jacobian", lambda q: (r, j * np.nan))
+    with pytest.raises(LoopClosureError, match="broke down"):
+        loops.solve(q, FREE, 1e-12, 50)
+
+
+def test_check_real_and_check_count():
+    assert check_real("x", np.float32(0.5), 0.0, 1.0) == 0.5
+    assert check_real("x", np.array(0.25), 0.0, 1.0) == 0.25
+    assert check_count("n", np.int64(3)) == 3
+    for bad in (np.nan, np.inf, 2.0, -0.1, True, "0.5", 0.5j, [0.5], np.array([0.5])):
+        with pytest.raises(InvalidInputError, match=r"x must be .*\[0, 1\]"):
+            check_real("x", bad, 0.0, 1.0)
+    for bad in (-1, 2.5, np.nan, True, "3", None):
+        with pytest.raises(InvalidInputError, match="n must be an integer >= 0"):
+            check_count("n", bad)

@@ -13,6 +13,9 @@ coincide when the loop is closed. ``type="point"`` makes their origins coincide
 
 from __future__ import annotations
 
+import math
+import numbers
+import operator
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,11 +23,68 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from .errors import LegkinError, LoopClosureError
+from .analytic._batch import as_input
+from .errors import InvalidInputError, LegkinError, LoopClosureError
 
-__all__ = ["LoopSpec", "LoopSolveInfo", "parse_loops", "build_constraint", "LoopSet", "levenberg_marquardt"]
+__all__ = [
+    "LoopSpec",
+    "LoopSolveInfo",
+    "parse_loops",
+    "build_constraint",
+    "LoopSet",
+    "levenberg_marquardt",
+    "check_real",
+    "check_count",
+]
 
 _TYPES = ("point", "frame")
+
+#: Initial Levenberg-Marquardt damping of :func:`levenberg_marquardt`.
+DEFAULT_DAMPING = 1e-6
+
+
+# ---------------------------------------------------------------- keyword checks
+def _interval(low, high, low_open, high_open) -> str:
+    lo = "-inf" if low is None else f"{low:g}"
+    hi = "inf" if high is None else f"{high:g}"
+    return f"{'(' if low_open or low is None else '['}{lo}, {hi}{')' if high_open or high is None else ']'}"
+
+
+def check_real(
+    name: str, value, low: float | None = None, high: float | None = None, *, low_open: bool = False,
+    high_open: bool = False,
+) -> float:
+    """``value`` as a finite real number in the interval given, or :class:`InvalidInputError` naming both.
+
+    Booleans, strings, complex numbers and arrays of more than one element are refused.
+    """
+    interval = _interval(low, high, low_open, high_open)
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
+        raise InvalidInputError(f"{name} must be a real number in {interval}, got {value!r}")
+    x = float(value)
+    bad = not math.isfinite(x)
+    if low is not None:
+        bad = bad or x < low or (low_open and x == low)
+    if high is not None:
+        bad = bad or x > high or (high_open and x == high)
+    if bad:
+        raise InvalidInputError(f"{name} must be a finite number in {interval}, got {value!r}")
+    return x
+
+
+def check_count(name: str, value, low: int = 0) -> int:
+    """``value`` as an integer ``>= low`` (a float such as ``2.0`` or a bool is refused)."""
+    if isinstance(value, (bool, np.bool_)):
+        raise InvalidInputError(f"{name} must be an integer >= {low}, got {value!r}")
+    try:
+        n = operator.index(value)
+    except TypeError:
+        raise InvalidInputError(f"{name} must be an integer >= {low}, got {value!r}") from None
+    if n < low:
+        raise InvalidInputError(f"{name} must be an integer >= {low}, got {n}")
+    return n
 
 
 @dataclass(frozen=True)
@@ -104,24 +164,54 @@ class LoopSet:
     def residual(self, q: np.ndarray) -> np.ndarray:
         return self.residual_and_jacobian(q)[0]
 
+    def _check(self, q, free) -> tuple[np.ndarray, np.ndarray]:
+        """The solver's and :meth:`mobility`'s inputs, checked (shape, finiteness, kind)."""
+        nq, nv = self.model.nq, self.model.nv
+        q = as_input(q, "q")
+        if q.shape != (nq,):
+            raise InvalidInputError(f"q must have shape ({nq},), got shape {q.shape}")
+        free = np.asarray(free)
+        if free.dtype != bool or free.shape != (nv,):
+            raise InvalidInputError(f"free must be a boolean mask of shape ({nv},), got {free.dtype} {free.shape}")
+        return q, free
+
     def mobility(self, q: np.ndarray, free: np.ndarray, tol: float) -> int:
         """Number of free velocity coordinates minus the rank of the constraint Jacobian on them.
 
-        The rank counts singular values above ``tol`` times the largest one (relative tolerance).
+        The rank counts singular values above ``tol`` times the largest one (relative tolerance, in [0, 1)).
         """
+        q, free = self._check(q, free)
+        tol = check_real("tol", tol, 0.0, 1.0, high_open=True)
         _, jac = self.residual_and_jacobian(q)
         jac = jac[:, free]
         if jac.size == 0:
             return int(free.sum())
+        if not np.all(np.isfinite(jac)):
+            raise LegkinError("the loop-closure Jacobian is not finite at this configuration")
         s = np.linalg.svd(jac, compute_uv=False)
         rank = int(np.sum(s > tol * max(s[0], 1e-300)))
         return int(free.sum()) - rank
 
     def solve(
-        self, q: np.ndarray, free: np.ndarray, tol: float, max_iter: int
+        self, q: np.ndarray, free: np.ndarray, tol: float, max_iter: int, damping: float = DEFAULT_DAMPING
     ) -> tuple[np.ndarray, LoopSolveInfo]:
-        """:func:`levenberg_marquardt` on the stacked loop residual; raises if the loops do not close."""
-        q, it, _, converged, err = levenberg_marquardt(self.model, self.residual_and_jacobian, q, free, tol, max_iter)
+        """:func:`levenberg_marquardt` on the stacked loop residual; raises if the loops do not close.
+
+        Raises:
+            InvalidInputError: ``q`` of the wrong shape or not finite, ``tol`` or ``damping`` not a finite
+                positive number, ``max_iter`` not an integer >= 0.
+            LoopClosureError: the residual did not reach ``tol``.
+        """
+        q, free = self._check(q, free)
+        tol = check_real("tol", tol, 0.0, low_open=True)
+        max_iter = check_count("max_iter", max_iter)
+        damping = check_real("damping", damping, 0.0, low_open=True)
+        try:
+            q, it, _, converged, err = levenberg_marquardt(
+                self.model, self.residual_and_jacobian, q, free, tol, max_iter, damping=damping
+            )
+        except np.linalg.LinAlgError as exc:  # a non-finite residual or Jacobian on the way (overflow)
+            raise LoopClosureError(f"could not close the loops: the iteration broke down ({exc})") from None
         if converged:
             return q, LoopSolveInfo(it, err)
         raise LoopClosureError(
@@ -132,16 +222,21 @@ class LoopSet:
         )
 
 
-def levenberg_marquardt(model: pin.Model, residual_and_jacobian, q: np.ndarray, free: np.ndarray, tol: float, max_iter: int):
+def levenberg_marquardt(
+    model: pin.Model, residual_and_jacobian, q: np.ndarray, free: np.ndarray, tol: float, max_iter: int,
+    *, damping: float = DEFAULT_DAMPING,
+):
     """Levenberg-Marquardt on a stacked residual over the velocity coordinates ``free`` of ``model``.
 
     Each iteration tries the Gauss-Newton step ``dq = -pinv(J_free) r`` (pseudo-inverse: redundant rows of
     planar loops make the stack rank-deficient); if it does not reduce ``|r|``, damped steps
     ``-(J^T J + mu I)^-1 J^T r`` with growing ``mu`` are tried; configurations are updated with
     ``pin.integrate``. Stops at ``|r| <= tol``, after ``max_iter`` iterations, or when no step reduces ``|r|``.
+    The inputs are not checked here (the benches call it in their timed loops): :meth:`LoopSet.solve` does.
 
     Args:
         residual_and_jacobian: ``q -> (r (rows,), J (rows, nv))``.
+        damping: the smallest damping ``mu`` tried (then ``mu * 10**k``, k < 12).
 
     Returns:
         ``(q, iterations, residual evaluations, converged, |r|)``.
@@ -149,7 +244,7 @@ def levenberg_marquardt(model: pin.Model, residual_and_jacobian, q: np.ndarray, 
     r, jac = residual_and_jacobian(q)
     evals = 1
     err = float(np.linalg.norm(r))
-    mu = 1e-6
+    mu = damping
     it = 0
     for it in range(max_iter + 1):
         if err <= tol:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from pathlib import Path
+import difflib
 from typing import Iterable, Mapping
 
 import numpy as np
@@ -10,10 +10,33 @@ import pinocchio as pin
 
 from ._generate import model_files
 from ._registry import MODELS, get_spec
+from .analytic._batch import as_input
 from .errors import InvalidInputError, InvalidParameterError, LegkinError
-from .loops import LoopSet, LoopSolveInfo, parse_loops
+from .loops import DEFAULT_DAMPING, LoopSet, LoopSolveInfo, check_count, check_real, parse_loops
 
 __all__ = ["Robot", "load"]
+
+_REFERENCE_FRAMES = dict(pin.ReferenceFrame.names)
+
+
+def _check_flag(name: str, value) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise InvalidInputError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def _names(name: str, value) -> list[str]:
+    """A collection of joint names (a list, tuple, set or the keys of a mapping; None for none; a lone string
+    is refused)."""
+    if value is None:
+        return []
+    if isinstance(value, (str, bytes)):
+        raise InvalidInputError(f"{name} must be a collection of joint names, got the string {value!r} (write [{value!r}])")
+    try:
+        names = list(value)
+    except TypeError:
+        raise InvalidInputError(f"{name} must be a collection of joint names, got {value!r}") from None
+    return names
 
 
 class Robot:
@@ -75,8 +98,15 @@ class Robot:
         return list(self.model.names)[1:]
 
     def joint_id(self, name: str) -> int:
+        """Pinocchio id of joint ``name``.
+
+        Raises:
+            InvalidInputError: ``name`` is not a string or not a joint of the model (the message lists them).
+        """
+        if not isinstance(name, str):
+            raise InvalidInputError(f"a joint name must be a string, got {name!r}; joints: {', '.join(self.joint_names)}")
         if not self.model.existJointName(name):
-            raise LegkinError(f"model {self.name!r} has no joint {name!r}; joints: {', '.join(self.joint_names)}")
+            raise InvalidInputError(f"model {self.name!r} has no joint {name!r}; joints: {', '.join(self.joint_names)}")
         return self.model.getJointId(name)
 
     def idx_q(self, name: str) -> int:
@@ -88,40 +118,96 @@ class Robot:
         return self.model.joints[self.joint_id(name)].idx_v
 
     def frame_id(self, name: str) -> int:
+        """Pinocchio id of frame ``name``.
+
+        Raises:
+            InvalidInputError: ``name`` is not a string or not a frame of the model (with close matches).
+        """
+        if not isinstance(name, str):
+            raise InvalidInputError(f"a frame name must be a string, got {name!r}")
         if not self.model.existFrame(name):
-            raise LegkinError(f"model {self.name!r} has no frame {name!r}")
+            frames = [f.name for f in self.model.frames]
+            close = difflib.get_close_matches(name, frames, n=5)
+            hint = f"; did you mean {', '.join(close)}?" if close else f"; it has {len(frames)} frames"
+            raise InvalidInputError(f"model {self.name!r} has no frame {name!r}{hint}")
         return self.model.getFrameId(name)
 
+    def _joint_value(self, what: str, name: str, value) -> tuple[slice, np.ndarray]:
+        """The ``q`` slice of joint ``name`` and ``value`` checked for it (a number for a 1-coordinate joint)."""
+        j = self.model.joints[self.joint_id(name)]
+        x = as_input(value, what)
+        if j.nq == 1 and x.shape in ((), (1,)):
+            x = x.reshape(1)
+        elif x.shape != (j.nq,):
+            want = "a number" if j.nq == 1 else f"{j.nq} coordinates"
+            raise InvalidInputError(f"{what} must be {want} (joint {name!r} has nq = {j.nq}), got shape {x.shape}")
+        return slice(j.idx_q, j.idx_q + j.nq), x
+
     def configuration(self, values: Mapping[str, float] | None = None, base: np.ndarray | None = None) -> np.ndarray:
-        """A configuration vector: ``base`` (default ``q0``) with the named 1-DOF joints set."""
-        q = np.array(self.q0 if base is None else base, dtype=float)
-        for name, value in (values or {}).items():
-            q[self.idx_q(name)] = value
+        """A configuration vector: ``base`` (default ``q0``) with the named joints set.
+
+        Raises:
+            InvalidInputError: an unknown joint, a value that is not a finite number (or, for a joint of several
+                coordinates, not a vector of its ``nq`` coordinates), or ``base`` not a valid configuration.
+        """
+        q = self.check_q(self.q0 if base is None else base, "base").copy()
+        if values is None:
+            return q
+        if not isinstance(values, Mapping):
+            raise InvalidInputError(f"values must be a mapping joint name -> value, got {values!r}")
+        for name, value in values.items():
+            sl, x = self._joint_value(f"values[{name!r}]", name, value)
+            q[sl] = x
         return q
 
-    def check_q(self, q) -> np.ndarray:
-        q = np.asarray(q, dtype=float)
-        if q.shape != (self.model.nq,):
-            raise InvalidInputError(f"q must have shape ({self.model.nq},) for {self.name!r}, got {q.shape}")
-        if not np.all(np.isfinite(q)):
-            raise InvalidInputError(f"q must be finite, got {q}")
-        return q
+    def check_q(self, q, name: str = "q") -> np.ndarray:
+        """``q`` as a float vector of shape ``(nq,)``, finite and real.
+
+        Raises:
+            InvalidInputError: (a ``ValueError``) a wrong shape, NaN/inf entries (named by joint), complex,
+                string, ragged or other non-numeric input.
+        """
+        arr = as_input(q, name, allow_nan=True)
+        nq = self.model.nq
+        if arr.shape != (nq,):
+            raise InvalidInputError(f"{name} must have shape ({nq},) for {self.name!r}, got shape {arr.shape}")
+        bad = np.flatnonzero(~np.isfinite(arr))
+        if bad.size:
+            i = int(bad[0])
+            joint = next(n for n in reversed(self.joint_names) if self.idx_q(n) <= i)
+            raise InvalidInputError(
+                f"{name} must be finite: {bad.size} entr{'y is' if bad.size == 1 else 'ies are'} not, "
+                f"first {name}[{i}] = {arr[i]} (joint {joint!r})"
+            )
+        return arr
 
     def frame_placement(self, q, frame: str) -> pin.SE3:
         """World placement of ``frame`` at ``q`` (loops are not enforced)."""
         q = self.check_q(q)
+        fid = self.frame_id(frame)
         pin.framesForwardKinematics(self.model, self.data, q)
-        return self.data.oMf[self.frame_id(frame)].copy()
+        return self.data.oMf[fid].copy()
 
     def frame_jacobian(self, q, frame: str, reference=pin.LOCAL_WORLD_ALIGNED) -> np.ndarray:
-        """6 x nv Jacobian of ``frame`` of the tree (loops are not enforced)."""
+        """6 x nv Jacobian of ``frame`` of the tree (loops are not enforced).
+
+        Args:
+            reference: a ``pinocchio.ReferenceFrame`` or its name (``"LOCAL"``, ``"WORLD"``, ``"LOCAL_WORLD_ALIGNED"``).
+        """
         q = self.check_q(q)
-        return pin.computeFrameJacobian(self.model, self.data, q, self.frame_id(frame), reference)
+        fid = self.frame_id(frame)
+        if isinstance(reference, str) and reference in _REFERENCE_FRAMES:
+            reference = _REFERENCE_FRAMES[reference]
+        if not isinstance(reference, pin.ReferenceFrame):
+            raise InvalidInputError(
+                f"reference must be a pinocchio.ReferenceFrame or one of {', '.join(_REFERENCE_FRAMES)}, got {reference!r}"
+            )
+        return pin.computeFrameJacobian(self.model, self.data, q, fid, reference)
 
     # ----------------------------------------------------------------- closed loops
-    def _free_mask(self, fixed: Iterable[str]) -> np.ndarray:
+    def _free_mask(self, fixed: Iterable[str], what: str = "fixed") -> np.ndarray:
         free = np.ones(self.model.nv, dtype=bool)
-        for name in fixed:
+        for name in _names(what, fixed):
             j = self.model.joints[self.joint_id(name)]
             free[j.idx_v : j.idx_v + j.nv] = False
         return free
@@ -139,10 +225,15 @@ class Robot:
 
         Args:
             q: configuration (the loops should be closed).
-            locked: joints held fixed (their velocity columns are removed).
-            tol: singular values below ``tol`` times the largest count as zero.
+            locked: joints held fixed (their velocity columns are removed), a collection of names.
+            tol: singular values below ``tol`` times the largest count as zero; in [0, 1).
+
+        Raises:
+            InvalidInputError: a bad ``q``, an unknown joint in ``locked``, ``tol`` outside [0, 1).
         """
-        return self._loopset.mobility(self.check_q(q), self._free_mask(locked), tol)
+        q = self.check_q(q)
+        free = self._free_mask(locked, "locked")
+        return self._loopset.mobility(q, free, check_real("tol", tol, 0.0, 1.0, high_open=True))
 
     def solve_loops(
         self,
@@ -151,6 +242,7 @@ class Robot:
         *,
         tol: float = 1e-12,
         max_iter: int = 100,
+        damping: float = DEFAULT_DAMPING,
         return_info: bool = False,
     ) -> np.ndarray | tuple[np.ndarray, LoopSolveInfo]:
         """Assemble a configuration that closes every loop, with some joints held.
@@ -160,21 +252,30 @@ class Robot:
 
         Args:
             q_init: starting configuration (default ``q0``).
-            fixed: joints held: a mapping name -> value (set first), or names held at ``q_init``.
-            tol: stop when the residual norm is at most ``tol``.
-            max_iter: iteration cap.
+            fixed: joints held: a mapping name -> value (set first), or a collection of names held at ``q_init``.
+            tol: stop when the residual norm is at most ``tol`` (a finite number > 0).
+            max_iter: iteration cap (an integer >= 0; 0 only tests whether ``q_init`` closes).
+            damping: the smallest Levenberg-Marquardt damping tried when the Gauss-Newton step fails (> 0).
             return_info: also return a :class:`LoopSolveInfo` (iterations, residual).
 
         Raises:
+            InvalidInputError: (a ``ValueError``) a bad ``q_init`` (shape, NaN/inf, complex), an unknown joint
+                in ``fixed`` or a held value that is not a finite number, or a keyword out of its range.
             LoopClosureError: the residual did not reach ``tol`` (carries the residual reached).
         """
-        q = self.check_q(self.q0 if q_init is None else q_init).copy()
-        fixed = fixed or {}
+        q = self.check_q(self.q0 if q_init is None else q_init, "q_init").copy()
+        tol = check_real("tol", tol, 0.0, low_open=True)
+        max_iter = check_count("max_iter", max_iter)
+        damping = check_real("damping", damping, 0.0, low_open=True)
+        return_info = _check_flag("return_info", return_info)
+        if fixed is None:
+            fixed = ()
         if isinstance(fixed, Mapping):
             for name, value in fixed.items():
-                j = self.model.joints[self.joint_id(name)]
-                q[j.idx_q : j.idx_q + j.nq] = value
-        q, info = self._loopset.solve(q, self._free_mask(fixed), tol, max_iter)
+                sl, x = self._joint_value(f"fixed[{name!r}]", name, value)
+                q[sl] = x
+        free = self._free_mask(fixed)
+        q, info = self._loopset.solve(q, free, tol, max_iter, damping)
         self.last_solve = info
         return (q, info) if return_info else q
 
@@ -189,9 +290,24 @@ def load(name: str, *, floating: bool = False, **params) -> Robot:
 
     Raises:
         UnknownModelError: ``name`` is not registered.
-        InvalidParameterError: an unknown argument or a value out of range.
+        InvalidParameterError: an unknown argument, a value out of range or of the wrong kind (a string
+            argument given a non-string, a number given a bool, an array or a complex), ``floating`` not a bool.
     """
     spec = get_spec(name)
+    if not isinstance(floating, (bool, np.bool_)):
+        raise InvalidParameterError(f"floating must be True or False, got {floating!r}")
+    floating = bool(floating)
+    for key, value in params.items():
+        param = spec.params.get(key)
+        if param is None:
+            continue  # resolve_params names every unknown argument
+        if param.choices:
+            if not isinstance(value, str):
+                raise InvalidParameterError(f"{key}={value!r} is not valid: must be {param.range_text()}")
+        elif isinstance(value, (bool, np.bool_, complex, np.complexfloating)) or (
+            isinstance(value, np.ndarray) and value.ndim > 0
+        ):
+            raise InvalidParameterError(f"{key}={value!r} is not a number; valid range {param.range_text()}")
     args = spec.resolve_params(params)
     if floating and not spec.floating:
         floating_models = ", ".join(n for n, s in MODELS.items() if s.floating)

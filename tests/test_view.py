@@ -15,7 +15,8 @@ from conftest import shot
 
 CHROMIUM = chromium_path()
 
-pytestmark = pytest.mark.skipif(
+# Only the browser tests need Chromium; the server life-cycle tests below run everywhere.
+needs_chromium = pytest.mark.skipif(
     CHROMIUM is None and not os.environ.get("CI"),
     reason="headless Chromium not installed (apt-get install chromium); required on CI",
 )
@@ -27,6 +28,7 @@ def assert_shows_something(img: np.ndarray, empty: np.ndarray) -> None:
     assert changed.mean() > 0.01, f"only {changed.mean():.2%} of the pixels differ from the empty scene"
 
 
+@needs_chromium
 @pytest.mark.parametrize("name", sorted(MODELS))
 def test_model_page_renders(name, tmp_path, empty_scene):
     robot = legkin.load(name)
@@ -36,6 +38,7 @@ def test_model_page_renders(name, tmp_path, empty_scene):
     assert_shows_something(img, empty_scene)
 
 
+@needs_chromium
 def test_animation_page_renders(tmp_path, empty_scene):
     from legkin.__main__ import main
 
@@ -74,26 +77,34 @@ def test_html_export_leaves_no_server(tmp_path):
     assert {p for p in _children(os.getpid()) - before if _alive(p)} == set()
 
 
-def test_live_view_serves_until_interrupted():
+@pytest.mark.parametrize("model, sig", [("quadruped", "SIGINT"), ("tripod", "SIGTERM")])
+def test_live_view_serves_until_stopped(model, sig):
+    """``legkin view`` serves until Ctrl-C (SIGINT) or SIGTERM, and stops its meshcat server either way."""
     import signal
     import subprocess
     import sys
     import time
 
     proc = subprocess.Popen(
-        [sys.executable, "-m", "legkin", "view", "quadruped"], stdout=subprocess.PIPE, text=True
+        [sys.executable, "-m", "legkin", "view", model], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
     )
+    servers: set[int] = set()
     try:
         line = proc.stdout.readline()
         assert "http://127.0.0.1:" in line
         servers = _children(proc.pid)
         assert servers, "the viewer runs a meshcat server process"
-        proc.send_signal(signal.SIGINT)
+        assert all("meshcat" in Path(f"/proc/{p}/cmdline").read_text() for p in servers)
+        proc.send_signal(getattr(signal, sig))
         assert proc.wait(timeout=30) == 0
+        assert "Traceback" not in proc.stderr.read()
     finally:
         if proc.poll() is None:
             proc.kill()
-    deadline = time.time() + 10
-    while any(_alive(p) for p in servers) and time.time() < deadline:
-        time.sleep(0.2)
-    assert not any(_alive(p) for p in servers)
+        deadline = time.time() + 10
+        while any(_alive(p) for p in servers) and time.time() < deadline:
+            time.sleep(0.2)
+        leaked = {p for p in servers if _alive(p)}
+        for p in leaked:  # do not leave a server behind even when the test fails
+            os.kill(p, signal.SIGKILL)
+    assert not leaked, f"meshcat server(s) {leaked} still running after {sig}"

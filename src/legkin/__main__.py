@@ -1,15 +1,108 @@
-"""The ``legkin`` command line: list, generate, check, view."""
+"""The ``legkin`` command line: list, generate, check, view, bench.
+
+Every error ends the command with one line on stderr (``legkin: error: ...``) and a non-zero exit status:
+1 when checks fail or files are stale, 2 for a bad command line or a legkin error, 3 for an unexpected
+internal error (set ``LEGKIN_DEBUG=1`` to see its traceback), 130 when interrupted.
+"""
 
 from __future__ import annotations
 
 import argparse
+import math
+import os
 import sys
-
-import numpy as np
+from pathlib import Path
 
 from . import errors
 
+#: Unsolved IK targets ``legkin check`` classifies per model unless ``--classify-all``.
+CLASSIFY_DEFAULT = 2000
 
+
+class UsageError(Exception):
+    """A bad command line (printed as one line, exit status 2)."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (argparse prints the usage first, on several lines)."""
+
+    def error(self, message):  # noqa: D102 - argparse API
+        raise UsageError(f"{self.prog}: error: {message} (see `{self.prog} --help`)")
+
+
+# ------------------------------------------------------------------------------------------ argument types
+def _int(text: str, low: int, what: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be {what}, got {text!r}") from None
+    if value < low:
+        raise argparse.ArgumentTypeError(f"must be {what}, got {value}")
+    return value
+
+
+def positive_int(text: str) -> int:
+    return _int(text, 1, "a positive integer")
+
+
+def nonnegative_int(text: str) -> int:
+    return _int(text, 0, "an integer >= 0")
+
+
+def finite_float(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"must be a finite number, got {text!r}")
+    return value
+
+
+def output_file(text: str) -> str:
+    """A path a file can be written to: its directory exists, and the path is not a directory."""
+    path = Path(text)
+    parent = path.parent
+    if text == "" or path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a directory, not a file name")
+    if not parent.is_dir():
+        why = "is not a directory" if parent.exists() else "does not exist"
+        raise argparse.ArgumentTypeError(f"cannot write {text!r}: directory {str(parent)!r} {why}")
+    if not os.access(parent, os.W_OK):
+        raise argparse.ArgumentTypeError(f"cannot write {text!r}: directory {str(parent)!r} is not writable")
+    return text
+
+
+def output_dir(text: str) -> str:
+    """A directory that exists or can be made (its first existing ancestor is a writable directory)."""
+    path = Path(text)
+    if path.exists() and not path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} exists and is not a directory")
+    ancestor = path
+    while not ancestor.exists():
+        ancestor = ancestor.parent
+    if not ancestor.is_dir():
+        raise argparse.ArgumentTypeError(f"cannot create {text!r}: {str(ancestor)!r} is not a directory")
+    if not os.access(ancestor, os.W_OK):
+        raise argparse.ArgumentTypeError(f"cannot write into {text!r}: {str(ancestor)!r} is not writable")
+    return text
+
+
+def _check_models(names) -> list[str] | None:
+    """The model names of the command line, every one checked before any work starts."""
+    from ._registry import get_spec
+
+    for name in names:
+        get_spec(name)  # UnknownModelError lists the known names
+    return list(names) or None
+
+
+def _show_progress(args) -> bool:
+    """Progress bars go to stderr, only when it is a terminal and ``--quiet`` was not given."""
+    return not getattr(args, "quiet", False) and sys.stderr.isatty()
+
+
+# ------------------------------------------------------------------------------------------ commands
 def _cmd_list(args) -> int:
     from ._registry import MODELS
 
@@ -22,22 +115,35 @@ def _cmd_list(args) -> int:
 def _cmd_generate(args) -> int:
     from ._generate import check_all, generate_all
 
+    models = _check_models(args.models)
     if args.check:
-        stale = check_all(args.models or None)
+        stale = check_all(models)
         if stale:
             print("out of date (run `legkin generate`): " + ", ".join(stale), file=sys.stderr)
             return 1
         print("urdf/ matches xacro/")
         return 0
-    for path in generate_all(args.models or None):
+    for path in generate_all(models):
         print(f"wrote {path}")
     return 0
 
 
 def _cmd_check(args) -> int:
+    import importlib.util
+
     from .validation import all_passed, format_table, run_checks, write_json
 
-    results = run_checks(args.models or None, samples=args.samples, seed=args.seed)
+    models = _check_models(args.models)
+    if args.plots and importlib.util.find_spec("matplotlib") is None:
+        raise errors.LegkinError('--plots needs matplotlib: pip install -e ".[plots]"')
+    results = run_checks(
+        models,
+        samples=args.samples,
+        seed=args.seed,
+        ik_targets=args.ik_targets,
+        classify=None if args.classify_all else CLASSIFY_DEFAULT,
+        progress=_show_progress(args),
+    )
     print(format_table(results))
     if args.json:
         write_json(results, args.json)
@@ -52,9 +158,13 @@ def _cmd_check(args) -> int:
 
 
 def _cmd_view(args) -> int:
+    import numpy as np
+
     from . import load
     from .viewer import show, write_html
 
+    if args.animate and (args.q is not None or args.pose is not None):
+        raise UsageError("legkin view: error: --animate plays a clip: it takes no --pose or --q")
     robot = load(args.model)
     if args.q is not None:
         if len(args.q) != robot.model.nq:
@@ -91,12 +201,13 @@ def _cmd_view(args) -> int:
 def _cmd_bench(args) -> int:
     from .bench import run_bench_cli
 
+    args.models = _check_models(args.models) or []
     return run_bench_cli(args)
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="legkin", description=__doc__)
-    sub = parser.add_subparsers(dest="command", required=True)
+    parser = _Parser(prog="legkin", description="Kinematic models of legged and parallel mechanisms.")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
 
     p = sub.add_parser("list", help="list the registered models")
     p.set_defaults(func=_cmd_list)
@@ -108,40 +219,77 @@ def build_parser() -> argparse.ArgumentParser:
 
     p = sub.add_parser("check", help="validate the analytic kinematics against Pinocchio")
     p.add_argument("models", nargs="*", help="models (default: all)")
-    p.add_argument("--samples", type=int, default=10_000, help="random samples per check (default 10000)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.add_argument("--json", metavar="PATH", help="also write the results as JSON")
-    p.add_argument("--plots", metavar="DIR", help="also write PNG figures (needs matplotlib)")
+    p.add_argument("--samples", type=positive_int, default=10_000, help="random samples per check (default 10000)")
+    p.add_argument("--seed", type=nonnegative_int, default=0, help="random seed, an integer >= 0 (default 0)")
+    p.add_argument(
+        "--ik-targets", type=positive_int, default=None, metavar="N",
+        help="random targets of each model's IK robustness row (default: --samples)",
+    )
+    p.add_argument(
+        "--classify-all", action="store_true",
+        help=f"classify every unsolved IK target by a single call (default: at most {CLASSIFY_DEFAULT} per model)",
+    )
+    p.add_argument("--json", metavar="PATH", type=output_file, help="also write the results as JSON")
+    p.add_argument("--plots", metavar="DIR", type=output_dir, help="also write PNG figures (needs matplotlib)")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=_cmd_check)
 
     p = sub.add_parser("view", help="show a model in meshcat")
     p.add_argument("model")
     g = p.add_mutually_exclusive_group()
     g.add_argument("--pose", help="a named pose from the SRDF")
-    g.add_argument("--q", type=float, nargs="+", help="a configuration vector")
+    g.add_argument("--q", type=finite_float, nargs="+", help="a configuration vector")
     p.add_argument("--animate", metavar="NAME", help="play an animation clip (see legkin.animations)")
-    p.add_argument("--html", metavar="PATH", help="write a static page and exit")
+    p.add_argument("--html", metavar="PATH", type=output_file, help="write a static page and exit")
     p.set_defaults(func=_cmd_view)
+
     p = sub.add_parser("bench", help="time analytic kinematics against iterative solvers")
     p.add_argument("models", nargs="*", help="models (default: all)")
-    p.add_argument("--n", type=int, default=None, help="targets per method (default: per model)")
-    p.add_argument("--json", metavar="PATH", help="also write the results as JSON")
+    p.add_argument("--n", type=positive_int, default=None, help="targets per method (default: per model)")
+    p.add_argument("--json", metavar="PATH", type=output_file, help="also write the results as JSON")
     p.add_argument("--quick", action="store_true", help="small run for smoke tests (under a minute)")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=nonnegative_int, default=0, help="random seed, an integer >= 0 (default 0)")
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=_cmd_bench)
     return parser
 
 
+def _fail(message: str, status: int) -> int:
+    print(message.replace("\n", " "), file=sys.stderr)
+    return status
+
+
 def main(argv: list[str] | None = None) -> int:
+    """Run the command line; returns the exit status (never raises, except SystemExit from --help)."""
     parser = build_parser()
-    args = parser.parse_args(argv)
-    if getattr(args, "samples", 1) is not None and getattr(args, "samples", 1) < 1:
-        parser.error(f"--samples must be a positive integer, got {args.samples}")
     try:
+        args = parser.parse_args(argv)
         return args.func(args)
+    except UsageError as exc:
+        return _fail(str(exc), 2)
     except errors.LegkinError as exc:
-        print(f"legkin: error: {exc}", file=sys.stderr)
-        return 2
+        return _fail(f"legkin: error: {exc}", 2)
+    except KeyboardInterrupt:
+        return _fail("legkin: interrupted", 130)
+    except BrokenPipeError:  # e.g. `legkin list | head -1`: stop quietly
+        try:
+            sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - Python flushes stdout at exit
+        except OSError:
+            pass
+        return 1
+    except OSError as exc:
+        where = f"{exc.filename}: " if getattr(exc, "filename", None) else ""
+        return _fail(f"legkin: error: {where}{exc.strerror or exc}", 2)
+    except MemoryError:
+        return _fail("legkin: error: out of memory (try a smaller --samples / --n)", 2)
+    except Exception as exc:  # noqa: BLE001 - a defect; the user still gets one line, not a traceback
+        if os.environ.get("LEGKIN_DEBUG"):
+            raise
+        return _fail(
+            f"legkin: internal error (a bug, please report it): {type(exc).__name__}: {exc} "
+            "(LEGKIN_DEBUG=1 shows the traceback)",
+            3,
+        )
 
 
 if __name__ == "__main__":

@@ -156,31 +156,27 @@ class MethodResult:
 
 # ------------------------------------------------------------------------------------------- progress
 class _Progress:
-    """A one-line progress bar on stderr (only when stderr is a terminal)."""
+    """A progress bar (tqdm) on stderr: methods timed so far, the one running now; off when disabled.
 
-    def __init__(self, total: int, label: str):
-        self.total, self.done, self.label = max(total, 1), 0, label
-        self.enabled = sys.stderr.isatty()
-        self.t0 = time.perf_counter()
+    Enabled by default only when stderr is a terminal; ``legkin bench --quiet`` disables it.
+    """
+
+    def __init__(self, total: int, label: str, enabled: bool | None = None):
+        from .validation import progress_bar
+
+        self.enabled = sys.stderr.isatty() if enabled is None else bool(enabled)
+        self._ctx = progress_bar(max(total, 1), f"legkin bench {label}".rstrip(), enabled=self.enabled)
+        self._bar = self._ctx.__enter__()
 
     def show(self, what: str) -> None:
-        if not self.enabled:
-            return
-        width = 24
-        k = int(width * self.done / self.total)
-        bar = "#" * k + "-" * (width - k)
-        line = f"\r{self.label} [{bar}] {self.done}/{self.total} {what} ({time.perf_counter() - self.t0:.0f} s)"
-        sys.stderr.write(line[:120].ljust(120))
-        sys.stderr.flush()
+        self._bar.set_postfix_str(what[:80])
 
     def step(self, what: str) -> None:
-        self.done += 1
+        self._bar.update(1)
         self.show(what)
 
     def close(self) -> None:
-        if self.enabled:
-            sys.stderr.write("\r" + " " * 120 + "\r")
-            sys.stderr.flush()
+        self._ctx.__exit__(None, None, None)
 
 
 # ------------------------------------------------------------------------------------------- running
@@ -230,11 +226,24 @@ def _count(inputs) -> int:
     return len(inputs[0]) if isinstance(inputs, tuple) else len(inputs)
 
 
-def run_model(bench: ModelBench, label: str = "", progress: _Progress | None = None) -> list[MethodResult]:
-    """Time and score every method of a model; fills the ratio to the fastest method of each group."""
+def run_model(
+    bench: ModelBench, label: str = "", progress: _Progress | None = None, quiet: bool = False
+) -> list[MethodResult]:
+    """Time and score every method of a model; fills the ratio to the fastest method of each group.
+
+    A progress bar shows on stderr when it is a terminal, unless ``quiet``.
+    """
     runnable = [m for m in bench.methods if m.skip is None]
     own = progress is None
-    progress = progress or _Progress(len(runnable), label)
+    progress = progress or _Progress(len(runnable), label, enabled=False if quiet else None)
+    try:
+        return _run_methods(bench, runnable, progress)
+    finally:
+        if own:
+            progress.close()
+
+
+def _run_methods(bench: ModelBench, runnable: list[Method], progress: _Progress) -> list[MethodResult]:
     results: list[MethodResult] = []
     for m in runnable:
         inputs = _subset(m.inputs, m.max_targets)
@@ -274,8 +283,6 @@ def run_model(bench: ModelBench, label: str = "", progress: _Progress | None = N
         for r in results:
             if r.group == g:
                 r.ratio = r.time_per_target_s / fastest
-    if own:
-        progress.close()
     return results
 
 
@@ -291,9 +298,9 @@ def _load_bench_module(name: str):
 
 
 def run_bench(
-    models: list[str] | None = None, n: int | None = None, seed: int = 0, quick: bool = False
+    models: list[str] | None = None, n: int | None = None, seed: int = 0, quick: bool = False, quiet: bool = False
 ) -> dict:
-    """Build and run the benches of ``models`` (default: all registered).
+    """Build and run the benches of ``models`` (default: all registered); ``quiet``: no progress bar.
 
     Returns:
         ``{"models": {name: (ModelBench, [MethodResult])}, "skipped": {name: reason}}``.
@@ -309,7 +316,7 @@ def run_bench(
             continue
         rng = np.random.default_rng(seed)
         bench = module.build(n, rng, quick)
-        out["models"][name] = (bench, run_model(bench, label=name))
+        out["models"][name] = (bench, run_model(bench, label=name, quiet=quiet))
     return out
 
 
@@ -468,7 +475,9 @@ def run_bench_cli(args) -> int:
         return 2
     t0 = time.perf_counter()
     info = machine_info()  # before the run: the load average then is the other processes'
-    run = run_bench(args.models or None, n=args.n, seed=args.seed, quick=args.quick)
+    run = run_bench(
+        args.models or None, n=args.n, seed=args.seed, quick=args.quick, quiet=getattr(args, "quiet", False)
+    )
     print(
         f"legkin bench on {info['cpu']} ({info['cpu_count']} cores), Python {info['python']}, "
         f"numpy {info['numpy']}, pin {info['pin']}, load average {info['load_average_1min']:.2f}"

@@ -2,8 +2,10 @@
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import json
+import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -70,6 +72,39 @@ def per_sample(diff, axis=-1):
     return np.linalg.norm(np.asarray(diff, dtype=float), axis=axis)
 
 
+@contextlib.contextmanager
+def progress_bar(total: int, desc: str, enabled: bool = True):
+    """A tqdm bar on stderr (steps done, elapsed time, what runs now in its postfix), redrawn every second.
+
+    A step can take several seconds: a thread redraws the bar so that its clock keeps running. Disabled,
+    the bar prints nothing and starts no thread.
+    """
+    import threading
+
+    from tqdm import tqdm
+
+    bar = tqdm(
+        total=total, desc=desc, unit="step", file=sys.stderr, disable=not enabled, leave=False,
+        dynamic_ncols=True, bar_format="{desc}: {n_fmt}/{total_fmt} |{bar:20}| {elapsed}{postfix}",
+    )
+    stop = threading.Event()
+
+    def tick():
+        while not stop.wait(1.0):
+            bar.refresh()
+
+    ticker = threading.Thread(target=tick, daemon=True) if enabled else None
+    if ticker is not None:
+        ticker.start()
+    try:
+        yield bar
+    finally:
+        stop.set()
+        if ticker is not None:
+            ticker.join()
+        bar.close()
+
+
 def run_checks(
     models: list[str] | None = None,
     samples: int = 10_000,
@@ -77,25 +112,33 @@ def run_checks(
     *,
     ik_targets: int | None = None,
     classify: int | None = 2000,
+    progress: bool = False,
 ):
     """Run every check of each model; returns ``{model: (rows, seconds)}``.
 
     A model's checks module may define ``ik_robustness(n, rng, *, classify) -> CheckResult`` (the IK contract
     row on ``n`` random targets in and around the workspace, see :func:`robustness_row`); it runs on
     ``ik_targets`` targets (default ``samples``), classifying at most ``classify`` unsolved ones (None: all)
-    by single calls.
+    by single calls. ``progress=True`` shows a progress bar (tqdm) on stderr, one step per model and stage.
     """
+    names = list(models or list_models())
+    specs = [get_spec(name) for name in names]  # every unknown name raises before any work
+    modules = [importlib.import_module(spec.checks) for spec in specs]
+    steps = sum(2 if hasattr(m, "ik_robustness") else 1 for m in modules)
     out = {}
-    for name in models or list_models():
-        spec = get_spec(name)
-        rng = np.random.default_rng(seed)
-        t0 = time.perf_counter()
-        module = importlib.import_module(spec.checks)
-        rows = list(module.run(samples, rng))
-        if hasattr(module, "ik_robustness"):
-            n = samples if ik_targets is None else ik_targets
-            rows.append(module.ik_robustness(n, np.random.default_rng(seed + 1), classify=classify))
-        out[name] = (rows, time.perf_counter() - t0)
+    with progress_bar(steps, "legkin check", enabled=progress) as bar:
+        for name, module in zip(names, modules):
+            rng = np.random.default_rng(seed)
+            t0 = time.perf_counter()
+            bar.set_postfix_str(f"{name}: checks ({samples} samples)")
+            rows = list(module.run(samples, rng))
+            bar.update(1)
+            if hasattr(module, "ik_robustness"):
+                n = samples if ik_targets is None else ik_targets
+                bar.set_postfix_str(f"{name}: IK robustness ({n} targets)")
+                rows.append(module.ik_robustness(n, np.random.default_rng(seed + 1), classify=classify))
+                bar.update(1)
+            out[name] = (rows, time.perf_counter() - t0)
     return out
 
 

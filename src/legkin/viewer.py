@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import contextlib
 import io
+import signal
+import subprocess
+import threading
 from pathlib import Path
 from typing import Iterator, Sequence
 
@@ -18,29 +21,61 @@ DEFAULT_CAMERA = (1.2, 0.7, 1.2)
 
 
 @contextlib.contextmanager
+def _sigterm_interrupts() -> Iterator[None]:
+    """Inside the block, SIGTERM raises KeyboardInterrupt (as Ctrl-C does), so that ``finally`` clauses run.
+
+    Only in the main thread (Python delivers signals there); the previous handler is restored on exit.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt(f"signal {signum}")
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+@contextlib.contextmanager
 def open_viewer(robot: Robot, camera: Sequence[float] | None = None) -> Iterator[object]:
     """A ``pinocchio.visualize.MeshcatVisualizer`` with ``robot`` loaded; its zmq server is always stopped.
 
     meshcat 0.3.2 starts the server as a child process and has no working ``close``: the context
-    manager terminates it on exit, whatever happens inside.
+    manager terminates it on exit, whatever happens inside, SIGTERM included (it raises KeyboardInterrupt
+    inside the block, as Ctrl-C does).
     """
     import meshcat
     from pinocchio.visualize import MeshcatVisualizer
 
-    with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; callers decide what to show
-        viewer = meshcat.Visualizer()
+    with _sigterm_interrupts():
+        with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; callers decide what to show
+            viewer = meshcat.Visualizer()
+        try:
+            viz = MeshcatVisualizer(robot.model, robot.collision_model, robot.visual_model)
+            viz.initViewer(viewer=viewer, open=False)
+            viz.loadViewerModel(rootNodeName=robot.name)
+            cam = camera if camera is not None else _camera_for(robot)
+            viewer["/Cameras/default/rotated/<object>"].set_property("position", list(map(float, cam)))
+            yield viz
+        finally:
+            _stop_server(viewer)
+
+
+def _stop_server(viewer) -> None:
+    """Terminate meshcat's server process (kill it if it does not stop within 10 s)."""
+    proc = getattr(viewer.window, "server_proc", None)
+    if proc is None:
+        return
+    proc.terminate()
     try:
-        viz = MeshcatVisualizer(robot.model, robot.collision_model, robot.visual_model)
-        viz.initViewer(viewer=viewer, open=False)
-        viz.loadViewerModel(rootNodeName=robot.name)
-        cam = camera if camera is not None else _camera_for(robot)
-        viewer["/Cameras/default/rotated/<object>"].set_property("position", list(map(float, cam)))
-        yield viz
-    finally:
-        proc = getattr(viewer.window, "server_proc", None)
-        if proc is not None:
-            proc.terminate()
-            proc.wait(timeout=10)
+        proc.wait(timeout=10)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        proc.wait(timeout=10)
 
 
 def _camera_for(robot: Robot) -> tuple[float, float, float]:

@@ -1,0 +1,221 @@
+"""The command line: every misuse is one line on stderr and a non-zero exit (never a traceback); options reach
+the library; progress bars on stderr only on a terminal."""
+
+from __future__ import annotations
+
+import fcntl
+import json
+import os
+import pty
+import struct
+import subprocess
+import sys
+import termios
+
+import pytest
+
+from legkin import validation
+from legkin.__main__ import main
+
+NO_DIR = "/nonexistent-legkin-dir/out"
+
+
+def _misuse(tmp_path):
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    return [
+        (["check", "--seed", "-1"], "--seed"),
+        (["check", "--seed", "x"], "--seed"),
+        (["check", "--samples", "0"], "--samples"),
+        (["check", "--samples", "-5"], "--samples"),
+        (["check", "--samples", "1.5"], "--samples"),
+        (["check", "--ik-targets", "0"], "--ik-targets"),
+        (["check", "no_such_robot"], "known models"),
+        (["check", "quadruped", "no_such_robot"], "known models"),
+        (["check", "--json", f"{NO_DIR}/c.json"], "does not exist"),
+        (["check", "--json", str(tmp_path)], "is a directory"),
+        (["check", "--json", f"{a_file}/c.json"], "is not a directory"),
+        (["check", "--plots", str(a_file)], "not a directory"),
+        (["view", "no_such_robot"], "known models"),
+        (["view", "quadruped", "--q", "a"], "--q"),
+        (["view", "quadruped", "--q", "nan", *["0"] * 11], "finite"),
+        (["view", "quadruped", "--q", "inf", *["0"] * 11], "finite"),
+        (["view", "quadruped", "--q", "1", "2"], "takes 12 values"),
+        (["view", "quadruped", "--html", f"{NO_DIR}/v.html"], "does not exist"),
+        (["view", "quadruped", "--html", str(tmp_path)], "is a directory"),
+        (["view", "quadruped", "--pose", "no_such_pose", "--html", str(tmp_path / "v.html")], "poses:"),
+        (["view", "quadruped", "--animate", "no_such_clip", "--html", str(tmp_path / "v.html")], "animations:"),
+        (["view", "quadruped", "--animate", "foot_circles", "--pose", "standing"], "--animate"),
+        (["view", "quadruped", "--pose", "standing", "--q", "0"], "not allowed"),
+        (["bench", "--n", "0"], "--n"),
+        (["bench", "--seed", "-1"], "--seed"),
+        (["bench", "--json", f"{NO_DIR}/b.json"], "does not exist"),
+        (["bench", "no_such_robot"], "known models"),
+        (["generate", "no_such_robot"], "known models"),
+        ([], "COMMAND"),
+        (["no_such_command"], "invalid choice"),
+        (["check", "--no-such-option"], "unrecognized"),
+    ]
+
+
+@pytest.mark.parametrize("case", range(31))
+def test_misuse_is_one_line_and_status_2(case, tmp_path, capsys):
+    cases = _misuse(tmp_path)
+    assert len(cases) == 31
+    argv, word = cases[case]
+    assert main(argv) == 2
+    out, err = capsys.readouterr()
+    lines = err.strip().splitlines()
+    assert len(lines) == 1, err
+    assert lines[0].startswith("legkin") and "error" in lines[0], err
+    assert word in lines[0], err
+    assert "Traceback" not in out + err
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["view", "tripod", "--html", f"{NO_DIR}/v.html"],
+        ["check", "--seed", "-1"],
+        ["check", "--samples", "0"],
+        ["check", "--json", f"{NO_DIR}/c.json"],
+        ["view", "tripod", "--q", "x"],
+    ],
+)
+def test_misuse_in_a_real_process(argv):
+    proc = subprocess.run([sys.executable, "-m", "legkin", *argv], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 2
+    assert len(proc.stderr.strip().splitlines()) == 1, proc.stderr
+    assert "Traceback" not in proc.stderr
+
+
+def test_write_failure_is_one_line(tmp_path, monkeypatch, capsys):
+    # The path passed the up-front checks, then the write fails (e.g. the disk is full).
+    def full(*args, **kwargs):
+        raise OSError(28, "No space left on device", str(tmp_path / "c.json"))
+
+    monkeypatch.setattr(validation, "write_json", full)
+    assert main(["check", "quadruped", "--samples", "20", "--json", str(tmp_path / "c.json"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "No space left on device" in err[0] and "c.json" in err[0]
+
+
+def test_internal_error_is_one_line_status_3(monkeypatch, capsys):
+    def broken(*args, **kwargs):
+        raise RuntimeError("boom")
+
+    monkeypatch.setattr(validation, "run_checks", broken)
+    monkeypatch.delenv("LEGKIN_DEBUG", raising=False)
+    assert main(["check", "quadruped"]) == 3
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "internal error" in err[0] and "RuntimeError: boom" in err[0]
+    monkeypatch.setenv("LEGKIN_DEBUG", "1")
+    with pytest.raises(RuntimeError):
+        main(["check", "quadruped"])
+
+
+def test_interrupt_is_status_130(monkeypatch, capsys):
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(validation, "run_checks", interrupted)
+    assert main(["check", "quadruped"]) == 130
+    assert capsys.readouterr().err.strip() == "legkin: interrupted"
+
+
+# ---------------------------------------------------------------------------------------------- options
+def _capture_run_checks(monkeypatch):
+    seen = {}
+
+    def fake(models, **kwargs):
+        seen.update(kwargs, models=models)
+        return {}
+
+    monkeypatch.setattr(validation, "run_checks", fake)
+    return seen
+
+
+def test_check_passes_ik_options(monkeypatch, capsys):
+    seen = _capture_run_checks(monkeypatch)
+    assert main(["check", "wheel_leg", "--samples", "30"]) == 0
+    assert seen["ik_targets"] is None and seen["classify"] == 2000 and seen["samples"] == 30
+    assert seen["models"] == ["wheel_leg"]
+    assert main(["check", "--ik-targets", "7", "--classify-all", "--seed", "3"]) == 0
+    assert seen["ik_targets"] == 7 and seen["classify"] is None and seen["seed"] == 3
+    assert seen["models"] is None
+    assert seen["progress"] is False  # stderr is captured, not a terminal
+
+
+def test_check_ik_targets_sets_the_robustness_row(tmp_path):
+    out = tmp_path / "c.json"
+    assert main(["check", "wheel_leg", "--samples", "20", "--ik-targets", "24", "--classify-all", "--json", str(out)]) == 0
+    rows = [r for r in json.loads(out.read_text())["models"]["wheel_leg"]["checks"] if r.get("counts")]
+    assert len(rows) == 1 and rows[0]["counts"]["targets"] == 24
+
+
+# ---------------------------------------------------------------------------------------------- progress
+def _run_on_terminal(argv, timeout=300):
+    """Run ``legkin argv`` with stderr on a pseudo-terminal (100 columns); returns (status, stderr bytes)."""
+    master, slave = pty.openpty()
+    fcntl.ioctl(slave, termios.TIOCSWINSZ, struct.pack("HHHH", 24, 100, 0, 0))
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "legkin", *argv], stdout=subprocess.DEVNULL, stderr=slave, stdin=subprocess.DEVNULL
+    )
+    os.close(slave)
+    data = b""
+    try:
+        while True:
+            try:
+                chunk = os.read(master, 4096)
+            except OSError:  # EIO: the child closed the terminal
+                break
+            if not chunk:
+                break
+            data += chunk
+        return proc.wait(timeout=timeout), data
+    finally:
+        os.close(master)
+        if proc.poll() is None:
+            proc.kill()
+
+
+def test_check_progress_on_a_terminal_only():
+    argv = ["check", "quadruped", "--samples", "30"]
+    status, err = _run_on_terminal(argv)
+    assert status == 0 and b"legkin check" in err and b"quadruped" in err
+    status, err = _run_on_terminal([*argv, "--quiet"])
+    assert status == 0 and err == b""
+    proc = subprocess.run([sys.executable, "-m", "legkin", *argv], capture_output=True, timeout=300)
+    assert proc.returncode == 0 and proc.stderr == b""  # stderr is a pipe: no bar
+
+
+def test_run_checks_progress_bar(capsys):
+    validation.run_checks(["quadruped"], samples=20, progress=True)
+    assert "legkin check" in capsys.readouterr().err
+    validation.run_checks(["quadruped"], samples=20)
+    assert capsys.readouterr().err == ""
+
+
+def test_bench_progress_bar(capsys, monkeypatch):
+    from legkin import bench
+
+    bar = bench._Progress(2, "quadruped", enabled=True)
+    bar.show("first method (run 1/5)")
+    bar.step("first method")
+    bar.close()
+    err = capsys.readouterr().err
+    assert "legkin bench quadruped" in err and "first method" in err
+    quiet = bench._Progress(2, "quadruped", enabled=False)
+    quiet.step("x")
+    quiet.close()
+    assert capsys.readouterr().err == ""
+
+    seen = {}
+
+    def fake(models=None, n=None, seed=0, quick=False, quiet=False):
+        seen.update(quiet=quiet, seed=seed, n=n)
+        return {"models": {}, "skipped": {}}
+
+    monkeypatch.setattr(bench, "run_bench", fake)
+    assert main(["bench", "--quiet", "--n", "5", "--seed", "2"]) == 0
+    assert seen == {"quiet": True, "seed": 2, "n": 5}

@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import legkin
@@ -88,6 +88,7 @@ def test_ik_all_branches_reach_target_everywhere(leg, direction, frac, s_u, tilt
     leg=st.sampled_from(LEGS),
     u=st.tuples(st.floats(0, 1), st.floats(0, 1), st.floats(0, 1)),
 )
+@example(leg="LF", u=(0.0, 0.43359375, 0.0))  # q1, q3 on their lower limits (failed during the clip change)
 def test_ik_round_trip_inside_limits(leg, u):
     lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
     q = lo + np.array(u) * (hi - lo)
@@ -214,3 +215,246 @@ def test_textbook_literal_and_atan2_agree_for_positive_zf():
     np.testing.assert_allclose(
         aq.textbook_ik(pf, aq.Y12, L1, L2, literal=True), aq.textbook_ik(pf, aq.Y12, L1, L2), atol=1e-15
     )
+
+
+# ----------------------------------------------------------------------------- input validation
+def test_scalar_target_with_batch_q_ref_is_a_batch():
+    """Rule: p and q_ref broadcast; a single target with a batch of q_ref is a batch (one answer per q_ref)."""
+    q_true = np.array([0.1, 0.75, 1.5])
+    p = aq.foot_position(q_true, "LF")
+    q_ref = np.array([q_true, q_true + 0.05, [0.0, 0.5, 1.0]])
+    q, ok = aq.foot_ik(p, "LF", q_ref=q_ref, return_mask=True)
+    assert q.shape == (3, 3) and ok.shape == (3,) and ok.all()
+    np.testing.assert_allclose(q, np.broadcast_to(aq.foot_ik(p, "LF", q_ref=q_true), (3, 3)), atol=1e-12)
+    assert aq.foot_ik(p, "LF", q_ref=q_ref[None, :1]).shape == (1, 1, 3)
+    # an unreachable single target with a batch of q_ref: NaN rows and a False mask, no exception
+    far = aq.hip_position("LF") + np.array([0.0, 0.0, -1.0])
+    q, ok = aq.foot_ik(far, "LF", q_ref=q_ref, return_mask=True)
+    assert not ok.any() and np.isnan(q).all()
+    with pytest.raises(legkin.InvalidInputError, match="do not broadcast"):
+        aq.foot_ik(np.stack([p, p]), "LF", q_ref=q_ref)
+
+
+@pytest.mark.parametrize("bad", ["abc", ["a", "b", "c"], np.zeros(3) + 1j, [[0.0, 0.0, 0.0], [0.0, 0.0]], np.zeros(2), None])
+def test_within_limits_refuses_non_numeric(bad):
+    with pytest.raises(legkin.InvalidInputError):
+        aq.within_limits(bad)
+
+
+def test_within_limits_nan_rows_are_outside():
+    q = np.array([[0.0, 1.0, 1.0], [np.nan, 1.0, 1.0], [np.inf, 1.0, 1.0]])
+    assert aq.within_limits(q).tolist() == [True, False, False]
+
+
+@pytest.mark.parametrize(
+    "kw, match",
+    [
+        ({"foot_z": float("nan")}, r"foot_z=nan is out of range: must be in \[-0.1, 0.1\]"),
+        ({"foot_z": 5}, r"foot_z=5.0 is out of range: must be in \[-0.1, 0.1\]"),
+        ({"foot_z": -0.2}, r"out of range: must be in \[-0.1, 0.1\]"),
+        ({"foot_z": float("inf")}, r"out of range"),
+        ({"foot_z": "0.01"}, r"foot_z must be a real number, got '0.01'; valid range \[-0.1, 0.1\]"),
+        ({"foot_z": True}, r"foot_z must be a real number"),
+        ({"foot_z": 0.01 + 0j}, r"foot_z must be a real number"),
+        ({"foot_z": [0.01]}, r"foot_z must be a real number"),
+        ({"return_mask": "yes"}, r"return_mask must be True or False"),
+    ],
+)
+def test_keyword_parameters_are_validated(kw, match):
+    p = aq.foot_position(np.array([0.0, 0.75, 1.5]), "LF")
+    q = np.array([0.0, 0.75, 1.5])
+    calls = [lambda: aq.foot_ik(p, "LF", **kw), lambda: aq.foot_ik_all(p, "LF", **kw)]
+    if "foot_z" in kw:
+        calls += [lambda: aq.foot_position(q, "LF", **kw), lambda: aq.foot_jacobian(q, "LF", **kw)]
+    for call in calls:
+        with pytest.raises(legkin.InvalidParameterError, match=match):
+            call()
+
+
+def test_foot_z_range_is_the_registry_one():
+    from legkin.models.quadruped import SPEC
+
+    param = SPEC.params["foot_z"]
+    q = np.array([0.0, 0.75, 1.5])
+    aq.foot_position(q, "LF", foot_z=param.low)
+    aq.foot_position(q, "LF", foot_z=np.float64(param.high))
+    aq.foot_position(q, "LF", foot_z=np.float32(0.0625))
+    aq.foot_position(q, "LF", foot_z=np.array(0.0))
+    with pytest.raises(legkin.InvalidParameterError):
+        aq.foot_position(q, "LF", foot_z=param.high * (1 + 1e-12))
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: aq.within_limits(np.zeros(3), tol=-1e-9),
+        lambda: aq.within_limits(np.zeros(3), tol=float("nan")),
+        lambda: aq.within_limits(np.zeros(3), tol="0"),
+        lambda: aq.textbook_ik(np.array([0.1, 0.0, 0.4]), aq.Y12, 0.0, L2),
+        lambda: aq.textbook_ik(np.array([0.1, 0.0, 0.4]), float("nan"), L1, L2),
+        lambda: aq.textbook_ik(np.array([0.1, 0.0, 0.4]), aq.Y12, L1, "x"),
+        lambda: aq.textbook_ik(np.array([0.1, 0.0, 0.4]), aq.Y12, L1, L2, literal="no"),
+        lambda: aq.foot_ik(np.zeros(3), 3),
+    ],
+)
+def test_other_parameters_are_validated(call):
+    with pytest.raises(legkin.InvalidParameterError):
+        call()
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: aq.foot_ik(np.zeros(3) + 1j, "LF"),
+        lambda: aq.foot_ik(np.array([0.3, 0.3, -0.4]), "LF", q_ref=np.zeros(3) + 0j),
+        lambda: aq.foot_ik("abc", "LF"),
+        lambda: aq.foot_ik([[0.3, 0.3, -0.4], [0.3, 0.3]], "LF"),
+        lambda: aq.foot_ik(np.array([0.3, 0.3, -0.4]), "LF", q_ref=[0.0, np.nan, 0.0]),
+        lambda: aq.foot_position(np.array([1.0, 2.0, 3.0], dtype=object), "LF"),
+        lambda: aq.textbook_frame(np.zeros(3) + 1j, "LF"),
+        lambda: aq.textbook_to_joints(np.zeros(3) + 1j, "LF"),
+    ],
+)
+def test_bad_arrays_raise_invalid_input(call):
+    with pytest.raises(legkin.InvalidInputError):
+        call()
+
+
+# ----------------------------------------------------------------------------- the IK contract (property tests)
+LO, HI = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
+ATOL_CONTRACT = 1e-9
+
+
+def _joint(k):
+    """A joint value inside limit row k: anywhere, exactly on a limit, or a hair inside one."""
+    lo, hi = float(LO[k]), float(HI[k])
+    hair = st.floats(1e-15, 1e-6)
+    return st.one_of(
+        st.floats(lo, hi),
+        st.sampled_from([lo, hi]),
+        hair.map(lambda h: lo + h),
+        hair.map(lambda h: hi - h),
+    )
+
+
+def _check_answer(q, p, leg, tol=ATOL_CONTRACT):
+    """Contract (a) and (c) for one answer."""
+    assert q.shape == (3,) and np.all(np.isfinite(q))
+    assert np.all(q >= LO) and np.all(q <= HI), q  # inside the URDF limits, no slack
+    assert np.linalg.norm(aq.foot_position(q, leg) - p) <= tol
+
+
+def _near_cylinder_joints(q, log_rho, sign):
+    """Replace q2 of q so that the foot is rho = sign 10**log_rho from the abduction cylinder (u_z = rho)."""
+    vx, vz = aq._knee_vector(q[2], 0.0)
+    r, rho = math.hypot(vx, vz), sign * 10.0**log_rho
+    return np.array([q[0], float(aq._wrap(math.atan2(rho, math.sqrt(r * r - rho * rho)) - math.atan2(vz, vx))), q[2]])
+
+
+@settings(max_examples=400, deadline=None)
+@example(leg="LF", q1=-0.4, q2=0.0, q3=1.5, log_rho=-8.0, sign=-1.0, with_ref=False)  # q1 1.3e-9 off its limit
+@example(leg="LF", q1=-0.4, q2=1.36, q3=0.26, log_rho=None, sign=1.0, with_ref=False)  # two joints on limits
+@given(
+    leg=st.sampled_from(LEGS),
+    q1=_joint(0), q2=_joint(1), q3=_joint(2),
+    log_rho=st.one_of(st.none(), st.floats(-12, -2)),
+    sign=st.sampled_from([-1.0, 1.0]),
+    with_ref=st.booleans(),
+)
+def test_contract_targets_made_by_fk_are_solved(leg, q1, q2, q3, log_rho, sign, with_ref):
+    """(b): every foot_position of in-limit joints is solved by the default foot_ik, (a) and (c) hold;
+    incl. joints on their limits and feet rho -> 0 from the abduction cylinder (the branches merge)."""
+    q = np.array([q1, q2, q3])
+    if log_rho is not None:
+        q = _near_cylinder_joints(q, log_rho, sign)
+        if not aq.within_limits(q, 0.0):
+            return
+    p = aq.foot_position(q, leg)
+    q_ik = aq.foot_ik(p, leg, q_ref=q if with_ref else None)
+    _check_answer(q_ik, p, leg)
+    qb, ok = aq.foot_ik(p[None], leg, q_ref=q[None] if with_ref else None, return_mask=True)
+    assert ok.tolist() == [True] and np.array_equal(qb[0], q_ik)
+
+
+def _target(leg, kind, a, b, c, hair):
+    """Targets in and around the workspace: a box about the hip, or a hair off a boundary surface."""
+    h = aq.hip_position(leg)
+    sy = 1.0 if leg[0] == "L" else -1.0
+    l1, l2 = L1, L2
+    if kind == "box":
+        return h + 0.8 * np.array([a, b, c])
+    if kind == "cylinder":  # distance to the abduction axis = Y12 + hair
+        axis, dx = aq.Y12 + hair, 0.6 * a
+    else:
+        radius = (l1 + l2 if kind == "stretch" else abs(l1 - l2)) + hair
+        rho = abs(radius * math.sin(math.pi * b))
+        axis, dx = math.sqrt(aq.Y12**2 + rho * rho), radius * math.cos(math.pi * b)
+    t = math.pi * c
+    return h + np.array([dx, sy * axis * math.cos(t), axis * math.sin(t)])
+
+
+@settings(max_examples=400, deadline=None)
+@given(
+    leg=st.sampled_from(LEGS),
+    kind=st.sampled_from(["box", "cylinder", "stretch", "inner"]),
+    a=st.floats(-1, 1), b=st.floats(-1, 1), c=st.floats(-1, 1),
+    hair=st.one_of(st.just(0.0), st.floats(-1e-3, 1e-3), st.floats(-1e-12, 1e-12)),
+)
+def test_contract_random_targets(leg, kind, a, b, c, hair):
+    """Any target: a single call returns a contract answer or raises Unreachable/JointLimitError; the
+    batch call agrees with it item by item (NaN + mask False where the single call raises)."""
+    p = _target(leg, kind, a, b, c, hair)
+    try:
+        q = aq.foot_ik(p, leg)
+    except legkin.UnreachableError as exc:  # JointLimitError included
+        assert exc.target is not None
+        q = None
+    qb, ok = aq.foot_ik(np.stack([p, p]), leg, return_mask=True)
+    if q is None:
+        assert not ok.any() and np.isnan(qb).all()
+    else:
+        _check_answer(q, p, leg)
+        assert ok.all() and np.array_equal(qb[0], q)
+
+
+finite = st.floats(allow_nan=False, allow_infinity=False)
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    p=st.tuples(finite, finite, finite),
+    q_ref=st.one_of(st.none(), st.tuples(finite, finite, finite)),
+    leg=st.sampled_from(LEGS),
+    foot_z=st.floats(-0.1, 0.1),
+)
+def test_no_foreign_exception_or_warning_on_any_finite_input(p, q_ref, leg, foot_z):
+    """Huge or tiny finite inputs: only legkin errors, and no numpy warning (overflow etc.) either."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for call in (
+            lambda: aq.foot_ik(np.array(p), leg, q_ref=q_ref, foot_z=foot_z),
+            lambda: aq.foot_ik_all(np.array(p), leg, foot_z=foot_z),
+            lambda: aq.foot_position(np.array(p), leg, foot_z=foot_z),
+            lambda: aq.foot_jacobian(np.array(p), leg, foot_z=foot_z),
+            lambda: aq.within_limits(np.array(p)),
+            lambda: aq.textbook_to_joints(np.array(p), leg),
+        ):
+            try:
+                call()
+            except legkin.LegkinError:
+                pass
+        q, ok = aq.foot_ik(np.array([p, p]), leg, q_ref=q_ref, foot_z=foot_z, return_mask=True)
+        assert q.shape == (2, 3) and ok.shape == (2,)
+
+
+def test_ik_robustness_row_passes():
+    import time
+
+    t0 = time.perf_counter()
+    row = checks.ik_robustness(10_000, np.random.default_rng(3))
+    assert row.passed, row.name
+    assert row.counts.made == 5000 and row.counts.wrong == 0 and row.counts.missed == 0
+    assert row.counts.exceptions == 0 and row.max_error <= 1e-9
+    assert time.perf_counter() - t0 < 10

@@ -10,17 +10,27 @@ Conventions (base frame: x forward, y left, z up; metres, radians):
 
 Every function takes arrays with leading batch dimensions. A single input (``q`` or ``p`` of shape (3,))
 returns plain arrays and raises on failure; a batch returns NaN rows where an item fails, and
-``return_mask=True`` also returns the boolean mask of successes.
+``return_mask=True`` also returns the boolean mask of successes. Where two arrays come in (``foot_ik``'s ``p``
+and ``q_ref``) their leading shapes broadcast, and the call is a single one only if the broadcast shape is ``()``
+(a single target with a batch of ``q_ref`` is a batch).
+
+Inputs are checked at every public function: arrays by :func:`legkin.analytic._batch.as_input` (wrong shape,
+NaN/inf, complex, strings, ragged: ``InvalidInputError``), keyword parameters for kind and range
+(``InvalidParameterError`` naming the value and the valid range; ``foot_z``'s range is the registry's,
+:data:`legkin.models.quadruped.SPEC`). No numpy exception escapes: a failed item is NaN in a batch (mask False)
+and a legkin error in a single call.
 """
 
 from __future__ import annotations
 
 import math
+import numbers
 from typing import NamedTuple
 
 import numpy as np
 
-from ..errors import InvalidParameterError, JointLimitError, UnreachableError
+from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
+from ..models.quadruped import SPEC as _SPEC
 from ._batch import as_input, finish
 
 __all__ = [
@@ -61,6 +71,39 @@ REACH_TOL = 1e-12
 #: Branch order of :func:`foot_ik_all`: (s_u, k) with s_u = -1 foot below the hip plane, k the knee sign.
 BRANCHES = ((-1, -1), (-1, 1), (1, -1), (1, 1))
 
+#: Default slack (rad) of :func:`within_limits`, and of the representative choice of q2 near +-pi.
+LIMIT_TOL = 1e-9
+#: A branch of :func:`foot_ik` up to this far (rad) outside :data:`JOINT_LIMITS` is a candidate: targets made
+#: at a limit come back a rounding error outside it, and near the abduction singularity (rho -> 0) the joints
+#: err by up to ~rho / y12 <= 1.4e-8 rad along the singular direction (the foot itself stays exact). Such a
+#: branch is clipped into the limits and the other joints re-solved (Gauss-Newton on the foot position); it is
+#: kept only if the result is inside the limits and reproduces the target within :data:`CLIP_TOL`.
+LIMIT_SLACK = 1e-7
+#: Largest foot error (m) of a branch clipped into the limits.
+CLIP_TOL = 1e-12
+
+
+def _number(value, name: str, valid: str) -> float:
+    """A real scalar parameter (int, float, numpy real, 0-d real array; not bool, str, complex) as float."""
+    ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+    if not ok and isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        ok, value = True, value.item()
+    if not ok:
+        raise InvalidParameterError(f"{name} must be a real number, got {value!r}; valid range {valid}")
+    return float(value)
+
+
+def _checked_foot_z(foot_z) -> float:
+    """``foot_z`` checked against the registry's range (:data:`legkin.models.quadruped.SPEC`)."""
+    param = _SPEC.params["foot_z"]
+    return param.check("foot_z", _number(foot_z, "foot_z", param.range_text()))
+
+
+def _flag(value, name: str) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise InvalidParameterError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
 
 def _signs(leg: str) -> tuple[float, float]:
     try:
@@ -98,6 +141,13 @@ def _forward(q: np.ndarray, leg: str, foot_z: float):
     return sx, sy, c1, s1, c2, s2, ux, uy, uz
 
 
+def _foot(q: np.ndarray, leg: str, foot_z: float) -> np.ndarray:
+    """Unchecked :func:`foot_position`."""
+    _, _, c1, s1, _, _, ux, uy, uz = _forward(q, leg, foot_z)
+    h = hip_position(leg)
+    return np.stack([h[0] + ux, h[1] + c1 * uy - s1 * uz, h[2] + s1 * uy + c1 * uz], axis=-1)
+
+
 def foot_position(q, leg: str, *, foot_z: float = 0.0) -> np.ndarray:
     """Foot position in the base frame: the product of seed 004's transforms T01 T12 T23 T34.
 
@@ -114,10 +164,10 @@ def foot_position(q, leg: str, *, foot_z: float = 0.0) -> np.ndarray:
     Returns:
         Positions (..., 3) in metres.
     """
+    foot_z = _checked_foot_z(foot_z)
+    _signs(leg)
     q = as_input(q, "q", (3,))
-    _, _, c1, s1, _, _, ux, uy, uz = _forward(q, leg, foot_z)
-    h = hip_position(leg)
-    return np.stack([h[0] + ux, h[1] + c1 * uy - s1 * uz, h[2] + s1 * uy + c1 * uz], axis=-1)
+    return _foot(q, leg, foot_z)
 
 
 def foot_jacobian(q, leg: str, *, foot_z: float = 0.0) -> np.ndarray:
@@ -126,7 +176,13 @@ def foot_jacobian(q, leg: str, *, foot_z: float = 0.0) -> np.ndarray:
     Differentiates :func:`foot_position` (seed 004's product) factor by factor:
     ``dp/dq1 = s_y R_x' u``, ``dp/dq2 = R_x (-u_z, 0, u_x)``, ``dp/dq3 = R_x R_y(-q_2) dv/dq_3``.
     """
-    q = as_input(q, "q", (3,))
+    foot_z = _checked_foot_z(foot_z)
+    _signs(leg)
+    return _jacobian(as_input(q, "q", (3,)), leg, foot_z)
+
+
+def _jacobian(q: np.ndarray, leg: str, foot_z: float) -> np.ndarray:
+    """Unchecked :func:`foot_jacobian`."""
     _, sy, c1, s1, c2, s2, ux, uy, uz = _forward(q, leg, foot_z)
     c3, s3 = np.cos(q[..., 2]), np.sin(q[..., 2])
     dvx = -X34 * s3 + foot_z * c3
@@ -139,11 +195,22 @@ def foot_jacobian(q, leg: str, *, foot_z: float = 0.0) -> np.ndarray:
     return np.stack([col1, col2, col3], axis=-1)
 
 
-def within_limits(q, tol: float = 1e-9) -> np.ndarray:
-    """Whether joint vectors (..., 3) lie inside :data:`JOINT_LIMITS` (with slack ``tol`` rad)."""
-    q = np.asarray(q, dtype=float)
+def within_limits(q, tol: float = LIMIT_TOL) -> np.ndarray:
+    """Whether joint vectors (..., 3) lie inside :data:`JOINT_LIMITS` (with slack ``tol`` rad).
+
+    NaN and infinite entries (e.g. the unreachable rows of :func:`foot_ik_all`) count as outside.
+
+    Raises:
+        InvalidInputError: ``q`` not a real array of shape (..., 3).
+        InvalidParameterError: ``tol`` not a finite number >= 0.
+    """
+    tol = _number(tol, "tol", "[0, inf)")
+    if not (math.isfinite(tol) and tol >= 0):
+        raise InvalidParameterError(f"tol={tol!r} is out of range: must be in [0, inf) (rad)")
+    q = as_input(q, "q", (3,), allow_nan=True)
     lo, hi = JOINT_LIMITS[:, 0], JOINT_LIMITS[:, 1]
-    return np.all((q >= lo - tol) & (q <= hi + tol), axis=-1)
+    with np.errstate(invalid="ignore"):
+        return np.all((q >= lo - tol) & (q <= hi + tol), axis=-1)
 
 
 class _Solution(NamedTuple):
@@ -156,12 +223,12 @@ class _Solution(NamedTuple):
     l2: float
 
 
-def _inside(x: np.ndarray, row: int, tol: float = 1e-9) -> np.ndarray:
+def _inside(x: np.ndarray, row: int, tol: float = LIMIT_TOL) -> np.ndarray:
     lo, hi = JOINT_LIMITS[row]
     return (x >= lo - tol) & (x <= hi + tol)
 
 
-def _toward_limits(x: np.ndarray, row: int, tol: float = 1e-9) -> np.ndarray:
+def _toward_limits(x: np.ndarray, row: int, tol: float = LIMIT_TOL) -> np.ndarray:
     """The representative of angle ``x`` (mod 2 pi) inside the limits of joint ``row`` when one is.
 
     Needed where a limit is +-pi (q2's upper limit): rounding can return -pi + eps for pi - eps.
@@ -179,6 +246,11 @@ def _solve(p: np.ndarray, leg: str, foot_z: float, limited: bool = False) -> _So
     inside the limits for some target (q3 depends on the knee sign alone): inside POPI's limits the k = +1
     branch never is, which halves the work of :func:`foot_ik`.
     """
+    with np.errstate(over="ignore", invalid="ignore"):  # huge finite targets: inf, never reachable
+        return _solve_unchecked(p, leg, foot_z, limited)
+
+
+def _solve_unchecked(p: np.ndarray, leg: str, foot_z: float, limited: bool) -> _Solution:
     _, sy = _signs(leg)
     h = hip_position(leg)
     dx, dy, dz = p[..., 0] - h[0], p[..., 1] - h[1], p[..., 2] - h[2]
@@ -220,13 +292,16 @@ def _solve(p: np.ndarray, leg: str, foot_z: float, limited: bool = False) -> _So
 
 
 def _unreachable_message(leg, p, rho2, r2, l1, l2) -> str:
-    if rho2 < 0 and math.sqrt(max(rho2 + Y12**2, 0.0)) < Y12 - REACH_TOL:
-        dist = math.sqrt(max(rho2 + Y12**2, 0.0))
+    # distances recomputed from p with hypot (no overflow for huge finite targets)
+    d = np.asarray(p, dtype=float) - hip_position(leg)
+    axis = math.hypot(float(d[1]), float(d[2]))
+    if axis < Y12 - REACH_TOL:
         return (
             f"target {p.tolist()} for leg {leg} is inside the abduction cylinder: its distance to the "
-            f"abduction axis is {dist:.6g} m < {Y12} m (by {Y12 - dist:.3g} m)"
+            f"abduction axis is {axis:.6g} m < {Y12} m (by {Y12 - axis:.3g} m)"
         )
-    r = math.sqrt(max(r2, 0.0))
+    rho = math.sqrt(max(axis - Y12, 0.0)) * math.sqrt(axis + Y12)
+    r = math.hypot(float(d[0]), rho)
     if r > l1 + l2:
         return (
             f"target {p.tolist()} for leg {leg} is beyond full stretch: the hip-to-foot distance in the "
@@ -253,7 +328,11 @@ def foot_ik_all(p, leg: str, *, foot_z: float = 0.0, return_mask: bool = False):
 
     Raises:
         UnreachableError: single target out of reach (message says why and by how much).
+        InvalidInputError: ``p`` not a finite real array (..., 3). InvalidParameterError: bad ``leg``/``foot_z``.
     """
+    foot_z = _checked_foot_z(foot_z)
+    return_mask = _flag(return_mask, "return_mask")
+    _signs(leg)
     p = as_input(p, "p", (3,))
     sol = _solve(p, leg, foot_z)
     ok = sol.reachable
@@ -266,44 +345,90 @@ def foot_ik_all(p, leg: str, *, foot_z: float = 0.0, return_mask: bool = False):
     return (q, np.repeat(ok[..., None], 4, axis=-1)) if return_mask else q
 
 
+def _clip_repair(qc: np.ndarray, q: np.ndarray, p: np.ndarray, leg: str, foot_z: float):
+    """Branches ``q`` (k, 3) clipped into the limits (``qc``): re-solve the unclipped joints for the foot ``p``.
+
+    Two Gauss-Newton steps on the foot position over the joints that clipping left alone (the clipped ones stay
+    on their limit). Near the abduction singularity the branch's error lies along the singular direction of
+    the Jacobian, which the free joints absorb exactly. Returns the joints and whether they are inside the limits
+    and reproduce ``p`` within :data:`CLIP_TOL`.
+    """
+    lo, hi = JOINT_LIMITS[:, 0], JOINT_LIMITS[:, 1]
+    free = qc == q
+    for _ in range(3):
+        r = p - _foot(qc, leg, foot_z)
+        step = (np.linalg.pinv(_jacobian(qc, leg, foot_z) * free[:, None, :], rcond=1e-10) @ r[..., None])[..., 0]
+        moved = qc + step
+        qc = np.minimum(np.maximum(moved, lo), hi)
+        free &= qc == moved  # a joint pushed onto its limit by the step stays there
+    err = np.linalg.norm(_foot(qc, leg, foot_z) - p, axis=-1)
+    return qc, err <= CLIP_TOL
+
+
 def foot_ik(p, leg: str, q_ref=None, *, foot_z: float = 0.0, return_mask: bool = False) -> np.ndarray:
     """Joint angles (..., 3) placing the foot at ``p``: the branch inside the joint limits.
 
-    Among the four branches of :func:`foot_ik_all`, keeps those inside :data:`JOINT_LIMITS`; picks the one
-    nearest ``q_ref`` (wrapped angular distance) when given, else the first in branch order (foot below
-    the hip plane first). Inside POPI's limits only the k = -1 knee branch occurs, but both s_u
+    Branch choice (the knee and abduction branches are IK-only choices: the forward map has none). Among the
+    four branches of :func:`foot_ik_all`, keeps those inside :data:`JOINT_LIMITS` (a branch a hair outside,
+    by at most :data:`LIMIT_SLACK`, is clipped into the limits and kept if it still reaches the target within
+    :data:`CLIP_TOL`, see :func:`_clip_repair`: the answer is always inside the URDF limits); picks
+    the one nearest ``q_ref`` (Euclidean norm of the wrapped joint differences; ties go to the earlier
+    branch) when given, else the first in :data:`BRANCHES` order: (s_u, k) = (-1, -1), (-1, 1), (1, -1), (1, 1)
+    (foot below the hip plane first). Inside POPI's limits only the k = -1 knee branch occurs, but both s_u
     branches do (s_u = +1 for large q2), so the choice is made here, not assumed.
 
     Args:
         p: foot targets (..., 3) in the base frame.
         leg: ``"LF"``, ``"LH"``, ``"RF"`` or ``"RH"``.
-        q_ref: configurations (..., 3) to stay near (broadcast against ``p``).
+        q_ref: configurations (..., 3) to stay near. The leading shapes of ``p`` and ``q_ref`` broadcast
+            together: a single target with a batch of ``q_ref`` is a batch (one answer per ``q_ref``).
+        foot_z: the foot drop (m), in the registry's range [-0.1, 0.1].
         return_mask: also return the boolean mask of targets solved inside the limits.
 
     Raises:
         UnreachableError: single target out of reach.
         JointLimitError: single target reachable only outside the joint limits.
+        InvalidInputError: ``p`` or ``q_ref`` not finite real arrays (..., 3), or not broadcastable.
+        InvalidParameterError: bad ``leg``, ``foot_z`` or ``return_mask``.
     """
+    foot_z = _checked_foot_z(foot_z)
+    return_mask = _flag(return_mask, "return_mask")
+    _signs(leg)
     p = as_input(p, "p", (3,))
+    batch = p.shape[:-1]
     if q_ref is not None:
         q_ref = as_input(q_ref, "q_ref", (3,))
+        try:
+            batch = np.broadcast_shapes(batch, q_ref.shape[:-1])
+        except ValueError:
+            raise InvalidInputError(
+                f"p (shape {p.shape}) and q_ref (shape {q_ref.shape}) do not broadcast together"
+            ) from None
     sol = _solve(p, leg, foot_z, limited=True)
     ok = sol.reachable
+    lo, hi = JOINT_LIMITS[:, 0], JOINT_LIMITS[:, 1]
     # Walk the candidate branches keeping, per target, the first inside the limits (or the nearest q_ref).
-    q = np.full(np.broadcast_shapes(p.shape, () if q_ref is None else q_ref.shape), np.nan)
-    best = np.full(q.shape[:-1], np.inf)
-    for b in range(len(sol.branches)):
-        qb = sol.q[..., b, :].copy()
-        qb[..., 1] = _toward_limits(qb[..., 1], 1)  # q1 and q3 limits are far from +-pi
-        inside = ok & _inside(qb[..., 0], 0) & _inside(qb[..., 1], 1) & _inside(qb[..., 2], 2)
-        if q_ref is None:
-            take = inside & np.isinf(best)
-            best = np.where(take, 0.0, best)
-        else:
-            cost = np.linalg.norm(_wrap(qb - q_ref), axis=-1)
-            take = inside & (cost < best)
-            best = np.where(take, cost, best)
-        q = np.where(take[..., None], qb, q)
+    q = np.full(batch + (3,), np.nan)
+    best = np.full(batch, np.inf)
+    with np.errstate(invalid="ignore", over="ignore"):
+        for b in range(len(sol.branches)):
+            qb = sol.q[..., b, :].copy()
+            qb[..., 1] = _toward_limits(qb[..., 1], 1)  # q1 and q3 limits are far from +-pi
+            inside = np.array(ok & np.all((qb >= lo - LIMIT_SLACK) & (qb <= hi + LIMIT_SLACK), axis=-1))
+            clipped = np.minimum(np.maximum(qb, lo), hi)
+            moved = inside & np.any(clipped != qb, axis=-1)
+            if np.any(moved):  # a branch just outside the limits: clip it and re-solve the other joints
+                fixed, good = _clip_repair(clipped[moved], qb[moved], np.broadcast_to(p, qb.shape)[moved], leg, foot_z)
+                clipped[moved] = fixed
+                inside[moved] = good
+            if q_ref is None:
+                take = inside & np.isinf(best)
+                best = np.where(take, 0.0, best)
+            else:
+                cost = np.linalg.norm(_wrap(clipped - q_ref), axis=-1)
+                take = inside & (cost < best)
+                best = np.where(take, cost, best)
+            q = np.where(take[..., None], clipped, q)
     solved = np.isfinite(best)
 
     def error():
@@ -316,7 +441,7 @@ def foot_ik(p, leg: str, q_ref=None, *, foot_z: float = 0.0, return_mask: bool =
             target=p,
         )
 
-    return finish(q, solved, p.ndim == 1, return_mask, error)
+    return finish(q, solved, len(batch) == 0, return_mask, error)
 
 
 # ----------------------------------------------------------------------------- seed 002
@@ -344,13 +469,27 @@ def textbook_ik(p, a: float, b: float, c: float, *, literal: bool = False) -> np
     Two fixes to the seed as printed: "90" is pi/2 (radians), and ``atan(x_f / z_f)`` is ``atan2(x_f, z_f)``
     (the literal atan is wrong for every z_f < 0 and divides by zero at z_f = 0). ``literal=True`` keeps the
     printed atan, to show that failure. Only one branch (knee k = -1, foot below the hip) is returned.
-    ``theta_adab`` and ``theta_abd`` in the seed are typos for theta_abad. NaN where acos/asin are out of range.
+    ``theta_adab`` and ``theta_abd`` in the seed are typos for theta_abad. NaN where acos/asin are out of range
+    (a transcription of the seed: it does not follow the single-call-raises rule of the other functions).
+
+    Raises:
+        InvalidInputError: ``p`` not a finite real array (..., 3).
+        InvalidParameterError: ``a`` not a finite number >= 0, ``b`` or ``c`` not finite and > 0, ``literal`` not a bool.
     """
+    a = _number(a, "a", "[0, inf)")
+    b = _number(b, "b", "(0, inf)")
+    c = _number(c, "c", "(0, inf)")
+    for name, value, positive in (("a", a, False), ("b", b, True), ("c", c, True)):
+        if not math.isfinite(value) or value < 0 or (positive and value == 0):
+            raise InvalidParameterError(
+                f"{name}={value!r} is out of range: must be in {'(0, inf)' if positive else '[0, inf)'} (m)"
+            )
+    literal = _flag(literal, "literal")
     p = as_input(p, "p", (3,))
     xf, yf, zf = p[..., 0], p[..., 1], p[..., 2]
-    big_l = xf * xf + yf * yf + zf * zf
-    m = np.sqrt(big_l - a * a)
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        big_l = xf * xf + yf * yf + zf * zf
+        m = np.sqrt(big_l - a * a)
         first = np.arctan(xf / zf) if literal else np.arctan2(xf, zf)
         abad = first + np.arccos(a / np.sqrt(xf * xf + zf * zf))
         hip = np.pi / 2 - np.arcsin(-yf / m) - np.arccos((b * b - a * a - c * c + big_l) / (2 * b * m))
@@ -371,6 +510,7 @@ def textbook_to_joints(theta, leg: str) -> np.ndarray:
     mirrored on right legs (see :func:`textbook_frame`).
     """
     _signs(leg)
-    theta = as_input(theta, "theta", (3,), allow_nan=True)
+    theta = as_input(theta, "theta", (3,), allow_nan=True)  # NaN (textbook_ik out of range) maps to NaN
     q = theta - np.array([np.pi / 2, KNEE_OFFSET, KNEE_OFFSET])
-    return _wrap(q)
+    with np.errstate(invalid="ignore"):
+        return _wrap(q)

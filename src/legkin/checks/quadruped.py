@@ -2,11 +2,21 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .. import load
 from ..analytic import quadruped as aq
-from ..validation import CheckResult, compare, per_sample, pinocchio_frames, sample_within_limits
+from ..validation import (
+    CheckResult,
+    classify_failures,
+    compare,
+    per_sample,
+    pinocchio_frames,
+    robustness_row,
+    sample_within_limits,
+)
 
 TOL = 1e-12
 #: Abduction-singularity band: below this distance rho (m) of the foot from the abduction cylinder
@@ -83,3 +93,108 @@ def _yourdfpy_row(robot, qs: np.ndarray, pos: np.ndarray, frames: list[str]) -> 
         for k, f in enumerate(frames):
             err[i, k] = np.linalg.norm(urdf.get_transform(f, "base")[:3, 3] - pos[i, k])
     return compare("feet: yourdfpy FK vs Pinocchio", err, TOL)
+
+
+# ---------------------------------------------------------------- the IK contract row
+#: Contract tolerance: every solved answer reproduces its target to this (m) with the default foot_position.
+CONTRACT_TOL = 1e-9
+
+
+def made_joints(n: int, rng: np.random.Generator) -> np.ndarray:
+    """``n`` joint vectors inside the limits, biased to the hard places: uniform (60 %), with joints snapped
+    exactly onto a limit (20 %), and with the foot rho in [1e-10, 1e-3] m from the abduction cylinder (20 %)."""
+    lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
+    q = rng.uniform(lo, hi, (n, 3))
+    kind = rng.uniform(size=n)
+    snap = (kind < 0.2)[:, None] & (rng.uniform(size=(n, 3)) < 0.5)
+    q = np.where(snap, np.where(rng.uniform(size=(n, 3)) < 0.5, lo, hi), q)
+    near = np.nonzero(kind > 0.8)[0]
+    if len(near):
+        qn = q[near]
+        vx, vz = aq._knee_vector(qn[:, 2], 0.0)
+        rho = 10 ** rng.uniform(-10, -3, len(near)) * rng.choice([-1.0, 1.0], len(near))
+        r = np.hypot(vx, vz)
+        q2 = aq._wrap(np.arctan2(rho, np.sqrt(r * r - rho * rho)) - np.arctan2(vz, vx))
+        keep = (q2 >= lo[1]) & (q2 <= hi[1])
+        qn[keep, 1] = q2[keep]
+        q[near] = qn
+    return q
+
+
+def random_targets(n: int, rng: np.random.Generator, legs: np.ndarray) -> np.ndarray:
+    """``n`` foot targets in and around the workspace of ``legs[i]``: a box of +-0.8 m about the hip (50 %),
+    points a hair (1e-15 .. 1e-3 m) inside / outside the abduction cylinder, full stretch and the inner
+    radius |L1 - L2| (30 %), and FK of joints just outside the limits (by 1e-12 .. 1e-2 rad, 20 %)."""
+    hips = np.stack([aq.hip_position(leg) for leg in aq.LEGS])[np.searchsorted(aq.LEGS, legs)]
+    sy = np.where(np.char.startswith(legs.astype(str), "L"), 1.0, -1.0)
+    p = hips + rng.uniform(-0.8, 0.8, (n, 3))
+    kind = rng.uniform(size=n)
+    l1, l2 = math.hypot(aq.X23, aq.Z23), aq.X34
+    hair = 10 ** rng.uniform(-15, -3, n) * rng.choice([-1.0, 1.0], n)
+    # near the boundary surfaces: pick rho (distance from the cylinder's tangent plane) and r (in-plane reach)
+    radius = np.where(kind < 0.6, l1 + l2 + hair, np.abs(l1 - l2) + hair)
+    angle = rng.uniform(-np.pi, np.pi, n)
+    rho = np.where(kind < 0.6, np.abs(radius * np.sin(angle)), 10 ** rng.uniform(-12, -3, n))
+    dx = np.where(kind < 0.6, radius * np.cos(angle), np.sqrt(np.maximum(radius**2 - rho**2, 0.0)) * np.sign(np.cos(angle)))
+    axis = np.sqrt(aq.Y12**2 + rho**2)
+    axis = np.where(kind < 0.45, aq.Y12 + hair, axis)  # some straddle the cylinder itself
+    tilt = rng.uniform(-np.pi, np.pi, n)
+    surf = hips + np.stack([dx, sy * axis * np.cos(tilt), axis * np.sin(tilt)], axis=-1)
+    boundary = (kind >= 0.5) & (kind < 0.8)
+    p[boundary] = surf[boundary]
+    outside = np.nonzero(kind >= 0.8)[0]
+    if len(outside):
+        lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
+        q = rng.uniform(lo, hi, (len(outside), 3))
+        j = rng.integers(0, 3, len(outside))
+        over = 10 ** rng.uniform(-12, -2, len(outside))
+        side = rng.uniform(size=len(outside)) < 0.5
+        q[np.arange(len(outside)), j] = np.where(side, lo[j] - over, hi[j] + over)
+        for leg in aq.LEGS:
+            sel = legs[outside] == leg
+            p[outside[sel]] = aq.foot_position(q[sel], leg)
+    return p
+
+
+def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 2000) -> CheckResult:
+    """The IK contract row of the quadruped legs (see :func:`legkin.validation.robustness_row`).
+
+    Half the targets are ``foot_position`` of in-limit joints (:func:`made_joints`, each must be solved), the
+    rest :func:`random_targets`; legs are drawn at random. ``foot_ik`` runs once per leg as a batch with
+    default options; for the solved targets the error is |foot_position(q) - p| (m), and an answer outside
+    the URDF limits (no slack) counts as not reproduced (error inf). Up to ``classify`` unsolved targets
+    (None: all) are classified by single calls.
+    """
+    n_made = n // 2
+    legs = np.asarray(aq.LEGS)[rng.integers(0, 4, n)]
+    made = np.zeros(n, dtype=bool)
+    made[:n_made] = True
+    p = np.empty((n, 3))
+    q_made = made_joints(n_made, rng)
+    for leg in aq.LEGS:
+        sel = np.nonzero(legs[:n_made] == leg)[0]
+        p[sel] = aq.foot_position(q_made[sel], leg)
+    p[n_made:] = random_targets(n - n_made, rng, legs[n_made:])
+    solved = np.zeros(n, dtype=bool)
+    error = np.full(n, np.nan)
+    exceptions = 0
+    lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
+    for leg in aq.LEGS:
+        sel = np.nonzero(legs == leg)[0]
+        try:
+            q, ok = aq.foot_ik(p[sel], leg, return_mask=True)
+        except Exception:  # noqa: BLE001 - a foreign (or any) exception from a batch call is a defect
+            exceptions += 1
+            continue
+        err = np.linalg.norm(aq.foot_position(np.where(ok[:, None], q, 0.0), leg) - p[sel], axis=-1)
+        inside = np.all((q >= lo) & (q <= hi), axis=-1)
+        error[sel] = np.where(inside, err, np.inf)
+        solved[sel] = ok
+    unsolved = np.nonzero(~solved)[0]
+    if classify is not None and len(unsolved) > classify:
+        unsolved = np.sort(rng.choice(unsolved, classify, replace=False))
+    reasons, foreign = classify_failures(lambda i: aq.foot_ik(p[i], str(legs[i])), unsolved)
+    return robustness_row(
+        "quadruped", made=made, solved=solved, error=error, reasons=reasons, classified=len(unsolved),
+        exceptions=exceptions + foreign, tolerance=CONTRACT_TOL,
+    )

@@ -395,11 +395,13 @@ def test_unreachable_foot():
             ah.foot_platform_ik(p)
         with pytest.raises(UnreachableError):
             ah.foot_ik(p, all_branches=True)
-    # on the LL arc but beyond the motors: needs the platform pitched ~ -90 deg
+    # on the LL arc but beyond the motors on the extension side (ll_branch -1): needs the platform pitched
+    # ~ -90 deg. (The default search also tries ll_branch +1, which reaches it in the neutral mode at pitch 0.66.)
     beyond = ah.foot_position_from_platform(0.0, -1.5, -0.2)
     with pytest.raises(UnreachableError, match="roll, pitch"):
-        ah.foot_ik(beyond)
-    sol, ok = ah.foot_ik(np.stack([ah.foot_position_from_platform(0.0, 0.0, -0.1), far, beyond]), return_mask=True)
+        ah.foot_ik(beyond, ll_branch=-1)
+    sol, ok = ah.foot_ik(np.stack([ah.foot_position_from_platform(0.0, 0.0, -0.1), far, beyond]), ll_branch=-1,
+                         return_mask=True)
     assert ok.tolist() == [True, False, False]
     assert np.all(np.isnan(sol[1:])) and np.all(np.isfinite(sol[0]))
 

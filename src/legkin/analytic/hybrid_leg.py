@@ -24,11 +24,19 @@ returns plain arrays and raises on failure; a batch returns NaN where an item fa
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from typing import NamedTuple, Sequence
 
 import numpy as np
 
-from ..errors import ConvergenceError, InvalidInputError, SingularityError, UnreachableError
+from ..errors import (
+    AssemblyModeError,
+    ConvergenceError,
+    InvalidInputError,
+    InvalidParameterError,
+    JointLimitError,
+    SingularityError,
+    UnreachableError,
+)
 from ._batch import as_angles, as_input, finish
 
 __all__ = [
@@ -62,6 +70,20 @@ __all__ = [
     "foot_ik",
     "foot_jacobian",
     "spherical_free_axis",
+    "K_TOL",
+    "LL_TOL",
+    "RHO_TOL",
+    "PLATFORM_LIMIT",
+    "LL_LIMIT",
+    "MOTOR_LIMIT",
+    "FK_GAIN_MAX",
+    "PITCH_SPLIT",
+    "FOOT_IK_ORDER",
+    "assembly_mode",
+    "platform_poses",
+    "PlatformPoses",
+    "foot_ik_solutions",
+    "FootIKSolutions",
 ]
 
 # ----------------------------------------------------------------------------- geometry (seed 003)
@@ -103,35 +125,129 @@ LL_DELTA = math.atan2(-LL_ORIGIN[2], LL_ORIGIN[0])
 _H = abs(FOOT_X)
 
 
+#: Reach tolerance: a chain whose reach ratio |k| (see :func:`motor_angles`) exceeds 1 by at most this counts
+#: as reachable, with acos(k) clipped (rounding at the reach boundary: a pose built on the boundary gives
+#: |k| = 1 +- a few 1e-16; clipping 1e-14 leaves a rod-length error of ~1e-15 m). The forward kinematics also
+#: treats a chain within it of |k| = 1 as on its reach boundary, where both motor branches meet.
+K_TOL = 1e-14
+#: The same for the LL arc: |cos(theta_LL - LL_DELTA)| up to 1 + LL_TOL is reachable (~1e-12 m at the arc's ends).
+LL_TOL = 1e-12
+#: Feet within this distance (m) of the roll axis (x through the LCS centre), but not exactly on it: the roll
+#: moves the foot by at most 2 RHO_TOL, so foot_ik and foot_platform_ik take roll = 0 (roll_branch +1) or pi (-1).
+RHO_TOL = 1e-12
+#: URDF limits (rad): LCS_x and LCS_y (roll, pitch) in [-pi/2, pi/2], LL in [-pi, pi], MCS1/MCS2 in [-pi, pi].
+#: (Sph_i_1_y is limited to [-pi/2, pi/2], which its closed form -asin(u_z) always meets.)
+PLATFORM_LIMIT = math.pi / 2
+LL_LIMIT = math.pi
+MOTOR_LIMIT = math.pi
+_LIMIT_TOL = 1e-12
+#: Forward-singularity band: where the foot moves more than this (m) per radian of the motors (spectral norm of
+#: d(foot)/d(theta1, theta2)), double-precision motor angles fix the foot only to ~1e-15 x this; foot_position
+#: and foot_ik refuse such poses (SingularityError), so that every foot_ik answer is reproduced by foot_position
+#: to better than 1e-10 m. Only the neighbourhood of det N = 0 (the forward singularity) reaches it.
+FK_GAIN_MAX = 1e4
+#: In the assembly mode of the neutral pose on branch (1, 1) the platform's pitch stays below 0.9634 rad; a second
+#: region of the same sign of det(dtheta/dx) lies at pitch >= 1.48 rad, separated from it by the other mode. A
+#: pitch below PITCH_SPLIT puts a pose of that mode in the neutral aspect, where the motor map is one-to-one.
+PITCH_SPLIT = 1.2
+#: Order in which the default foot_ik / foot_platform_ik try the two IK-only branches: (ll_branch, roll_branch).
+FOOT_IK_ORDER = ((-1, 1), (1, 1), (-1, -1), (1, -1))
+
+
 def _wrap(a):
     """Wrap angles to (-pi, pi]."""
     return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
 
 
-def _check_branch(branch) -> np.ndarray:
+class _ArgumentError(InvalidParameterError, InvalidInputError):
+    """A keyword argument of the wrong kind or out of range.
+
+    Both an :class:`InvalidParameterError` and an :class:`InvalidInputError` (hence a ``ValueError``).
+    """
+
+
+def _is_int(value) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def _is_real(value) -> bool:
+    return (_is_int(value) or isinstance(value, (float, np.floating))) and not isinstance(value, (bool, np.bool_))
+
+
+def _to_float(value) -> float:
+    """float(value) for a real scalar, NaN for anything else (including ints too large for a float)."""
+    if not _is_real(value):
+        return math.nan
     try:
-        b = np.asarray(branch, dtype=float)
-    except (TypeError, ValueError):
-        b = None
-    if b is None or b.shape != (2,) or not np.all(np.abs(b) == 1.0):
-        raise InvalidInputError(f"branch must be a pair of +1/-1 (one per motor chain), got {branch!r}")
+        return float(value)
+    except (OverflowError, ValueError, TypeError):
+        return math.nan
+
+
+def _check_branch(branch) -> np.ndarray:
+    """Motor branch pair (b1, b2), each +1 or -1, as a float array."""
+    b = None
+    if not isinstance(branch, (str, bytes)):
+        try:
+            raw = np.asarray(branch)
+        except (TypeError, ValueError):
+            raw = None
+        if raw is not None and raw.dtype.kind in "iuf" and raw.shape == (2,) and np.all(np.abs(raw) == 1):
+            b = raw.astype(float)
+    if b is None:
+        raise _ArgumentError(
+            f"branch must be one of {', '.join(map(str, MOTOR_BRANCHES))} (b1, b2: the motor branch of each chain), "
+            f"got {branch!r}"
+        )
     return b
 
 
-def _check_sign(value, name: str) -> float:
-    if value not in (1, -1):
-        raise InvalidInputError(f"{name} must be +1 or -1, got {value!r}")
-    return float(value)
+def _check_sign(value, name: str, allow_none: bool = False):
+    """+1 or -1 (as float), or None if allowed."""
+    if value is None and allow_none:
+        return None
+    if _is_real(value) and value in (1, -1):
+        return float(value)
+    valid = "+1 or -1" + (" (or None: try both, see FOOT_IK_ORDER)" if allow_none else "")
+    raise _ArgumentError(f"{name} must be {valid}, got {value!r}")
+
+
+def _check_assembly(value) -> float:
+    if _is_real(value) and value in (1, -1):
+        return float(value)
+    raise _ArgumentError(
+        f"assembly must be +1 (the assembly mode of the neutral pose, R_P = I, on the given branch) or -1 (the other "
+        f"sign of det(dtheta/d(roll, pitch))), got {value!r}"
+    )
 
 
 def _check_offset(starting_value) -> float:
-    try:
-        x = float(starting_value)
-    except (TypeError, ValueError):
-        raise InvalidInputError(f"starting_value must be a finite number (rad), got {starting_value!r}") from None
-    if not math.isfinite(x):
-        raise InvalidInputError(f"starting_value must be a finite number (rad), got {starting_value!r}")
+    x = _to_float(starting_value)
+    if not (math.isfinite(x) and abs(x) <= math.pi):
+        raise _ArgumentError(
+            f"starting_value must be a finite real number in [-pi, pi] rad (the LL zero offset of eq 19, the xacro "
+            f"argument's range), got {starting_value!r}"
+        )
     return x
+
+
+def _check_flag(value, name: str) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise _ArgumentError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def _check_real(value, name: str, lo: float, hi: float, what: str) -> float:
+    x = _to_float(value)
+    if not (math.isfinite(x) and lo < x <= hi):
+        raise _ArgumentError(f"{name} must be a finite real number in ({lo:g}, {hi:g}] ({what}), got {value!r}")
+    return x
+
+
+def _check_count(value, name: str, lo: int, hi: int, what: str) -> int:
+    if not (_is_int(value) and lo <= value <= hi):
+        raise _ArgumentError(f"{name} must be an integer in [{lo}, {hi}] ({what}), got {value!r}")
+    return int(value)
 
 
 def _rotz(t):
@@ -184,6 +300,11 @@ def platform_rotation(roll, pitch) -> np.ndarray:
     2-DOF platform (see the docs: the spherical centre leaves one rotation uncontrolled).
     """
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
+    return _rot(r, p)
+
+
+def _rot(r, p) -> np.ndarray:
+    """Rx(r) Ry(p) without input checks (internal: NaN propagates)."""
     cr, sr, cp, sp = np.cos(r), np.sin(r), np.cos(p), np.sin(p)
     z = np.zeros_like(r)
     return np.stack(
@@ -219,7 +340,7 @@ def rod_spans(theta1, theta2, roll=0.0, pitch=0.0) -> np.ndarray:
 def _chains(rot: np.ndarray, b: np.ndarray):
     """Closed form of both rod-length equations for rotations (..., 3, 3).
 
-    Returns theta (..., 2) (NaN where unreachable), the reach ratio k (..., 2), and ok (..., 2).
+    Returns theta (..., 2) (NaN where unreachable), the reach ratio k (..., 2), and ok (..., 2) (|k| <= 1 + K_TOL).
     """
     w = MOTOR_POS - _attach_world(rot)  # w_i = p_i - A_i  so  S_i - A_i = w_i + Rz(phi_i) l
     lx, lz = LEVER[0], LEVER[2]
@@ -229,17 +350,18 @@ def _chains(rot: np.ndarray, b: np.ndarray):
     rho = np.hypot(a, bb)
     with np.errstate(divide="ignore", invalid="ignore"):
         k = c / rho
-    ok = np.isfinite(k) & (np.abs(k) <= 1.0)
+    ok = np.isfinite(k) & (np.abs(k) <= 1.0 + K_TOL)
     phi = np.arctan2(bb, a) - _SIGMA * b * np.arccos(np.clip(k, -1.0, 1.0))
     theta = np.where(ok, _wrap(phi - MOTOR_YAW), np.nan)
     return theta, k, ok
 
 
 def _unreachable(what: str, k: np.ndarray) -> UnreachableError:
-    bad = [f"chain {i + 1} (|k| = {abs(float(k[i])):.6g})" for i in range(2) if not abs(float(k[i])) <= 1.0]
+    bad = [f"chain {i + 1} (|k| = {abs(float(k[i])):.15g})" for i in range(2) if not abs(float(k[i])) <= 1.0 + K_TOL]
     return UnreachableError(
         f"{what} is out of the motors' reach: the rod-length equation A cos(theta) + B sin(theta) = C has no "
-        f"solution for {', '.join(bad)}; it needs |k| = |C| / sqrt(A^2 + B^2) <= 1",
+        f"solution for {', '.join(bad) or 'a chain (|k| not finite)'}; it needs |k| = |C| / sqrt(A^2 + B^2) <= 1 "
+        f"(+ {K_TOL:g} for rounding)",
         target=None,
     )
 
@@ -369,79 +491,337 @@ def sphere_joint_angles(rotation, branch: Sequence[int] = (1, 1), *, return_mask
 
 
 # ----------------------------------------------------------------------------- forward kinematics
-def _newton(target: np.ndarray, b: np.ndarray, x: np.ndarray, max_iter: int, tol: float, sign0: float = 0.0):
-    """Damped Newton on motor_angles(x) = target, x = (roll, pitch), rows (n, 2). Returns x, ok.
+# The closed sub-chain's forward kinematics in closed form. With the lever tips S_i known (motor angles given),
+# rod i closes iff |A_i - S_i| = L, A_i = c + R a_i, i.e. w_i . R a_i = kappa_i with w_i = c - S_i and
+# kappa_i = (L^2 - |w_i|^2 - |a_i|^2) / 2. With R = Rx(roll) Ry(pitch) and q = Rx(roll)^T w that is, per rod,
+#     alpha_i cos(pitch) + beta_i sin(pitch) + gamma_i = 0,
+#     alpha = w_x a_x + a_z q_z,  beta = w_x a_z - a_x q_z,  gamma = a_y q_y - kappa,
+#     q_y = cos(roll) w_y + sin(roll) w_z,  q_z = -sin(roll) w_y + cos(roll) w_z,
+# two linear equations in (cos pitch, sin pitch): Cramer gives cos = C / D, sin = S / D, and cos^2 + sin^2 = 1
+# is C^2 + S^2 - D^2 = 0, a trigonometric polynomial of degree 4 in roll. With t = tan(roll / 2) (times
+# (1 + t^2)^4) it is a polynomial of degree 8: up to 8 poses; roll in the joint limits is |t| <= 1.
+_T_C = np.array([1.0, 0.0, -1.0])  # cos(roll) (1 + t^2), ascending powers of t
+_T_S = np.array([0.0, 2.0, 0.0])  # sin(roll) (1 + t^2)
+_T_1 = np.array([1.0, 0.0, 1.0])  # 1 + t^2
 
-    With ``sign0`` (+-1) a step is accepted only if det(dtheta/dx) keeps that sign: the iterates stay in
-    one assembly mode, the forward-singularity curve acting as a barrier.
 
-    An item is done when its last accepted step was below 1e-10 rad (the error before it was then
-    ~1e-10 and quadratic convergence leaves rounding error) and its residual is <= ``tol``.
+def _pmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Product of polynomials (ascending coefficients along the last axis)."""
+    out = np.zeros(np.broadcast_shapes(a.shape[:-1], b.shape[:-1]) + (a.shape[-1] + b.shape[-1] - 1,))
+    for i in range(a.shape[-1]):
+        out[..., i : i + b.shape[-1]] += a[..., i : i + 1] * b
+    return out
+
+
+def _pval(c: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """Evaluate polynomials c (..., m) at t (broadcast against c[..., 0]) by Horner's rule."""
+    out = c[..., -1]
+    for j in range(c.shape[-1] - 2, -1, -1):
+        out = out * t + c[..., j]
+    return out
+
+
+def _roll_polynomial(tip: np.ndarray):
+    """Degree-8 polynomial (n, 9) in t = tan(roll/2) of the platform poses closing both rods, and the
+    per-rod quadratics alpha, beta, gamma (n, 2, 3) of the pitch equation (all times 1 + t^2)."""
+    w = CENTER - tip
+    kap = 0.5 * (ROD_LENGTH**2 - np.sum(w * w, -1) - np.sum(ATTACH * ATTACH, -1))
+    ax, ay, az = ATTACH[:, 0, None], ATTACH[:, 1, None], ATTACH[:, 2, None]
+    wx, wy, wz = w[..., 0, None], w[..., 1, None], w[..., 2, None]
+    qz = -wy * _T_S + wz * _T_C
+    qy = wy * _T_C + wz * _T_S
+    al = wx * ax * _T_1 + az * qz
+    be = wx * az * _T_1 - ax * qz
+    ga = ay * qy - kap[..., None] * _T_1
+    det = _pmul(al[:, 0], be[:, 1]) - _pmul(al[:, 1], be[:, 0])
+    cc = _pmul(be[:, 0], ga[:, 1]) - _pmul(be[:, 1], ga[:, 0])
+    ss = _pmul(al[:, 1], ga[:, 0]) - _pmul(al[:, 0], ga[:, 1])
+    return _pmul(cc, cc) + _pmul(ss, ss) - _pmul(det, det), al, be, ga
+
+
+def _poly_roots(poly: np.ndarray) -> np.ndarray:
+    """Complex roots (n, 8) of polynomials (n, 9) (ascending), NaN-padded; companion-matrix eigenvalues."""
+    n = len(poly)
+    z = np.full((n, 8), np.nan + 0j)
+    lead = poly[:, -1]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        mon = poly[:, :-1] / lead[:, None]
+    good = np.all(np.isfinite(mon), -1) & (np.abs(mon).max(-1, initial=0.0) < 1e150)
+    if good.any():
+        comp = np.zeros((int(good.sum()), 8, 8))
+        comp[:, 1:, :-1] = np.eye(7)
+        comp[:, :, -1] = -mon[good]
+        try:
+            z[good] = np.linalg.eigvals(comp)
+        except np.linalg.LinAlgError:  # pragma: no cover - eigvals of finite matrices converges in practice
+            good[:] = False
+    for i in np.flatnonzero(~good):  # leading coefficient (near) zero: a pose at roll = pi; measure zero
+        if not np.all(np.isfinite(poly[i])):
+            continue
+        try:
+            r = np.roots(poly[i, ::-1])
+        except np.linalg.LinAlgError:  # pragma: no cover
+            continue
+        z[i, : min(len(r), 8)] = r[:8]
+    return z
+
+
+def _n_matrix(ra: np.ndarray, d: np.ndarray, roll: np.ndarray) -> np.ndarray:
+    """N (..., 2, 2), N_ik = d_i . dA_i/dx_k, for R a_i = ra (..., 2, 3), d_i = A_i - S_i, x = (roll, pitch)."""
+    ex = np.array([1.0, 0.0, 0.0])
+    ey_r = np.stack([np.zeros_like(roll), np.cos(roll), np.sin(roll)], -1)[..., None, :]
+    return np.stack([np.sum(d * np.cross(ex, ra), -1), np.sum(d * np.cross(ey_r, ra), -1)], -1)
+
+
+def _rod_system(x: np.ndarray, tip: np.ndarray):
+    """Rod equations g_i = (|A_i - S_i|^2 - L^2) / 2 (m, 2) and their Jacobian N (m, 2, 2) at poses x (m, 2)."""
+    ra = np.einsum("...jk,ik->...ij", _rot(x[:, 0], x[:, 1]), ATTACH)
+    d = CENTER + ra - tip
+    return 0.5 * (np.sum(d * d, -1) - ROD_LENGTH**2), _n_matrix(ra, d, x[:, 0])
+
+
+def _det2(m: np.ndarray) -> np.ndarray:
+    return m[..., 0, 0] * m[..., 1, 1] - m[..., 0, 1] * m[..., 1, 0]
+
+
+def _solve2(m: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """m^-1 r for (..., 2, 2) and (..., 2), by Cramer's rule (non-finite where m is singular)."""
+    det = _det2(m)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        return np.stack([m[..., 1, 1] * r[..., 0] - m[..., 0, 1] * r[..., 1],
+                         m[..., 0, 0] * r[..., 1] - m[..., 1, 0] * r[..., 0]], -1) / det[..., None]
+
+
+def _rod_newton(x: np.ndarray, tip: np.ndarray, max_iter: int, keep_sign: bool = False):
+    """Damped Newton on both rod equations from poses x (m, 2) for lever tips (m, 2, 3).
+
+    Each accepted step decreases max|g|; with ``keep_sign`` it must also keep the sign of det N of the start
+    (the forward-singularity curve det N = 0 is then a barrier). Returns x and the rod-length error (m).
     """
-    n = len(x)
-    done = np.zeros(n, dtype=bool)
-    failed = np.zeros(n, dtype=bool)
-    err = np.full(n, np.inf)
+    x = np.array(x, dtype=float)
+    g, nm = _rod_system(x, tip)
+    cur = np.abs(g).max(-1)
+    sign = np.sign(_det2(nm)) if keep_sign else None
+    act = np.isfinite(cur)
     for _ in range(max_iter):
-        act = np.flatnonzero(~(done | failed))
-        if not len(act):
+        ia = np.flatnonzero(act)
+        if not len(ia):
             break
-        xa, tg = x[act], target[act]
-        rot = platform_rotation(xa[:, 0], xa[:, 1])
-        th, _, ok2 = _chains(rot, b)
-        res = _wrap(th - tg)
-        cur = np.linalg.norm(res, axis=-1)
-        nmat, dd = _jacobian_parts(rot, xa[:, 0], np.where(ok2, th, 0.0))
-        with np.errstate(divide="ignore", invalid="ignore"):
-            jac = nmat / dd[..., None]
-        fin = np.all(ok2, -1) & np.all(np.isfinite(jac), axis=(-1, -2))
-        det = np.linalg.det(np.where(fin[:, None, None], jac, np.eye(2)))
-        good = fin & (np.abs(det) > 1e-14)
-        step = np.zeros_like(xa)
-        if good.any():
-            step[good] = -np.linalg.solve(jac[good], res[good][..., None])[..., 0]
-        lam = np.ones(len(xa))
-        accept = np.zeros(len(xa), dtype=bool)
-        new = cur.copy()
-        for _ in range(25):  # backtracking: the step must stay reachable and not increase the residual
-            trial = good & ~accept
-            if not trial.any():
+        step = -_solve2(nm[ia], g[ia])
+        fin = np.all(np.isfinite(step), -1)
+        step = np.where(fin[:, None], np.clip(step, -0.3, 0.3), 0.0)
+        lam = np.ones(len(ia))
+        acc = np.zeros(len(ia), dtype=bool)
+        for _ in range(30):
+            tr = fin & ~acc
+            if not tr.any():
                 break
-            xt = xa[trial] + lam[trial, None] * step[trial]
-            tht, _, okt = _chains(platform_rotation(xt[:, 0], xt[:, 1]), b)
-            nt = np.linalg.norm(_wrap(tht - tg[trial]), axis=-1)
-            acc = np.all(okt, -1) & ((nt < cur[trial]) | (nt <= 1e-15))
-            if sign0:
-                acc &= np.sign(_jac_det(xt, b)) == sign0
-            idx = np.flatnonzero(trial)
-            accept[idx[acc]] = True
-            new[idx[acc]] = nt[acc]
-            lam[idx[~acc]] *= 0.5
-        xa = np.where(accept[:, None], xa + lam[:, None] * step, xa)
-        x[act] = xa
-        err[act] = np.where(accept, new, cur)
-        size = np.abs(step).max(axis=-1) * lam
-        # done: the step is at rounding level, or the residual (<= tol) stopped shrinking (rounding floor;
-        # near the forward singularity the last steps are eps / sigma_min, not smaller)
-        done[act[accept & (new <= tol) & ((size <= 1e-14) | (new >= 0.5 * cur))]] = True
-        # no acceptable step: converged at rounding level if the residual is tiny, else stuck
-        stuck = good & ~accept
-        done[act[stuck & (cur <= tol)]] = True
-        failed[act[(stuck & (cur > tol)) | ~good]] = True
-    return x, done & (err <= tol)
+            it = ia[tr]
+            xt = x[it] + lam[tr, None] * step[tr]
+            gt, nt = _rod_system(xt, tip[it])
+            ct = np.abs(gt).max(-1)
+            ok = ct < cur[it]
+            if keep_sign:
+                ok &= np.sign(_det2(nt)) == sign[it]
+            j = np.flatnonzero(tr)
+            acc[j[ok]] = True
+            x[it[ok]], g[it[ok]], nm[it[ok]], cur[it[ok]] = xt[ok], gt[ok], nt[ok], ct[ok]
+            lam[j[~ok]] *= 0.5
+        # stop where no step decreases the residual (converged to the rounding floor, or stuck) or the
+        # step is at rounding level
+        act[ia[~acc | (np.abs(step).max(-1) * lam <= 1e-16)]] = False
+    with np.errstate(invalid="ignore"):
+        err = np.abs(g).max(-1) * 2.0 / (ROD_LENGTH + np.sqrt(np.maximum(2.0 * np.abs(g).max(-1) + ROD_LENGTH**2, 0.0)))
+    return x, np.where(np.isfinite(err), err, np.inf)
 
 
-#: Restarts of platform_orientation, inside the neutral mode, nearest the forward singularity first.
-_FALLBACK_GUESSES = np.array([[0.0, 0.8], [-0.45, 0.8], [0.45, 0.8], [-0.85, 0.65], [0.85, 0.65], [0.0, 0.4], [0.0, -0.4]])
-
-
-def _jac_det(x: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """det(dtheta/dx) at rows x (n, 2) (NaN where unreachable)."""
-    rot = platform_rotation(x[:, 0], x[:, 1])
-    th, _, ok2 = _chains(rot, b)
-    nmat, dd = _jacobian_parts(rot, x[:, 0], np.where(ok2, th, 0.0))
+def _pose_seeds(z: np.ndarray, al, be, ga):
+    """Starting poses (item index, (roll, pitch)) from the (near-)real roots z (n, 8) with |roll| <= ~pi/2."""
+    cand = np.isfinite(z) & (np.abs(z.imag) <= 1e-2 * (1.0 + np.abs(z))) & (np.abs(z.real) <= 1.0 + 1e-3)
+    item, j = np.nonzero(cand)
+    t = z.real[item, j]
+    a, b, g = _pval(al[item], t[:, None]), _pval(be[item], t[:, None]), _pval(ga[item], t[:, None])
+    det = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
     with np.errstate(divide="ignore", invalid="ignore"):
-        return np.where(np.all(ok2, -1), np.linalg.det(nmat) / (dd[:, 0] * dd[:, 1]), np.nan)
+        cp = (b[:, 0] * g[:, 1] - b[:, 1] * g[:, 0]) / det
+        sp = (a[:, 1] * g[:, 0] - a[:, 0] * g[:, 1]) / det
+    roll = 2.0 * np.arctan(t)
+    pitch = np.arctan2(sp, cp)
+    seeds = [np.stack([roll, pitch], -1)]
+    items = [item]
+    # the two rod equations (nearly) parallel in (cos, sin) - e.g. at roll = 0 for mirror-symmetric motor angles,
+    # a double root in t - leave the pitch to the stronger equation alone: both of its solutions are seeds
+    with np.errstate(invalid="ignore", over="ignore"):
+        bad = ~(np.abs(det) > 1e-6 * (np.abs(a[:, 0] * b[:, 1]) + np.abs(a[:, 1] * b[:, 0])))
+    if bad.any():
+        k = np.argmax(np.hypot(a[bad], b[bad]), -1)
+        rows = np.arange(int(bad.sum()))
+        ab, bb, gb = a[bad][rows, k], b[bad][rows, k], g[bad][rows, k]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            c = np.arccos(np.clip(-gb / np.hypot(ab, bb), -1.0, 1.0))
+        base = np.arctan2(bb, ab)
+        for sgn in (1.0, -1.0):
+            seeds.append(np.stack([roll[bad], base + sgn * c], -1))
+            items.append(item[bad])
+    x = np.concatenate(seeds)
+    return np.concatenate(items), np.where(np.isfinite(x), x, 0.0)
+
+
+#: Offsets (rad) of the extra starting poses on either side of a near-singular solution (along the null vector of
+#: N), from which Newton runs with the forward-singularity barrier: near det N = 0 two poses of opposite modes are
+#: close together, and the plain Newton iteration from the roots may find only one of them.
+_FOLD_OFFSETS = (1e-9, 1e-7, 1e-5, 1e-3)
+
+
+def _platform_solutions(theta: np.ndarray, tol: float = 1e-12, max_iter: int = 50):
+    """Every platform pose within the joint limits closing both rods for motor angles theta (n, 2).
+
+    Returns (item (m,), x (m, 2), branch (m, 2) in {+1, -1, 0}, sign det N (m,)): branch 0 for a chain on its
+    reach boundary (|k| within K_TOL of 1), where both motor branches meet. Duplicates are possible.
+    """
+    tip, dtip = _lever_tips(theta)
+    poly, al, be, ga = _roll_polynomial(tip)
+    item, x0 = _pose_seeds(_poly_roots(poly), al, be, ga)
+    x, err = _rod_newton(x0, tip[item], max_iter)
+    # near the forward singularity: seeds on both sides of each near-singular (or unconverged) solution
+    xs = np.where((err <= 1e-6)[:, None], x, x0)
+    _, nm = _rod_system(xs, tip[item])
+    sv = np.linalg.svd(np.where(np.isfinite(nm), nm, 0.0), compute_uv=False) if len(nm) else np.zeros((0, 2))
+    near = ~(err <= tol) | (sv[:, 1] < 1e-3 * np.maximum(sv[:, 0], 1e-300))
+    if near.any():
+        _, _, vt = np.linalg.svd(np.where(np.isfinite(nm[near]), nm[near], 0.0))
+        v = vt[:, -1]
+        extra = [xs[near] + sgn * h * v for h in _FOLD_OFFSETS for sgn in (1.0, -1.0)]
+        xi = np.tile(item[near], 2 * len(_FOLD_OFFSETS))
+        xe, ee = _rod_newton(np.concatenate(extra), tip[xi], max_iter, keep_sign=True)
+        item, x, err = np.concatenate([item, xi]), np.concatenate([x, xe]), np.concatenate([err, ee])
+    x = _wrap(x)
+    keep = (err <= tol) & np.all(np.abs(x) <= PLATFORM_LIMIT + _LIMIT_TOL, -1)
+    item, x = item[keep], np.clip(x[keep], -PLATFORM_LIMIT, PLATFORM_LIMIT)
+    rot = _rot(x[:, 0], x[:, 1])
+    _, k, _ = _chains(rot, np.ones(2))
+    ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
+    d = CENTER + ra - tip[item]
+    dd = np.sum(d * dtip[item], -1)
+    bl = np.where(np.abs(np.abs(k) - 1.0) <= K_TOL, 0.0, -_SIGMA * np.sign(dd))
+    sdet = np.sign(_det2(_n_matrix(ra, d, x[:, 0])))
+    return item, x, bl, sdet
+
+
+_REF_SIGN: dict = {}
+
+
+def _assembly_ref(b: np.ndarray) -> float:
+    """Sign of det N at the neutral pose (R_P = I) on motor branch b."""
+    key = (int(b[0]), int(b[1]))
+    if key not in _REF_SIGN:
+        rot = np.eye(3)[None]
+        th, _, _ = _chains(rot, b)
+        tip, _ = _lever_tips(th)
+        ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
+        _REF_SIGN[key] = float(np.sign(_det2(_n_matrix(ra, CENTER + ra - tip, np.zeros(1)))[0]))
+    return _REF_SIGN[key]
+
+
+def _in_class(bl: np.ndarray, sdet: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
+    """Solutions on motor branch b (boundary chains match both) in assembly mode s."""
+    return np.all((bl == b) | (bl == 0.0), -1) & (sdet * _assembly_ref(b) == s)
+
+
+def _first_per_item(n: int, item: np.ndarray, key: np.ndarray, mask: np.ndarray):
+    """Index into the candidate arrays of the masked candidate with the smallest key per item (-1: none)."""
+    out = np.full(n, -1)
+    sel = np.flatnonzero(mask)
+    if len(sel):
+        order = sel[np.lexsort((key[sel], item[sel]))]
+        first = np.unique(item[order], return_index=True)
+        out[first[0]] = order[first[1]]
+    return out
+
+
+def _fk_select(theta: np.ndarray, b: np.ndarray, s: float, tol: float = 1e-12, max_iter: int = 50):
+    """The pose (n, 2) of motor angles theta (n, 2) in mode (b, s) within the limits nearest R_P = I, and ok."""
+    n = len(theta)
+    x = np.full((n, 2), np.nan)
+    if not n:
+        return x, np.zeros(0, dtype=bool)
+    item, xs, bl, sdet = _platform_solutions(theta, tol, max_iter)
+    pick = _first_per_item(n, item, np.linalg.norm(xs, axis=-1), _in_class(bl, sdet, b, s))
+    ok = pick >= 0
+    x[ok] = xs[pick[ok]]
+    return x, ok
+
+
+def assembly_mode(roll, pitch, branch: Sequence[int] = (1, 1), *, return_mask: bool = False):
+    """Assembly mode (..., ) of platform poses on a motor branch: +1, -1 (0 on the forward singularity).
+
+    +1 where det(dtheta/d(roll, pitch)) (:func:`motor_jacobian`) has the sign it has at the neutral pose
+    R_P = I on the same branch (equivalently det N, ``N_ik = d_i . dA_i/dx_k``), -1 where it has the other
+    sign. The mechanism is built in mode +1 on branch (1, 1) (the SRDF pose ``neutral``).
+
+    Raises:
+        UnreachableError: single pose out of the motors' reach on that branch.
+    """
+    r, p = as_angles(roll, pitch, names=("roll", "pitch"))
+    b = _check_branch(branch)
+    _check_flag(return_mask, "return_mask")
+    rot = _rot(r, p)
+    theta, k, ok2 = _chains(rot, b)
+    ok = np.all(ok2, axis=-1)
+    tip, _ = _lever_tips(np.where(ok[..., None], theta, 0.0))
+    ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
+    mode = np.sign(_det2(_n_matrix(ra, CENTER + ra - tip, r))) * _assembly_ref(b)
+    mode = np.where(ok, mode, 0.0).astype(int)
+    what = f"(roll, pitch) = ({float(r):.6g}, {float(p):.6g})" if r.ndim == 0 else ""
+    return finish(mode, ok, r.ndim == 0, return_mask, lambda: _unreachable(what, k))
+
+
+class PlatformPoses(NamedTuple):
+    """Every platform pose of :func:`platform_poses`, nearest R_P = I first (NaN / 0 padded to 8)."""
+
+    #: (..., 8, 2) (roll, pitch), NaN where there is no further pose.
+    x: np.ndarray
+    #: (..., 8, 2) motor branch of each chain: +1, -1, or 0 on the chain's reach boundary (both branches).
+    branch: np.ndarray
+    #: (..., 8) assembly mode on that branch (+1: as at R_P = I); for a boundary chain, that of branch +1.
+    assembly: np.ndarray
+    #: (..., 8) True where there is a pose.
+    mask: np.ndarray
+
+
+def platform_poses(theta1, theta2, *, tol: float = 1e-12, max_iter: int = 50) -> PlatformPoses:
+    """Every platform pose within the joint limits for motor angles (theta1, theta2), with its mode.
+
+    The forward kinematics of the closed sub-chain in closed form (see :func:`platform_orientation`): the real
+    roots of a degree-8 polynomial in tan(roll / 2), the pitch of each from the two (linear in cos, sin) rod
+    equations, polished by Newton's method. All modes, nearest R_P = I first. Never raises for valid input (a
+    single input gives arrays of shape (8, ...)).
+    """
+    t1, t2 = as_angles(theta1, theta2, names=("theta1", "theta2"))
+    tol = _check_real(tol, "tol", 0.0, 1e-6, "rod-length residual, m")
+    max_iter = _check_count(max_iter, "max_iter", 1, 10_000, "Newton iterations")
+    shape = t1.shape
+    theta = np.stack([t1.ravel(), t2.ravel()], -1)
+    n = len(theta)
+    x = np.full((n, 8, 2), np.nan)
+    bran = np.zeros((n, 8, 2), dtype=int)
+    asm = np.zeros((n, 8), dtype=int)
+    if n:
+        item, xs, bl, sdet = _platform_solutions(theta, tol, max_iter)
+        order = np.lexsort((np.linalg.norm(xs, axis=-1), item))
+        slot = np.zeros(n, dtype=int)
+        sd = np.zeros((n, 8))
+        for c in order:  # drop duplicates: the same pose with the same sign of det N
+            i, j = item[c], slot[item[c]]
+            if j >= 8 or (j and np.any((np.abs(x[i, :j] - xs[c]).max(-1) <= 1e-9) & (sd[i, :j] == sdet[c]))):
+                continue
+            x[i, j], sd[i, j] = xs[c], sdet[c]
+            bran[i, j] = bl[c].astype(int)
+            asm[i, j] = int(sdet[c] * _assembly_ref(np.where(bl[c] == 0.0, 1.0, bl[c])))
+            slot[i] += 1
+    mask = np.isfinite(x[..., 0])
+    return PlatformPoses(x.reshape(shape + (8, 2)), bran.reshape(shape + (8, 2)), asm.reshape(shape + (8,)),
+                         mask.reshape(shape + (8,)))
 
 
 def platform_orientation(
@@ -449,6 +829,7 @@ def platform_orientation(
     theta2,
     branch: Sequence[int] = (1, 1),
     *,
+    assembly: int = 1,
     guess=None,
     steps: int = 4,
     tol: float = 1e-12,
@@ -457,72 +838,83 @@ def platform_orientation(
 ):
     """(roll, pitch) (..., 2) of the universal-centre platform for motor angles (theta1, theta2).
 
-    Forward kinematics of the closed sub-chain (seed eqs 1-16 with both motors given): Newton's method on
-    :func:`motor_angles` ``(x) = theta`` with its analytic Jacobian :func:`motor_jacobian`, damped by
-    backtracking (a step that leaves the reachable set or increases the residual is halved). Without a
-    ``guess`` it follows the assembly mode of the neutral pose: a continuation from R_P = I (the
-    closed-form motor angles of ``branch`` at roll = pitch = 0) to ``theta`` in ``steps`` stages; where
-    that path leaves the image of the motor map (near the forward singularity), Newton restarts from a
-    coarse grid of guesses. Every accepted step keeps the sign of det dtheta/dx it had at R_P = I, so
-    the solution is always of the neutral assembly mode. Near the forward singularity (det N = 0, where the platform could move
-    with the motors locked) the solution is ill-conditioned: error ~ 1e-16 / sigma_min(dtheta/dx).
+    Forward kinematics of the closed sub-chain (seed eqs 1-16 with both motors given), in closed form: with
+    the lever tips known, rod i closes iff ``w_i . R_P a_i = kappa_i`` (``w_i = c - S_i``), which is linear in
+    (cos pitch, sin pitch); eliminating the pitch leaves a polynomial of degree 8 in tan(roll / 2). Its real
+    roots with |roll| <= pi/2 give every pose within the joint limits (:func:`platform_poses`), each polished by
+    Newton's method on the rod equations (with the forward-singularity barrier near det N = 0). The answer is
+    the pose on motor branch ``branch`` in assembly mode ``assembly`` (:func:`assembly_mode`); if that mode
+    holds several poses, the one nearest R_P = I. The defaults (branch (1, 1), mode +1) are the mode the
+    mechanism is built in (SRDF ``neutral``); there the motor map is one-to-one over the pitches below
+    :data:`PITCH_SPLIT`, and the region of the same sign beyond it (pitch >= 1.48 rad) is only used when the
+    motors reach no pose below it. Near the forward singularity (det N = 0, where the platform could move with
+    the motors locked) the solution is ill-conditioned: error ~ 1e-16 / sigma_min(dtheta/dx).
 
     Args:
         theta1, theta2: motor angles (rad), broadcast together.
-        branch: the motor branch pair the solution must lie on.
-        guess: starting (roll, pitch) (..., 2) instead of the continuation.
-        steps: continuation stages.
-        tol: required residual |motor_angles(x) - theta| (rad).
-        max_iter: Newton iterations per stage.
+        branch: the motor branch pair (b1, b2) the solution must lie on (a chain on its reach boundary lies on
+            both).
+        assembly: +1 (default) or -1, see :func:`assembly_mode`.
+        guess: starting (roll, pitch) (..., 2): plain Newton from it instead (the pose it reaches on ``branch``,
+            whatever its assembly mode).
+        steps: unused since the forward kinematics is solved in closed form (kept for compatibility;
+            an integer in [1, 1000]).
+        tol: required rod-length residual | |A_i - S_i| - L | (m), in (0, 1e-6].
+        max_iter: Newton iterations, in [1, 10000].
 
     Raises:
-        ConvergenceError: single input for which Newton did not converge (the motor angles may not
-            assemble on this branch, or the path crossed a singularity: try a ``guess``).
+        ConvergenceError: single input whose closed sub-chain does not assemble in that mode within the joint
+            limits (the message lists the modes in which it does).
     """
     t1, t2 = as_angles(theta1, theta2, names=("theta1", "theta2"))
     b = _check_branch(branch)
+    s = _check_assembly(assembly)
+    _check_count(steps, "steps", 1, 1000, "unused, kept for compatibility")
+    tol = _check_real(tol, "tol", 0.0, 1e-6, "rod-length residual, m")
+    max_iter = _check_count(max_iter, "max_iter", 1, 10_000, "Newton iterations")
+    _check_flag(return_mask, "return_mask")
     shape = t1.shape
     target = np.stack([t1, t2], -1).reshape(-1, 2)
-    n = len(target)
     if guess is not None:
-        g = np.broadcast_to(as_input(guess, "guess", (2,)), shape + (2,)).reshape(-1, 2)
-        x, ok = _newton(target, b, g.astype(float).copy(), max_iter, tol)
+        g = as_input(guess, "guess", (2,))
+        try:
+            g = np.broadcast_to(g, shape + (2,)).reshape(-1, 2)
+        except ValueError:
+            raise InvalidInputError(f"guess must broadcast to shape {shape + (2,)}, got shape {g.shape}") from None
+        tip, _ = _lever_tips(target)
+        x, err = _rod_newton(g.astype(float).copy(), tip, max_iter)
+        x = _wrap(x)
+        ok = err <= tol
+        if ok.any():
+            th, _, ok2 = _chains(_rot(x[:, 0], x[:, 1]), b)
+            near = np.abs(_wrap(th - target)).max(-1) <= 1e-6
+            ok &= np.all(ok2, -1) & near
     else:
-        th0 = _chains(np.eye(3)[None], b)[0][0]
-        if not np.all(np.isfinite(th0)):
-            raise ConvergenceError(f"branch {tuple(b.astype(int))} has no neutral pose to start from: give a guess")
-        delta = _wrap(target - th0)
-        sign0 = float(np.sign(_jac_det(np.zeros((1, 2)), b)[0]))
-        x = np.zeros((n, 2))
-        nsteps = max(int(steps), 1)
-        for s in range(1, nsteps + 1):
-            # intermediate stages only provide starting points; the last one decides
-            stage = _wrap(th0 + delta * (s / nsteps))
-            xs, ok = _newton(stage, b, x.copy(), max_iter, tol if s == nsteps else 1e-6, sign0)
-            x = np.where(ok[:, None], xs, x)
-        # fallback where the straight path in motor space leaves the image (near the forward
-        # singularity): Newton from a coarse grid of guesses, kept in the neutral assembly mode
-        for guess_x in _FALLBACK_GUESSES:
-            todo = np.flatnonzero(~ok)
-            if not len(todo):
-                break
-            g = np.tile(guess_x, (len(todo), 1))
-            if not np.sign(_jac_det(g[:1], b)[0]) == sign0:
-                continue
-            xs, oks = _newton(target[todo], b, g, min(max_iter, 30), tol, sign0)
-            x[todo[oks]] = xs[oks]
-            ok[todo[oks]] = True
-    x = np.where(ok[:, None], _wrap(x), np.nan).reshape(shape + (2,))
+        x, ok = _fk_select(target, b, s, tol, max_iter)
+    x = np.where(ok[:, None], x, np.nan).reshape(shape + (2,))
     ok = ok.reshape(shape)
 
     def error():
-        return ConvergenceError(
-            f"platform_orientation did not converge for (theta1, theta2) = ({float(t1):.6g}, {float(t2):.6g}) "
-            f"on branch {tuple(b.astype(int))}: the motor angles may not assemble, or the path from the neutral "
-            "pose crosses a singularity (pass a guess)"
-        )
+        return ConvergenceError(_fk_failure(float(t1), float(t2), b, s, guess is not None))
 
     return finish(x, ok, t1.ndim == 0, return_mask, error)
+
+
+def _mode_text(b, s) -> str:
+    return f"branch=({int(b[0])}, {int(b[1])}), assembly={int(s):+d}"
+
+
+def _fk_failure(t1: float, t2: float, b: np.ndarray, s: float, guessed: bool = False) -> str:
+    what = f"(theta1, theta2) = ({t1:.17g}, {t2:.17g})"
+    if guessed:
+        return (f"platform_orientation: Newton from the guess did not close both rods for {what} on branch "
+                f"({int(b[0])}, {int(b[1])}) within the joint limits")
+    poses = platform_poses(t1, t2)
+    found = [f"({pose[0]:.6g}, {pose[1]:.6g}) on branch ({br[0]}, {br[1]}) in assembly mode {a:+d}"
+             for pose, br, a, m in zip(poses.x, poses.branch, poses.assembly, poses.mask) if m]
+    return (f"the closed sub-chain does not assemble for {what} in mode {_mode_text(b, s)} within the joint limits "
+            f"(|roll|, |pitch| <= pi/2); " + ("it does at (roll, pitch) = " + "; ".join(found) if found
+                                              else "it assembles nowhere within the limits"))
 
 
 # ----------------------------------------------------------------------------- foot
@@ -542,55 +934,296 @@ def foot_position_from_platform(roll, pitch, theta_ll) -> np.ndarray:
     (0.140, 0, -0.037) in P.
     """
     r, p, t = as_angles(roll, pitch, theta_ll, names=("roll", "pitch", "theta_ll"))
+    return _foot_from_pose(r, p, t)
+
+
+def _foot_from_pose(r, p, t):
     f, _ = _foot_in_p(t)
-    return CENTER + np.einsum("...ij,...j->...i", platform_rotation(r, p), f)
+    return CENTER + np.einsum("...ij,...j->...i", _rot(r, p), f)
+
+
+def _foot_gain(x: np.ndarray, theta: np.ndarray, tll: np.ndarray) -> np.ndarray:
+    """Spectral norm (m,) of d(foot)/d(theta1, theta2) (m/rad) at poses x (m, 2) closed by motors theta (m, 2).
+
+    ``dx/dtheta = N^-1 diag(D)`` (implicit differentiation of the rod lengths), ``dp/dx = [e_x x R f,
+    (Rx(roll) e_y) x R f]``. Infinite on the forward singularity (det N = 0).
+    """
+    rot = _rot(x[:, 0], x[:, 1])
+    ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
+    tip, dtip = _lever_tips(theta)
+    d = CENTER + ra - tip
+    nm = _n_matrix(ra, d, x[:, 0])
+    dd = np.sum(d * dtip, -1)
+    det = _det2(nm)
+    adj = np.stack([np.stack([nm[:, 1, 1], -nm[:, 0, 1]], -1), np.stack([-nm[:, 1, 0], nm[:, 0, 0]], -1)], -2)
+    f, _ = _foot_in_p(tll)
+    rf = np.einsum("...ij,...j->...i", rot, f)
+    ey_r = np.stack([np.zeros_like(x[:, 0]), np.cos(x[:, 0]), np.sin(x[:, 0])], -1)
+    dpdx = np.stack([np.cross(np.array([1.0, 0.0, 0.0]), rf), np.cross(ey_r, rf)], -1)
+    m = dpdx @ (adj * dd[:, None, :])  # det N x d(foot)/d(theta)
+    mtm = np.swapaxes(m, -1, -2) @ m
+    a, b, c = mtm[:, 0, 0], mtm[:, 0, 1], mtm[:, 1, 1]
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+        gain = np.sqrt(0.5 * (a + c) + np.sqrt(0.25 * (a - c) ** 2 + b * b)) / np.abs(det)
+    return np.where(np.isfinite(gain), gain, np.inf)
 
 
 def foot_position(
-    theta1, theta2, theta0, *, starting_value: float = 0.0, branch: Sequence[int] = (1, 1), return_mask: bool = False
+    theta1,
+    theta2,
+    theta0,
+    *,
+    starting_value: float = 0.0,
+    branch: Sequence[int] = (1, 1),
+    assembly: int = 1,
+    return_mask: bool = False,
 ):
     """Foot FCS in CCS (..., 3) for the three motors: (theta1, theta2) -> (roll, pitch) -> foot.
 
-    :func:`platform_orientation` (Newton on the closed sub-chain, eqs 1-16), :func:`ll_angle` (eq 19) and
-    :func:`foot_position_from_platform` (eqs 17, 18, 20).
+    :func:`platform_orientation` (the closed sub-chain, eqs 1-16, in the mode ``branch``, ``assembly``; the
+    defaults are the mode of the SRDF reference pose), :func:`ll_angle` (eq 19) and
+    :func:`foot_position_from_platform` (eqs 17, 18, 20). Poses in the forward-singularity band (the foot moving
+    more than :data:`FK_GAIN_MAX` m per motor radian) are refused: there double-precision motor angles do not fix
+    the foot to 1e-9 m.
 
     Raises:
-        ConvergenceError: single input whose closed sub-chain did not assemble.
+        ConvergenceError: single input whose closed sub-chain does not assemble in that mode.
+        SingularityError: single input in the forward-singularity band.
     """
     t1, t2, t0 = as_angles(theta1, theta2, theta0, names=("theta1", "theta2", "theta0"))
-    x, ok = platform_orientation(t1.ravel(), t2.ravel(), branch, return_mask=True)
-    tll = ll_angle(t0.ravel(), starting_value)
-    p = foot_position_from_platform(np.where(ok, x[:, 0], 0.0), np.where(ok, x[:, 1], 0.0), tll)
+    sv = _check_offset(starting_value)
+    b = _check_branch(branch)
+    s = _check_assembly(assembly)
+    _check_flag(return_mask, "return_mask")
+    theta = np.stack([t1.ravel(), t2.ravel()], -1)
+    x, assembled = _fk_select(theta, b, s)
+    tll = -RATIO * t0.ravel() + sv
+    gain = np.full(len(theta), np.inf)
+    gain[assembled] = _foot_gain(x[assembled], theta[assembled], tll[assembled])
+    ok = assembled & (gain < FK_GAIN_MAX)
+    p = _foot_from_pose(np.where(ok, x[:, 0], 0.0), np.where(ok, x[:, 1], 0.0), tll)
     p = np.where(ok[:, None], p, np.nan).reshape(t1.shape + (3,))
-    ok = ok.reshape(t1.shape)
 
     def error():
-        return ConvergenceError(
-            f"the closed sub-chain does not assemble for (theta1, theta2) = ({float(t1):.6g}, {float(t2):.6g}) "
-            f"on branch {tuple(branch)}"
-        )
+        if not bool(assembled[0]):
+            return ConvergenceError(_fk_failure(float(t1), float(t2), b, s))
+        return SingularityError(_band_message(f"(theta1, theta2) = ({float(t1):.17g}, {float(t2):.17g})", x[0], gain[0]))
 
-    return finish(p, ok, t1.ndim == 0, return_mask, error)
+    return finish(p, ok.reshape(t1.shape), t1.ndim == 0, return_mask, error)
+
+
+def _band_message(what: str, x, gain: float) -> str:
+    return (
+        f"{what}: the platform pose (roll, pitch) = ({float(x[0]):.6g}, {float(x[1]):.6g}) is at the forward "
+        f"singularity (det N = 0, the platform could move with the motors locked) or within its band: the foot moves "
+        f"{gain:.3g} m per motor radian (limit FK_GAIN_MAX = {FK_GAIN_MAX:g}), so double-precision motor angles do not "
+        "fix it to 1e-9 m"
+    )
 
 
 def _platform_ik(u: np.ndarray, ll_branch: float, roll_branch: float):
-    """(theta_LL, roll, pitch) (..., 3) for u = p - CENTER, plus reach ratio, rho and ok."""
-    r2 = np.sum(u * u, -1)
-    kk = (_LL0**2 + _H**2 - r2) / (2.0 * _H * _LL0)
-    reach = np.abs(kk) <= 1.0
-    tll = LL_DELTA + ll_branch * np.arccos(np.clip(kk, -1.0, 1.0))
+    """(theta_LL, roll, pitch) (..., 3) for u = p - CENTER, plus LL ratio kk, rho, LL reach and not-on-axis."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        r2 = np.sum(u * u, -1)
+        kk = (_LL0**2 + _H**2 - r2) / (2.0 * _H * _LL0)
+    reach = np.isfinite(kk) & (np.abs(kk) <= 1.0 + LL_TOL)
+    tll = LL_DELTA + ll_branch * np.arccos(np.clip(np.where(reach, kk, 1.0), -1.0, 1.0))
     f, _ = _foot_in_p(tll)
-    rho = np.hypot(u[..., 1], u[..., 2])
+    with np.errstate(over="ignore", invalid="ignore"):
+        rho = np.hypot(u[..., 1], u[..., 2])
     s = np.where(u[..., 2] >= 0.0, 1.0, -1.0) * roll_branch
     vz = s * rho
-    roll = np.arctan2(-u[..., 1] * s, u[..., 2] * s)
+    roll = np.where(rho <= RHO_TOL, 0.0 if roll_branch > 0 else np.pi, np.arctan2(-u[..., 1] * s, u[..., 2] * s))
     pitch = np.arctan2(f[..., 2], f[..., 0]) - np.arctan2(vz, u[..., 0])
     out = _wrap(np.stack([tll, roll, pitch], -1))
-    nonsing = rho > 1e-12 * np.sqrt(r2)
-    return out, kk, rho, reach, nonsing
+    return out, kk, rho, reach, rho > 0.0
 
 
-def foot_platform_ik(p, *, ll_branch: int = -1, roll_branch: int = 1, return_mask: bool = False):
+def _ik_candidate(u: np.ndarray, sv: float, llb: float, rb: float, b: np.ndarray) -> dict:
+    """One (ll_branch, roll_branch, motor branch) closed-form candidate for targets u = p - CENTER (n, 3).
+
+    Keys: pose (n, 3) (theta_LL, roll, pitch), motors (n, 3) (theta1, theta2, theta0), exists (reachable, off
+    the roll axis), inlim (inside the URDF limits), mode (+1/-1/0, :func:`assembly_mode`), gain (m/rad).
+    """
+    x, kk, rho, reach, nonsing = _platform_ik(u, llb, rb)
+    near = np.abs(x[:, 1:]) <= PLATFORM_LIMIT + _LIMIT_TOL
+    inlim = np.all(near, -1)
+    x[:, 1:] = np.where(near, np.clip(x[:, 1:], -PLATFORM_LIMIT, PLATFORM_LIMIT), x[:, 1:])  # rounding at a limit
+    rot = _rot(x[:, 1], x[:, 2])
+    th, _, ok2 = _chains(rot, b)
+    exists = reach & nonsing & np.all(ok2, -1)
+    th = np.where(exists[:, None], th, np.nan)
+    ths = np.where(exists[:, None], th, 0.0)
+    tip, _ = _lever_tips(ths)
+    ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
+    mode = np.where(exists, np.sign(_det2(_n_matrix(ra, CENTER + ra - tip, x[:, 1]))) * _assembly_ref(b), 0.0)
+    gain = np.full(len(u), np.inf)
+    if exists.any():
+        gain[exists] = _foot_gain(x[exists, 1:], ths[exists], x[exists, 0])
+    motors = np.concatenate([th, ((sv - x[:, 0]) / RATIO)[:, None]], -1)
+    return {"pose": x, "motors": np.where(exists[:, None], motors, np.nan), "exists": exists, "inlim": inlim,
+            "mode": mode, "gain": gain, "kk": kk, "reach": reach}
+
+
+def _accepted(c: dict, b: np.ndarray, s: float) -> np.ndarray:
+    """Candidates the mode-checked IK keeps: inside the limits, in mode (b, s), off the forward-singularity band,
+    and the pose the forward kinematics of their motor angles returns in that mode."""
+    acc = c["exists"] & c["inlim"] & (c["mode"] == s) & (c["gain"] < FK_GAIN_MAX)
+    # the neutral aspect (branch (1, 1), mode +1, pitch < PITCH_SPLIT) is one-to-one and nearer R_P = I than the
+    # other region of that mode: the forward kinematics returns exactly these poses. Elsewhere ask it.
+    fast = bool(np.all(b == 1.0)) and s == 1.0
+    need = acc & ~(fast & (c["pose"][:, 2] < PITCH_SPLIT))
+    if need.any():
+        xf, okf = _fk_select(c["motors"][need, :2], b, s)
+        same = okf & (np.abs(xf - c["pose"][need, 1:]).max(-1, initial=0.0) <= 1e-7)
+        acc[np.flatnonzero(need)[~same]] = False
+    return acc
+
+
+def _combos(llb, rb) -> list:
+    return [(l, r) for l, r in FOOT_IK_ORDER if (llb is None or l == llb) and (rb is None or r == rb)]
+
+
+def _search(u: np.ndarray, sv: float, combos: list, b: np.ndarray, s, limits_only: bool = False):
+    """First candidate per target, in the order ``combos``, that is accepted; returns motors, pose, ok."""
+    n = len(u)
+    motors = np.full((n, 3), np.nan)
+    pose = np.full((n, 3), np.nan)
+    done = np.zeros(n, dtype=bool)
+    for llb, rb in combos:
+        todo = np.flatnonzero(~done)
+        if not len(todo):
+            break
+        c = _ik_candidate(u[todo], sv, float(llb), float(rb), b)
+        if limits_only:
+            acc = c["reach"] & (_platform_ik(u[todo], llb, rb)[4]) & c["inlim"]
+        else:
+            acc = _accepted(c, b, s)
+        motors[todo[acc]] = c["motors"][acc]
+        pose[todo[acc]] = c["pose"][acc]
+        done[todo[acc]] = True
+    return motors, pose, done
+
+
+def _fmt(p) -> str:
+    return "[" + ", ".join(f"{float(v):.17g}" for v in np.ravel(p)) + "]"
+
+
+def _arc_error(p: np.ndarray, kk: float) -> UnreachableError:
+    r = float(np.linalg.norm(p - CENTER))
+    lo, hi = _LL0 - _H, _LL0 + _H
+    side = f"{r - hi:.3g} m beyond its outer end" if r > hi else f"{lo - r:.3g} m inside its inner end"
+    return UnreachableError(
+        f"foot target {_fmt(p)} is {r:.17g} m from the LCS centre; the LL arc reaches [{lo:.17g}, {hi:.17g}] m "
+        f"(+- {LL_TOL:g} in the arc's cosine for rounding): the target is {side}",
+        target=p,
+    )
+
+
+def _axis_error(p: np.ndarray) -> SingularityError:
+    return SingularityError(
+        f"foot target {_fmt(p)} lies exactly on the platform's roll axis (x through the LCS centre): roll is "
+        "undetermined (any roll reaches it; move the target off the axis by any amount, or pick the roll yourself "
+        "with foot_position_from_platform)"
+    )
+
+
+def _mode_dict(llb, rb, b, s) -> dict:
+    return {"ll_branch": int(llb), "roll_branch": int(rb), "branch": (int(b[0]), int(b[1])), "assembly": int(s)}
+
+
+def _mode_str(m: dict) -> str:
+    return (f"ll_branch={m['ll_branch']:+d}, roll_branch={m['roll_branch']:+d}, branch=({m['branch'][0]}, "
+            f"{m['branch'][1]}), assembly={m['assembly']:+d}")
+
+
+def _ik_error(p: np.ndarray, sv: float, combos: list, b: np.ndarray, s: float, limits_only: bool = False) -> Exception:
+    """Why the mode-checked search found nothing for the single target p (3,)."""
+    u = (p - CENTER)[None]
+    _, kk, rho, reach, nonsing = _platform_ik(u, -1.0, 1.0)
+    if not bool(reach[0]):
+        return _arc_error(p, float(kk[0]))
+    if not bool(nonsing[0]):
+        return _axis_error(p)
+    asked = f"ll_branch, roll_branch in {combos}" + ("" if limits_only else f", {_mode_text(b, s)}")
+    cands = []
+    for llb, rb in FOOT_IK_ORDER:
+        for bb in MOTOR_BRANCHES:
+            bv = np.array(bb, float)
+            c = _ik_candidate(u, sv, float(llb), float(rb), bv)
+            c = {k: v[0] for k, v in c.items()}
+            c.update(ll=llb, rb=rb, b=bv, requested=(llb, rb) in combos and (limits_only or bool(np.all(bv == b))))
+            if c["exists"] and c["inlim"] and c["mode"] != 0:
+                one = {k: np.asarray(v)[None] for k, v in c.items() if k in ("pose", "motors", "exists", "inlim",
+                                                                             "mode", "gain")}
+                one["gain"] = np.array([0.0])  # the band is judged separately below
+                c["fk"] = bool(_accepted(one, bv, float(c["mode"]))[0])
+            else:
+                c["fk"] = False
+            cands.append(c)
+    if limits_only:
+        inl = [c for c in cands if c["requested"] and c["inlim"]]
+        if not inl:
+            x = _platform_ik(u, combos[0][0], combos[0][1])[0][0]
+            return JointLimitError(
+                f"foot target {_fmt(p)} needs (theta_LL, roll, pitch) = ({x[0]:.6g}, {x[1]:.6g}, {x[2]:.6g}) or the "
+                f"other branches asked for ({asked}): outside the joint limits |roll|, |pitch| <= pi/2 (LCS_x, LCS_y)",
+                target=p,
+            )
+    # reachable in the mode asked for, but in the forward-singularity band
+    band = [c for c in cands if c["requested"] and c["exists"] and c["inlim"] and c["mode"] == s and c["fk"]
+            and not c["gain"] < FK_GAIN_MAX]
+    if band:
+        c = band[0]
+        return SingularityError(_band_message(f"foot target {_fmt(p)}", c["pose"][1:], c["gain"]))
+    valid = [c for c in cands if c["exists"] and c["inlim"] and c["fk"] and c["gain"] < FK_GAIN_MAX]
+    if valid:
+        modes = [_mode_dict(c["ll"], c["rb"], c["b"], c["mode"]) for c in valid]
+        where = "; ".join(f"{_mode_str(m)} at (roll, pitch) = ({c['pose'][1]:.6g}, {c['pose'][2]:.6g})"
+                          for m, c in zip(modes, valid))
+        return AssemblyModeError(
+            f"foot target {_fmt(p)} is reachable within the joint limits, but not in the mode asked for ({asked}); "
+            f"it is reachable with {where}",
+            target=p, modes=modes,
+        )
+    inl = [c for c in cands if c["exists"] and c["inlim"]]
+    if inl:
+        c = inl[0]
+        return AssemblyModeError(
+            f"foot target {_fmt(p)} needs (roll, pitch) = ({c['pose'][1]:.6g}, {c['pose'][2]:.6g}) (branch "
+            f"({int(c['b'][0])}, {int(c['b'][1])})), a pose the forward kinematics of its motor angles does not return "
+            f"(another pose of the same mode is nearer R_P = I, or it is in the forward-singularity band); asked: {asked}",
+            target=p, modes=[],
+        )
+    out = [c for c in cands if c["exists"]]
+    if out:
+        c = out[0]
+        raw = _platform_ik(u, float(c["ll"]), float(c["rb"]))[0][0]
+        return JointLimitError(
+            f"foot target {_fmt(p)} is reachable only outside the joint limits |roll|, |pitch| <= pi/2 (LCS_x, LCS_y): "
+            f"{len(out)} of the 16 closed-form branches reach it, none within the limits (e.g. (roll, pitch) = "
+            f"({raw[1]:.6g}, {raw[2]:.6g}) with ll_branch={c['ll']:+d}, roll_branch={c['rb']:+d})",
+            target=p,
+        )
+    x = _platform_ik(u, combos[0][0], combos[0][1])[0][0]
+    _, k, _ = _chains(_rot(x[1], x[2]), b)
+    return UnreachableError(
+        f"foot target {_fmt(p)} needs (roll, pitch) = ({x[1]:.6g}, {x[2]:.6g}) (ll_branch={combos[0][0]:+d}, "
+        f"roll_branch={combos[0][1]:+d}): " + str(_unreachable("that platform pose", k)).split(": ", 1)[1].replace(
+            "is out", "out", 1) + "; no other branch reaches it either",
+        target=p,
+    )
+
+
+def foot_platform_ik(
+    p,
+    *,
+    ll_branch: int | None = None,
+    roll_branch: int | None = None,
+    branch: Sequence[int] | None = None,
+    assembly: int | None = None,
+    return_mask: bool = False,
+):
     """(theta_LL, roll, pitch) (..., 3) placing the foot at ``p`` (CCS), in closed form.
 
     Inverts :func:`foot_position_from_platform`:
@@ -598,49 +1231,59 @@ def foot_platform_ik(p, *, ll_branch: int = -1, roll_branch: int = 1, return_mas
     1. the distance from the LCS centre depends on theta_LL alone:
        ``|p - c|^2 = |o|^2 + h^2 - 2 h |o| cos(theta_LL - delta)`` with ``o = (1.640, -0.037)``,
        ``h = 1.5``, ``delta = atan2(0.037, 1.640)``; ``theta_LL = delta + ll_branch acos(...)``
-       (``ll_branch = -1``: theta_LL <= delta, the extension side, default). Unreachable unless
-       ``|o| - h <= |p - c| <= |o| + h`` (0.14042 to 3.14042 m).
+       (``ll_branch = -1``: theta_LL <= delta, the extension side). Unreachable unless
+       ``|o| - h <= |p - c| <= |o| + h`` (0.14042 to 3.14042 m, :data:`LL_TOL` of rounding allowed).
     2. ``u = p - c = Rx(roll) v``, ``v = Ry(pitch) f`` with ``f`` the foot in P: ``v_y = 0`` gives
        ``v_z = +-sqrt(u_y^2 + u_z^2)``, ``roll = atan2(-u_y / v_z, u_z / v_z)`` (``roll_branch = +1``:
-       |roll| <= pi/2, default), and ``pitch = atan2(f_z, f_x) - atan2(v_z, u_x)``.
+       |roll| <= pi/2), and ``pitch = atan2(f_z, f_x) - atan2(v_z, u_x)``.
 
-    Singular where the foot lies on the roll axis (``u_y = u_z = 0``: roll is undetermined).
+    Branches: with neither ``ll_branch`` nor ``roll_branch`` given (default) the branches are tried in the order
+    :data:`FOOT_IK_ORDER` and the first inside the joint limits (|roll|, |pitch| <= pi/2) is returned; with
+    ``branch`` / ``assembly`` given (either; the other defaults to (1, 1) / +1), also in that assembly mode, as
+    :func:`foot_ik` (the foot's forward map from the pose has no assembly mode, hence no mode check by default).
+    Giving ``ll_branch`` or ``roll_branch`` alone returns that closed-form branch as is (the other defaulting to
+    -1 / +1), unchecked, as before.
+
+    Singular exactly on the roll axis (``u_y = u_z = 0``: roll undetermined); within :data:`RHO_TOL` of it roll
+    is taken as 0 (or pi).
 
     Raises:
-        UnreachableError: single target out of reach.
-        SingularityError: single target on the roll axis.
+        UnreachableError: single target out of reach (JointLimitError: only outside the limits;
+            AssemblyModeError: only in another mode).
+        SingularityError: single target exactly on the roll axis.
     """
     p = as_input(p, "p", (3,))
-    llb = _check_sign(ll_branch, "ll_branch")
-    rb = _check_sign(roll_branch, "roll_branch")
-    out, kk, rho, reach, nonsing = _platform_ik(p - CENTER, llb, rb)
-    ok = reach & nonsing
-    out = np.where(ok[..., None], out, np.nan)
+    llb = _check_sign(ll_branch, "ll_branch", allow_none=True)
+    rb = _check_sign(roll_branch, "roll_branch", allow_none=True)
+    moded = branch is not None or assembly is not None
+    b = _check_branch((1, 1) if branch is None else branch)
+    s = _check_assembly(1 if assembly is None else assembly)
+    _check_flag(return_mask, "return_mask")
+    shape = p.shape[:-1]
+    u = (p - CENTER).reshape(-1, 3)
+    if (llb is not None or rb is not None) and not moded:
+        out, kk, rho, reach, nonsing = _platform_ik(u, -1.0 if llb is None else llb, 1.0 if rb is None else rb)
+        ok = reach & nonsing
+        out = np.where(ok[:, None], out, np.nan)
 
-    def error():
-        return _foot_error(p, kk, reach)
+        def error():
+            return _arc_error(p, float(kk[0])) if not bool(reach[0]) else _axis_error(p)
 
-    return finish(out, ok, p.ndim == 1, return_mask, error)
-
-
-def _foot_error(p: np.ndarray, kk, reach) -> Exception:
-    r = float(np.linalg.norm(p - CENTER))
-    if not bool(reach):
-        return UnreachableError(
-            f"foot target {p.tolist()} is {r:.6g} m from the LCS centre; the LL arc reaches "
-            f"[{_LL0 - _H:.6g}, {_LL0 + _H:.6g}] m",
-            target=p,
-        )
-    return SingularityError(f"foot target {p.tolist()} lies on the platform's roll axis (x through the LCS centre): roll is undetermined")
+        return finish(out.reshape(shape + (3,)), ok.reshape(shape), p.ndim == 1, return_mask, error)
+    combos = _combos(llb, rb)
+    _, pose, ok = _search(u, 0.0, combos, b, s, limits_only=not moded)
+    return finish(pose.reshape(shape + (3,)), ok.reshape(shape), p.ndim == 1, return_mask,
+                  lambda: _ik_error(p, 0.0, combos, b, s, limits_only=not moded))
 
 
 def foot_ik(
     p,
     *,
     starting_value: float = 0.0,
-    ll_branch: int = -1,
-    roll_branch: int = 1,
+    ll_branch: int | None = None,
+    roll_branch: int | None = None,
     branch: Sequence[int] = (1, 1),
+    assembly: int = 1,
     all_branches: bool = False,
     return_mask: bool = False,
 ):
@@ -649,95 +1292,145 @@ def foot_ik(
     :func:`foot_platform_ik` (target -> theta_LL -> roll, pitch), :func:`motor_angles` (eqs 3-16 per chain)
     and :func:`extension_motor_angle` (eq 19 inverted).
 
+    The IK contract: the answer is in the mode ``branch`` (motor branches), ``assembly`` (:func:`assembly_mode`)
+    that :func:`foot_position` uses with the same arguments (defaults: the mode of the SRDF reference pose
+    ``neutral``), inside the URDF joint limits, and :func:`foot_position` of it is the target. The IK-only
+    branches ``ll_branch`` (LL side) and ``roll_branch`` are tried in the order :data:`FOOT_IK_ORDER`
+    ((-1, +1), (+1, +1), (-1, -1), (+1, -1)); giving one restricts the search to it. The first candidate kept is
+    inside the limits, in the mode, outside the forward-singularity band (:data:`FK_GAIN_MAX`) and the pose the
+    forward kinematics returns for its motor angles.
+
     Args:
         p: foot targets (..., 3) in CCS.
-        starting_value: LL zero offset (rad) of eq 19.
-        ll_branch, roll_branch, branch: which solution (see :func:`foot_platform_ik`, :func:`motor_angles`).
-        all_branches: return every branch instead, shape (..., 16, 3) in :data:`FOOT_IK_BRANCHES` order,
-            NaN rows where a branch does not exist; the mask (with ``return_mask``) is then (..., 16).
-            A single target raises only when no branch exists.
+        starting_value: LL zero offset (rad) of eq 19, in [-pi, pi].
+        ll_branch, roll_branch: None (search both, default) or +1 / -1.
+        branch, assembly: the assembly mode (default (1, 1), +1).
+        all_branches: return every closed-form branch instead, unchecked (no limit or mode check), shape
+            (..., 16, 3) in :data:`FOOT_IK_BRANCHES` order, NaN rows where a branch does not exist; the mask
+            (with ``return_mask``) is then (..., 16). A single target raises only when no branch exists. Their
+            modes and validity: :func:`foot_ik_solutions`.
 
     Raises:
-        UnreachableError: single target out of reach (of the LL arc or of the motors).
-        SingularityError: single target on the roll axis.
+        UnreachableError: single target out of reach (of the LL arc or of the motors);
+            JointLimitError: reachable only outside the joint limits;
+            AssemblyModeError: reachable only in other modes (``.modes`` lists the arguments that reach it).
+        SingularityError: single target exactly on the roll axis, or in the forward-singularity band.
     """
     p = as_input(p, "p", (3,))
     sv = _check_offset(starting_value)
-    u = p - CENTER
+    llb = _check_sign(ll_branch, "ll_branch", allow_none=True)
+    rb = _check_sign(roll_branch, "roll_branch", allow_none=True)
+    b = _check_branch(branch)
+    s = _check_assembly(assembly)
+    all_branches = _check_flag(all_branches, "all_branches")
+    _check_flag(return_mask, "return_mask")
+    shape = p.shape[:-1]
+    u = (p - CENTER).reshape(-1, 3)
     if all_branches:
         outs, oks = [], []
-        for llb, rb, b1, b2 in FOOT_IK_BRANCHES:
-            o, ok = _foot_ik_one(u, sv, llb, rb, np.array([b1, b2], float))
-            outs.append(o)
-            oks.append(ok)
-        out = np.stack(outs, -2)
-        ok = np.stack(oks, -1)
-        any_ok = np.any(ok, -1)
-        if p.ndim == 1 and not bool(any_ok):
+        for l_, r_, b1, b2 in FOOT_IK_BRANCHES:
+            c = _ik_candidate(u, sv, float(l_), float(r_), np.array([b1, b2], float))
+            outs.append(c["motors"])
+            oks.append(c["exists"])
+        out = np.stack(outs, -2).reshape(shape + (16, 3))
+        ok = np.stack(oks, -1).reshape(shape + (16,))
+        if p.ndim == 1 and not bool(np.any(ok)):
             _, kk, _, reach, nonsing = _platform_ik(u, -1.0, 1.0)
-            if bool(reach) and bool(nonsing):
-                raise UnreachableError(f"foot target {p.tolist()} is out of the motors' reach on every branch", target=p)
-            raise _foot_error(p, kk, reach)
+            if not bool(reach[0]):
+                raise _arc_error(p, float(kk[0]))
+            if not bool(nonsing[0]):
+                raise _axis_error(p)
+            raise UnreachableError(f"foot target {_fmt(p)} is out of the motors' reach on every branch", target=p)
         return (out, ok) if return_mask else out
-    llb = _check_sign(ll_branch, "ll_branch")
-    rb = _check_sign(roll_branch, "roll_branch")
-    b = _check_branch(branch)
-    out, ok = _foot_ik_one(u, sv, llb, rb, b)
-
-    def error():
-        _, kk, _, reach, nonsing = _platform_ik(u, llb, rb)
-        if bool(reach) and bool(nonsing):
-            x = _platform_ik(u, llb, rb)[0]
-            _, k, _ = _chains(platform_rotation(x[1], x[2]), b)
-            return UnreachableError(
-                f"foot target {p.tolist()} needs (roll, pitch) = ({float(x[1]):.6g}, {float(x[2]):.6g}): "
-                + str(_unreachable("that platform pose", k)).split(": ", 1)[1].replace("is out", "out", 1),
-                target=p,
-            )
-        return _foot_error(p, kk, reach)
-
-    return finish(out, ok, p.ndim == 1, return_mask, error)
+    combos = _combos(llb, rb)
+    motors, _, ok = _search(u, sv, combos, b, s)
+    return finish(motors.reshape(shape + (3,)), ok.reshape(shape), p.ndim == 1, return_mask,
+                  lambda: _ik_error(p, sv, combos, b, s))
 
 
-def _foot_ik_one(u, sv, llb, rb, b):
-    x, _, _, reach, nonsing = _platform_ik(u, llb, rb)
-    th, _, ok2 = _chains(platform_rotation(x[..., 1], x[..., 2]), b)
-    ok = reach & nonsing & np.all(ok2, -1)
-    t0 = (sv - x[..., 0]) / RATIO
-    out = np.concatenate([th, t0[..., None]], -1)
-    return np.where(ok[..., None], out, np.nan), ok
+class FootIKSolutions(NamedTuple):
+    """Every closed-form foot IK branch of :func:`foot_ik_solutions`, in :data:`FOOT_IK_BRANCHES` order."""
+
+    #: (..., 16, 3) motor angles (theta1, theta2, theta0), NaN where the branch does not exist.
+    motors: np.ndarray
+    #: (..., 16, 3) (theta_LL, roll, pitch) of each branch.
+    pose: np.ndarray
+    #: (..., 16) the branch exists (LL arc and motors reach, target off the roll axis).
+    mask: np.ndarray
+    #: (..., 16) assembly mode of the branch's pose on its motor branch (+1 / -1, 0 where it does not exist).
+    assembly: np.ndarray
+    #: (..., 16) the branch's pose is inside the joint limits.
+    within_limits: np.ndarray
+    #: (..., 16) what :func:`foot_ik` returns with these mode arguments: inside the limits, off the
+    #: forward-singularity band, reproduced by :func:`foot_position` in that mode.
+    valid: np.ndarray
+
+
+def foot_ik_solutions(p, *, starting_value: float = 0.0) -> FootIKSolutions:
+    """Every foot IK solution with its mode: the 16 closed-form branches ((ll_branch, roll_branch, b1, b2) in
+    :data:`FOOT_IK_BRANCHES` order) with their assembly mode, joint-limit and validity flags. Never raises for
+    valid input."""
+    p = as_input(p, "p", (3,))
+    sv = _check_offset(starting_value)
+    shape = p.shape[:-1]
+    u = (p - CENTER).reshape(-1, 3)
+    parts = {k: [] for k in ("motors", "pose", "exists", "mode", "inlim", "valid")}
+    for l_, r_, b1, b2 in FOOT_IK_BRANCHES:
+        bv = np.array([b1, b2], float)
+        c = _ik_candidate(u, sv, float(l_), float(r_), bv)
+        valid = np.zeros(len(u), dtype=bool)
+        for s in (1.0, -1.0):
+            valid |= _accepted(c, bv, s)
+        c["valid"] = valid
+        for k in parts:
+            parts[k].append(c[k])
+    st = {k: np.stack(v, 1) for k, v in parts.items()}
+    return FootIKSolutions(
+        st["motors"].reshape(shape + (16, 3)), np.where(st["exists"][..., None], st["pose"], np.nan).reshape(
+            shape + (16, 3)), st["exists"].reshape(shape + (16,)), st["mode"].astype(int).reshape(shape + (16,)),
+        (st["inlim"] & st["exists"]).reshape(shape + (16,)), st["valid"].reshape(shape + (16,)),
+    )
 
 
 def foot_jacobian(
-    theta1, theta2, theta0, *, starting_value: float = 0.0, branch: Sequence[int] = (1, 1), return_mask: bool = False
+    theta1,
+    theta2,
+    theta0,
+    *,
+    starting_value: float = 0.0,
+    branch: Sequence[int] = (1, 1),
+    assembly: int = 1,
+    return_mask: bool = False,
 ):
     """d(foot position)/d(theta1, theta2, theta0), shape (..., 3, 3), of the closed-loop leg.
 
-    With x = (roll, pitch) from :func:`platform_orientation` and ``dtheta/dx = D^-1 N``
-    (:func:`motor_jacobian`), ``dx/dtheta = N^-1 D``; the foot ``p = c + R_P f(theta_LL)`` gives
-    ``dp/droll = e_x x R f``, ``dp/dpitch = (Rx(roll) e_y) x R f``, ``dp/dtheta_LL = R_P df/dtheta_LL`` and
+    With x = (roll, pitch) from :func:`platform_orientation` (mode ``branch``, ``assembly``) and
+    ``dtheta/dx = D^-1 N`` (:func:`motor_jacobian`), ``dx/dtheta = N^-1 D``; the foot ``p = c + R_P f(theta_LL)``
+    gives ``dp/droll = e_x x R f``, ``dp/dpitch = (Rx(roll) e_y) x R f``, ``dp/dtheta_LL = R_P df/dtheta_LL`` and
     ``dtheta_LL/dtheta0 = -RATIO`` (eq 19). Finite on the reach boundary (D = 0: a column vanishes);
     undefined where N is singular (the platform moves with the motors locked).
 
     Raises:
-        ConvergenceError: single input whose closed sub-chain did not assemble.
+        ConvergenceError: single input whose closed sub-chain did not assemble in that mode.
         SingularityError: single input where N is singular.
     """
     t1, t2, t0 = as_angles(theta1, theta2, theta0, names=("theta1", "theta2", "theta0"))
     sv = _check_offset(starting_value)
     b = _check_branch(branch)
-    x, assembled = platform_orientation(t1.ravel(), t2.ravel(), b, return_mask=True)
+    s = _check_assembly(assembly)
+    _check_flag(return_mask, "return_mask")
+    theta = np.stack([t1.ravel(), t2.ravel()], -1)
+    x, assembled = _fk_select(theta, b, s)
     r = np.where(assembled, x[:, 0], 0.0)
     pch = np.where(assembled, x[:, 1], 0.0)
-    rot = platform_rotation(r, pch)
-    theta = np.stack([t1.ravel(), t2.ravel()], -1)
+    rot = _rot(r, pch)
     nmat, dd = _jacobian_parts(rot, r, theta)
-    det = np.linalg.det(nmat)
-    scale = np.abs(nmat).max(axis=(-1, -2)) ** 2
+    det = _det2(nmat)
+    scale = np.abs(nmat).max(axis=(-1, -2), initial=0.0) ** 2
     nonsing = np.abs(det) > 1e-12 * np.maximum(scale, 1e-300)
     ninv = np.linalg.inv(np.where(nonsing[:, None, None], nmat, np.eye(2)))
     dx_dth = ninv * dd[:, None, :]
-    tll = ll_angle(t0.ravel(), sv)
+    tll = -RATIO * t0.ravel() + sv
     f, df = _foot_in_p(tll)
     rf = np.einsum("...ij,...j->...i", rot, f)
     ey_r = np.stack([np.zeros_like(r), np.cos(r), np.sin(r)], -1)
@@ -748,13 +1441,10 @@ def foot_jacobian(
     ok = assembled & nonsing
     jac = np.where(ok[:, None, None], jac, np.nan).reshape(t1.shape + (3, 3))
     ok = ok.reshape(t1.shape)
-    assembled = assembled.reshape(t1.shape)
 
     def error():
-        if not bool(assembled):
-            return ConvergenceError(
-                f"the closed sub-chain does not assemble for (theta1, theta2) = ({float(t1):.6g}, {float(t2):.6g})"
-            )
+        if not bool(assembled[0]):
+            return ConvergenceError(_fk_failure(float(t1), float(t2), b, s))
         return SingularityError(
             f"(theta1, theta2) = ({float(t1):.6g}, {float(t2):.6g}) is a forward singularity: the platform can move "
             "with both motors locked (N singular), the foot Jacobian is undefined"

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import re
 
 import numpy as np
 import pytest
@@ -341,3 +342,229 @@ def test_fk_scalar_is_a_batch_of_one():
     q = at.ik(0.3, -0.4)
     y, z, inc, ok = at.fk(q[[0]], q[[4]], q[[8]] + 1e-3, return_mask=True)
     assert not ok[0] and np.isnan(y[0]) and np.isnan(inc[0])
+
+
+# ------------------------------------------------------------------------------------------ parameter validation
+@pytest.mark.parametrize(
+    "kw, match",
+    [
+        ({"d": float("nan")}, r"d=nan is out of range: must be in \(0, inf\)"),
+        ({"d": float("inf")}, r"d=inf is out of range"),
+        ({"d": -0.1}, r"d=-0.1 is out of range"),
+        ({"d": True}, r"d must be a real number, got True"),
+        ({"d": "0.05"}, r"d must be a real number, got '0.05'; valid range \(0, inf\)"),
+        ({"d": 0.05 + 0j}, r"d must be a real number"),
+        ({"d": [0.05]}, r"d must be a real number"),
+        ({"alpha": 0.0}, r"alpha=0.0 is out of range: must be in \(0, 3.14159\)"),
+        ({"alpha": float("nan")}, r"alpha=nan is out of range"),
+        ({"alpha": "pi"}, r"alpha must be a real number"),
+        ({"eta": "abc"}, r"eta must be three finite real angles"),
+        ({"eta": [0.0, 1.0, 2.0j]}, r"eta must be three finite real angles"),
+        ({"eta": [0.0, float("nan"), 1.0]}, r"eta must be three finite real angles"),
+        ({"eta": [[0.0, 1.0, 2.0]]}, r"eta must be three finite real angles"),
+        ({"eta": [0.0, [1.0], 2.0]}, r"eta must be three finite real angles"),
+        ({"mode": "-+"}, r"mode='-\+' is not valid: must be one of -\+\+\+, "),
+        ({"mode": None}, r"mode=None is not valid"),
+        ({"return_mask": "yes"}, r"return_mask must be True or False"),
+        ({"return_mask": 1}, r"return_mask must be True or False"),
+    ],
+)
+def test_keyword_parameters_are_validated(kw, match):
+    q = at.ik(0.1, 0.2)
+    calls = [lambda: at.ik(0.1, 0.2, **kw), lambda: at.fk(q[0], q[4], q[8], **kw)]
+    if "mode" not in kw or kw["mode"] != "all":
+        calls.append(lambda: at.actuation_jacobian(0.1, 0.2, **kw))
+    if set(kw) <= {"d", "alpha", "eta"}:
+        calls.append(lambda: at.workspace(n=5, m=5, **kw))
+        if "eta" not in kw:
+            calls += [lambda: at.platform_position(0.1, 0.2, **kw), lambda: at.leg_transform(np.zeros(4), 0.0, **kw)]
+    for call in calls:
+        with pytest.raises(InvalidParameterError, match=match):
+            call()
+
+
+@pytest.mark.parametrize(
+    "kw, match",
+    [
+        ({"tol": float("nan")}, r"tol=nan is out of range: must be in \[0, 0.1\]"),
+        ({"tol": -1e-13}, r"tol=-1e-13 is out of range"),
+        ({"tol": 1.0}, r"tol=1.0 is out of range"),
+        ({"tol": "1e-13"}, r"tol must be a real number"),
+        ({"max_iter": 2.5}, r"max_iter must be an integer, got 2.5; valid range \[1, 10000\]"),
+        ({"max_iter": 0}, r"max_iter=0 is out of range: must be in \[1, 10000\]"),
+        ({"max_iter": -1}, r"max_iter=-1 is out of range"),
+        ({"max_iter": True}, r"max_iter must be an integer"),
+        ({"max_iter": 10**6}, r"max_iter=1000000 is out of range"),
+        ({"max_inconsistency": float("nan")}, r"max_inconsistency=nan is out of range: must be in \[0, inf\]"),
+        ({"max_inconsistency": -1.0}, r"max_inconsistency=-1.0 is out of range"),
+        ({"max_inconsistency": None}, r"max_inconsistency must be a real number"),
+        ({"mode": "all!"}, r"is not valid"),
+    ],
+)
+def test_fk_options_are_validated(kw, match):
+    q = at.ik(0.1, 0.2)
+    with pytest.raises(InvalidParameterError, match=match):
+        at.fk(q[0], q[4], q[8], **kw)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: at.workspace(n=1),
+        lambda: at.workspace(n=2.5),
+        lambda: at.workspace(n=10**6),
+        lambda: at.workspace(m="10"),
+        lambda: at.leg_transform(np.zeros(4), [0.0, 1.0]),
+        lambda: at.leg_transform(np.zeros(4), "a"),
+        lambda: at.leg_transform(np.zeros(4), float("nan")),
+        lambda: at.leg_transform_cv(0.1, 0.2, 1j),
+        lambda: at.actuation_jacobian(0.1, 0.2, mode="all"),
+    ],
+)
+def test_other_parameters_are_validated(call):
+    with pytest.raises(InvalidParameterError):
+        call()
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: at.ik(0.1 + 1j, 0.2),
+        lambda: at.ik([[0.1], [0.2, 0.3]], 0.2),
+        lambda: at.fk(0.1, 0.2, np.array([0.3]) + 0j),
+        lambda: at.fk("a", 0.2, 0.3),
+        lambda: at.leg_transform(np.zeros(4) + 0j, 0.0),
+        lambda: at.orientation_from_axis(np.zeros(3)),
+        lambda: at.orientation_from_axis([[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]),
+        lambda: at.orientation_from_axis([1.0, 0.0, 0.0, 0.0]),
+        lambda: at.platform_axis(np.nan, 0.0),
+    ],
+)
+def test_bad_arrays_raise_invalid_input(call):
+    with pytest.raises(InvalidInputError):
+        call()
+
+
+# ------------------------------------------------------------------------------------------ assembly modes
+def test_modes_and_home_mode(robot):
+    assert len(at.MODES) == 16 and len(set(at.MODES)) == 16 and at.MODES[0] == at.HOME_MODE == "-+++"
+    # the reference pose is in the home mode: E_x < 0 (E = (-L, 0, 0)) and sin q_K2 > 0 on every leg
+    q0 = robot.q0
+    assert np.all(np.sin(q0[[1, 5, 9]]) > 0)
+    assert robot.frame_placement(q0, "platform").translation[0] < 0
+    np.testing.assert_allclose(at.ik(0.0, 0.0), q0, atol=1e-15)
+
+
+@pytest.mark.parametrize("alpha", ALPHAS)
+def test_every_mode_closes_the_loops_with_the_same_rotation(alpha):
+    robot = legkin.load("tripod") if alpha == math.pi / 3 else legkin.load("tripod", alpha=alpha)
+    u = (0.4, -0.7)
+    q_all, ok = at.ik(*u, alpha=alpha, mode="all", return_mask=True)
+    assert q_all.shape == (16, 12) and ok.all()
+    rot = at.platform_rotation(*u)
+    for m, q in zip(at.MODES, q_all):
+        assert np.linalg.norm(robot.constraint_residual(q)) < 1e-12, m
+        placement = robot.frame_placement(q, "platform")
+        assert np.abs(placement.rotation - rot).max() < 1e-12, m
+        assert np.sign(placement.translation[0]) == (-1 if m[0] == "-" else 1), m
+        assert [np.sign(np.sin(q[4 * k + 1])) for k in range(3)] == [(-1 if c == "-" else 1) for c in m[1:]], m
+        np.testing.assert_array_equal(at.ik(*u, alpha=alpha, mode=m), q)
+
+
+def test_fk_mode_is_explicit():
+    """fk solves motors in the mode asked for; motors of another mode: AssemblyModeError naming it (single),
+    mask False (batch); mode="all" finds it."""
+    u = (0.3, -0.4)
+    for m in at.MODES[1:]:
+        q = at.ik(*u, mode=m)
+        y, z, inc = at.fk(q[0], q[4], q[8], mode=m)
+        assert np.abs(at.platform_rotation(y, z) - at.platform_rotation(*u)).max() < 1e-12 and inc < 1e-12
+        with pytest.raises(legkin.AssemblyModeError, match=f"mode\\(s\\) {re.escape(m)}, not in mode -\\+\\+\\+") as exc:
+            at.fk(q[0], q[4], q[8])
+        assert exc.value.modes == [{"mode": m}]
+        assert isinstance(exc.value, UnreachableError)
+        _, _, _, ok = at.fk(q[[0]], q[[4]], q[[8]], return_mask=True)
+        assert not ok[0]
+        ys, zs, incs, oks = at.fk(q[0], q[4], q[8], mode="all", return_mask=True)
+        assert ys.shape == (16,) and oks.tolist() == [mm == m for mm in at.MODES]
+        assert np.isnan(ys[~oks]).all() and np.isfinite(ys[oks]).all()
+
+
+@pytest.mark.parametrize("mode", ["-+-+", "+++-", "+---"])
+def test_actuation_jacobian_in_other_modes_matches_differences(mode):
+    u, h = np.array([0.3, -0.4]), 1e-6
+    a = at.actuation_jacobian(*u, mode=mode)
+    for j in range(2):
+        du = np.zeros(2)
+        du[j] = h
+        fd = (at.ik(*(u + du), mode=mode) - at.ik(*(u - du), mode=mode))[[0, 4, 8]] / (2 * h)
+        np.testing.assert_allclose(a[:, j], fd, atol=1e-8)
+
+
+# ------------------------------------------------------------------------------------------ the guards
+def test_fk_reproduces_ik_next_to_the_flip():
+    """With 1 + c_y c_z computed without cancellation and the inconsistency measured off the range of A_u,
+    fk(ik(u)) reproduces u down to the singular tolerance (before: default fk failed below ~1e-6)."""
+    alpha = math.pi / 4
+    phi = np.linspace(-3, 3, 200)
+    for nb in (1e-11, 1e-9, 1e-7, 1e-5):
+        ay, az = _tilt_u(np.full_like(phi, np.arccos(nb - 1.0)), phi)
+        q, ok = at.ik(ay, az, alpha=alpha, return_mask=True)
+        assert ok.sum() > 20
+        ay, az, q = ay[ok], az[ok], q[ok]
+        y, z, inc, m = at.fk(q[:, 0], q[:, 4], q[:, 8], alpha=alpha, return_mask=True)
+        assert m.all(), nb
+        assert np.abs(y - ay).max() < 1e-12 and np.abs(at._wrap(z - az)).max() < 1e-12 and inc.max() < 1e-12
+
+
+def _home_det(alpha, ay, az):
+    """det M of the home mode's motor planes at (ay, az) (arrays), NaN outside the workspace; no guard."""
+    trig = tuple(fn(np.asarray(v, dtype=float))[..., None] for v in (ay, az) for fn in (np.cos, np.sin))
+    g = at._geometry(at.D, alpha, np.array(at.ETA))
+    with np.errstate(all="ignore"):
+        q1, _, c2, _, nb2, sn, cn = at._ik_eval(*trig, g, with_sc=True)
+        return q1, np.where(at._inside(c2, nb2)[..., 0], at._det_planes(sn, cn, g), np.nan)
+
+
+def det_zero_points(alpha, az, n=601):
+    """alpha_y where det M = 0 along alpha_z = az (bisection between sign changes on a grid)."""
+    ys = np.linspace(-np.pi / 2, np.pi / 2, n)
+    det = _home_det(alpha, ys, np.full(n, az))[1]
+    i = np.nonzero(np.sign(det[1:]) * np.sign(det[:-1]) < 0)[0]
+    lo, hi = ys[i], ys[i + 1]
+    flo = _home_det(alpha, lo, np.full(len(i), az))[1]
+    for _ in range(70):
+        mid = 0.5 * (lo + hi)
+        fm = _home_det(alpha, mid, np.full(len(i), az))[1]
+        left = np.sign(fm) == np.sign(flo)
+        lo, flo, hi = np.where(left, mid, lo), np.where(left, fm, flo), np.where(left, hi, mid)
+    return 0.5 * (lo + hi)
+
+
+def test_actuation_singularity_guard():
+    """On det M = 0 the motors fit two poses: ik and fk refuse them (SingularityError) instead of fk returning
+    the other pose (before: fk failed or returned the other pose); away from the guard fk(ik(u)) reproduces u."""
+    alpha, az = math.pi / 3, -2.5
+    y0 = det_zero_points(alpha, az)[0]
+    with pytest.raises(SingularityError, match="actuation singularity"):
+        at.ik(y0, az, alpha=alpha)
+    _, ok = at.ik(np.array([y0, y0 + 0.01]), np.array([az, az]), alpha=alpha, return_mask=True)
+    assert ok.tolist() == [False, True]
+    qm = _home_det(alpha, y0, az)[0]  # the motors, from an unguarded evaluation
+    with pytest.raises(SingularityError, match="actuation singularity"):
+        at.fk(*qm, alpha=alpha)
+    _, _, _, ok = at.fk(qm[[0]], qm[[1]], qm[[2]], alpha=alpha, return_mask=True)
+    assert not ok[0]
+    for off in (1e-3, -1e-4):
+        q = at.ik(y0 + off, az, alpha=alpha)
+        y, z, _ = at.fk(q[0], q[4], q[8], alpha=alpha)
+        assert abs(y - (y0 + off)) < 1e-10 and abs(z - az) < 1e-10
+
+
+def test_fk_near_boundary_and_near_singular_planes():
+    """A start a rounding error outside the workspace (planes nearly dependent, a hair from a leg's boundary)
+    is pulled in; before, fk reported "the solver left the workspace"."""
+    alpha, ay, az = math.pi / 2, -0.5236046131772432, -1.570796326775148
+    q = at.ik(ay, az, alpha=alpha)
+    y, z, inc = at.fk(q[0], q[4], q[8], alpha=alpha)
+    assert abs(y - ay) < 1e-12 and abs(z - az) < 1e-12 and inc < 1e-12

@@ -18,12 +18,21 @@ Conventions:
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 from typing import NamedTuple, Sequence
 
 import numpy as np
 
-from ..errors import ConvergenceError, InvalidParameterError, SingularityError, UnreachableError
+from ..errors import (
+    AssemblyModeError,
+    ConvergenceError,
+    InvalidInputError,
+    InvalidParameterError,
+    SingularityError,
+    UnreachableError,
+)
+from ..models.tripod import SPEC as _SPEC
 from ._batch import as_angles, as_input, finish
 
 __all__ = [
@@ -43,6 +52,9 @@ __all__ = [
     "fk",
     "workspace",
     "Workspace",
+    "MODES",
+    "HOME_MODE",
+    "DET_GUARD",
 ]
 
 LEGS = ("A", "B", "C")
@@ -54,23 +66,93 @@ ALPHA = math.pi / 3.0
 SINGULAR_TOL = 1e-12
 #: Below this, ``1 - |cos q_K2|`` counts as zero: leg K is on the workspace boundary, sin q_K2 = 0.
 BOUNDARY_TOL = 1e-12
+#: Assembly modes on the constant-velocity branch (q_K3 = q_K2, q_K4 = q_K1): a string of four signs, the side of
+#: the platform centre E along x (``-``: E_x < 0) then the signs of sin q_A2, sin q_B2, sin q_C2. Every
+#: orientation has one configuration per mode (E = -+L b/|b|, q_K2 = +-acos(cos q_K2)), all realising the
+#: same platform rotation; the motors differ. See docs/tripod.md, "IK contract".
+MODES = tuple(c + a + b + k for c in "-+" for a in "+-" for b in "+-" for k in "+-")
+#: The mode the mechanism is built in: that of its SRDF reference pose ``home`` (E = (-L, 0, 0), q_K2 = pi/2).
+HOME_MODE = "-+++"
+#: Actuation-singularity guard: :func:`ik` and :func:`fk` refuse motor angles whose planes (see
+#: :func:`_initial_guess`) have ``|det M| < DET_GUARD`` (unit normals). There the motors fix the pose only
+#: to ~2e-16 / |det M| rad, and on det M = 0 they fit two poses (the planes share a line that cuts the sphere
+#: |E| = L twice; at tangency the two merge and A_u loses rank): fk could not reproduce ik's answers to 1e-9.
+DET_GUARD = 1e-6
 
 
 # ------------------------------------------------------------------------------------------ helpers
+def _mode_signs(mode: str):
+    """``None`` for :data:`HOME_MODE`, else ``(e, s)``: e = -1/+1 the side of E, s (3,) the signs of sin q_K2."""
+    if mode == HOME_MODE:
+        return None
+    return (-1.0 if mode[0] == "-" else 1.0), np.array([-1.0 if c == "-" else 1.0 for c in mode[1:]])
+
+
+def _number(value, name: str, valid) -> float:
+    """A real scalar parameter (int, float, numpy real, 0-d real array; not bool, str, complex) as float.
+    ``valid``: the range text for the message (or a callable making it)."""
+    if type(value) is float:  # the common case, fast
+        return value
+    ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+    if not ok and isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        ok, value = True, value.item()
+    if not ok:
+        text = valid() if callable(valid) else valid
+        raise InvalidParameterError(f"{name} must be a real number, got {value!r}; valid range {text}")
+    return float(value)
+
+
+def _in_range(value, name: str, lo: float, hi: float, valid: str, *, lo_open=False, hi_open=False) -> float:
+    x = _number(value, name, valid)
+    bad = math.isnan(x) or x < lo or x > hi or (lo_open and x == lo) or (hi_open and x == hi)
+    if bad:
+        raise InvalidParameterError(f"{name}={value!r} is out of range: must be in {valid}")
+    return x
+
+
+def _integer(value, name: str, lo: int, hi: int) -> int:
+    ok = isinstance(value, numbers.Integral) and not isinstance(value, (bool, np.bool_))
+    if not ok:
+        raise InvalidParameterError(f"{name} must be an integer, got {value!r}; valid range [{lo}, {hi}]")
+    if not lo <= int(value) <= hi:
+        raise InvalidParameterError(f"{name}={value!r} is out of range: must be in [{lo}, {hi}]")
+    return int(value)
+
+
+def _flag(value, name: str) -> bool:
+    if not isinstance(value, (bool, np.bool_)):
+        raise InvalidParameterError(f"{name} must be True or False, got {value!r}")
+    return bool(value)
+
+
+def _checked_mode(mode, allow_all: bool = False) -> str:
+    if isinstance(mode, str) and (mode in MODES or (allow_all and mode == "all")):
+        return mode
+    extra = ', or "all"' if allow_all else ""
+    raise InvalidParameterError(f"mode={mode!r} is not valid: must be one of {', '.join(MODES)}{extra}")
+
+
+def _angle(value, name: str) -> float:
+    return _in_range(value, name, -math.inf, math.inf, "(-inf, inf) (rad), finite", lo_open=True, hi_open=True)
+
+
 def _params(d: float, alpha: float, eta: Sequence[float] | None = None) -> tuple[float, float, np.ndarray]:
-    """Validate the geometry (same ranges as the registry); return (d, alpha, eta as (3,))."""
-    try:
-        d, alpha = float(d), float(alpha)
-    except (TypeError, ValueError):
-        raise InvalidParameterError(f"d and alpha must be numbers, got d={d!r}, alpha={alpha!r}") from None
-    if not (math.isfinite(d) and d > 0):
-        raise InvalidParameterError(f"d={d!r} is out of range: must be in (0, inf) (metres)")
-    if not (0 < alpha < math.pi):
-        raise InvalidParameterError(f"alpha={alpha!r} is out of range: must be in (0, pi) (radians)")
-    eta_arr = np.asarray(ETA if eta is None else eta, dtype=float)
-    if eta_arr.shape != (3,) or not np.all(np.isfinite(eta_arr)):
-        raise InvalidParameterError(f"eta must be three finite angles (eta_A, eta_B, eta_C), got {eta!r}")
-    return d, alpha, eta_arr
+    """Validate the geometry against the registry's ranges (:data:`legkin.models.tripod.SPEC`); return
+    (d, alpha, eta as (3,))."""
+    out = []
+    for name, value in (("d", d), ("alpha", alpha)):
+        param = _SPEC.params[name]
+        out.append(param.check(name, _number(value, name, param.range_text)))
+    if eta is None:
+        eta_arr = np.asarray(ETA, dtype=float)
+    else:
+        try:
+            eta_arr = as_input(eta, "eta", (3,))
+        except InvalidInputError:
+            eta_arr = None
+        if eta_arr is None or eta_arr.shape != (3,):
+            raise InvalidParameterError(f"eta must be three finite real angles (eta_A, eta_B, eta_C), got {eta!r}")
+    return out[0], out[1], eta_arr
 
 
 def _rx(t: np.ndarray) -> np.ndarray:
@@ -137,8 +219,8 @@ def leg_transform(q, eta: float, d: float = D, alpha: float = ALPHA) -> np.ndarr
         (..., 4, 4) homogeneous transforms.
     """
     d, alpha, _ = _params(d, alpha)
+    eta = _angle(eta, "eta")
     q = as_input(q, "q", (4,))
-    eta = float(as_input(eta, "eta"))
     q1, q2, q3, q4 = (q[..., i] for i in range(4))
     shape = q1.shape
     rot = (
@@ -167,8 +249,8 @@ def leg_transform_cv(q1, q2, eta: float, d: float = D, alpha: float = ALPHA) -> 
         (..., 4, 4) homogeneous transforms.
     """
     d, alpha, _ = _params(d, alpha)
+    eta = _angle(eta, "eta")
     q1, q2 = as_angles(q1, q2, names=("q1", "q2"))
-    eta = float(as_input(eta, "eta"))
     c1, s1, c2, s2 = np.cos(q1), np.sin(q1), np.cos(q2), np.sin(q2)
     ca, sa = math.cos(alpha), math.sin(alpha)
     ce, se = math.cos(eta), math.sin(eta)
@@ -228,6 +310,11 @@ def orientation_from_axis(axis) -> tuple[np.ndarray, np.ndarray]:
     :func:`platform_rotation`; at ``c_y = 0`` (axis = -+z) alpha_z is arbitrary and 0 is returned.
     """
     r = as_input(axis, "axis", (3,))
+    with np.errstate(over="ignore"):
+        scale = np.max(np.abs(r), axis=-1, keepdims=True)
+    if not np.all(scale > 0):
+        raise InvalidInputError("axis must be a nonzero vector (every row)")
+    r = r / scale  # no overflow / underflow in the norm
     r = r / np.linalg.norm(r, axis=-1, keepdims=True)
     ay = -np.arcsin(np.clip(r[..., 2], -1.0, 1.0))
     az = np.arctan2(r[..., 1], r[..., 0])
@@ -256,8 +343,8 @@ def platform_position(alpha_y, alpha_z, d: float = D, alpha: float = ALPHA) -> n
     d, alpha, _ = _params(d, alpha)
     ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))
     b = platform_axis(ay, az)
-    b[..., 0] += 1.0
-    nb2 = 1.0 + np.cos(ay) * np.cos(az)
+    nb2 = _one_plus_cc(np.cos(ay), np.sin(ay), np.cos(az), np.sin(az))
+    b[..., 0] = nb2
     with np.errstate(invalid="ignore", divide="ignore"):
         scale = np.where(nb2 > SINGULAR_TOL, -d * np.sqrt(2.0 * (1.0 - math.cos(alpha))) / np.sqrt(2.0 * nb2), np.nan)
     return b * scale[..., None]
@@ -300,28 +387,86 @@ def _geometry(d: float, alpha: float, eta: np.ndarray) -> _Geometry:
     )
 
 
-def _ik_eval(cy, sy, cz, sz, g: _Geometry):
+def _one_plus_cc(cy, sy, cz, sz):
+    """``1 + c_y c_z`` without cancellation near the flip (c_y c_z -> -1), from the cos / sin of u.
+
+    Where ``c_y c_z < -1/2`` one factor is positive and one negative; with ``a >= 0 > b`` (a, b the cosines, sa, sb
+    the sines) ``1 + a b = (1 + b) + (-b)(1 - a) = sb^2 / (1 - b) - b sa^2 / (1 + a)``, a sum of two
+    non-negative terms, each to a few ulps (the direct form loses ``1e-16 / (1 + c_y c_z)`` relative accuracy
+    there). Elsewhere the direct form (bit for bit as before).
+    """
+    p = cy * cz
+    out = 1.0 + p
+    near = p < -0.5
+    if near.any():
+        pos = cy >= 0.0
+        a, b = np.where(pos, cy, cz), np.where(pos, cz, cy)
+        sa, sb = np.where(pos, sy, sz), np.where(pos, sz, sy)
+        out = np.where(near, sb * sb / (1.0 - b) - b * (sa * sa) / (1.0 + a), out)
+    return out
+
+
+def _ik_eval(cy, sy, cz, sz, g: _Geometry, signs=None, with_sc: bool = False):
     """Unchecked seed eqs (98), (102) on a trailing leg axis (call under ``np.errstate(invalid, divide)``).
 
     Args:
         cy, sy, cz, sz: cos / sin of alpha_y, alpha_z, shape (..., 1).
         g: the geometry's constants.
+        signs: ``None`` for the home assembly mode, else ``(e, s)`` of :func:`_mode_signs`: the platform
+            centre is ``E = e L b / |b|`` and ``q_K2 = s_K acos(cos q_K2)``.
 
     Returns:
         ``(q1, q2, cos q2, sin q2)`` per leg (..., 3) and ``1 + c_y c_z`` (..., 1); NaN where undefined.
-        The platform centre E is :func:`platform_position` (same operations, so the same bits).
+        The platform centre E is :func:`platform_position` (same operations, so the same bits) in the home mode.
+        With ``with_sc`` also ``(sin q1, cos q1)`` (..., 3), the arguments of the atan2 (unit norm to rounding).
     """
-    nb2 = 1.0 + cy * cz
-    scale = np.where(nb2 > SINGULAR_TOL, g.minus_l / np.sqrt(2.0 * nb2), np.nan)
-    x, y, z = nb2 * scale, sz * cy * scale, -sy * scale  # E = -L b / |b|, b = (1 + c_y c_z, s_z c_y, -s_y)
+    nb2 = _one_plus_cc(cy, sy, cz, sz)
+    lead = g.minus_l if signs is None else -signs[0] * g.minus_l  # e L, e = -1 at home
+    scale = np.where(nb2 > SINGULAR_TOL, lead / np.sqrt(2.0 * nb2), np.nan)
+    x, y, z = nb2 * scale, sz * cy * scale, -sy * scale  # E = e L b / |b|, b = (1 + c_y c_z, s_z c_y, -s_y)
     c2 = (g.ce * z - g.se * y) / g.dsa  # eq (98)
     q2 = np.arccos(c2)  # branch q2 in (0, pi); NaN where |c2| > 1
+    if signs is not None:
+        q2 = signs[1] * q2
     s2 = np.sin(q2)
     w = -(g.ce * y + g.se * z)
     s2sa = s2 * g.sa
     det = g.d * (g.k2 + s2sa**2)  # corrected determinant (d^2 (...) with 1/d folded in)
-    q1 = np.arctan2((g.k * x + s2sa * w) / det, (-s2sa * x + g.k * w) / det)  # eq (102)
+    sn, cn = (g.k * x + s2sa * w) / det, (-s2sa * x + g.k * w) / det
+    q1 = np.arctan2(sn, cn)  # eq (102)
+    if with_sc:
+        return q1, q2, c2, s2, nb2, sn, cn
     return q1, q2, c2, s2, nb2
+
+
+def _jac_general(cy, sy, cz, sz, c2, s2, nb2, g: _Geometry, e: float) -> tuple[np.ndarray, np.ndarray]:
+    """A_u's two columns (..., 3) in any assembly mode, by the chain rule through :func:`_ik_eval`.
+
+    With ``E = e L b / sqrt(2 n)`` (n = 1 + c_y c_z): ``dE = e L (2 n)^(-1/2) (db - b dn / (2 n))``;
+    ``d cos q2 = (c_K dz - s_K dy) / (d s_alpha)``, ``d sin q2 = -cos q2 d cos q2 / sin q2`` (either sign of
+    sin q2); ``q1 = atan2(P, Q)`` with ``P = k x + sigma w``, ``Q = -sigma x + k w``, ``sigma = s_alpha sin q2``,
+    ``w = -(c_K y + s_K z)``, ``k = 1 - c_alpha``: ``dq1 = (Q dP - P dQ) / (P^2 + Q^2)``. In the home mode it
+    equals eqs (103)-(105) (:func:`_jac_eval`) to rounding.
+    """
+    n = nb2
+    lead = -e * g.minus_l / np.sqrt(2.0 * n)
+    bx, by, bz = n, sz * cy, -sy
+    x, y, z = lead * bx, lead * by, lead * bz
+    w = -(g.ce * y + g.se * z)
+    sig = g.sa * s2
+    p_, q_ = g.k * x + sig * w, -sig * x + g.k * w
+    pq = p_ * p_ + q_ * q_
+    cols = []
+    for dn, dbx, dby, dbz in ((-sy * cz, -sy * cz, -sz * sy, -cy), (-cy * sz, -cy * sz, cz * cy, 0.0 * cy)):
+        h = dn / (2.0 * n)
+        dx, dy, dz = lead * (dbx - bx * h), lead * (dby - by * h), lead * (dbz - bz * h)
+        dc2 = (g.ce * dz - g.se * dy) / g.dsa
+        dsig = g.sa * (-c2 * dc2 / s2)
+        dw = -(g.ce * dy + g.se * dz)
+        dp = g.k * dx + sig * dw + w * dsig
+        dq = -sig * dx - x * dsig + g.k * dw
+        cols.append((q_ * dp - p_ * dq) / pq)
+    return cols[0], cols[1]
 
 
 def _inside(c2: np.ndarray, nb2: np.ndarray) -> np.ndarray:
@@ -382,6 +527,29 @@ def _checked_u(alpha_y, alpha_z, d, alpha, eta):
     return ay, az, (np.cos(yc), np.sin(yc), np.cos(zc), np.sin(zc)), _geometry(d, alpha, eta_arr)
 
 
+def _ik_mode(trig, g: _Geometry, mode: str):
+    """Unchecked :func:`ik` in one mode: joints (..., 12) (NaN where not ok), ok, cos q_K2, 1 + c_y c_z, det M."""
+    with np.errstate(invalid="ignore", divide="ignore"):
+        q1, q2, c2, _, nb2, sn, cn = _ik_eval(*trig, g, _mode_signs(mode), with_sc=True)
+        det = _det_planes(sn, cn, g)
+        ok = _inside(c2, nb2)[..., 0] & (np.abs(det) >= DET_GUARD)
+    out = np.where(ok[..., None, None], np.stack([q1, q2, q2, q1], axis=-1), np.nan).reshape(ok.shape + (12,))
+    return out, ok, c2, nb2, det
+
+
+def _ik_single_error(ay, az, trig, g: _Geometry, mode: str, c2, nb2, det) -> Exception:
+    sing, unreachable, leg_sing = _ik_status(c2, nb2[..., 0])
+    if sing or unreachable.any() or leg_sing.any():
+        return _ik_error(ay, az, c2, sing, unreachable, leg_sing)
+    others = [m for m in MODES if m != mode and bool(_ik_mode(trig, g, m)[1])]
+    return SingularityError(
+        f"(alpha_y, alpha_z) = ({float(ay):.17g}, {float(az):.17g}) is an actuation singularity in mode {mode}: "
+        f"its motor planes have |det M| = {abs(float(det)):.3g} < DET_GUARD = {DET_GUARD:g}, so the motor angles "
+        f"do not determine the pose (fk could not reproduce it to 1e-9 rad); solvable in mode(s) "
+        f"{', '.join(others) or 'none'}"
+    )
+
+
 def ik(
     alpha_y,
     alpha_z,
@@ -389,6 +557,7 @@ def ik(
     alpha: float = ALPHA,
     eta: Sequence[float] | None = None,
     *,
+    mode: str = HOME_MODE,
     return_mask: bool = False,
 ):
     """Every joint of every leg for the platform orientation (alpha_y, alpha_z): seed eqs (98), (102).
@@ -402,9 +571,16 @@ def ik(
       ``d^2 ((1 - c_alpha)^2 + (s2 s_alpha)^2)``; (102) is right with ``d~ = d ((1 - c_alpha)^2 + (s2 s_alpha)^2)``;
     * ``q_K3 = q_K2`` and ``q_K4 = q_K1`` (the constant-velocity branch).
 
+    That is the home assembly mode (:data:`HOME_MODE`, that of the SRDF pose ``home``). ``mode`` picks another
+    of :data:`MODES`: ``E = +L b / |b|`` when its first sign is ``+``, and ``q_K2 = -acos(.)`` for the legs
+    whose sign is ``-`` (eq 102 then uses that sin q_K2). Every mode reaches the same orientations (the
+    reachability test |cos q_K2| < 1 does not depend on the mode) with other motors; ``mode="all"`` returns
+    every mode, shape (..., 16, 12) in :data:`MODES` order (mask (..., 16)).
+
     Args:
         alpha_y, alpha_z: platform orientation (rad), broadcast together.
         d, alpha: geometry; eta: (eta_A, eta_B, eta_C) (default 0, 2pi/3, 4pi/3).
+        mode: assembly mode, one of :data:`MODES` or ``"all"``.
         return_mask: (batch) also return the success mask.
 
     Returns:
@@ -412,17 +588,23 @@ def ik(
 
     Raises:
         UnreachableError: (scalar) ``|cos q_K2| > 1`` for some leg K (outside the workspace).
-        SingularityError: (scalar) ``sin q_K2 = 0`` (workspace boundary) or ``1 + c_y c_z = 0``.
-        InvalidInputError: non-finite or non-broadcastable angles; InvalidParameterError: bad geometry.
+        SingularityError: (scalar) ``sin q_K2 = 0`` (workspace boundary), ``1 + c_y c_z = 0``, or an actuation
+            singularity: the motors' planes have ``|det M| < DET_GUARD`` (the motors do not determine the pose,
+            so :func:`fk` could not reproduce it; the message lists the modes where the pose is solvable).
+        InvalidInputError: non-finite, complex or non-broadcastable angles; InvalidParameterError: bad geometry,
+            mode or return_mask.
     """
+    mode = _checked_mode(mode, allow_all=True)
+    return_mask = _flag(return_mask, "return_mask")
     ay, az, trig, g = _checked_u(alpha_y, alpha_z, d, alpha, eta)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        q1, q2, c2, _, nb2 = _ik_eval(*trig, g)
-    ok = _inside(c2, nb2)[..., 0]
-    out = np.where(ok[..., None, None], np.stack([q1, q2, q2, q1], axis=-1), np.nan).reshape(ok.shape + (12,))
-    return finish(
-        out, ok, ay.ndim == 0, return_mask, lambda: _ik_error(ay, az, c2, *_ik_status(c2, nb2[..., 0]))
-    )
+    if mode == "all":
+        res = [_ik_mode(trig, g, m) for m in MODES]
+        out, ok = np.stack([r[0] for r in res], axis=-2), np.stack([r[1] for r in res], axis=-1)
+        if ay.ndim == 0 and not ok.any():
+            raise _ik_single_error(ay, az, trig, g, HOME_MODE, *res[0][2:])
+        return (out, ok) if return_mask else out
+    out, ok, c2, nb2, det = _ik_mode(trig, g, mode)
+    return finish(out, ok, ay.ndim == 0, return_mask, lambda: _ik_single_error(ay, az, trig, g, mode, c2, nb2, det))
 
 
 def _jac_eval(cy, sy, cz, sz, s2, nb2, g: _Geometry) -> tuple[np.ndarray, np.ndarray]:
@@ -454,6 +636,7 @@ def actuation_jacobian(
     alpha: float = ALPHA,
     eta: Sequence[float] | None = None,
     *,
+    mode: str = HOME_MODE,
     return_mask: bool = False,
 ):
     """A_u = d(q_A1, q_B1, q_C1) / d(alpha_y, alpha_z): seed Appendix D, eqs (103)-(105), shape (..., 3, 2).
@@ -469,12 +652,20 @@ def actuation_jacobian(
 
     transcribed as printed (no error found: it matches Pinocchio's closed-loop differential kinematics
     and central differences of :func:`ik`, on the branch q_K2 in (0, pi)). A_u does not depend on d.
-    Undefined where :func:`ik` fails (NaN / same exceptions).
+    In another assembly ``mode`` (:data:`MODES`) the chain rule through that mode's IK (:func:`_jac_general`).
+    Undefined where the pose is outside the workspace or singular (NaN / the exceptions of :func:`ik`); the
+    actuation-singularity guard of :func:`ik` (:data:`DET_GUARD`) does not apply: A_u is defined there.
     """
+    mode = _checked_mode(mode)
+    return_mask = _flag(return_mask, "return_mask")
     ay, az, trig, g = _checked_u(alpha_y, alpha_z, d, alpha, eta)
+    signs = _mode_signs(mode)
     with np.errstate(invalid="ignore", divide="ignore"):
-        _, _, c2, s2, nb2 = _ik_eval(*trig, g)
-        a1, a2 = _jac_eval(*trig, s2, nb2, g)
+        _, _, c2, s2, nb2 = _ik_eval(*trig, g, signs)
+        if signs is None:
+            a1, a2 = _jac_eval(*trig, s2, nb2, g)
+        else:
+            a1, a2 = _jac_general(*trig, c2, s2, nb2, g, signs[0])
     ok = _inside(c2, nb2)[..., 0]
     out = np.where(ok[..., None, None], np.stack([a1, a2], axis=-1), np.nan)
     return finish(
@@ -492,7 +683,7 @@ PLANES_DET_MIN = 1e-8
 STEP_RCOND = 1e-12
 
 
-def _initial_guess(qm: np.ndarray, g: _Geometry) -> tuple[np.ndarray, np.ndarray]:
+def _initial_guess(qm: np.ndarray, g: _Geometry, with_det: bool = False):
     """Closed-form start for :func:`fk` from the motor angles (n, 3); returns alpha_y, alpha_z as (n, 1).
 
     Eliminating s_K2 from the two rows of eq (101) leaves one linear equation per motor,
@@ -527,6 +718,8 @@ def _initial_guess(qm: np.ndarray, g: _Geometry) -> tuple[np.ndarray, np.ndarray
     t = ex + ex
     ay = -np.arcsin(np.minimum(np.maximum(t * ez / ee, -1.0), 1.0))
     az = np.arctan2(t * ey, t * ex - ee)
+    if with_det:
+        return ay, az, det3 / 3.0  # det M, (n,)
     return ay, az
 
 
@@ -554,44 +747,142 @@ def _gauss_newton_step(a1: np.ndarray, a2: np.ndarray, r: np.ndarray) -> tuple[n
     return s0, s1
 
 
-def _fk_core(qm: np.ndarray, g: _Geometry, tol: float, max_iter: int):
-    """Unchecked :func:`fk` on motors (n, 3) (call under ``np.errstate(invalid, divide)``).
+def _det_planes(s: np.ndarray, c: np.ndarray, g: _Geometry) -> np.ndarray:
+    """det M of the motor planes' unit normals ``n_K = (s_K1, -c_K1 c_K, -c_K1 s_K)`` from sin / cos of the
+    motors (..., 3); the triple product ``n_A . (n_B x n_C)``, shape (...)."""
+    cn, cp, sn, sp = c[..., _NEXT], c[..., _PREV], s[..., _NEXT], s[..., _PREV]
+    p, q = cn * sp, sn * cp
+    x = cn * cp * g.w
+    y = q * g.se_p - p * g.se_n
+    z = p * g.ce_n - q * g.ce_p
+    return np.add.reduce(s * x - c * (g.ce * y + g.se * z), axis=-1) / 3.0
+
+
+def _shrunk(ay: np.ndarray, az: np.ndarray, f: float) -> tuple[np.ndarray, np.ndarray]:
+    """The orientation of tilt ``(1 - f) theta`` in the same direction as (ay, az) (towards home)."""
+    cy = np.cos(ay)
+    r = np.stack([np.cos(az) * cy, np.sin(az) * cy, -np.sin(ay)], axis=-1)
+    theta = np.arccos(np.clip(r[..., 0], -1.0, 1.0)) * (1.0 - f)
+    side = np.hypot(r[..., 1], r[..., 2])
+    side = np.where(side > 0, side, 1.0)
+    st = np.sin(theta) / side
+    return -np.arcsin(np.clip(r[..., 2] * st, -1.0, 1.0)), np.arctan2(r[..., 1] * st, np.cos(theta))
+
+
+def _normal_residual(a1: np.ndarray, a2: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """|r - A A^+ r| for ``A = [a1 a2]`` (n, 3, 2) given as its columns: the part of r off the range of A, (n, 1).
+
+    Rank 2: ``|r . n| / |n|`` with ``n = a1 x a2``; where ``sigma_2 <= STEP_RCOND sigma_1`` (as in
+    :func:`_gauss_newton_step`) the rank-1 projection ``A A^T r / |A|_F^2``.
+    """
+    n = a1[:, _NEXT] * a2[:, _PREV] - a1[:, _PREV] * a2[:, _NEXT]
+    nn = np.add.reduce(n * n, axis=-1, keepdims=True)
+    f = np.add.reduce(a1 * a1 + a2 * a2, axis=-1, keepdims=True)
+    out = np.abs(np.add.reduce(r * n, axis=-1, keepdims=True)) / np.sqrt(nn)
+    rank1 = ~(nn > (STEP_RCOND * STEP_RCOND) * f * f)
+    if rank1.any():
+        fs = np.where(f > 0, f, 1.0)
+        p = r - (a1 * np.add.reduce(a1 * r, axis=-1, keepdims=True) + a2 * np.add.reduce(a2 * r, axis=-1, keepdims=True)) / fs
+        out = np.where(rank1, np.sqrt(np.add.reduce(p * p, axis=-1, keepdims=True)), out)
+    return out
+
+
+def _fk_core(qm: np.ndarray, g: _Geometry, tol: float, max_iter: int, signs=None, det_out=None):
+    """Unchecked :func:`fk` on motors (n, 3) in one assembly mode (call under ``np.errstate(invalid, divide)``).
+
+    Gauss-Newton from :func:`_initial_guess`. The iterates stay inside the workspace (where :func:`ik` is
+    defined): a step that lands outside is halved (from the last iterate inside), and a start outside (the
+    planes' intersection carries a rounding error ~1e-16 / |det M|, which matters a hair from the boundary) is
+    pulled in towards home by shrinking its tilt by 1e-12, 1e-10, ... (the workspace is star-shaped about home).
 
     Returns:
-        alpha_y, alpha_z, inconsistency, converged, active: (n, 1) each.
+        alpha_y, alpha_z, inconsistency, converged, active, inside: (n, 1) each; ``inside``: the :func:`ik`
+        success test (:func:`_inside`) at the reported pose. ``det_out`` (a list), if given, receives det M.
     """
-    ay, az = _initial_guess(qm, g)
+    ay, az, det = _initial_guess(qm, g, with_det=True)
+    if det_out is not None:
+        det_out.append(det)
+    y0, z0 = ay, az
     converged = np.zeros(ay.shape, dtype=bool)
     active = np.ones(ay.shape, dtype=bool)
     rn_prev = np.full(ay.shape, np.inf)
+    py = pz = np.full(ay.shape, np.nan)  # the last iterate evaluated inside the workspace (NaN: none yet)
+    tries = None
     for _ in range(max_iter):
         cy, sy, cz, sz = np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
-        q1, _, c2, s2, nb2 = _ik_eval(cy, sy, cz, sz, g)
-        a1, a2 = _jac_eval(cy, sy, cz, sz, s2, nb2, g)
+        q1, _, c2, s2, nb2 = _ik_eval(cy, sy, cz, sz, g, signs)
         r = _wrap(q1 - qm)
         rn = np.sqrt(np.add.reduce(r * r, axis=-1, keepdims=True))
+        good = _inside(c2, nb2) & np.isfinite(rn)  # A_u and r are finite there
+        out = active & ~converged & ~good
+        if out.any():
+            tries = np.where(out, 1.0, 0.0) if tries is None else tries + out
+            active &= ~(out & (tries > 6))
+            seen = np.isfinite(py)
+            back = out & active & seen  # halve the step from the last iterate inside
+            ay, az = np.where(back, 0.5 * (py + ay), ay), np.where(back, 0.5 * (pz + az), az)
+            pull = out & active & ~seen  # pull the start in
+            if pull.any():
+                ay, az = ay.copy(), az.copy()
+                ay[pull], az[pull] = _shrunk(y0[pull], z0[pull], 10.0 ** (-14 + 2 * tries[pull]))
+        work = active & ~converged & good
+        if signs is None:
+            a1, a2 = _jac_eval(cy, sy, cz, sz, s2, nb2, g)
+        else:
+            a1, a2 = _jac_general(cy, sy, cz, sz, c2, s2, nb2, g, signs[0])
         stalled = rn >= rn_prev  # no progress: at the (least-squares) minimum to rounding
-        finite = np.isfinite(rn)
-        rn_prev = np.where(finite, rn, np.inf)
-        active &= _inside(c2, nb2) & finite  # A_u and r are finite exactly there
+        rn_prev = np.where(work, rn, rn_prev)
         s0, s1 = _gauss_newton_step(a1, a2, r)
         # converged when the step, or its effect on the motors (the step is ill-determined near the
         # parametrisation singularity c_y = 0 and near 1 + c_y c_z = 0), is below tol
         motor_step = np.maximum.reduce(np.abs(a1 * s0 + a2 * s1), axis=-1, keepdims=True)
         small = (np.maximum(np.abs(s0), np.abs(s1)) <= tol) | (motor_step <= tol) | stalled
-        upd = active & ~converged
-        ay = np.where(upd, ay + s0, ay)
-        az = np.where(upd, az + s1, az)
-        converged |= active & small
+        py, pz = np.where(work, ay, py), np.where(work, az, pz)
+        ay = np.where(work, ay + s0, ay)
+        az = np.where(work, az + s1, az)
+        converged |= work & small
         if (converged | ~active).all():
             break
-    # report alpha_y in [-pi/2, pi/2], alpha_z in [-pi, pi)
+    active &= np.isfinite(py)
+    # the inconsistency uses the last A_u evaluated (at most a step of size <= tol away): its range is what matters
+    ay, az, inconsistency, inside = _fk_report(ay, az, qm, g, signs, a1, a2)
+    if (converged & ~inside).any():  # the last (tiny) step left the workspace: report the iterate before it
+        alt = _fk_report(py, pz, qm, g, signs, a1, a2)
+        use = converged & ~inside & alt[3]
+        ay, az, inconsistency, inside = (np.where(use, a, b) for a, b in zip(alt, (ay, az, inconsistency, inside)))
+    return ay, az, inconsistency, converged, active, inside
+
+
+def _fk_report(ay, az, qm, g: _Geometry, signs, a1, a2):
+    """The reported pose (alpha_y in [-pi/2, pi/2], alpha_z in [-pi, pi)), its inconsistency and ik's success test.
+
+    The inconsistency is the distance of the motors from the tangent plane of the consistent set at the pose:
+    the residual r less its part in the range of A_u (:func:`_normal_residual`). At a least-squares solution r
+    is orthogonal to that range already, so this is |r| there; for consistent motors it drops the A_u-amplified
+    rounding of the pose (|A_u| ~ 1 / sqrt(1 + c_y c_z) near the flip), which |r| would report.
+    """
     flip = np.cos(ay) < 0
     ay = _wrap(np.where(flip, np.pi - ay, ay))
     az = _wrap(np.where(flip, az + np.pi, az))
-    q1 = _ik_eval(np.cos(ay), np.sin(ay), np.cos(az), np.sin(az), g)[0]
-    r = _wrap(q1 - qm)
-    return ay, az, np.sqrt(np.add.reduce(r * r, axis=-1, keepdims=True)), converged, active
+    q1, _, c2, _, nb2 = _ik_eval(np.cos(ay), np.sin(ay), np.cos(az), np.sin(az), g, signs)
+    return ay, az, _normal_residual(a1, a2, _wrap(q1 - qm)), _inside(c2, nb2)
+
+
+def _fk_mode(qm: np.ndarray, g: _Geometry, tol: float, max_iter: int, max_inconsistency: float, mode: str):
+    """:func:`fk` on motors (n, 3) in one mode: alpha_y, alpha_z, inconsistency (n,), ok (n,), status (n,)
+    (0 ok, 1 actuation singular, 2 left the workspace, 3 not converged, 4 inconsistent, 5 ended outside)."""
+    dets = []
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        ay, az, inc, converged, active, inside = (
+            a[:, 0] for a in _fk_core(qm, g, tol, max_iter, _mode_signs(mode), dets)
+        )
+        consistent = inc <= max_inconsistency
+    regular = np.abs(dets[0]) >= DET_GUARD
+    ok = regular & active & converged & consistent & inside
+    if ok.all():
+        return ay, az, inc, ok, np.zeros(ok.shape, dtype=int)
+    status = np.select([~regular, ~active, ~converged, ~consistent, ~inside], [1, 2, 3, 4, 5], default=0)
+    return ay, az, inc, ok, status
 
 
 def fk(
@@ -602,6 +893,7 @@ def fk(
     alpha: float = ALPHA,
     eta: Sequence[float] | None = None,
     *,
+    mode: str = HOME_MODE,
     tol: float = 1e-13,
     max_iter: int = 30,
     max_inconsistency: float = 1e-9,
@@ -613,59 +905,116 @@ def fk(
     ``u <- u - pinv(A_u) r`` (the 3 x 2 least-squares step in closed form, see :func:`_gauss_newton_step`),
     from the closed-form start of :func:`_initial_guess` (the motor planes; not in the seed), until the step
     (or its image ``A_u du`` in the motors) is below ``tol``; from consistent motors the start is already
-    exact to rounding and one iteration confirms it. The result is reported with ``alpha_y`` in
-    [-pi/2, pi/2] (``(pi - alpha_y, alpha_z + pi)`` is the same orientation). Inputs are checked once here;
-    the iteration runs on the unchecked private functions (a single call is a batch of one).
+    exact to rounding and one iteration confirms it. The iterates are kept inside the workspace (a step that
+    leaves it is halved, see :func:`_fk_core`). The result is reported with ``alpha_y`` in [-pi/2, pi/2]
+    (``(pi - alpha_y, alpha_z + pi)`` is the same orientation). Inputs are checked once here; the iteration
+    runs on the unchecked private functions (a single call is a batch of one).
+
+    Assembly mode: ``ik_motors`` is :func:`ik` in ``mode`` (default :data:`HOME_MODE`, the mode the mechanism is
+    built in). Motors from another mode are not consistent with any pose of this one: unsolved (batch: NaN,
+    mask False; single call: ``AssemblyModeError`` naming the mode(s) in which they are consistent, in
+    ``.modes`` as ``[{"mode": ...}]``). ``mode="all"`` solves in every mode: each output then has a trailing
+    axis of 16 (:data:`MODES` order), NaN where the motors do not fit that mode.
 
     Redundant actuation: three motor angles produced by no pose are not averaged silently. The
-    inconsistency ``|r|`` (rad) at the least-squares solution is returned; above ``max_inconsistency`` the
-    call fails (scalar: ``UnreachableError`` carrying the least-squares pose in ``closest``; batch: NaN).
-    Pass ``max_inconsistency=np.inf`` to get least-squares poses for noisy motor readings.
+    inconsistency (rad) is the distance of the motors from the consistent set, to first order: the residual
+    ``r`` at the reported pose less its projection on the range of A_u (at the least-squares solution that is
+    ``|r|``; for consistent motors it is rounding, also near the flip where A_u is large). Above
+    ``max_inconsistency`` the call fails (scalar: ``UnreachableError`` carrying the least-squares pose in
+    ``closest``; batch: NaN). Pass ``max_inconsistency=np.inf`` to get least-squares poses for noisy readings.
+
+    Actuation singularity: motors whose planes have ``|det M| < DET_GUARD`` are refused (they fit two poses,
+    or fix the pose only to ~2e-16 / |det M| rad); :func:`ik` refuses the same poses, so every pose ik returns
+    is reproduced by fk and every pose fk returns is solved by ik.
 
     Args:
         q_A1, q_B1, q_C1: motor angles (rad), broadcast together.
         d, alpha, eta: geometry.
-        tol: step-size tolerance (rad). max_iter: iteration cap.
-        max_inconsistency: largest accepted residual norm of the motor angles (rad).
+        mode: assembly mode, one of :data:`MODES` or ``"all"``.
+        tol: step-size tolerance (rad), in [0, 0.1]. max_iter: iteration cap, an integer in [1, 10000].
+        max_inconsistency: largest accepted inconsistency (rad), in [0, inf].
         return_mask: (batch) also return the success mask.
 
     Returns:
         ``(alpha_y, alpha_z, inconsistency)`` (each of the batch shape).
 
     Raises:
-        UnreachableError: (scalar) the motor angles are inconsistent beyond ``max_inconsistency``, or
-            the iterate left the workspace.
-        ConvergenceError: (scalar) no convergence within ``max_iter`` (e.g. at a singularity of A_u).
+        AssemblyModeError: (scalar) the motors are consistent only in other assembly modes.
+        UnreachableError: (scalar) the motor angles are inconsistent beyond ``max_inconsistency`` (in every
+            mode), or the iterate left the workspace.
+        SingularityError: (scalar) an actuation singularity (``|det M| < DET_GUARD``), or the solution is on
+            the workspace boundary (where :func:`ik` fails).
+        ConvergenceError: (scalar) no convergence within ``max_iter``.
+        InvalidInputError: non-finite, complex or non-broadcastable motors; InvalidParameterError: bad geometry,
+            mode, tol, max_iter, max_inconsistency or return_mask.
     """
     d, alpha, eta_arr = _params(d, alpha, eta)
+    mode = _checked_mode(mode, allow_all=True)
+    tol = _in_range(tol, "tol", 0.0, 0.1, "[0, 0.1] (rad)")
+    max_iter = _integer(max_iter, "max_iter", 1, 10000)
+    max_inconsistency = _in_range(max_inconsistency, "max_inconsistency", 0.0, math.inf, "[0, inf] (rad)")
+    return_mask = _flag(return_mask, "return_mask")
     a1, b1, c1 = as_angles(q_A1, q_B1, q_C1, names=("q_A1", "q_B1", "q_C1"))
     shape = a1.shape
     qm = np.stack([a1, b1, c1], axis=-1).reshape(-1, 3)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ay, az, inconsistency, converged, active = _fk_core(qm, _geometry(d, alpha, eta_arr), tol, max_iter)
-    ay, az, inconsistency = ay.reshape(shape), az.reshape(shape), inconsistency.reshape(shape)
-    converged, active = converged.reshape(shape), active.reshape(shape)
-    ok = converged & active & (inconsistency <= max_inconsistency)
+    g = _geometry(d, alpha, eta_arr)
+
+    def motors() -> str:
+        return f"(q_A1, q_B1, q_C1) = ({float(a1.flat[0]):.17g}, {float(b1.flat[0]):.17g}, {float(c1.flat[0]):.17g})"
+
+    def solve(m: str):
+        return _fk_mode(qm, g, tol, max_iter, max_inconsistency, m)
+
+    if mode == "all":
+        res = [solve(m) for m in MODES]
+        ok = np.stack([r[3] for r in res], axis=-1).reshape(shape + (len(MODES),))
+        outs = tuple(
+            np.where(ok, np.stack([r[k] for r in res], axis=-1).reshape(ok.shape), np.nan) for k in range(3)
+        )
+        if a1.ndim == 0 and not ok.any():
+            raise _fk_error(motors(), qm, res[0], HOME_MODE, [], max_iter, max_inconsistency)
+        return (*outs, ok) if return_mask else outs
+    ay, az, inconsistency, ok, status = solve(mode)
     nan = np.where(ok, 0.0, np.nan)
 
     def error() -> Exception:
-        motors = f"(q_A1, q_B1, q_C1) = ({float(a1):.17g}, {float(b1):.17g}, {float(c1):.17g})"
-        target = qm.reshape(shape + (3,))
-        if not active:
-            return UnreachableError(f"{motors}: the solver left the workspace; no pose was found", target=target)
-        if not converged:
-            return ConvergenceError(
-                f"{motors}: Gauss-Newton did not converge in {max_iter} iterations (singular A_u?)"
-            )
-        return UnreachableError(
-            f"{motors} are inconsistent: no pose produces all three; the least-squares pose "
-            f"(alpha_y, alpha_z) = ({float(ay):.17g}, {float(az):.17g}) misses them by {float(inconsistency):.3e} rad "
-            f"(max_inconsistency = {max_inconsistency:.1e})",
-            target=target,
-            closest=(float(ay), float(az)),
-        )
+        others = [m for m in MODES if m != mode and bool(solve(m)[3][0])] if status[0] != 1 else []
+        return _fk_error(motors(), qm, (ay, az, inconsistency, ok, status), mode, others, max_iter, max_inconsistency)
 
-    return finish((ay + nan, az + nan, inconsistency + nan), ok, a1.ndim == 0, return_mask, error)
+    out = tuple(v.reshape(shape) + nan.reshape(shape) for v in (ay, az, inconsistency))
+    return finish(out, ok.reshape(shape), a1.ndim == 0, return_mask, error)
+
+
+def _fk_error(motors: str, qm, res, mode: str, others, max_iter: int, max_inconsistency: float) -> Exception:
+    """The exception of a failed single :func:`fk` call (``res`` from :func:`_fk_mode` on one item)."""
+    ay, az, inconsistency, _, status = (float(np.ravel(v)[0]) for v in res)
+    target = qm.reshape(3).copy()
+    if others:
+        return AssemblyModeError(
+            f"{motors} are consistent only in assembly mode(s) {', '.join(others)}, not in mode {mode}",
+            target=target, modes=[{"mode": m} for m in others],
+        )
+    if status == 1:
+        return SingularityError(
+            f"{motors} are an actuation singularity: their planes have |det M| < DET_GUARD = {DET_GUARD:g} "
+            "(nearly sharing a line): the motor angles do not determine the pose"
+        )
+    if status == 2:
+        return UnreachableError(f"{motors}: the solver left the workspace; no pose was found", target=target)
+    if status == 3:
+        return ConvergenceError(f"{motors}: Gauss-Newton did not converge in {max_iter} iterations (singular A_u?)")
+    if status == 5:
+        return SingularityError(
+            f"{motors}: the pose (alpha_y, alpha_z) = ({ay:.17g}, {az:.17g}) is on the workspace boundary or the "
+            "platform singularity, where ik is undefined"
+        )
+    return UnreachableError(
+        f"{motors} are inconsistent: no pose produces all three; the least-squares pose "
+        f"(alpha_y, alpha_z) = ({ay:.17g}, {az:.17g}) misses them by {inconsistency:.3e} rad "
+        f"(max_inconsistency = {max_inconsistency:.1e})",
+        target=target,
+        closest=(ay, az),
+    )
 
 
 # ------------------------------------------------------------------------------------------ workspace
@@ -676,7 +1025,8 @@ class Workspace:
     Attributes:
         alpha_y, alpha_z: 1-D grids (rad); fields below are indexed ``[i_y, i_z]``.
         cos_q2: (3, ny, nz) cos q_K2 per leg (eq 98); the leg reaches the pose where |cos q_K2| < 1.
-        reachable: (ny, nz) True inside the workspace (all legs reach, not singular).
+        reachable: (ny, nz) True where :func:`ik` succeeds (home mode): all legs reach, not singular, and not
+            an actuation singularity (:data:`DET_GUARD`).
         boundary: (m, 2) the workspace boundary (alpha_y, alpha_z), where some leg has sin q_K2 = 0
             (a singular curve); NaN rows separate pieces.
         leg_singular: {leg: (m, 2)} the whole curve sin q_K2 = 0 of each leg (NaN-separated pieces).
@@ -722,15 +1072,18 @@ def workspace(
     1 + c_y c_z = 0 is theta = pi. The grid covers alpha_y in [-pi/2, pi/2], alpha_z in [-pi, pi].
 
     Args:
-        d, alpha, eta: geometry. n: grid size per axis. m: samples of phi along the curves.
+        d, alpha, eta: geometry. n: grid size per axis, an integer in [2, 1001]. m: samples of phi along the
+            curves, an integer in [2, 100001].
     """
     d, alpha, eta_arr = _params(d, alpha, eta)
+    n = _integer(n, "n", 2, 1001)
+    m = _integer(m, "m", 2, 100001)
     ay = np.linspace(-np.pi / 2, np.pi / 2, n)
     az = np.linspace(-np.pi, np.pi, n)
     gy, gz = np.meshgrid(ay, az, indexing="ij")
-    _, c2, one_cc = _ik_core(gy, gz, d, alpha, eta_arr)
-    sing, unreachable, leg_sing = _ik_status(c2, one_cc)
-    reachable = ~sing & ~unreachable.any(axis=-1) & ~leg_sing.any(axis=-1)
+    _, c2, _ = _ik_core(gy, gz, d, alpha, eta_arr)
+    yc, zc = gy[..., None], gz[..., None]
+    reachable = _ik_mode((np.cos(yc), np.sin(yc), np.cos(zc), np.sin(zc)), _geometry(d, alpha, eta_arr), HOME_MODE)[1]
     phi = np.linspace(-np.pi, np.pi, m)
     ch = math.cos(alpha / 2.0)
     with np.errstate(divide="ignore", invalid="ignore"):

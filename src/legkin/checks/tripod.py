@@ -10,7 +10,7 @@ import pinocchio as pin
 from .. import load
 from ..errors import LoopClosureError
 from ..analytic import tripod as at
-from ..validation import CheckResult, compare, per_sample, pinocchio_frames
+from ..validation import CheckResult, classify_failures, compare, per_sample, pinocchio_frames, robustness_row
 
 TOL = 1e-12
 #: The parameter sets checked: the default (alpha = pi/3) and alpha = pi/4, pi/2 (generated into the cache).
@@ -265,3 +265,157 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     for tag, alpha in ALPHAS:
         rows += _run_alpha(tag, alpha, samples, rng)
     return rows
+
+
+# ---------------------------------------------------------------- the IK contract row
+#: Contract tolerance (rad): every solved orientation is reproduced by the default fk to this.
+CONTRACT_TOL = 1e-9
+
+
+def pose_error(ay, az, y, z) -> np.ndarray:
+    """How far the pose (y, z) is from (ay, az) (rad): the smaller of the parameter distance (modulo 2 pi and
+    the equivalence (pi - alpha_y, alpha_z + pi)) and the rotation angle between the platform rotations.
+
+    Each measure is ill-conditioned at one singular set of the parametrisation, the other is not: alpha_z is
+    undefined at c_y = 0 (same rotation for every alpha_z), and R(u) folds a circle of rotations onto the flip
+    point 1 + c_y c_z = 0 (the parameters are well determined there)."""
+    d1 = np.hypot(at._wrap(y - ay), at._wrap(z - az))
+    d2 = np.hypot(at._wrap(np.pi - y - ay), at._wrap(z + np.pi - az))
+    with np.errstate(invalid="ignore"):
+        rot = _rot_err(at.platform_rotation(ay, az), at.platform_rotation(np.nan_to_num(y), np.nan_to_num(z)))
+    return np.minimum(np.minimum(d1, d2), np.where(np.isfinite(y) & np.isfinite(z), rot, np.inf))
+
+
+def made_targets(n: int, rng: np.random.Generator, alpha: float = at.ALPHA) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` orientations made by the default :func:`fk` from in-limit joints of a closed configuration.
+
+    Motors q_A1, q_B1 uniform in the joint limits [-pi, pi]; E on both motor planes and the sphere |E| = L (a
+    line cut by a sphere: zero or two points, see :func:`legkin.analytic.tripod._initial_guess`); for the points
+    in the home mode's half (E_x < 0, sin q_A2, sin q_B2 > 0), q_C1 from leg C on its home branch; the target
+    is ``fk(q_A1, q_B1, q_C1)`` with default options, kept where fk solves it (so about 15 % of the pairs).
+    """
+    g = at._geometry(at.D, alpha, np.asarray(at.ETA))
+    ce, se, dk, big_l = g.ce, g.se, g.d * g.k, -g.minus_l
+    ys, zs, total = [], [], 0
+    while total < n:
+        m = max(2 * n, 1000) * 4
+        q = rng.uniform(-np.pi, np.pi, (m, 2))
+        s, c = np.sin(q), np.cos(q)
+        na = np.stack([s[:, 0], -c[:, 0] * ce[0], -c[:, 0] * se[0]], axis=-1)
+        nb = np.stack([s[:, 1], -c[:, 1] * ce[1], -c[:, 1] * se[1]], axis=-1)
+        cab = np.sum(na * nb, axis=-1)
+        v = np.cross(na, nb)
+        vv = np.sum(v * v, axis=-1)
+        p0 = dk * (na + nb) / (1.0 + cab)[:, None]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = np.sqrt(big_l**2 - np.sum(p0 * p0, axis=-1)) / np.sqrt(vv)
+        keep = np.isfinite(t) & (vv > 1e-12)
+        for sign in (-1.0, 1.0):
+            e = p0 + (sign * t)[:, None] * v
+            h1, h2 = -e[:, 0] / g.d, -(ce[:2, None] * e[:, 1] + se[:2, None] * e[:, 2]).T / g.d
+            s2sa = c * h1[:, None] + s * h2  # sin q_K2 sin(alpha) of legs A and B at E
+            home = keep & (e[:, 0] < 0) & np.all(s2sa > 0, axis=-1)
+            ee = e[home] / big_l
+            r = 2.0 * ee[:, :1] * ee - np.array([1.0, 0.0, 0.0])
+            ay, az = at.orientation_from_axis(r)
+            qc, ok = at.ik(ay, az, alpha=alpha, return_mask=True)
+            qa, qb = q[home][ok], qc[ok]
+            y, z, _, solved = at.fk(qa[:, 0], qa[:, 1], qb[:, 8], alpha=alpha, return_mask=True)
+            ys.append(y[solved])
+            zs.append(z[solved])
+            total += int(solved.sum())
+    return np.concatenate(ys)[:n], np.concatenate(zs)[:n]
+
+
+def _det_curve_points(rng: np.random.Generator, alpha: float, grid: int = 121) -> np.ndarray:
+    """Points (alpha_y, alpha_z) on the actuation-singular curves det M = 0 of the home mode's motors, by
+    bisection along alpha_y between grid neighbours where det M changes sign."""
+    ay = np.linspace(-np.pi / 2, np.pi / 2, grid)
+    az = rng.uniform(-np.pi, np.pi, grid)
+    gy, gz = np.meshgrid(ay, az, indexing="ij")
+
+    def det_of(y, z):
+        trig = tuple(f(v)[..., None] for v in (y, z) for f in (np.cos, np.sin))
+        trig = (trig[0], trig[1], trig[2], trig[3])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            q1, _, c2, _, nb2, sn, cn = at._ik_eval(*trig, at._geometry(at.D, alpha, np.asarray(at.ETA)), with_sc=True)
+            return np.where(at._inside(c2, nb2)[..., 0], at._det_planes(sn, cn, at._geometry(at.D, alpha, np.asarray(at.ETA))), np.nan)
+
+    dm = det_of(gy, gz)
+    i, j = np.nonzero((np.sign(dm[1:]) * np.sign(dm[:-1]) < 0))
+    lo, hi, z = ay[i], ay[i + 1], az[j]
+    flo = det_of(lo, z)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        fm = det_of(mid, z)
+        left = np.sign(fm) == np.sign(flo)
+        lo, flo, hi = np.where(left, mid, lo), np.where(left, fm, flo), np.where(left, hi, mid)
+    return np.stack([0.5 * (lo + hi), z], axis=-1)
+
+
+def random_orientations(n: int, rng: np.random.Generator, alpha: float = at.ALPHA) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` orientations in and around the workspace: uniform over a box a little larger than the principal
+    range (40 %), any representation (|alpha_y|, |alpha_z| up to 20 rad, 10 %), near the flip
+    (1 + c_y c_z log-uniform in [1e-14, 1e-2], 15 %), a hair inside or outside a leg's boundary
+    (|1 - |cos q_K2|| log-uniform in [1e-15, 1e-3], 25 %), and near the actuation-singular curves det M = 0
+    (offsets log-uniform in [1e-12, 1e-2] rad, 10 %)."""
+    ay = rng.uniform(-np.pi / 2 - 0.3, np.pi / 2 + 0.3, n)
+    az = rng.uniform(-np.pi - 0.3, np.pi + 0.3, n)
+    kind = rng.uniform(size=n)
+    far = (kind >= 0.4) & (kind < 0.5)
+    ay[far], az[far] = rng.uniform(-20, 20, far.sum()), rng.uniform(-20, 20, far.sum())
+    phi = rng.uniform(-np.pi, np.pi, n)
+    flip = (kind >= 0.5) & (kind < 0.65)
+    theta = np.arccos(np.clip(10 ** rng.uniform(-14, -2, n) - 1.0, -1.0, 1.0))
+    bnd = (kind >= 0.65) & (kind < 0.9)
+    k = rng.integers(0, 3, n)
+    sk = np.abs(np.sin(phi - np.asarray(at.ETA)[k]))
+    gap = 10 ** rng.uniform(-15, -3, n) * rng.choice([-1.0, 1.0], n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        arg = (1.0 - gap) * math.cos(alpha / 2) / sk
+    theta = np.where(bnd, 2.0 * np.arcsin(np.clip(arg, -1.0, 1.0)), theta)
+    sel = flip | bnd
+    r = np.stack([np.cos(theta), np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi)], axis=-1)[sel]
+    ay[sel], az[sel] = at.orientation_from_axis(r)
+    det = np.nonzero(kind >= 0.9)[0]
+    pts = _det_curve_points(rng, alpha)
+    if len(det) and len(pts):
+        base = pts[rng.integers(0, len(pts), len(det))]
+        off = 10 ** rng.uniform(-12, -2, (len(det), 1)) * rng.normal(size=(len(det), 2))
+        ay[det], az[det] = (base + off).T
+    return ay, az
+
+
+def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 2000) -> CheckResult:
+    """The IK contract row of the tripod (default geometry; see :func:`legkin.validation.robustness_row`).
+
+    Half the targets are :func:`made_targets` (fk of in-limit motors, each must be solved), the rest
+    :func:`random_orientations`. The default batch ``ik`` solves them; for the solved ones the error is
+    :func:`pose_error` between the target and the default ``fk`` of the answer's motors (an answer whose
+    joints leave the URDF limits [-pi, pi], or that fk does not solve, counts as not reproduced). Up to
+    ``classify`` unsolved targets (None: all) are classified by single calls.
+    """
+    n_made = n // 2
+    my, mz = made_targets(n_made, rng)
+    ry, rz = random_orientations(n - n_made, rng)
+    ay, az = np.concatenate([my, ry]), np.concatenate([mz, rz])
+    made = np.arange(n) < n_made
+    exceptions = 0
+    y, z, ok = np.full(n, np.nan), np.full(n, np.nan), np.zeros(n, dtype=bool)
+    try:
+        q, solved = at.ik(ay, az, return_mask=True)
+        qs = q[solved]
+        y[solved], z[solved], _, ok[solved] = at.fk(qs[:, 0], qs[:, 4], qs[:, 8], return_mask=True)
+    except Exception:  # noqa: BLE001 - a foreign (or any) exception from a batch call is a defect
+        exceptions += 1
+        q, solved = np.full((n, 12), np.nan), np.zeros(n, dtype=bool)
+    inside = np.all((q >= -np.pi) & (q <= np.pi), axis=-1)
+    error = np.where(solved & ok & inside, pose_error(ay, az, y, z), np.inf)
+    unsolved = np.nonzero(~solved)[0]
+    if classify is not None and len(unsolved) > classify:
+        unsolved = np.sort(rng.choice(unsolved, classify, replace=False))
+    reasons, foreign = classify_failures(lambda i: at.ik(float(ay[i]), float(az[i])), unsolved)
+    return robustness_row(
+        "tripod", made=made, solved=solved, error=error, reasons=reasons, classified=len(unsolved),
+        exceptions=exceptions + foreign, tolerance=CONTRACT_TOL,
+    )

@@ -567,10 +567,15 @@ def _poly_roots(poly: np.ndarray) -> np.ndarray:
 
 
 def _n_matrix(ra: np.ndarray, d: np.ndarray, roll: np.ndarray) -> np.ndarray:
-    """N (..., 2, 2), N_ik = d_i . dA_i/dx_k, for R a_i = ra (..., 2, 3), d_i = A_i - S_i, x = (roll, pitch)."""
-    ex = np.array([1.0, 0.0, 0.0])
-    ey_r = np.stack([np.zeros_like(roll), np.cos(roll), np.sin(roll)], -1)[..., None, :]
-    return np.stack([np.sum(d * np.cross(ex, ra), -1), np.sum(d * np.cross(ey_r, ra), -1)], -1)
+    """N (..., 2, 2), N_ik = d_i . dA_i/dx_k, for R a_i = ra (..., 2, 3), d_i = A_i - S_i, x = (roll, pitch).
+
+    dA/droll = e_x x R a, dA/dpitch = (Rx(roll) e_y) x R a, Rx(roll) e_y = (0, c, s), written out.
+    """
+    c, s = np.cos(roll)[..., None], np.sin(roll)[..., None]
+    ax, ay, az = ra[..., 0], ra[..., 1], ra[..., 2]
+    n_roll = -d[..., 1] * az + d[..., 2] * ay
+    n_pitch = d[..., 0] * (c * az - s * ay) + (d[..., 1] * s - d[..., 2] * c) * ax
+    return np.stack([n_roll, n_pitch], -1)
 
 
 def _rod_system(x: np.ndarray, tip: np.ndarray):
@@ -603,16 +608,20 @@ def _rod_newton(x: np.ndarray, tip: np.ndarray, max_iter: int, keep_sign: bool =
     cur = np.abs(g).max(-1)
     sign = np.sign(_det2(nm)) if keep_sign else None
     act = np.isfinite(cur)
-    for _ in range(max_iter):
+    for it_ in range(max_iter):
+        if it_ == 8:  # Newton from a seed near a pose has converged by now (quadratically; linearly at a fold)
+            act &= cur <= 1e-4 * ROD_LENGTH
         ia = np.flatnonzero(act)
         if not len(ia):
             break
         step = -_solve2(nm[ia], g[ia])
         fin = np.all(np.isfinite(step), -1)
         step = np.where(fin[:, None], np.clip(step, -0.3, 0.3), 0.0)
+        # a step at rounding level: converged (trying it would only cost backtracking)
+        fin &= np.abs(step).max(-1) > 1e-16 * (1.0 + np.abs(x[ia]).max(-1))
         lam = np.ones(len(ia))
         acc = np.zeros(len(ia), dtype=bool)
-        for _ in range(30):
+        for _ in range(16):
             tr = fin & ~acc
             if not tr.any():
                 break
@@ -664,7 +673,9 @@ def _pose_seeds(z: np.ndarray, al, be, ga):
             seeds.append(np.stack([roll[bad], base + sgn * c], -1))
             items.append(item[bad])
     x = np.concatenate(seeds)
-    return np.concatenate(items), np.where(np.isfinite(x), x, 0.0)
+    im = np.abs(z.imag[item, j])
+    imag = np.concatenate([im] + [im[bad]] * (len(seeds) - 1))
+    return np.concatenate(items), np.where(np.isfinite(x), x, 0.0), imag
 
 
 #: Offsets (rad) of the extra starting poses on either side of a near-singular solution (along the null vector of
@@ -681,13 +692,14 @@ def _platform_solutions(theta: np.ndarray, tol: float = 1e-12, max_iter: int = 5
     """
     tip, dtip = _lever_tips(theta)
     poly, al, be, ga = _roll_polynomial(tip)
-    item, x0 = _pose_seeds(_poly_roots(poly), al, be, ga)
+    item, x0, imag = _pose_seeds(_poly_roots(poly), al, be, ga)
     x, err = _rod_newton(x0, tip[item], max_iter)
-    # near the forward singularity: seeds on both sides of each near-singular (or unconverged) solution
+    # near the forward singularity (two poses of opposite modes close together: a near-double root, or a nearly
+    # real complex pair): seeds on both sides of each near-singular solution, or of an unconverged nearly real root
     xs = np.where((err <= 1e-6)[:, None], x, x0)
     _, nm = _rod_system(xs, tip[item])
     sv = np.linalg.svd(np.where(np.isfinite(nm), nm, 0.0), compute_uv=False) if len(nm) else np.zeros((0, 2))
-    near = ~(err <= tol) | (sv[:, 1] < 1e-3 * np.maximum(sv[:, 0], 1e-300))
+    near = np.where(err <= tol, sv[:, 1] < 1e-3 * np.maximum(sv[:, 0], 1e-300), imag <= 1e-4)
     if near.any():
         _, _, vt = np.linalg.svd(np.where(np.isfinite(nm[near]), nm[near], 0.0))
         v = vt[:, -1]
@@ -708,23 +720,31 @@ def _platform_solutions(theta: np.ndarray, tol: float = 1e-12, max_iter: int = 5
     return item, x, bl, sdet
 
 
-_REF_SIGN: dict = {}
-
-
-def _assembly_ref(b: np.ndarray) -> float:
+def _neutral_sign(b: tuple) -> float:
     """Sign of det N at the neutral pose (R_P = I) on motor branch b."""
-    key = (int(b[0]), int(b[1]))
-    if key not in _REF_SIGN:
-        rot = np.eye(3)[None]
-        th, _, _ = _chains(rot, b)
-        tip, _ = _lever_tips(th)
-        ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
-        _REF_SIGN[key] = float(np.sign(_det2(_n_matrix(ra, CENTER + ra - tip, np.zeros(1)))[0]))
-    return _REF_SIGN[key]
+    bv = np.array(b, dtype=float)
+    rot = np.eye(3)[None]
+    th, _, _ = _chains(rot, bv)
+    tip, _ = _lever_tips(th)
+    ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
+    return float(np.sign(_det2(_n_matrix(ra, CENTER + ra - tip, np.zeros(1)))[0]))
 
 
-def _in_class(bl: np.ndarray, sdet: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
-    """Solutions on motor branch b (boundary chains match both) in assembly mode s."""
+_REF_SIGN = {b: _neutral_sign(b) for b in MOTOR_BRANCHES}
+
+
+def _assembly_ref(b: np.ndarray):
+    """Sign of det N at the neutral pose on motor branch b: (2,) -> float, (..., 2) -> (...,)."""
+    b = np.asarray(b, dtype=float)
+    if b.ndim == 1:
+        return _REF_SIGN[(int(b[0]), int(b[1]))]
+    p0, p1 = b[..., 0] > 0, b[..., 1] > 0
+    return np.where(p0, np.where(p1, _REF_SIGN[(1, 1)], _REF_SIGN[(1, -1)]),
+                    np.where(p1, _REF_SIGN[(-1, 1)], _REF_SIGN[(-1, -1)]))
+
+
+def _in_class(bl: np.ndarray, sdet: np.ndarray, b: np.ndarray, s) -> np.ndarray:
+    """Solutions on motor branch b (boundary chains match both) in assembly mode s (b, s per solution or one)."""
     return np.all((bl == b) | (bl == 0.0), -1) & (sdet * _assembly_ref(b) == s)
 
 
@@ -739,13 +759,18 @@ def _first_per_item(n: int, item: np.ndarray, key: np.ndarray, mask: np.ndarray)
     return out
 
 
-def _fk_select(theta: np.ndarray, b: np.ndarray, s: float, tol: float = 1e-12, max_iter: int = 50):
-    """The pose (n, 2) of motor angles theta (n, 2) in mode (b, s) within the limits nearest R_P = I, and ok."""
+def _fk_select(theta: np.ndarray, b: np.ndarray, s, tol: float = 1e-12, max_iter: int = 50):
+    """The pose (n, 2) of motor angles theta (n, 2) in mode (b, s) within the limits nearest R_P = I, and ok.
+
+    b (2,) or (n, 2), s scalar or (n,).
+    """
     n = len(theta)
     x = np.full((n, 2), np.nan)
     if not n:
         return x, np.zeros(0, dtype=bool)
     item, xs, bl, sdet = _platform_solutions(theta, tol, max_iter)
+    b = np.broadcast_to(np.asarray(b, dtype=float), (n, 2))[item]
+    s = np.broadcast_to(np.asarray(s, dtype=float), (n,))[item]
     pick = _first_per_item(n, item, np.linalg.norm(xs, axis=-1), _in_class(bl, sdet, b, s))
     ok = pick >= 0
     x[ok] = xs[pick[ok]]
@@ -1021,8 +1046,11 @@ def _band_message(what: str, x, gain: float) -> str:
     )
 
 
-def _platform_ik(u: np.ndarray, ll_branch: float, roll_branch: float):
-    """(theta_LL, roll, pitch) (..., 3) for u = p - CENTER, plus LL ratio kk, rho, LL reach and not-on-axis."""
+def _platform_ik(u: np.ndarray, ll_branch, roll_branch):
+    """(theta_LL, roll, pitch) (..., 3) for u = p - CENTER, plus LL ratio kk, rho, LL reach and not-on-axis.
+
+    ll_branch, roll_branch: +-1, scalars or per target.
+    """
     with np.errstate(over="ignore", invalid="ignore"):
         r2 = np.sum(u * u, -1)
         kk = (_LL0**2 + _H**2 - r2) / (2.0 * _H * _LL0)
@@ -1033,14 +1061,15 @@ def _platform_ik(u: np.ndarray, ll_branch: float, roll_branch: float):
         rho = np.hypot(u[..., 1], u[..., 2])
     s = np.where(u[..., 2] >= 0.0, 1.0, -1.0) * roll_branch
     vz = s * rho
-    roll = np.where(rho <= RHO_TOL, 0.0 if roll_branch > 0 else np.pi, np.arctan2(-u[..., 1] * s, u[..., 2] * s))
+    roll = np.where(rho <= RHO_TOL, np.where(roll_branch > 0, 0.0, np.pi), np.arctan2(-u[..., 1] * s, u[..., 2] * s))
     pitch = np.arctan2(f[..., 2], f[..., 0]) - np.arctan2(vz, u[..., 0])
     out = _wrap(np.stack([tll, roll, pitch], -1))
     return out, kk, rho, reach, rho > 0.0
 
 
-def _ik_candidate(u: np.ndarray, sv: float, llb: float, rb: float, b: np.ndarray) -> dict:
-    """One (ll_branch, roll_branch, motor branch) closed-form candidate for targets u = p - CENTER (n, 3).
+def _ik_candidate(u: np.ndarray, sv: float, llb, rb, b: np.ndarray) -> dict:
+    """One (ll_branch, roll_branch, motor branch) closed-form candidate for targets u = p - CENTER (n, 3)
+    (llb, rb scalars or (n,), b (2,) or (n, 2)).
 
     Keys: pose (n, 3) (theta_LL, roll, pitch), motors (n, 3) (theta1, theta2, theta0), exists (reachable, off
     the roll axis), inlim (inside the URDF limits), mode (+1/-1/0, :func:`assembly_mode`), gain (m/rad).
@@ -1071,10 +1100,13 @@ def _accepted(c: dict, b: np.ndarray, s: float) -> np.ndarray:
     acc = c["exists"] & c["inlim"] & (c["mode"] == s) & (c["gain"] < FK_GAIN_MAX)
     # the neutral aspect (branch (1, 1), mode +1, pitch < PITCH_SPLIT) is one-to-one and nearer R_P = I than the
     # other region of that mode: the forward kinematics returns exactly these poses. Elsewhere ask it.
-    fast = bool(np.all(b == 1.0)) and s == 1.0
+    n = len(acc)
+    b = np.broadcast_to(np.asarray(b, dtype=float), (n, 2))
+    s = np.broadcast_to(np.asarray(s, dtype=float), (n,))
+    fast = np.all(b == 1.0, -1) & (s == 1.0)
     need = acc & ~(fast & (c["pose"][:, 2] < PITCH_SPLIT))
     if need.any():
-        xf, okf = _fk_select(c["motors"][need, :2], b, s)
+        xf, okf = _fk_select(c["motors"][need, :2], b[need], s[need])
         same = okf & (np.abs(xf - c["pose"][need, 1:]).max(-1, initial=0.0) <= 1e-7)
         acc[np.flatnonzero(need)[~same]] = False
     return acc
@@ -1086,23 +1118,22 @@ def _combos(llb, rb) -> list:
 
 def _search(u: np.ndarray, sv: float, combos: list, b: np.ndarray, s, limits_only: bool = False):
     """First candidate per target, in the order ``combos``, that is accepted; returns motors, pose, ok."""
-    n = len(u)
-    motors = np.full((n, 3), np.nan)
-    pose = np.full((n, 3), np.nan)
-    done = np.zeros(n, dtype=bool)
-    for llb, rb in combos:
-        todo = np.flatnonzero(~done)
-        if not len(todo):
-            break
-        c = _ik_candidate(u[todo], sv, float(llb), float(rb), b)
-        if limits_only:
-            acc = c["reach"] & (_platform_ik(u[todo], llb, rb)[4]) & c["inlim"]
-        else:
-            acc = _accepted(c, b, s)
-        motors[todo[acc]] = c["motors"][acc]
-        pose[todo[acc]] = c["pose"][acc]
-        done[todo[acc]] = True
-    return motors, pose, done
+    n, k = len(u), len(combos)
+    lls = np.repeat([float(c[0]) for c in combos], n)
+    rbs = np.repeat([float(c[1]) for c in combos], n)
+    uu = np.tile(u, (k, 1))
+    c = _ik_candidate(uu, sv, lls, rbs, b)
+    if limits_only:
+        acc = c["reach"] & _platform_ik(uu, lls, rbs)[4] & c["inlim"]
+    else:
+        acc = _accepted(c, b, s)
+    acc = acc.reshape(k, n)
+    first = np.argmax(acc, 0)
+    ok = acc[first, np.arange(n)] if n else np.zeros(0, dtype=bool)
+    row = first * n + np.arange(n)
+    motors = np.where(ok[:, None], c["motors"][row], np.nan)
+    pose = np.where(ok[:, None], c["pose"][row], np.nan)
+    return motors, pose, ok
 
 
 def _fmt(p) -> str:
@@ -1146,21 +1177,24 @@ def _ik_error(p: np.ndarray, sv: float, combos: list, b: np.ndarray, s: float, l
     if not bool(nonsing[0]):
         return _axis_error(p)
     asked = f"ll_branch, roll_branch in {combos}" + ("" if limits_only else f", {_mode_text(b, s)}")
+    rows = [(llb, rb, bb) for llb, rb in FOOT_IK_ORDER for bb in MOTOR_BRANCHES]
+    lls = np.array([r[0] for r in rows], float)
+    rbs = np.array([r[1] for r in rows], float)
+    bs = np.array([r[2] for r in rows], float)
+    c16 = _ik_candidate(np.repeat(u, len(rows), 0), sv, lls, rbs, bs)
+    # which of them the forward kinematics reproduces in their own mode (the band is judged separately below)
+    probe = dict(c16, gain=np.zeros(len(rows)))
+    fk = np.zeros(len(rows), dtype=bool)
+    live = c16["exists"] & c16["inlim"] & (c16["mode"] != 0)
+    if live.any():
+        fk[live] = _accepted({k: v[live] for k, v in probe.items()}, bs[live], c16["mode"][live])
     cands = []
-    for llb, rb in FOOT_IK_ORDER:
-        for bb in MOTOR_BRANCHES:
-            bv = np.array(bb, float)
-            c = _ik_candidate(u, sv, float(llb), float(rb), bv)
-            c = {k: v[0] for k, v in c.items()}
-            c.update(ll=llb, rb=rb, b=bv, requested=(llb, rb) in combos and (limits_only or bool(np.all(bv == b))))
-            if c["exists"] and c["inlim"] and c["mode"] != 0:
-                one = {k: np.asarray(v)[None] for k, v in c.items() if k in ("pose", "motors", "exists", "inlim",
-                                                                             "mode", "gain")}
-                one["gain"] = np.array([0.0])  # the band is judged separately below
-                c["fk"] = bool(_accepted(one, bv, float(c["mode"]))[0])
-            else:
-                c["fk"] = False
-            cands.append(c)
+    for j, (llb, rb, bb) in enumerate(rows):
+        c = {k: v[j] for k, v in c16.items()}
+        bv = bs[j]
+        c.update(ll=llb, rb=rb, b=bv, fk=bool(fk[j]),
+                 requested=(llb, rb) in combos and (limits_only or bool(np.all(bv == b))))
+        cands.append(c)
     if limits_only:
         inl = [c for c in cands if c["requested"] and c["inlim"]]
         if not inl:

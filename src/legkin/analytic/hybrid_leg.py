@@ -1071,8 +1071,9 @@ def _ik_candidate(u: np.ndarray, sv: float, llb, rb, b: np.ndarray) -> dict:
     """One (ll_branch, roll_branch, motor branch) closed-form candidate for targets u = p - CENTER (n, 3)
     (llb, rb scalars or (n,), b (2,) or (n, 2)).
 
-    Keys: pose (n, 3) (theta_LL, roll, pitch), motors (n, 3) (theta1, theta2, theta0), exists (reachable, off
-    the roll axis), inlim (inside the URDF limits), mode (+1/-1/0, :func:`assembly_mode`), gain (m/rad).
+    Keys: pose (n, 3) (theta_LL, roll, pitch), motors (n, 3) (theta1, theta2, theta0), exists (LL arc and motors
+    reach), inlim (inside the URDF limits), mode (+1/-1/0, :func:`assembly_mode`), gain (m/rad), kk, reach (LL
+    arc), axis (exactly on the roll axis).
     """
     x, kk, rho, reach, nonsing = _platform_ik(u, llb, rb)
     near = np.abs(x[:, 1:]) <= PLATFORM_LIMIT + _LIMIT_TOL
@@ -1080,7 +1081,7 @@ def _ik_candidate(u: np.ndarray, sv: float, llb, rb, b: np.ndarray) -> dict:
     x[:, 1:] = np.where(near, np.clip(x[:, 1:], -PLATFORM_LIMIT, PLATFORM_LIMIT), x[:, 1:])  # rounding at a limit
     rot = _rot(x[:, 1], x[:, 2])
     th, _, ok2 = _chains(rot, b)
-    exists = reach & nonsing & np.all(ok2, -1)
+    exists = reach & np.all(ok2, -1)  # on the roll axis (rho = 0) roll is 0 or pi, see _platform_ik
     th = np.where(exists[:, None], th, np.nan)
     ths = np.where(exists[:, None], th, 0.0)
     tip, _ = _lever_tips(ths)
@@ -1091,7 +1092,7 @@ def _ik_candidate(u: np.ndarray, sv: float, llb, rb, b: np.ndarray) -> dict:
         gain[exists] = _foot_gain(x[exists, 1:], ths[exists], x[exists, 0])
     motors = np.concatenate([th, ((sv - x[:, 0]) / RATIO)[:, None]], -1)
     return {"pose": x, "motors": np.where(exists[:, None], motors, np.nan), "exists": exists, "inlim": inlim,
-            "mode": mode, "gain": gain, "kk": kk, "reach": reach}
+            "mode": mode, "gain": gain, "kk": kk, "reach": reach, "axis": ~nonsing}
 
 
 def _accepted(c: dict, b: np.ndarray, s: float) -> np.ndarray:
@@ -1116,17 +1117,21 @@ def _combos(llb, rb) -> list:
     return [(l, r) for l, r in FOOT_IK_ORDER if (llb is None or l == llb) and (rb is None or r == rb)]
 
 
-def _search(u: np.ndarray, sv: float, combos: list, b: np.ndarray, s, limits_only: bool = False):
-    """First candidate per target, in the order ``combos``, that is accepted; returns motors, pose, ok."""
+def _search(u: np.ndarray, sv: float, combos: list, b: np.ndarray, s, limits_only: bool = False,
+            axis_ok: bool = True):
+    """First candidate per target, in the order ``combos``, that is accepted; returns motors, pose, ok.
+
+    limits_only: accept by LL reach and joint limits alone (foot_platform_ik); axis_ok: accept targets exactly on
+    the roll axis (with roll 0 or pi).
+    """
     n, k = len(u), len(combos)
     lls = np.repeat([float(c[0]) for c in combos], n)
     rbs = np.repeat([float(c[1]) for c in combos], n)
     uu = np.tile(u, (k, 1))
     c = _ik_candidate(uu, sv, lls, rbs, b)
-    if limits_only:
-        acc = c["reach"] & _platform_ik(uu, lls, rbs)[4] & c["inlim"]
-    else:
-        acc = _accepted(c, b, s)
+    acc = (c["reach"] & c["inlim"]) if limits_only else _accepted(c, b, s)
+    if not axis_ok:
+        acc &= ~c["axis"]
     acc = acc.reshape(k, n)
     first = np.argmax(acc, 0)
     ok = acc[first, np.arange(n)] if n else np.zeros(0, dtype=bool)
@@ -1151,11 +1156,16 @@ def _arc_error(p: np.ndarray, kk: float) -> UnreachableError:
     )
 
 
-def _axis_error(p: np.ndarray) -> SingularityError:
+def _axis_error(p: np.ndarray, pose: bool = True) -> SingularityError:
+    if pose:
+        return SingularityError(
+            f"foot target {_fmt(p)} lies exactly on the platform's roll axis (x through the LCS centre): roll is "
+            "undetermined, any roll reaches it (foot_ik takes roll = 0 or pi there; or move the target off the axis "
+            "by any amount)"
+        )
     return SingularityError(
-        f"foot target {_fmt(p)} lies exactly on the platform's roll axis (x through the LCS centre): roll is "
-        "undetermined (any roll reaches it; move the target off the axis by any amount, or pick the roll yourself "
-        "with foot_position_from_platform)"
+        f"foot target {_fmt(p)} lies exactly on the platform's roll axis (x through the LCS centre), where roll is "
+        "undetermined, and neither roll = 0 nor roll = pi reaches it in the mode asked for (another roll might)"
     )
 
 
@@ -1175,7 +1185,7 @@ def _ik_error(p: np.ndarray, sv: float, combos: list, b: np.ndarray, s: float, l
     if not bool(reach[0]):
         return _arc_error(p, float(kk[0]))
     if not bool(nonsing[0]):
-        return _axis_error(p)
+        return _axis_error(p, limits_only)
     asked = f"ll_branch, roll_branch in {combos}" + ("" if limits_only else f", {_mode_text(b, s)}")
     rows = [(llb, rb, bb) for llb, rb in FOOT_IK_ORDER for bb in MOTOR_BRANCHES]
     lls = np.array([r[0] for r in rows], float)
@@ -1278,8 +1288,9 @@ def foot_platform_ik(
     Giving ``ll_branch`` or ``roll_branch`` alone returns that closed-form branch as is (the other defaulting to
     -1 / +1), unchecked, as before.
 
-    Singular exactly on the roll axis (``u_y = u_z = 0``: roll undetermined); within :data:`RHO_TOL` of it roll
-    is taken as 0 (or pi).
+    Singular exactly on the roll axis (``u_y = u_z = 0``: roll undetermined, SingularityError; with ``branch`` /
+    ``assembly`` given, as :func:`foot_ik`, roll 0 or pi is tried there); within :data:`RHO_TOL` of it roll is
+    taken as 0 (roll_branch +1) or pi (-1).
 
     Raises:
         UnreachableError: single target out of reach (JointLimitError: only outside the limits;
@@ -1305,7 +1316,7 @@ def foot_platform_ik(
 
         return finish(out.reshape(shape + (3,)), ok.reshape(shape), p.ndim == 1, return_mask, error)
     combos = _combos(llb, rb)
-    _, pose, ok = _search(u, 0.0, combos, b, s, limits_only=not moded)
+    _, pose, ok = _search(u, 0.0, combos, b, s, limits_only=not moded, axis_ok=moded)
     return finish(pose.reshape(shape + (3,)), ok.reshape(shape), p.ndim == 1, return_mask,
                   lambda: _ik_error(p, 0.0, combos, b, s, limits_only=not moded))
 
@@ -1348,7 +1359,8 @@ def foot_ik(
         UnreachableError: single target out of reach (of the LL arc or of the motors);
             JointLimitError: reachable only outside the joint limits;
             AssemblyModeError: reachable only in other modes (``.modes`` lists the arguments that reach it).
-        SingularityError: single target exactly on the roll axis, or in the forward-singularity band.
+        SingularityError: single target in the forward-singularity band, or exactly on the roll axis (where roll
+            is undetermined and foot_ik tries roll = 0 and pi) with neither roll reaching it in the mode.
     """
     p = as_input(p, "p", (3,))
     sv = _check_offset(starting_value)
@@ -1373,7 +1385,7 @@ def foot_ik(
             if not bool(reach[0]):
                 raise _arc_error(p, float(kk[0]))
             if not bool(nonsing[0]):
-                raise _axis_error(p)
+                raise _axis_error(p, False)
             raise UnreachableError(f"foot target {_fmt(p)} is out of the motors' reach on every branch", target=p)
         return (out, ok) if return_mask else out
     combos = _combos(llb, rb)

@@ -333,3 +333,146 @@ def _mobility_rows(robot, roll, pitch, rng) -> list[CheckResult]:
     rows.append(compare("spherical: free axis, Pinocchio null space vs (R a1 x d1) x (R a2 x d2)",
                         per_sample(axes - axis_a), TOL))
     return rows
+
+
+# ---------------------------------------------------------------- the IK contract row
+def _aspect_poses(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` (roll, pitch) uniform in the neutral aspect (branch (1, 1), assembly mode +1, pitch < PITCH_SPLIT)."""
+    out_r, out_p, got = [], [], 0
+    while got < n:
+        r = rng.uniform(-1.3, 1.3, 3 * n + 16)
+        p = rng.uniform(-0.62, 0.98, 3 * n + 16)
+        mode, ok = ah.assembly_mode(r, p, return_mask=True)
+        keep = ok & (mode == 1) & (p < ah.PITCH_SPLIT)
+        out_r.append(r[keep])
+        out_p.append(p[keep])
+        got += int(keep.sum())
+    return np.concatenate(out_r)[:n], np.concatenate(out_p)[:n]
+
+
+def _aspect_boundary(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` poses on the edge of the neutral aspect (reach boundary |k| = 1, or just inside det N = 0), found by
+    bisection along random directions from R_P = I on "reachable on branch (1, 1) and in mode +1"."""
+    d = rng.normal(size=(n, 2))
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    lo, hi = np.zeros(n), np.full(n, 2.0)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        mode, ok = ah.assembly_mode(mid * d[:, 0], mid * d[:, 1], return_mask=True)
+        inside = ok & (mode == 1)
+        lo, hi = np.where(inside, mid, lo), np.where(inside, hi, mid)
+    return lo * d[:, 0], lo * d[:, 1]
+
+
+def _fk_made(roll, pitch, tll):
+    """Foot targets made by the default ``foot_position`` from the in-limit joints of poses (roll, pitch, theta_LL)
+    of the neutral mode; returns the targets and the mask of those the FK produced."""
+    th, ok = ah.motor_angles(roll, pitch, return_mask=True)
+    th = np.where(ok[:, None], th, 0.0)
+    p, made = ah.foot_position(th[:, 0], th[:, 1], ah.extension_motor_angle(tll), return_mask=True)
+    return p, made & ok
+
+
+def ik_robustness_targets(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` foot targets (n, 3) and the mask of those made by the default FK from in-limit joints.
+
+    About half made: poses uniform in the neutral aspect with theta_LL uniform in the LL limits [-pi, pi]; poses
+    on the aspect's edge (reach boundary, and the forward-singularity side, where the FK refuses the band); the
+    LL arc's ends (theta_LL = LL_DELTA - pi: 3.14042 m from the centre, and theta_LL = LL_DELTA: 0.14042 m, where
+    the LL branches meet) and LL at its limits +-pi; feet on the roll axis (pitch = atan2(f_z, f_x)); random motor
+    angles over the neutral aspect's motor range. The rest (made = False): uniform in a ball of 3.3 m around the
+    centre (the arc reaches 3.14 m), FK-made targets moved by 1e-10 to 0.1 m, points on the roll axis, at the LL
+    arc's ends +- 1e-15..1e-9 relative, and the centre itself.
+    """
+    n = int(n)
+    n_made = n // 2
+    k = [int(n_made * f) for f in (0.4, 0.1, 0.1, 0.1, 0.1)]
+    k.append(n_made - sum(k))
+    parts_p, parts_m = [], []
+
+    def add(p, made):
+        parts_p.append(p)
+        parts_m.append(made)
+
+    r, pch = _aspect_poses(k[0], rng)
+    add(*_fk_made(r, pch, rng.uniform(-ah.LL_LIMIT, ah.LL_LIMIT, k[0])))
+    r, pch = _aspect_boundary(k[1], rng)
+    add(*_fk_made(r, pch, rng.uniform(-ah.LL_LIMIT, ah.LL_LIMIT, k[1])))
+    r, pch = _aspect_poses(k[2], rng)  # LL arc ends and LL limits
+    ends = np.array([ah.LL_DELTA - np.pi, ah.LL_DELTA, np.pi, -np.pi])
+    add(*_fk_made(r, pch, ends[rng.integers(0, 4, k[2])]))
+    r, pch = _aspect_boundary(k[3], rng)  # both at once
+    add(*_fk_made(r, pch, ends[rng.integers(0, 4, k[3])]))
+    # feet on the roll axis: pitch = atan2(f_z, f_x) puts R_P f on the x axis for any roll
+    tll = rng.uniform(-0.6, 0.6, 4 * k[4] + 16)
+    f = ah.LL_ORIGIN[[0, 2]][None] + ah.FOOT_X * np.stack([np.cos(tll), -np.sin(tll)], -1)
+    pa = np.arctan2(f[:, 1], f[:, 0])
+    ra = rng.uniform(-1.2, 1.2, len(tll))
+    mode, ok = ah.assembly_mode(ra, pa, return_mask=True)
+    sel = np.flatnonzero(ok & (mode == 1))[: k[4]]
+    add(*_fk_made(ra[sel], pa[sel], tll[sel]))
+    # random motor angles over the motor range of the neutral aspect (most assemble there)
+    th = rng.uniform([-1.6, -2.7], [2.7, 1.6], (3 * k[5] + 16, 2))
+    t0 = ah.extension_motor_angle(rng.uniform(-ah.LL_LIMIT, ah.LL_LIMIT, len(th)))
+    p, made = ah.foot_position(th[:, 0], th[:, 1], t0, return_mask=True)
+    sel = np.flatnonzero(made)[: k[5]]
+    add(p[sel], made[sel])
+
+    made_p = np.concatenate([q[m] for q, m in zip(parts_p, parts_m)])
+    while len(made_p) < n_made:  # the edge samples on the forward-singularity side are refused by the FK: top up
+        r, pch = _aspect_poses(n_made - len(made_p), rng)
+        p, ok = _fk_made(r, pch, rng.uniform(-ah.LL_LIMIT, ah.LL_LIMIT, len(r)))
+        made_p = np.concatenate([made_p, p[ok]])
+    m = n - len(made_p)
+    k = [int(m * f) for f in (0.4, 0.4, 0.08, 0.08)]
+    k.append(m - sum(k))
+    out = [made_p]
+    v = rng.normal(size=(k[0], 3))
+    v *= (3.3 * rng.uniform(0, 1, (k[0], 1)) ** (1 / 3)) / np.linalg.norm(v, axis=-1, keepdims=True)
+    out.append(ah.CENTER + v)
+    base = made_p[rng.integers(0, max(len(made_p), 1), k[1])] if len(made_p) else np.tile(ah.CENTER, (k[1], 1))
+    v = rng.normal(size=(k[1], 3))
+    v *= 10.0 ** rng.uniform(-10, -1, (k[1], 1)) / np.linalg.norm(v, axis=-1, keepdims=True)
+    out.append(base + v)
+    out.append(ah.CENTER + np.stack([rng.uniform(-3.3, 3.3, k[2]), np.zeros(k[2]), np.zeros(k[2])], -1))
+    v = rng.normal(size=(k[3], 3))
+    radius = np.where(rng.uniform(size=k[3]) < 0.5, ah._LL0 + ah._H, ah._LL0 - ah._H)
+    radius *= 1.0 + rng.choice([-1.0, 1.0], k[3]) * 10.0 ** rng.uniform(-15, -9, k[3])
+    out.append(ah.CENTER + v * (radius / np.linalg.norm(v, axis=-1))[:, None])
+    out.append(np.tile(ah.CENTER, (k[4], 1)))
+    targets = np.concatenate(out)
+    made = np.zeros(len(targets), dtype=bool)
+    made[: len(made_p)] = True
+    return targets, made
+
+
+def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 2000) -> CheckResult:
+    """The IK contract row of the hybrid leg: default ``foot_ik`` on ``n`` targets in and around the workspace.
+
+    Targets from :func:`ik_robustness_targets` (about half made by the default ``foot_position`` from in-limit
+    joints). The default batch IK runs on all; each solved answer is scored by ``|foot_position(IK(x)) - x|``
+    (default options); up to ``classify`` unsolved targets (None: all; FK-made ones first) are classified by the
+    error a single ``foot_ik`` call raises (:func:`legkin.validation.classify_failures`).
+    """
+    from ..validation import classify_failures, robustness_row
+
+    targets, made = ik_robustness_targets(n, rng)
+    exceptions = 0
+    try:
+        sol, solved = ah.foot_ik(targets, return_mask=True)
+    except Exception:  # noqa: BLE001 - a foreign exception from the batch call is a defect, counted
+        exceptions += 1
+        sol, solved = np.full(targets.shape, np.nan), np.zeros(len(targets), dtype=bool)
+    error = np.full(len(targets), np.inf)
+    if solved.any():
+        try:
+            back, ok = ah.foot_position(sol[solved, 0], sol[solved, 1], sol[solved, 2], return_mask=True)
+            error[solved] = np.where(ok, np.linalg.norm(back - targets[solved], axis=-1), np.inf)
+        except Exception:  # noqa: BLE001
+            exceptions += 1
+    unsolved = np.flatnonzero(~solved)
+    order = np.concatenate([unsolved[made[unsolved]], rng.permutation(unsolved[~made[unsolved]])])
+    idx = order if classify is None else order[: int(classify)]
+    reasons, exc = classify_failures(lambda i: ah.foot_ik(targets[i]), idx)
+    return robustness_row("hybrid_leg", made=made, solved=solved, error=error, reasons=reasons,
+                          classified=len(idx), exceptions=exceptions + exc)

@@ -7,7 +7,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
-from hypothesis import assume, given, settings
+from hypothesis import assume, example, given, settings
 from hypothesis import strategies as st
 
 import legkin
@@ -426,3 +426,390 @@ def test_forward_kinematics_does_not_assemble():
         ah.foot_jacobian(3.0, 3.0, 0.0)
     x, ok = ah.platform_orientation([0.3, 3.0], [-0.3, 3.0], return_mask=True)
     assert ok.tolist() == [True, False] and np.all(np.isnan(x[1]))
+
+
+# ------------------------------------------------------------------------------------------ IK contract (issue 10)
+# (a) every foot_ik answer is reproduced by foot_position (default options) to 1e-9 m; (b) every target the
+# default foot_position makes from in-limit joints is solved; (c) answers inside the URDF limits, JointLimitError
+# where reachable only outside them; (d) the assembly mode is an argument of FK and IK (default: the SRDF
+# reference pose's), AssemblyModeError names the modes that reach a target.
+REPRO = 1e-9
+
+
+def _aspect_box(n, rng):
+    r, p = rng.uniform(-1.3, 1.3, n), rng.uniform(-0.62, 0.98, n)
+    mode, ok = ah.assembly_mode(r, p, return_mask=True)
+    keep = ok & (mode == 1) & (p < ah.PITCH_SPLIT)
+    return r[keep], p[keep]
+
+
+def test_default_answers_are_reproduced_by_foot_position():
+    """Defect 1: foot_ik answered targets of the other assembly mode, foot_position put the foot cm away."""
+    rng = np.random.default_rng(7)
+    p = ah.CENTER + rng.uniform(-1.6, 1.6, (20000, 3))
+    sol, ok = ah.foot_ik(p, return_mask=True)
+    assert ok.sum() > 1000
+    back, fk_ok = ah.foot_position(sol[ok, 0], sol[ok, 1], sol[ok, 2], return_mask=True)
+    assert fk_ok.all()
+    assert np.linalg.norm(back - p[ok], axis=-1).max() < REPRO
+
+
+def test_fk_made_targets_are_solved():
+    """Defect 1, other way round: 1,802 of 4,900 FK-made targets needed ll_branch=+1 and were refused."""
+    rng = np.random.default_rng(8)
+    th = rng.uniform(-0.6, 0.6, (4900, 2))
+    t0 = rng.uniform(-20.0, 20.0, 4900)
+    p, made = ah.foot_position(th[:, 0], th[:, 1], t0, return_mask=True)
+    assert made.sum() > 4500
+    sol, ok = ah.foot_ik(p[made], return_mask=True)
+    assert ok.all()
+    back = ah.foot_position(sol[:, 0], sol[:, 1], sol[:, 2])
+    assert np.linalg.norm(back - p[made], axis=-1).max() < REPRO
+    # every one of them is a solution of the mode foot_position was asked for
+    assert np.all(ah.assembly_mode(*ah.platform_orientation(sol[:, 0], sol[:, 1]).T) == 1)
+
+
+@pytest.mark.parametrize("tll", [ah.LL_DELTA - math.pi, ah.LL_DELTA, math.pi, -math.pi], ids=["outer", "inner", "+pi", "-pi"])
+def test_reach_boundary_targets_made_by_fk_are_solved(tll):
+    """Defect 2: 262 of 10,000 FK-made targets at the outer reach (3.14042 m) were rejected."""
+    rng = np.random.default_rng(9)
+    r, pch = _aspect_box(4000, rng)
+    th = ah.motor_angles(r, pch)
+    p, made = ah.foot_position(th[:, 0], th[:, 1], ah.extension_motor_angle(np.full(len(r), tll)), return_mask=True)
+    sol, ok = ah.foot_ik(p[made], return_mask=True)
+    assert ok.all()
+    assert np.linalg.norm(ah.foot_position(*sol.T) - p[made], axis=-1).max() < REPRO
+
+
+def test_motor_reach_boundary_targets_made_by_fk_are_solved():
+    """Poses on the neutral aspect's reach boundary (|k| = 1, rounding either side) made into feet by FK."""
+    rng = np.random.default_rng(10)
+    r, pch = ch._aspect_boundary(400, rng)
+    th = ah.motor_angles(r, pch)
+    p, made = ah.foot_position(th[:, 0], th[:, 1], rng.uniform(-3, 3, len(r)), return_mask=True)
+    assert made.sum() > 100
+    sol, ok = ah.foot_ik(p[made], return_mask=True)
+    assert ok.all()
+    assert np.linalg.norm(ah.foot_position(*sol.T) - p[made], axis=-1).max() < REPRO
+
+
+def test_unreachable_arc_message_is_consistent():
+    """Defect 2: the message said '3.14042 m from the centre; the arc reaches [0.140417, 3.14042] m'."""
+    hi = ah._LL0 + ah._H
+    for r in (hi * (1 + 1e-11), hi + 1e-9, 0.5 * (ah._LL0 - ah._H)):
+        p = ah.CENTER + [r, 0.0, 1e-3]
+        with pytest.raises(UnreachableError) as info:
+            ah.foot_ik(p)
+        msg = str(info.value)
+        dist = float(msg.split(" m from the LCS centre")[0].rsplit(" ", 1)[1])
+        lo_, hi_ = (float(v) for v in msg.split("reaches [")[1].split("]")[0].split(", "))
+        assert not lo_ <= dist <= hi_, msg
+        assert ("beyond its outer end" in msg) == (r > hi)
+
+
+def test_other_assembly_mode_raises_and_modes_reach_it():
+    """A target reachable only in another assembly mode: unsolved by default, AssemblyModeError names the modes,
+    and foot_ik / foot_position with those mode arguments reproduce it."""
+    p = ah.foot_position_from_platform(-0.8438537262935863, 0.989660622822937, 0.15765221087324321)
+    with pytest.raises(legkin.AssemblyModeError) as info:
+        ah.foot_ik(p)
+    err = info.value
+    assert isinstance(err, UnreachableError) and err.modes
+    sol, ok = ah.foot_ik(p[None], return_mask=True)
+    assert not ok[0] and np.all(np.isnan(sol))
+    for mode in err.modes:
+        assert f"branch=({mode['branch'][0]}, {mode['branch'][1]}), assembly={mode['assembly']:+d}" in str(err)
+        m = ah.foot_ik(p, **mode)
+        back = ah.foot_position(m[0], m[1], m[2], branch=mode["branch"], assembly=mode["assembly"])
+        assert np.linalg.norm(back - p) < REPRO
+        # and foot_position with the default mode does not put the foot there
+        fk, fk_ok = ah.foot_position(m[:1], m[1:2], m[2:], return_mask=True)
+        assert not fk_ok[0] or np.linalg.norm(fk[0] - p) > 1e-6
+    # all modes on request
+    every = ah.foot_ik_solutions(p)
+    assert every.valid.sum() == len(err.modes) and not (every.valid & (every.assembly == 1))[[0, 4, 8, 12]].any()
+
+
+def test_joint_limit_error():
+    """Reachable only with |roll| > pi/2 (LCS_x limit): JointLimitError, mask False; no answer outside the limits."""
+    p = ah.foot_position_from_platform(-0.06284610557749781, -1.0207832560887642, 0.23457715140921453)
+    with pytest.raises(legkin.JointLimitError, match="outside the joint limits"):
+        ah.foot_ik(p)
+    every = ah.foot_ik_solutions(p)
+    assert every.mask.any() and not every.within_limits[every.mask].any()
+    assert not ah.foot_ik(p[None], return_mask=True)[1][0]
+
+
+def test_fk_mode_arguments_and_all_poses():
+    """(d): branch and assembly in FK; platform_poses lists every mode, foot_position follows the argument."""
+    th = ah.motor_angles(0.1, 0.3)
+    poses = ah.platform_poses(th[0], th[1])
+    assert poses.x.shape == (8, 2) and poses.mask[0]
+    assert np.allclose(poses.x[0], [0.1, 0.3], atol=1e-12)
+    assert tuple(poses.branch[0]) == (1, 1) and poses.assembly[0] == 1
+    assert np.allclose(ah.platform_orientation(th[0], th[1]), [0.1, 0.3], atol=1e-12)
+    for x, b, a in zip(poses.x[poses.mask], poses.branch[poses.mask], poses.assembly[poses.mask]):
+        if 0 in b:
+            continue
+        got = ah.platform_orientation(th[0], th[1], tuple(b), assembly=int(a))
+        assert np.linalg.norm(got) <= np.linalg.norm(x) + 1e-12  # the mode's pose nearest R_P = I
+        foot = ah.foot_position(th[0], th[1], 0.0, branch=tuple(b), assembly=int(a), return_mask=True)
+        if foot[1]:
+            m = ah.foot_ik(foot[0], branch=tuple(b), assembly=int(a))
+            back = ah.foot_position(m[0], m[1], m[2], branch=tuple(b), assembly=int(a))
+            assert np.linalg.norm(back - foot[0]) < REPRO
+    # R_P = I on the other motor branches: the default mode does not assemble, the message says where it does
+    th = ah.motor_angles(0.0, 0.0, (-1, -1))
+    with pytest.raises(ConvergenceError, match=r"it does at \(roll, pitch\) = \(0, 0\) on branch \(-1, -1\)"):
+        ah.platform_orientation(th[0], th[1])
+    assert np.abs(ah.platform_orientation(th[0], th[1], (-1, -1))).max() < 1e-12
+    foot = ah.foot_position(th[0], th[1], 0.0, branch=(-1, -1))
+    m = ah.foot_ik(foot, branch=(-1, -1))
+    assert np.allclose(m[:2], th, atol=1e-12)
+
+
+def test_forward_singularity_band():
+    """Near det N = 0 double-precision motor angles do not fix the foot to 1e-9 m: foot_position refuses the band,
+    foot_ik too; just outside it both work and agree."""
+    roll = 0.2
+    lo, hi = 0.0, 1.1
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ch._neutral_mode(np.array([roll]), np.array([mid]))[0] else (lo, mid)
+    for dist, refused in ((1e-9, True), (1e-2, False)):
+        th = ah.motor_angles(roll, lo - dist)
+        foot, ok = ah.foot_position([th[0]], [th[1]], [0.0], return_mask=True)
+        assert ok[0] != refused
+        p = ah.foot_position_from_platform(roll, lo - dist, 0.0)
+        if refused:
+            with pytest.raises(SingularityError, match="forward singularity"):
+                ah.foot_position(th[0], th[1], 0.0)
+            with pytest.raises(SingularityError, match="forward singularity"):
+                ah.foot_ik(p, ll_branch=-1)
+        else:
+            m = ah.foot_ik(p)
+            assert np.linalg.norm(ah.foot_position(*m) - p) < REPRO
+
+
+_BAD_KEYWORDS = [
+    (ah.foot_ik, {"ll_branch": np.array([1, -1])}, "ll_branch"),
+    (ah.foot_ik, {"ll_branch": True}, "ll_branch"),
+    (ah.foot_ik, {"ll_branch": 0.5}, "ll_branch"),
+    (ah.foot_ik, {"roll_branch": "1"}, "roll_branch"),
+    (ah.foot_ik, {"roll_branch": float("nan")}, "roll_branch"),
+    (ah.foot_ik, {"branch": np.array([[1, 1]])}, "branch"),
+    (ah.foot_ik, {"branch": "11"}, "branch"),
+    (ah.foot_ik, {"branch": (1, 1j)}, "branch"),
+    (ah.foot_ik, {"assembly": 0}, "assembly"),
+    (ah.foot_ik, {"assembly": "all"}, "assembly"),
+    (ah.foot_ik, {"starting_value": float("inf")}, "starting_value"),
+    (ah.foot_ik, {"starting_value": 4.0}, "starting_value"),
+    (ah.foot_ik, {"starting_value": np.array([0.1, 0.2])}, "starting_value"),
+    (ah.foot_ik, {"starting_value": 1j}, "starting_value"),
+    (ah.foot_ik, {"starting_value": 10**400}, "starting_value"),
+    (ah.foot_ik, {"all_branches": 1}, "all_branches"),
+    (ah.foot_ik, {"return_mask": "yes"}, "return_mask"),
+    (ah.foot_platform_ik, {"ll_branch": np.array([1])}, "ll_branch"),
+    (ah.foot_platform_ik, {"assembly": 2}, "assembly"),
+    (ah.foot_ik_solutions, {"starting_value": None}, "starting_value"),
+]
+
+
+@pytest.mark.parametrize("func, kwargs, name", _BAD_KEYWORDS, ids=[f"{f.__name__}-{n}-{i}" for i, (f, _, n) in enumerate(_BAD_KEYWORDS)])
+def test_bad_keyword_arguments(func, kwargs, name):
+    """Defect 3: every keyword validated, a legkin error naming it and its valid values (never a numpy error)."""
+    with pytest.raises(InvalidParameterError) as info:
+        func([0.4, 0.0, -0.2], **kwargs)
+    assert isinstance(info.value, InvalidInputError)
+    assert name in str(info.value) and repr(kwargs[name])[:20] in str(info.value)
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: ah.platform_orientation(0.3, -0.3, tol=0.0),
+        lambda: ah.platform_orientation(0.3, -0.3, tol=float("nan")),
+        lambda: ah.platform_orientation(0.3, -0.3, tol=1.0),
+        lambda: ah.platform_orientation(0.3, -0.3, tol="1e-12"),
+        lambda: ah.platform_orientation(0.3, -0.3, max_iter=0),
+        lambda: ah.platform_orientation(0.3, -0.3, max_iter=2.5),
+        lambda: ah.platform_orientation(0.3, -0.3, max_iter=True),
+        lambda: ah.platform_orientation(0.3, -0.3, steps=-1),
+        lambda: ah.platform_orientation(0.3, -0.3, assembly=-2),
+        lambda: ah.platform_orientation(0.3, -0.3, branch=[1, 1, 1]),
+        lambda: ah.platform_poses(0.3, -0.3, tol=-1.0),
+        lambda: ah.foot_position(0.3, -0.3, 0.0, assembly=None),
+        lambda: ah.foot_position(0.3, -0.3, 0.0, starting_value=True),
+        lambda: ah.foot_jacobian(0.3, -0.3, 0.0, branch=np.array([1.0, -1.0, 1.0])),
+        lambda: ah.motor_angles(0.0, 0.0, branch=np.array([1, 1]) * 1j),
+        lambda: ah.assembly_mode(0.0, 0.0, return_mask=None),
+        lambda: ah.ll_angle(0.0, starting_value=np.nan),
+    ],
+)
+def test_bad_parameters_of_other_functions(call):
+    with pytest.raises(InvalidParameterError):
+        call()
+
+
+@pytest.mark.parametrize(
+    "call",
+    [
+        lambda: ah.foot_ik([0.4, 0.0, -0.2j]),
+        lambda: ah.foot_ik([[0.4, 0.0, -0.2], [0.4, 0.0]]),
+        lambda: ah.foot_ik(["0.4", "0", "-0.2"]),
+        lambda: ah.foot_ik(np.zeros((2, 4))),
+        lambda: ah.foot_ik([0.4, float("inf"), 0.0]),
+        lambda: ah.foot_ik_solutions([0.4, 0.0, float("nan")]),
+        lambda: ah.foot_platform_ik(np.zeros(2)),
+        lambda: ah.foot_position(0.3 + 0j, -0.3, 0.0),
+        lambda: ah.platform_poses([0.3, 0.2], [0.1, 0.2, 0.3]),
+        lambda: ah.platform_orientation(0.3, -0.3, guess=[0.0, float("nan")]),
+        lambda: ah.platform_orientation([0.3, 0.3], [-0.3, 0.3], guess=np.zeros((3, 2))),
+        lambda: ah.assembly_mode(float("nan"), 0.0),
+    ],
+)
+def test_bad_inputs_raise_invalid_input(call):
+    with pytest.raises(InvalidInputError):
+        call()
+
+
+def test_extreme_inputs_give_nan_and_mask_or_legkin_errors():
+    """No numpy exception escapes: huge, tiny and empty inputs; a batch gives NaN + mask, a single call a legkin
+    error."""
+    big = np.array([[1e308, 1e308, 1e308], [-1e300, 0.0, 1e-300], [5e-324, 0.0, 0.0], ah.CENTER, [0.4, 0.0, -0.2]])
+    for f in (ah.foot_ik, ah.foot_platform_ik):
+        out, ok = f(big, return_mask=True)
+        assert ok.tolist()[:4] == [False, False, False, False] and np.all(np.isnan(out[:4]))
+        for p in big[:4]:
+            with pytest.raises(legkin.LegkinError):
+                f(p)
+    every = ah.foot_ik_solutions(big)
+    assert not every.mask[[0, 1, 3]].any()
+    assert ah.foot_ik(np.zeros((0, 3))).shape == (0, 3)
+    assert ah.foot_ik(np.zeros((0, 3)), all_branches=True).shape == (0, 16, 3)
+    assert ah.foot_position(np.zeros(0), np.zeros(0), np.zeros(0)).shape == (0, 3)
+    assert ah.platform_orientation(np.zeros((2, 0)), np.zeros((2, 0))).shape == (2, 0, 2)
+    assert ah.platform_poses(np.zeros(0), np.zeros(0)).x.shape == (0, 8, 2)
+    th, ok = ah.platform_orientation([1e300, -1e300, 0.3], [1e300, 0.0, -0.3], return_mask=True)
+    assert ok.tolist() == [False, False, True]
+    foot, ok = ah.foot_position([1e300, 0.3], [0.0, -0.3], [1e300, 1e300], return_mask=True)
+    assert not ok[0] and np.all(np.isnan(foot[0]))
+    with pytest.raises(legkin.LegkinError):
+        ah.foot_position(1e300, 0.0, 0.0)
+
+
+def test_roll_axis_targets_made_by_fk():
+    """FK-made feet can land exactly on the roll axis (u_y = u_z = 0 in floating point): solved with roll 0."""
+    for roll, pitch, tll in ((0.23340081963333725, 0.2950143493035182, 0.05348909126616064),
+                             (-0.031366530448811325, -0.2824036705663148, -0.002415647387188913)):
+        th = ah.motor_angles(roll, pitch)
+        p = ah.foot_position(th[0], th[1], ah.extension_motor_angle(tll))
+        assert p[1] == 0.0 and p[2] == ah.CENTER[2]
+        m = ah.foot_ik(p)
+        assert np.linalg.norm(ah.foot_position(*m) - p) < REPRO
+
+
+def test_ik_robustness_row():
+    row = ch.ik_robustness(3000, np.random.default_rng(4), classify=300)
+    assert row.passed, row.name
+    assert row.counts.made >= 1400 and row.counts.exceptions == 0
+
+
+def _fold_pitch(roll):
+    lo, hi = 0.0, 1.1
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if ch._neutral_mode(np.array([roll]), np.array([mid]))[0] else (lo, mid)
+    return lo
+
+
+_ENDS = (ah.LL_DELTA - math.pi, ah.LL_DELTA, math.pi, -math.pi)
+_cases = st.one_of(
+    # a pose (in the neutral aspect or not) and theta_LL (anywhere in the LL limits, or at the arc's ends)
+    st.tuples(st.just("pose"), st.floats(-1.6, 1.6), st.floats(-1.6, 1.6),
+              st.one_of(st.floats(-math.pi, math.pi), st.sampled_from(_ENDS))),
+    # the neutral aspect's edge along a direction (reach boundary or forward singularity)
+    st.tuples(st.just("edge"), st.floats(-math.pi, math.pi), st.floats(-8.0, -1.0),
+              st.one_of(st.floats(-math.pi, math.pi), st.sampled_from(_ENDS))),
+    # just inside the forward singularity
+    st.tuples(st.just("fold"), st.floats(-0.9, 0.9), st.floats(-10.0, -2.0), st.floats(-1.0, 1.0)),
+    # the roll axis: pitch = atan2(f_z, f_x) for theta_LL
+    st.tuples(st.just("axis"), st.floats(-1.3, 1.3), st.floats(-0.6, 0.6), st.floats(-12.0, -1.0)),
+    # anywhere around the workspace
+    st.tuples(st.just("box"), st.floats(-3.3, 3.3), st.floats(-3.3, 3.3), st.floats(-3.3, 3.3)),
+)
+
+
+def _build(case):
+    """(target, made): made = produced by the default foot_position from in-limit joints."""
+    kind, a, b, c = case
+    if kind == "pose":
+        roll, pitch, tll = a, b, c
+    elif kind == "edge":
+        d = np.array([math.cos(a), math.sin(a)])
+        lo, hi = 0.0, 2.0
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            mode, ok = ah.assembly_mode(*(mid * d)[:, None], return_mask=True)
+            lo, hi = (mid, hi) if ok[0] and mode[0] == 1 else (lo, mid)
+        roll, pitch = (lo - 10.0**b) * d
+        tll = c
+    elif kind == "fold":
+        roll, pitch, tll = a, _fold_pitch(a) - 10.0**b, c
+    elif kind == "axis":
+        tll = b
+        f = ah.LL_ORIGIN + ah.FOOT_X * np.array([math.cos(tll), 0.0, -math.sin(tll)])
+        roll, pitch = a, math.atan2(f[2], f[0]) + (10.0**c if c > -11.5 else 0.0)
+    else:
+        return ah.CENTER + np.array([a, b, c]), False
+    th, ok = ah.motor_angles([roll], [pitch], return_mask=True)
+    if ok[0] and abs(tll) <= math.pi:
+        foot, made = ah.foot_position(th[:, 0], th[:, 1], [ah.extension_motor_angle(tll)], return_mask=True)
+        if made[0]:
+            return foot[0], True
+    return ah.foot_position_from_platform(roll, pitch, tll), False
+
+
+@settings(max_examples=250, deadline=None)
+@given(_cases)
+@example(("axis", 0.23340081963333725, 0.05348909126616064, -12.0))  # FK-made, exactly on the roll axis
+@example(("pose", 0.23340081963333725, 0.2950143493035182, 0.05348909126616064))
+@example(("pose", -0.8438537262935863, 0.989660622822937, 0.15765221087324321))  # another mode only
+@example(("pose", 0.3, 0.2, ah.LL_DELTA - math.pi))  # the outer end of the LL arc
+@example(("pose", 0.0, 0.0, ah.LL_DELTA))  # the inner end: LL branches meet
+@example(("edge", -math.pi / 2, -8.0, 0.1))  # reach boundary
+@example(("fold", 0.0, -10.0, 0.0))  # forward-singularity band
+@example(("box", 0.3, 0.0, 0.0))  # exactly on the roll axis, no roll of 0 / pi in the mode
+@example(("box", 0.0, 0.0, 0.0))  # the centre
+def test_ik_contract_property(case):
+    p, made = _build(case)
+    try:
+        m = ah.foot_ik(p)
+        err = None
+    except (UnreachableError, SingularityError) as exc:
+        m, err = None, exc
+    sol, ok = ah.foot_ik(p[None], return_mask=True)
+    assert bool(ok[0]) == (err is None)  # batch and single call agree
+    if made:
+        assert err is None, (case, err)  # (b)
+    if err is None:
+        assert np.array_equal(sol[0], m)
+        assert np.linalg.norm(ah.foot_position(*m) - p) < REPRO  # (a)
+        assert np.all(np.abs(m[:2]) <= ah.MOTOR_LIMIT) and abs(ah.ll_angle(m[2])) <= ah.LL_LIMIT  # (c)
+        x = ah.platform_orientation(m[0], m[1])
+        assert np.all(np.abs(x) <= ah.PLATFORM_LIMIT)
+        assert ah.assembly_mode(x[0], x[1]) == 1  # (d) the default mode
+        return
+    assert np.all(np.isnan(sol[0]))
+    every = ah.foot_ik_solutions(p)
+    if isinstance(err, legkin.AssemblyModeError):
+        assert not (every.valid & (every.assembly == 1))[[0, 4, 8, 12]].any()  # no default-mode answer ...
+        for mode in err.modes[:3]:  # ... but each named mode reaches it
+            assert f"assembly={mode['assembly']:+d}" in str(err)
+            m2 = ah.foot_ik(p, **mode)
+            back = ah.foot_position(m2[0], m2[1], m2[2], branch=mode["branch"], assembly=mode["assembly"])
+            assert np.linalg.norm(back - p) < REPRO
+    elif isinstance(err, legkin.JointLimitError):
+        assert every.mask.any() and not every.within_limits.any()
+    elif isinstance(err, UnreachableError):
+        assert not every.valid.any()

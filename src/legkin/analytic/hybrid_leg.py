@@ -71,6 +71,8 @@ __all__ = [
     "foot_jacobian",
     "spherical_free_axis",
     "K_TOL",
+    "IK_K_TOL",
+    "BOUNDARY_TOL",
     "LL_TOL",
     "RHO_TOL",
     "PLATFORM_LIMIT",
@@ -127,9 +129,15 @@ _H = abs(FOOT_X)
 
 #: Reach tolerance: a chain whose reach ratio |k| (see :func:`motor_angles`) exceeds 1 by at most this counts
 #: as reachable, with acos(k) clipped (rounding at the reach boundary: a pose built on the boundary gives
-#: |k| = 1 +- a few 1e-16; clipping 1e-14 leaves a rod-length error of ~1e-15 m). The forward kinematics also
-#: treats a chain within it of |k| = 1 as on its reach boundary, where both motor branches meet.
+#: |k| = 1 +- a few 1e-16; clipping 1e-14 leaves a rod-length error of ~1e-15 m).
 K_TOL = 1e-14
+#: The same for foot_ik: its platform pose, computed from a foot target, carries ~1e-14 of rounding in k (the
+#: foot is up to 3 m from the centre); clipping 1e-11 leaves ~1e-12 m of rod-length error.
+IK_K_TOL = 1e-11
+#: The forward kinematics labels a chain with 1 - |k| <= BOUNDARY_TOL (acos(k) <= 1.4e-5 rad) as on its reach
+#: boundary, matching both motor branches: the motor angles foot_ik clips there give FK poses that close the chain
+#: within ~1e-11 of |k| = 1 on either side.
+BOUNDARY_TOL = 1e-10
 #: The same for the LL arc: |cos(theta_LL - LL_DELTA)| up to 1 + LL_TOL is reachable (~1e-12 m at the arc's ends).
 LL_TOL = 1e-12
 #: Feet within this distance (m) of the roll axis (x through the LCS centre), but not exactly on it: the roll
@@ -337,10 +345,10 @@ def rod_spans(theta1, theta2, roll=0.0, pitch=0.0) -> np.ndarray:
     return np.linalg.norm(_attach_world(platform_rotation(r, p)) - tip, axis=-1)
 
 
-def _chains(rot: np.ndarray, b: np.ndarray):
+def _chains(rot: np.ndarray, b: np.ndarray, tol: float = K_TOL):
     """Closed form of both rod-length equations for rotations (..., 3, 3).
 
-    Returns theta (..., 2) (NaN where unreachable), the reach ratio k (..., 2), and ok (..., 2) (|k| <= 1 + K_TOL).
+    Returns theta (..., 2) (NaN where unreachable), the reach ratio k (..., 2), and ok (..., 2) (|k| <= 1 + tol).
     """
     w = MOTOR_POS - _attach_world(rot)  # w_i = p_i - A_i  so  S_i - A_i = w_i + Rz(phi_i) l
     lx, lz = LEVER[0], LEVER[2]
@@ -350,7 +358,7 @@ def _chains(rot: np.ndarray, b: np.ndarray):
     rho = np.hypot(a, bb)
     with np.errstate(divide="ignore", invalid="ignore"):
         k = c / rho
-    ok = np.isfinite(k) & (np.abs(k) <= 1.0 + K_TOL)
+    ok = np.isfinite(k) & (np.abs(k) <= 1.0 + tol)
     phi = np.arctan2(bb, a) - _SIGMA * b * np.arccos(np.clip(k, -1.0, 1.0))
     theta = np.where(ok, _wrap(phi - MOTOR_YAW), np.nan)
     return theta, k, ok
@@ -688,7 +696,7 @@ def _platform_solutions(theta: np.ndarray, tol: float = 1e-12, max_iter: int = 5
     """Every platform pose within the joint limits closing both rods for motor angles theta (n, 2).
 
     Returns (item (m,), x (m, 2), branch (m, 2) in {+1, -1, 0}, sign det N (m,)): branch 0 for a chain on its
-    reach boundary (|k| within K_TOL of 1), where both motor branches meet. Duplicates are possible.
+    reach boundary (|k| within BOUNDARY_TOL of 1), where both motor branches meet. Duplicates are possible.
     """
     tip, dtip = _lever_tips(theta)
     poly, al, be, ga = _roll_polynomial(tip)
@@ -715,7 +723,7 @@ def _platform_solutions(theta: np.ndarray, tol: float = 1e-12, max_iter: int = 5
     ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
     d = CENTER + ra - tip[item]
     dd = np.sum(d * dtip[item], -1)
-    bl = np.where(np.abs(np.abs(k) - 1.0) <= K_TOL, 0.0, -_SIGMA * np.sign(dd))
+    bl = np.where(np.abs(np.abs(k) - 1.0) <= BOUNDARY_TOL, 0.0, -_SIGMA * np.sign(dd))
     sdet = np.sign(_det2(_n_matrix(ra, d, x[:, 0])))
     return item, x, bl, sdet
 
@@ -1080,7 +1088,7 @@ def _ik_candidate(u: np.ndarray, sv: float, llb, rb, b: np.ndarray) -> dict:
     inlim = np.all(near, -1)
     x[:, 1:] = np.where(near, np.clip(x[:, 1:], -PLATFORM_LIMIT, PLATFORM_LIMIT), x[:, 1:])  # rounding at a limit
     rot = _rot(x[:, 1], x[:, 2])
-    th, _, ok2 = _chains(rot, b)
+    th, _, ok2 = _chains(rot, b, IK_K_TOL)
     exists = reach & np.all(ok2, -1)  # on the roll axis (rho = 0) roll is 0 or pi, see _platform_ik
     th = np.where(exists[:, None], th, np.nan)
     ths = np.where(exists[:, None], th, 0.0)
@@ -1146,7 +1154,8 @@ def _fmt(p) -> str:
 
 
 def _arc_error(p: np.ndarray, kk: float) -> UnreachableError:
-    r = float(np.linalg.norm(p - CENTER))
+    with np.errstate(over="ignore"):
+        r = float(np.linalg.norm(p - CENTER))
     lo, hi = _LL0 - _H, _LL0 + _H
     side = f"{r - hi:.3g} m beyond its outer end" if r > hi else f"{lo - r:.3g} m inside its inner end"
     return UnreachableError(

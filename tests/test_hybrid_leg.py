@@ -437,10 +437,22 @@ REPRO = 1e-9
 
 
 def _aspect_box(n, rng):
+    """Poses of the neutral aspect: branch (1, 1), the sign of det(dtheta/dx) of R_P = I, pitch below 1.2 rad."""
     r, p = rng.uniform(-1.3, 1.3, n), rng.uniform(-0.62, 0.98, n)
-    mode, ok = ah.assembly_mode(r, p, return_mask=True)
-    keep = ok & (mode == 1) & (p < ah.PITCH_SPLIT)
+    keep = ch._neutral_mode(r, p) & (p < 1.2)
     return r[keep], p[keep]
+
+
+def _aspect_edge(n, rng):
+    """Poses on the neutral aspect's edge (reach boundary, or forward singularity) by bisection along rays."""
+    d = rng.normal(size=(n, 2))
+    d /= np.linalg.norm(d, axis=-1, keepdims=True)
+    lo, hi = np.zeros(n), np.full(n, 2.0)
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        inside = ch._neutral_mode(mid * d[:, 0], mid * d[:, 1])
+        lo, hi = np.where(inside, mid, lo), np.where(inside, hi, mid)
+    return lo * d[:, 0], lo * d[:, 1]
 
 
 def test_default_answers_are_reproduced_by_foot_position():
@@ -484,7 +496,7 @@ def test_reach_boundary_targets_made_by_fk_are_solved(tll):
 def test_motor_reach_boundary_targets_made_by_fk_are_solved():
     """Poses on the neutral aspect's reach boundary (|k| = 1, rounding either side) made into feet by FK."""
     rng = np.random.default_rng(10)
-    r, pch = ch._aspect_boundary(400, rng)
+    r, pch = _aspect_edge(400, rng)
     th = ah.motor_angles(r, pch)
     p, made = ah.foot_position(th[:, 0], th[:, 1], rng.uniform(-3, 3, len(r)), return_mask=True)
     assert made.sum() > 100
@@ -592,34 +604,34 @@ def test_forward_singularity_band():
 
 
 _BAD_KEYWORDS = [
-    (ah.foot_ik, {"ll_branch": np.array([1, -1])}, "ll_branch"),
-    (ah.foot_ik, {"ll_branch": True}, "ll_branch"),
-    (ah.foot_ik, {"ll_branch": 0.5}, "ll_branch"),
-    (ah.foot_ik, {"roll_branch": "1"}, "roll_branch"),
-    (ah.foot_ik, {"roll_branch": float("nan")}, "roll_branch"),
-    (ah.foot_ik, {"branch": np.array([[1, 1]])}, "branch"),
-    (ah.foot_ik, {"branch": "11"}, "branch"),
-    (ah.foot_ik, {"branch": (1, 1j)}, "branch"),
-    (ah.foot_ik, {"assembly": 0}, "assembly"),
-    (ah.foot_ik, {"assembly": "all"}, "assembly"),
-    (ah.foot_ik, {"starting_value": float("inf")}, "starting_value"),
-    (ah.foot_ik, {"starting_value": 4.0}, "starting_value"),
-    (ah.foot_ik, {"starting_value": np.array([0.1, 0.2])}, "starting_value"),
-    (ah.foot_ik, {"starting_value": 1j}, "starting_value"),
-    (ah.foot_ik, {"starting_value": 10**400}, "starting_value"),
-    (ah.foot_ik, {"all_branches": 1}, "all_branches"),
-    (ah.foot_ik, {"return_mask": "yes"}, "return_mask"),
-    (ah.foot_platform_ik, {"ll_branch": np.array([1])}, "ll_branch"),
-    (ah.foot_platform_ik, {"assembly": 2}, "assembly"),
-    (ah.foot_ik_solutions, {"starting_value": None}, "starting_value"),
+    ("foot_ik", {"ll_branch": np.array([1, -1])}, "ll_branch"),
+    ("foot_ik", {"ll_branch": True}, "ll_branch"),
+    ("foot_ik", {"ll_branch": 0.5}, "ll_branch"),
+    ("foot_ik", {"roll_branch": "1"}, "roll_branch"),
+    ("foot_ik", {"roll_branch": float("nan")}, "roll_branch"),
+    ("foot_ik", {"branch": np.array([[1, 1]])}, "branch"),
+    ("foot_ik", {"branch": "11"}, "branch"),
+    ("foot_ik", {"branch": (1, 1j)}, "branch"),
+    ("foot_ik", {"assembly": 0}, "assembly"),
+    ("foot_ik", {"assembly": "all"}, "assembly"),
+    ("foot_ik", {"starting_value": float("inf")}, "starting_value"),
+    ("foot_ik", {"starting_value": 4.0}, "starting_value"),
+    ("foot_ik", {"starting_value": np.array([0.1, 0.2])}, "starting_value"),
+    ("foot_ik", {"starting_value": 1j}, "starting_value"),
+    ("foot_ik", {"starting_value": 10**400}, "starting_value"),
+    ("foot_ik", {"all_branches": 1}, "all_branches"),
+    ("foot_ik", {"return_mask": "yes"}, "return_mask"),
+    ("foot_platform_ik", {"ll_branch": np.array([1])}, "ll_branch"),
+    ("foot_platform_ik", {"assembly": 2}, "assembly"),
+    ("foot_ik_solutions", {"starting_value": None}, "starting_value"),
 ]
 
 
-@pytest.mark.parametrize("func, kwargs, name", _BAD_KEYWORDS, ids=[f"{f.__name__}-{n}-{i}" for i, (f, _, n) in enumerate(_BAD_KEYWORDS)])
+@pytest.mark.parametrize("func, kwargs, name", _BAD_KEYWORDS, ids=[f"{f}-{n}-{i}" for i, (f, _, n) in enumerate(_BAD_KEYWORDS)])
 def test_bad_keyword_arguments(func, kwargs, name):
     """Defect 3: every keyword validated, a legkin error naming it and its valid values (never a numpy error)."""
     with pytest.raises(InvalidParameterError) as info:
-        func([0.4, 0.0, -0.2], **kwargs)
+        getattr(ah, func)([0.4, 0.0, -0.2], **kwargs)
     assert isinstance(info.value, InvalidInputError)
     assert name in str(info.value) and repr(kwargs[name])[:20] in str(info.value)
 

@@ -985,14 +985,20 @@ def _foot_gain(x: np.ndarray, theta: np.ndarray, tll: np.ndarray) -> np.ndarray:
     ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
     tip, dtip = _lever_tips(theta)
     d = CENTER + ra - tip
-    nm = _n_matrix(ra, d, x[:, 0])
-    dd = np.sum(d * dtip, -1)
+    return _gain(rot, _n_matrix(ra, d, x[:, 0]), np.sum(d * dtip, -1), x[:, 0], tll)
+
+
+def _gain(rot: np.ndarray, nm: np.ndarray, dd: np.ndarray, roll: np.ndarray, tll: np.ndarray) -> np.ndarray:
+    """:func:`_foot_gain` from the platform rotation, N, D = d_i . dS_i/dtheta_i, roll and theta_LL."""
     det = _det2(nm)
     adj = np.stack([np.stack([nm[:, 1, 1], -nm[:, 0, 1]], -1), np.stack([-nm[:, 1, 0], nm[:, 0, 0]], -1)], -2)
     f, _ = _foot_in_p(tll)
     rf = np.einsum("...ij,...j->...i", rot, f)
-    ey_r = np.stack([np.zeros_like(x[:, 0]), np.cos(x[:, 0]), np.sin(x[:, 0])], -1)
-    dpdx = np.stack([np.cross(np.array([1.0, 0.0, 0.0]), rf), np.cross(ey_r, rf)], -1)
+    c, s = np.cos(roll), np.sin(roll)
+    fx, fy, fz = rf[:, 0], rf[:, 1], rf[:, 2]
+    # dp/droll = e_x x R f, dp/dpitch = (0, c, s) x R f
+    dpdx = np.stack([np.stack([np.zeros_like(fx), c * fz - s * fy], -1), np.stack([-fz, s * fx], -1),
+                     np.stack([fy, -c * fx], -1)], -2)
     m = dpdx @ (adj * dd[:, None, :])  # det N x d(foot)/d(theta)
     mtm = np.swapaxes(m, -1, -2) @ m
     a, b, c = mtm[:, 0, 0], mtm[:, 0, 1], mtm[:, 1, 1]
@@ -1092,12 +1098,12 @@ def _ik_candidate(u: np.ndarray, sv: float, llb, rb, b: np.ndarray) -> dict:
     exists = reach & np.all(ok2, -1)  # on the roll axis (rho = 0) roll is 0 or pi, see _platform_ik
     th = np.where(exists[:, None], th, np.nan)
     ths = np.where(exists[:, None], th, 0.0)
-    tip, _ = _lever_tips(ths)
+    tip, dtip = _lever_tips(ths)
     ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
-    mode = np.where(exists, np.sign(_det2(_n_matrix(ra, CENTER + ra - tip, x[:, 1]))) * _assembly_ref(b), 0.0)
-    gain = np.full(len(u), np.inf)
-    if exists.any():
-        gain[exists] = _foot_gain(x[exists, 1:], ths[exists], x[exists, 0])
+    d = CENTER + ra - tip
+    nm = _n_matrix(ra, d, x[:, 1])
+    mode = np.where(exists, np.sign(_det2(nm)) * _assembly_ref(b), 0.0)
+    gain = np.where(exists, _gain(rot, nm, np.sum(d * dtip, -1), x[:, 1], x[:, 0]), np.inf)
     motors = np.concatenate([th, ((sv - x[:, 0]) / RATIO)[:, None]], -1)
     return {"pose": x, "motors": np.where(exists[:, None], motors, np.nan), "exists": exists, "inlim": inlim,
             "mode": mode, "gain": gain, "kk": kk, "reach": reach, "axis": ~nonsing}

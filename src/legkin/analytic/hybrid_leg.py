@@ -297,7 +297,8 @@ def ll_angle(theta0, starting_value: float = 0.0):
 def extension_motor_angle(theta_ll, starting_value: float = 0.0):
     """Inverse of :func:`ll_angle`: ``theta0 = (starting_value - theta_LL) / RATIO`` (eq 19 solved for theta0)."""
     (t,) = as_angles(theta_ll, names=("theta_ll",))
-    return (_check_offset(starting_value) - t) / RATIO
+    with np.errstate(over="ignore"):  # |theta_LL| > 1e306 rad: inf
+        return (_check_offset(starting_value) - t) / RATIO
 
 
 # ----------------------------------------------------------------------------- platform and chains
@@ -374,9 +375,10 @@ def _unreachable(what: str, k: np.ndarray) -> UnreachableError:
     )
 
 
-def _levers_at(rotation, branch):
+def _levers_at(rotation, branch, return_mask=False):
     """Checked rotation, motor angles, chain flags, success mask and lever tips for a platform rotation."""
     rot = _check_rotation(rotation)
+    _check_flag(return_mask, "return_mask")
     theta, k, ok2 = _chains(rot, _check_branch(branch))
     ok = np.all(ok2, axis=-1)
     tip, _ = _lever_tips(np.where(ok[..., None], theta, 0.0))
@@ -400,6 +402,7 @@ def motor_angles_from_rotation(rotation, branch: Sequence[int] = (1, 1), *, retu
     """
     rot = _check_rotation(rotation)
     b = _check_branch(branch)
+    _check_flag(return_mask, "return_mask")
     theta, k, ok2 = _chains(rot, b)
     ok = np.all(ok2, axis=-1)
     theta = np.where(ok[..., None], theta, np.nan)
@@ -418,7 +421,8 @@ def motor_angles(roll, pitch, branch: Sequence[int] = (1, 1), *, return_mask: bo
     """
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
     b = _check_branch(branch)
-    theta, k, ok2 = _chains(platform_rotation(r, p), b)
+    _check_flag(return_mask, "return_mask")
+    theta, k, ok2 = _chains(_rot(r, p), b)
     ok = np.all(ok2, axis=-1)
     theta = np.where(ok[..., None], theta, np.nan)
     what = f"(roll, pitch) = ({float(r):.6g}, {float(p):.6g})" if r.ndim == 0 else ""
@@ -455,7 +459,8 @@ def motor_jacobian(roll, pitch, branch: Sequence[int] = (1, 1), *, return_mask: 
     """
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
     b = _check_branch(branch)
-    rot = platform_rotation(r, p)
+    _check_flag(return_mask, "return_mask")
+    rot = _rot(r, p)
     theta, k, ok2 = _chains(rot, b)
     reach = np.all(ok2, axis=-1)
     n, dd = _jacobian_parts(rot, r, np.where(reach[..., None], theta, 0.0))
@@ -487,7 +492,7 @@ def sphere_joint_angles(rotation, branch: Sequence[int] = (1, 1), *, return_mask
     Raises:
         UnreachableError: single rotation out of reach.
     """
-    rot, theta, k, ok, tip = _levers_at(rotation, branch)
+    rot, theta, k, ok, tip = _levers_at(rotation, branch, return_mask)
     d = _attach_world(rot) - tip
     rz = _rotz(theta + MOTOR_YAW)
     u = np.einsum("...ji,...j->...i", rz, d) / ROD_LENGTH
@@ -1525,7 +1530,7 @@ def spherical_free_axis(rotation, branch: Sequence[int] = (1, 1), *, return_mask
     Raises:
         UnreachableError: single rotation out of reach.
     """
-    rot, theta, k, ok, tip = _levers_at(rotation, branch)
+    rot, theta, k, ok, tip = _levers_at(rotation, branch, return_mask)
     ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
     d = CENTER + ra - tip
     g = np.cross(ra, d)

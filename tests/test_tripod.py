@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import re
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import legkin
@@ -528,14 +529,22 @@ def _home_det(alpha, ay, az):
 
 def det_zero_points(alpha, az, n=601):
     """alpha_y where det M = 0 along alpha_z = az (bisection between sign changes on a grid)."""
-    ys = np.linspace(-np.pi / 2, np.pi / 2, n)
-    det = _home_det(alpha, ys, np.full(n, az))[1]
-    i = np.nonzero(np.sign(det[1:]) * np.sign(det[:-1]) < 0)[0]
-    lo, hi = ys[i], ys[i + 1]
-    flo = _home_det(alpha, lo, np.full(len(i), az))[1]
+    return _det_zeros(alpha, np.linspace(-np.pi / 2, np.pi / 2, n), az, along_y=True)
+
+
+def _det_zeros(alpha, grid, fixed, along_y):
+    """Zeros of det M along a line of u (alpha_y varying at alpha_z = fixed, or the other way round)."""
+    def det(v):
+        w = np.full(len(v), fixed)
+        return _home_det(alpha, v, w)[1] if along_y else _home_det(alpha, w, v)[1]
+
+    d = det(grid)
+    i = np.nonzero(np.sign(d[1:]) * np.sign(d[:-1]) < 0)[0]
+    lo, hi = grid[i], grid[i + 1]
+    flo = det(lo)
     for _ in range(70):
         mid = 0.5 * (lo + hi)
-        fm = _home_det(alpha, mid, np.full(len(i), az))[1]
+        fm = det(mid)
         left = np.sign(fm) == np.sign(flo)
         lo, flo, hi = np.where(left, mid, lo), np.where(left, fm, flo), np.where(left, hi, mid)
     return 0.5 * (lo + hi)
@@ -568,3 +577,191 @@ def test_fk_near_boundary_and_near_singular_planes():
     q = at.ik(ay, az, alpha=alpha)
     y, z, inc = at.fk(q[0], q[4], q[8], alpha=alpha)
     assert abs(y - ay) < 1e-12 and abs(z - az) < 1e-12 and inc < 1e-12
+
+
+# ------------------------------------------------------------------------------------------ the IK contract (property tests)
+CONTRACT_TOL = 1e-9
+
+
+def _mode_of(e_side, s_legs):
+    return ("-" if e_side < 0 else "+") + "".join("-" if s < 0 else "+" for s in s_legs)
+
+
+def _configuration_from_motors(qa, qb, branch, s_c, alpha):
+    """A closed configuration with motors q_A1 = qa, q_B1 = qb: E on both motor planes and |E| = L (the
+    ``branch`` of the two line-sphere points), leg C on the side ``s_c``. Returns (u, mode, q_C1) or None."""
+    g = at._geometry(at.D, alpha, np.array(at.ETA))
+    s, c = np.sin([qa, qb]), np.cos([qa, qb])
+    n = np.stack([s, -c * g.ce[:2], -c * g.se[:2]], axis=-1)
+    cab, v = float(n[0] @ n[1]), np.cross(n[0], n[1])
+    if v @ v < 1e-12:
+        return None
+    p0 = g.d * g.k * (n[0] + n[1]) / (1.0 + cab)
+    t2 = (g.minus_l**2 - p0 @ p0) / (v @ v)
+    if t2 < 0:
+        return None
+    e = p0 + branch * math.sqrt(t2) * v
+    h1, h2 = -e[0] / g.d, -(g.ce[:2] * e[1] + g.se[:2] * e[2]) / g.d
+    s_ab = c * h1 + s * h2  # sin q_K2 sin(alpha) of legs A and B at E
+    if np.any(np.abs(s_ab) < 1e-9) or abs(e[0]) < 1e-12:
+        return None
+    mode = _mode_of(e[0], [*np.sign(s_ab), s_c])
+    ee = e / np.linalg.norm(e)
+    u = at.orientation_from_axis(2.0 * ee[0] * ee - np.array([1.0, 0.0, 0.0]))
+    # q_C1 straight from E (eqs 98, 102 on the side s_c), not through u: near the flip u -> E is ill-conditioned
+    c2 = (g.ce[2] * e[2] - g.se[2] * e[1]) / g.dsa
+    if not abs(c2) < 1.0:
+        return None
+    s2sa = s_c * math.sqrt(1.0 - c2 * c2) * g.sa
+    w = -(g.ce[2] * e[1] + g.se[2] * e[2])
+    qc = math.atan2(g.k * e[0] + s2sa * w, -s2sa * e[0] + g.k * w)
+    return (float(u[0]), float(u[1])), mode, qc
+
+
+motor = st.one_of(st.floats(-math.pi, math.pi), st.sampled_from([-math.pi, math.pi, 0.0, math.pi / 2, -math.pi / 2]))
+
+
+@settings(max_examples=200, deadline=None)
+@example(qa=0.0, qb=6.103515625e-05, branch=1.0, s_c=-1.0, alpha=math.pi / 3)  # flip and boundary at once
+@example(qa=0.0, qb=6.103515625e-05, branch=-1.0, s_c=-1.0, alpha=math.pi / 3)
+@example(qa=0.0, qb=0.0, branch=-1.0, s_c=-1.0, alpha=math.pi / 3)  # on the flip (1 + c_y c_z = 1.8e-15)
+@example(qa=0.0, qb=1e-05, branch=-1.0, s_c=-1.0, alpha=math.pi / 3)  # leg B on its boundary, next to the flip
+@example(qa=1e-06, qb=1e-06, branch=1.0, s_c=-1.0, alpha=math.pi / 3)  # where the boundary meets the flip
+@example(qa=0.0, qb=1e-06, branch=1.0, s_c=-1.0, alpha=math.pi / 3)
+@example(qa=0.0, qb=-4.5661120220129836e-07, branch=-1.0, s_c=-1.0, alpha=math.pi / 3)
+@given(qa=motor, qb=motor, branch=st.sampled_from([-1.0, 1.0]), s_c=st.sampled_from([-1.0, 1.0]), alpha=st.sampled_from(ALPHAS))
+def test_contract_fk_from_in_limit_motors(qa, qb, branch, s_c, alpha):
+    """(b) and (d): fk of the motors of a closed configuration in the joint limits, in its mode, is a pose that ik
+    solves in that mode and whose motors it gives back; the default fk refuses motors of another mode with
+    AssemblyModeError naming it (mask False in a batch)."""
+    made = _configuration_from_motors(qa, qb, branch, s_c, alpha)
+    if made is None:
+        return
+    u, mode, qc = made
+    try:
+        y, z, inc = at.fk(qa, qb, qc, alpha=alpha, mode=mode)
+    except (SingularityError, UnreachableError) as exc:  # the guards, the flip, a boundary: refused by ik as well
+        assert not isinstance(exc, legkin.AssemblyModeError)
+        _, ok = at.ik(np.array([u[0]]), np.array([u[1]]), alpha=alpha, mode=mode, return_mask=True)
+        assert not ok[0], exc
+        return
+    assert ct.pose_error(u[0], u[1], y, z) <= CONTRACT_TOL
+    q = at.ik(y, z, alpha=alpha, mode=mode)  # (b): solved (its motors may differ from qa, qb, qc by more than
+    # 1e-9 where a leg is near its boundary: the motors are ill-conditioned functions of the pose there), and (a):
+    assert ct.pose_error(y, z, *at.fk(q[0], q[4], q[8], alpha=alpha, mode=mode)[:2]) <= CONTRACT_TOL
+    _, _, _, ok = at.fk(np.array([qa]), np.array([qb]), np.array([qc]), alpha=alpha, return_mask=True)
+    if mode == at.HOME_MODE:
+        assert ok[0] and np.array_equal(at.fk(qa, qb, qc, alpha=alpha)[0], y)
+    else:
+        assert not ok[0]
+        with pytest.raises(legkin.AssemblyModeError) as exc:
+            at.fk(qa, qb, qc, alpha=alpha)
+        assert {"mode": mode} in exc.value.modes
+
+
+@functools.cache
+def det_curves(alpha):
+    """Points on the actuation-singular curves det M = 0 (home motors): zeros along lines of constant alpha_z
+    and of constant alpha_y (at alpha = pi/2 det M vanishes on the lines alpha_z = +-pi/2, where two motors sit
+    at -pi/2 and their planes coincide)."""
+    pts = [(float(y), float(z)) for z in np.linspace(-math.pi, math.pi, 24)
+           for y in _det_zeros(alpha, np.linspace(-np.pi / 2, np.pi / 2, 201), z, True)]
+    pts += [(float(y), float(z)) for y in np.linspace(-1.5, 1.5, 24)
+            for z in _det_zeros(alpha, np.linspace(-np.pi, np.pi, 401), y, False)]
+    return pts
+
+
+def _orientation(kind, alpha, a, b, phi, log_small, sign, index):
+    if kind == "box":
+        return (math.pi / 2 + 0.3) * a, (math.pi + 0.3) * b
+    if kind == "far":
+        return 20.0 * a, 20.0 * b
+    if kind == "flip":  # 1 + c_y c_z = 10**log_small
+        return tuple(float(v) for v in _tilt_u(math.acos(10.0**log_small - 1.0), phi))
+    if kind == "boundary":  # some leg a hair inside / outside its boundary: 1 - |cos q_K2| = sign 10**log_small
+        k = index % 3
+        sk = abs(math.sin(phi - at.ETA[k]))
+        arg = (1.0 - sign * 10.0**log_small) * math.cos(alpha / 2) / max(sk, 1e-300)
+        return tuple(float(v) for v in _tilt_u(2.0 * math.asin(min(arg, 1.0)), phi))
+    pts = det_curves(alpha)
+    y, z = pts[index % len(pts)]
+    off = 10.0 ** (log_small / 1.4)
+    return y + off * a, z + off * b
+
+
+@settings(max_examples=400, deadline=None)
+@given(
+    kind=st.sampled_from(["box", "far", "flip", "boundary", "det"]),
+    alpha=st.sampled_from(ALPHAS),
+    a=st.floats(-1, 1), b=st.floats(-1, 1), phi=st.floats(-math.pi, math.pi),
+    log_small=st.floats(-16, -2), sign=st.sampled_from([-1.0, 1.0]), index=st.integers(0, 10**6),
+    mode=st.sampled_from([at.HOME_MODE, at.HOME_MODE] + list(at.MODES[1:])),
+)
+def test_contract_random_orientations(kind, alpha, a, b, phi, log_small, sign, index, mode):
+    """(a), (c): whatever the orientation (in and around the workspace, near the flip, a hair from a leg's
+    boundary, on and next to the actuation-singular curves), ik either raises a legkin error or returns joints in
+    the limits whose motors fk (same mode, default options) maps back to the orientation within 1e-9 rad; the
+    batch call agrees item by item."""
+    ay, az = _orientation(kind, alpha, a, b, phi, log_small, sign, index)
+    try:
+        q = at.ik(ay, az, alpha=alpha, mode=mode)
+    except (UnreachableError, SingularityError):
+        q = None
+    qb, ok = at.ik(np.array([ay, ay]), np.array([az, az]), alpha=alpha, mode=mode, return_mask=True)
+    if q is None:
+        assert not ok.any() and np.isnan(qb).all()
+        return
+    assert ok.all() and np.array_equal(qb[0], q)
+    assert np.all(np.abs(q) <= math.pi)  # the URDF limits of every joint
+    y, z, inc = at.fk(q[0], q[4], q[8], alpha=alpha, mode=mode)
+    assert ct.pose_error(ay, az, y, z) <= CONTRACT_TOL
+    at.ik(y, z, alpha=alpha, mode=mode)  # and fk's answer is solved by ik (b)
+
+
+finite = st.floats(allow_nan=False, allow_infinity=False)
+
+
+@settings(max_examples=100, deadline=None)
+@given(u=st.tuples(finite, finite), m=st.tuples(finite, finite, finite), mode=st.sampled_from(at.MODES),
+       alpha=st.sampled_from(ALPHAS))
+def test_no_foreign_exception_or_warning_on_any_finite_input(u, m, mode, alpha):
+    """Huge, tiny or odd finite inputs: only legkin errors, no numpy exception or warning."""
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        calls = [
+            lambda: at.ik(*u, alpha=alpha, mode=mode),
+            lambda: at.ik(*u, alpha=alpha, mode="all"),
+            lambda: at.actuation_jacobian(*u, alpha=alpha, mode=mode),
+            lambda: at.fk(*m, alpha=alpha, mode=mode),
+            lambda: at.fk(*m, alpha=alpha, max_inconsistency=np.inf),
+            lambda: at.platform_position(*u, alpha=alpha),
+            lambda: at.platform_rotation(*u),
+            lambda: at.orientation_from_axis(m),
+            lambda: at.leg_transform(np.array([*m, u[0]]), u[1], alpha=alpha),
+            lambda: at.leg_transform_cv(m[0], m[1], m[2], alpha=alpha),
+        ]
+        for call in calls:
+            try:
+                call()
+            except legkin.LegkinError:
+                pass
+        for call in (
+            lambda: at.ik(np.array([u[0], 0.1]), np.array([u[1], 0.2]), alpha=alpha, mode=mode, return_mask=True),
+            lambda: at.fk(np.array([m[0], 0.1]), np.array([m[1], 0.2]), np.array([m[2], 0.3]), alpha=alpha,
+                          mode=mode, return_mask=True),
+        ):
+            out = call()
+            assert out[-1].shape == (2,)
+
+
+def test_ik_robustness_row_passes():
+    import time
+
+    t0 = time.perf_counter()
+    row = ct.ik_robustness(10_000, np.random.default_rng(3))
+    assert row.passed, row.name
+    assert row.counts.made == 5000 and row.counts.wrong == 0 and row.counts.missed == 0
+    assert row.counts.exceptions == 0 and row.max_error <= 1e-9
+    assert time.perf_counter() - t0 < 10

@@ -55,6 +55,7 @@ __all__ = [
     "MODES",
     "HOME_MODE",
     "DET_GUARD",
+    "GAIN_GUARD",
 ]
 
 LEGS = ("A", "B", "C")
@@ -78,6 +79,13 @@ HOME_MODE = "-+++"
 #: to ~2e-16 / |det M| rad, and on det M = 0 they fit two poses (the planes share a line that cuts the sphere
 #: |E| = L twice; at tangency the two merge and A_u loses rank): fk could not reproduce ik's answers to 1e-9.
 DET_GUARD = 1e-6
+#: Motor-gain guard: :func:`ik` and :func:`fk` refuse poses where ``|A_u|_F > GAIN_GUARD``. The motors are then so
+#: sensitive to the orientation that its float representation fixes them only to ~ulp |A_u| > 1e-8 rad and the
+#: Gauss-Newton of fk stalls on that noise. |A_u|_F <= sqrt(3/2) / (min_K |sin q_K2| sqrt(1 + c_y c_z)) (measured),
+#: so this happens only where a leg is within ~1e-5 of its boundary next to the flip: near the points where the
+#: workspace boundary meets the flip (alpha <= pi/3, e.g. six directions at the default alpha). Away from them
+#: |A_u|_F stays below ~1e8 down to the singular tolerances (measured max 8e7 at alpha = pi/4).
+GAIN_GUARD = 1e8
 
 
 # ------------------------------------------------------------------------------------------ helpers
@@ -397,7 +405,7 @@ def _one_plus_cc(cy, sy, cz, sz):
     """
     p = cy * cz
     out = 1.0 + p
-    near = p < -0.5
+    near = np.asarray(p < -0.5)
     if near.any():
         pos = cy >= 0.0
         a, b = np.where(pos, cy, cz), np.where(pos, cz, cy)
@@ -527,21 +535,47 @@ def _checked_u(alpha_y, alpha_z, d, alpha, eta):
     return ay, az, (np.cos(yc), np.sin(yc), np.cos(zc), np.sin(zc)), _geometry(d, alpha, eta_arr)
 
 
+def _motor_gain(trig, c2, s2, nb2, g: _Geometry, signs) -> np.ndarray:
+    """|A_u|_F (...), from the cheap bound sqrt(3/2) / (min |sin q_K2| sqrt(1 + c_y c_z)) (measured to hold, with
+    1.3 for sqrt(3/2)), and exactly where that bound exceeds :data:`GAIN_GUARD`."""
+    gain = 1.3 / (np.minimum.reduce(np.abs(s2), axis=-1) * np.sqrt(nb2[..., 0]))
+    near = gain > GAIN_GUARD
+    if near.any():
+        sub = tuple(np.broadcast_to(t, nb2.shape)[near] for t in trig)
+        if signs is None:
+            a1, a2 = _jac_eval(*sub, s2[near], nb2[near], g)
+        else:
+            a1, a2 = _jac_general(*sub, c2[near], s2[near], nb2[near], g, signs[0])
+        gain = np.array(gain, dtype=float)
+        gain[near] = np.sqrt(np.add.reduce(a1 * a1 + a2 * a2, axis=-1))
+    return gain
+
+
 def _ik_mode(trig, g: _Geometry, mode: str):
-    """Unchecked :func:`ik` in one mode: joints (..., 12) (NaN where not ok), ok, cos q_K2, 1 + c_y c_z, det M."""
-    with np.errstate(invalid="ignore", divide="ignore"):
-        q1, q2, c2, _, nb2, sn, cn = _ik_eval(*trig, g, _mode_signs(mode), with_sc=True)
+    """Unchecked :func:`ik` in one mode: joints (..., 12) (NaN where not ok), ok, cos q_K2, 1 + c_y c_z, det M,
+    motor gain |A_u|_F (exact only where large)."""
+    signs = _mode_signs(mode)
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        q1, q2, c2, s2, nb2, sn, cn = _ik_eval(*trig, g, signs, with_sc=True)
         det = _det_planes(sn, cn, g)
-        ok = _inside(c2, nb2)[..., 0] & (np.abs(det) >= DET_GUARD)
+        inside = _inside(c2, nb2)[..., 0]
+        gain = _motor_gain(trig, c2, s2, np.where(inside[..., None], nb2, 1.0), g, signs)
+        ok = inside & (np.abs(det) >= DET_GUARD) & (gain <= GAIN_GUARD)
     out = np.where(ok[..., None, None], np.stack([q1, q2, q2, q1], axis=-1), np.nan).reshape(ok.shape + (12,))
-    return out, ok, c2, nb2, det
+    return out, ok, c2, nb2, det, gain
 
 
-def _ik_single_error(ay, az, trig, g: _Geometry, mode: str, c2, nb2, det) -> Exception:
+def _ik_single_error(ay, az, trig, g: _Geometry, mode: str, c2, nb2, det, gain) -> Exception:
     sing, unreachable, leg_sing = _ik_status(c2, nb2[..., 0])
     if sing or unreachable.any() or leg_sing.any():
         return _ik_error(ay, az, c2, sing, unreachable, leg_sing)
     others = [m for m in MODES if m != mode and bool(_ik_mode(trig, g, m)[1])]
+    if not gain <= GAIN_GUARD:
+        return SingularityError(
+            f"(alpha_y, alpha_z) = ({float(ay):.17g}, {float(az):.17g}): its motors are too sensitive to the "
+            f"orientation (|A_u| = {float(gain):.3g} > GAIN_GUARD = {GAIN_GUARD:g}: a leg next to its boundary near "
+            "the flip); the float orientation fixes them only to ~1e-16 |A_u| rad and fk could not reproduce it"
+        )
     return SingularityError(
         f"(alpha_y, alpha_z) = ({float(ay):.17g}, {float(az):.17g}) is an actuation singularity in mode {mode}: "
         f"its motor planes have |det M| = {abs(float(det)):.3g} < DET_GUARD = {DET_GUARD:g}, so the motor angles "
@@ -601,10 +635,12 @@ def ik(
         res = [_ik_mode(trig, g, m) for m in MODES]
         out, ok = np.stack([r[0] for r in res], axis=-2), np.stack([r[1] for r in res], axis=-1)
         if ay.ndim == 0 and not ok.any():
-            raise _ik_single_error(ay, az, trig, g, HOME_MODE, *res[0][2:])
+            raise _ik_single_error(ay, az, trig, g, HOME_MODE, *res[0][2:])  # c2, nb2, det, gain
         return (out, ok) if return_mask else out
-    out, ok, c2, nb2, det = _ik_mode(trig, g, mode)
-    return finish(out, ok, ay.ndim == 0, return_mask, lambda: _ik_single_error(ay, az, trig, g, mode, c2, nb2, det))
+    out, ok, c2, nb2, det, gain = _ik_mode(trig, g, mode)
+    return finish(
+        out, ok, ay.ndim == 0, return_mask, lambda: _ik_single_error(ay, az, trig, g, mode, c2, nb2, det, gain)
+    )
 
 
 def _jac_eval(cy, sy, cz, sz, s2, nb2, g: _Geometry) -> tuple[np.ndarray, np.ndarray]:
@@ -681,6 +717,11 @@ def actuation_jacobian(
 PLANES_DET_MIN = 1e-8
 #: Relative singular-value cut-off of the Gauss-Newton step (that of ``np.linalg.pinv(A_u, rcond=1e-12)``).
 STEP_RCOND = 1e-12
+#: fk's consistency test accepts ``inconsistency <= max_inconsistency + ROUNDING_FLOOR |A_u|_F``: a pose stored in
+#: floats (|u| <= pi, ulp <= 4.4e-16) reproduces its own motors only to ~ulp |A_u|, which exceeds 1e-9 rad
+#: where |A_u| is huge (a leg within ~1e-5 of its boundary sin q_K2 = 0 next to the flip: |A_u| ~ 1e9).
+#: Elsewhere (|A_u| <= ~1e3) the allowance is below 3e-12 rad.
+ROUNDING_FLOOR = 4.0 * math.pi * 2.0**-52
 
 
 def _initial_guess(qm: np.ndarray, g: _Geometry, with_det: bool = False):
@@ -770,7 +811,8 @@ def _shrunk(ay: np.ndarray, az: np.ndarray, f: float) -> tuple[np.ndarray, np.nd
 
 
 def _normal_residual(a1: np.ndarray, a2: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """|r - A A^+ r| for ``A = [a1 a2]`` (n, 3, 2) given as its columns: the part of r off the range of A, (n, 1).
+    """|r - A A^+ r| for ``A = [a1 a2]`` (n, 3, 2) given as its columns: the part of r off the range of A, (n, 1);
+    and |A|_F (n, 1).
 
     Rank 2: ``|r . n| / |n|`` with ``n = a1 x a2``; where ``sigma_2 <= STEP_RCOND sigma_1`` (as in
     :func:`_gauss_newton_step`) the rank-1 projection ``A A^T r / |A|_F^2``.
@@ -784,7 +826,7 @@ def _normal_residual(a1: np.ndarray, a2: np.ndarray, r: np.ndarray) -> np.ndarra
         fs = np.where(f > 0, f, 1.0)
         p = r - (a1 * np.add.reduce(a1 * r, axis=-1, keepdims=True) + a2 * np.add.reduce(a2 * r, axis=-1, keepdims=True)) / fs
         out = np.where(rank1, np.sqrt(np.add.reduce(p * p, axis=-1, keepdims=True)), out)
-    return out
+    return out, np.sqrt(f)
 
 
 def _fk_core(qm: np.ndarray, g: _Geometry, tol: float, max_iter: int, signs=None, det_out=None):
@@ -796,8 +838,10 @@ def _fk_core(qm: np.ndarray, g: _Geometry, tol: float, max_iter: int, signs=None
     pulled in towards home by shrinking its tilt by 1e-12, 1e-10, ... (the workspace is star-shaped about home).
 
     Returns:
-        alpha_y, alpha_z, inconsistency, converged, active, inside: (n, 1) each; ``inside``: the :func:`ik`
-        success test (:func:`_inside`) at the reported pose. ``det_out`` (a list), if given, receives det M.
+        alpha_y, alpha_z, inconsistency, converged, active, inside, floor: (n, 1) each; ``inside``: the
+        :func:`ik` success test (:func:`_inside`) at the reported pose; ``floor``: the inconsistency that the
+        rounding of the pose alone can cause (:data:`ROUNDING_FLOOR` |A_u|_F). ``det_out`` (a list), if given,
+        receives det M.
     """
     ay, az, det = _initial_guess(qm, g, with_det=True)
     if det_out is not None:
@@ -832,25 +876,30 @@ def _fk_core(qm: np.ndarray, g: _Geometry, tol: float, max_iter: int, signs=None
             a1, a2 = _jac_general(cy, sy, cz, sz, c2, s2, nb2, g, signs[0])
         stalled = rn >= rn_prev  # no progress: at the (least-squares) minimum to rounding
         rn_prev = np.where(work, rn, rn_prev)
+        # at the rounding floor (|r| no larger than the rounding of u alone can make it) the pose is as good as
+        # the motors can tell: no step (a step would only add the noise of r, amplified by pinv(A_u))
+        at_floor = rn <= ROUNDING_FLOOR * np.sqrt(np.add.reduce(a1 * a1 + a2 * a2, axis=-1, keepdims=True))
         s0, s1 = _gauss_newton_step(a1, a2, r)
         # converged when the step, or its effect on the motors (the step is ill-determined near the
         # parametrisation singularity c_y = 0 and near 1 + c_y c_z = 0), is below tol
         motor_step = np.maximum.reduce(np.abs(a1 * s0 + a2 * s1), axis=-1, keepdims=True)
-        small = (np.maximum(np.abs(s0), np.abs(s1)) <= tol) | (motor_step <= tol) | stalled
+        small = (np.maximum(np.abs(s0), np.abs(s1)) <= tol) | (motor_step <= tol) | stalled | at_floor
         py, pz = np.where(work, ay, py), np.where(work, az, pz)
-        ay = np.where(work, ay + s0, ay)
-        az = np.where(work, az + s1, az)
+        move = work & ~at_floor
+        ay = np.where(move, ay + s0, ay)
+        az = np.where(move, az + s1, az)
         converged |= work & small
         if (converged | ~active).all():
             break
     active &= np.isfinite(py)
     # the inconsistency uses the last A_u evaluated (at most a step of size <= tol away): its range is what matters
-    ay, az, inconsistency, inside = _fk_report(ay, az, qm, g, signs, a1, a2)
-    if (converged & ~inside).any():  # the last (tiny) step left the workspace: report the iterate before it
+    rep = _fk_report(ay, az, qm, g, signs, a1, a2)
+    if (converged & ~rep[3]).any():  # the last (tiny) step left the workspace: report the iterate before it
         alt = _fk_report(py, pz, qm, g, signs, a1, a2)
-        use = converged & ~inside & alt[3]
-        ay, az, inconsistency, inside = (np.where(use, a, b) for a, b in zip(alt, (ay, az, inconsistency, inside)))
-    return ay, az, inconsistency, converged, active, inside
+        use = converged & ~rep[3] & alt[3]
+        rep = tuple(np.where(use, a, b) for a, b in zip(alt, rep))
+    ay, az, inconsistency, inside, floor = rep
+    return ay, az, inconsistency, converged, active, inside, floor
 
 
 def _fk_report(ay, az, qm, g: _Geometry, signs, a1, a2):
@@ -865,23 +914,26 @@ def _fk_report(ay, az, qm, g: _Geometry, signs, a1, a2):
     ay = _wrap(np.where(flip, np.pi - ay, ay))
     az = _wrap(np.where(flip, az + np.pi, az))
     q1, _, c2, _, nb2 = _ik_eval(np.cos(ay), np.sin(ay), np.cos(az), np.sin(az), g, signs)
-    return ay, az, _normal_residual(a1, a2, _wrap(q1 - qm)), _inside(c2, nb2)
+    inconsistency, norm_a = _normal_residual(a1, a2, _wrap(q1 - qm))
+    return ay, az, inconsistency, _inside(c2, nb2), ROUNDING_FLOOR * norm_a
 
 
 def _fk_mode(qm: np.ndarray, g: _Geometry, tol: float, max_iter: int, max_inconsistency: float, mode: str):
     """:func:`fk` on motors (n, 3) in one mode: alpha_y, alpha_z, inconsistency (n,), ok (n,), status (n,)
-    (0 ok, 1 actuation singular, 2 left the workspace, 3 not converged, 4 inconsistent, 5 ended outside)."""
+    (0 ok, 1 actuation singular, 2 left the workspace, 3 not converged, 4 inconsistent, 5 ended outside,
+    6 motor gain above GAIN_GUARD)."""
     dets = []
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        ay, az, inc, converged, active, inside = (
+        ay, az, inc, converged, active, inside, floor = (
             a[:, 0] for a in _fk_core(qm, g, tol, max_iter, _mode_signs(mode), dets)
         )
-        consistent = inc <= max_inconsistency
+        consistent = inc <= max_inconsistency + floor
+        tame = floor <= ROUNDING_FLOOR * GAIN_GUARD  # |A_u|_F <= GAIN_GUARD (at the last iterate)
     regular = np.abs(dets[0]) >= DET_GUARD
-    ok = regular & active & converged & consistent & inside
+    ok = regular & active & converged & consistent & inside & tame
     if ok.all():
         return ay, az, inc, ok, np.zeros(ok.shape, dtype=int)
-    status = np.select([~regular, ~active, ~converged, ~consistent, ~inside], [1, 2, 3, 4, 5], default=0)
+    status = np.select([~regular, ~active, ~converged, ~inside, ~tame, ~consistent], [1, 2, 3, 5, 6, 4], default=0)
     return ay, az, inc, ok, status
 
 
@@ -972,20 +1024,40 @@ def fk(
             np.where(ok, np.stack([r[k] for r in res], axis=-1).reshape(ok.shape), np.nan) for k in range(3)
         )
         if a1.ndim == 0 and not ok.any():
-            raise _fk_error(motors(), qm, res[0], HOME_MODE, [], max_iter, max_inconsistency)
+            raise _fk_error(motors(), qm, res[0], HOME_MODE, [], max_iter, max_inconsistency, g)
         return (*outs, ok) if return_mask else outs
     ay, az, inconsistency, ok, status = solve(mode)
     nan = np.where(ok, 0.0, np.nan)
 
     def error() -> Exception:
-        others = [m for m in MODES if m != mode and bool(solve(m)[3][0])] if status[0] != 1 else []
-        return _fk_error(motors(), qm, (ay, az, inconsistency, ok, status), mode, others, max_iter, max_inconsistency)
+        others = []
+        if status[0] != 1:  # consistent motors fit the mode their planes' intersection E points to
+            likely = _motor_mode(qm[0], g)
+            for m in [likely] if likely else MODES:
+                if m != mode and bool(solve(m)[3][0]):
+                    others.append(m)
+                    break
+        return _fk_error(motors(), qm, (ay, az, inconsistency, ok, status), mode, others, max_iter, max_inconsistency, g)
 
     out = tuple(v.reshape(shape) + nan.reshape(shape) for v in (ay, az, inconsistency))
     return finish(out, ok.reshape(shape), a1.ndim == 0, return_mask, error)
 
 
-def _fk_error(motors: str, qm, res, mode: str, others, max_iter: int, max_inconsistency: float) -> Exception:
+def _motor_mode(qm: np.ndarray, g: _Geometry) -> str | None:
+    """The assembly mode of motors (3,) read off their planes: E = d (1 - c_alpha) M^-1 (1, 1, 1) (None if M is
+    singular): the side of E_x, and per leg the sign of sin q_K2 sin(alpha) = c_K1 h1 + s_K1 h2 with
+    (h1, h2) = (-x, -(c_K y + s_K z)) / d (the leg's position equations, eq 101)."""
+    s, c = np.sin(qm), np.cos(qm)
+    m = np.stack([s, -c * g.ce, -c * g.se], axis=-1)
+    try:
+        e = np.linalg.solve(m, np.full(3, g.d * g.k))
+    except np.linalg.LinAlgError:
+        return None
+    s2 = c * (-e[0] / g.d) + s * (-(g.ce * e[1] + g.se * e[2]) / g.d)
+    return ("-" if e[0] < 0 else "+") + "".join("-" if v < 0 else "+" for v in s2)
+
+
+def _fk_error(motors: str, qm, res, mode: str, others, max_iter: int, max_inconsistency: float, g) -> Exception:
     """The exception of a failed single :func:`fk` call (``res`` from :func:`_fk_mode` on one item)."""
     ay, az, inconsistency, _, status = (float(np.ravel(v)[0]) for v in res)
     target = qm.reshape(3).copy()
@@ -999,10 +1071,22 @@ def _fk_error(motors: str, qm, res, mode: str, others, max_iter: int, max_incons
             f"{motors} are an actuation singularity: their planes have |det M| < DET_GUARD = {DET_GUARD:g} "
             "(nearly sharing a line): the motor angles do not determine the pose"
         )
-    if status == 2:
+    if status == 2:  # diagnose at the planes' intersection (the start), as ik would there
+        with np.errstate(invalid="ignore", divide="ignore"):
+            y0, z0 = (v.ravel()[:1] for v in _initial_guess(qm.reshape(1, 3), g))
+        trig = tuple(f(v)[..., None] for v in (y0, z0) for f in (np.cos, np.sin))
+        res0 = _ik_mode(trig, g, mode)
+        if not res0[1][0]:
+            exc = _ik_single_error(y0[0], z0[0], tuple(t[0] for t in trig), g, mode, *(r[0] for r in res0[2:]))
+            return type(exc)(f"{motors}: no pose found; their planes meet at {exc}", *exc.args[1:])
         return UnreachableError(f"{motors}: the solver left the workspace; no pose was found", target=target)
     if status == 3:
         return ConvergenceError(f"{motors}: Gauss-Newton did not converge in {max_iter} iterations (singular A_u?)")
+    if status == 6:
+        return SingularityError(
+            f"{motors}: at the pose (alpha_y, alpha_z) = ({ay:.17g}, {az:.17g}) the motors are too sensitive to the "
+            f"orientation (|A_u| > GAIN_GUARD = {GAIN_GUARD:g}: a leg next to its boundary near the flip)"
+        )
     if status == 5:
         return SingularityError(
             f"{motors}: the pose (alpha_y, alpha_z) = ({ay:.17g}, {az:.17g}) is on the workspace boundary or the "

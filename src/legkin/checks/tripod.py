@@ -291,8 +291,9 @@ def made_targets(n: int, rng: np.random.Generator, alpha: float = at.ALPHA) -> t
 
     Motors q_A1, q_B1 uniform in the joint limits [-pi, pi]; E on both motor planes and the sphere |E| = L (a
     line cut by a sphere: zero or two points, see :func:`legkin.analytic.tripod._initial_guess`); for the points
-    in the home mode's half (E_x < 0, sin q_A2, sin q_B2 > 0), q_C1 from leg C on its home branch; the target
-    is ``fk(q_A1, q_B1, q_C1)`` with default options, kept where fk solves it (so about 15 % of the pairs).
+    in the home mode's half (E_x < 0, sin q_A2, sin q_B2 > 0) that leg C reaches, q_C1 from leg C on its home
+    branch (eqs 98, 102 at E); the target is ``fk(q_A1, q_B1, q_C1)`` with default options, kept where fk
+    solves it.
     """
     g = at._geometry(at.D, alpha, np.asarray(at.ETA))
     ce, se, dk, big_l = g.ce, g.se, g.d * g.k, -g.minus_l
@@ -314,13 +315,15 @@ def made_targets(n: int, rng: np.random.Generator, alpha: float = at.ALPHA) -> t
             e = p0 + (sign * t)[:, None] * v
             h1, h2 = -e[:, 0] / g.d, -(ce[:2, None] * e[:, 1] + se[:2, None] * e[:, 2]).T / g.d
             s2sa = c * h1[:, None] + s * h2  # sin q_K2 sin(alpha) of legs A and B at E
-            home = keep & (e[:, 0] < 0) & np.all(s2sa > 0, axis=-1)
-            ee = e[home] / big_l
-            r = 2.0 * ee[:, :1] * ee - np.array([1.0, 0.0, 0.0])
-            ay, az = at.orientation_from_axis(r)
-            qc, ok = at.ik(ay, az, alpha=alpha, return_mask=True)
-            qa, qb = q[home][ok], qc[ok]
-            y, z, _, solved = at.fk(qa[:, 0], qa[:, 1], qb[:, 8], alpha=alpha, return_mask=True)
+            # q_C1 from E on leg C's home branch (eqs 98, 102; straight from E, not through the orientation)
+            c2 = (ce[2] * e[:, 2] - se[2] * e[:, 1]) / g.dsa
+            home = keep & (e[:, 0] < 0) & np.all(s2sa > 0, axis=-1) & (np.abs(c2) < 1.0)
+            e, c2 = e[home], c2[home]
+            sc = np.sqrt(1.0 - c2 * c2) * g.sa
+            w = -(ce[2] * e[:, 1] + se[2] * e[:, 2])
+            qc = np.arctan2(g.k * e[:, 0] + sc * w, -sc * e[:, 0] + g.k * w)
+            qa = q[home]
+            y, z, _, solved = at.fk(qa[:, 0], qa[:, 1], qc, alpha=alpha, return_mask=True)
             ys.append(y[solved])
             zs.append(z[solved])
             total += int(solved.sum())

@@ -186,6 +186,7 @@ workspace = st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.1))
 
 @settings(max_examples=150, deadline=None)
 @given(workspace)
+@example((2.220446049250313e-16, 0.0))  # mirror-symmetric motors: roll = 0 is a double root of the FK polynomial
 def test_motor_angles_platform_orientation_round_trip(x):
     roll, pitch = x
     assume(_in_mode(roll, pitch))
@@ -212,6 +213,7 @@ def test_platform_orientation_near_forward_singularity(roll, log_dist):
 
 @settings(max_examples=60, deadline=None)
 @given(st.floats(-math.pi, math.pi), st.floats(-1.0, 1.0))
+@example(0.0, 0.0)  # failed with a reach tolerance of 1e-12 (rod-length error 1.2e-13 m)
 def test_motor_angles_at_reach_boundary(direction, log_gap):
     """Points just inside the reach boundary (|k| -> 1) still close the loops to 1e-15 m."""
     lo, hi = 0.0, 3.0
@@ -505,6 +507,20 @@ def test_motor_reach_boundary_targets_made_by_fk_are_solved():
     assert np.linalg.norm(ah.foot_position(*sol.T) - p[made], axis=-1).max() < REPRO
 
 
+@pytest.mark.parametrize("p", [
+    (0.35932548361747274, 0.052945636996343165, 0.12838996243829895),
+    (3.017622853706293, -0.55479095007595769, 1.4202339468074257),
+    (0.39687424261991033, 0.033343663692197233, 0.049344277550207906),
+    (3.0737579217644839, 0.65394394635417552, 1.257130052827369),
+])
+def test_fk_made_at_the_aspect_edge(p):
+    """FK-made targets (ik_robustness, 10^5 run) whose pose lies on the neutral aspect's reach boundary: the IK's
+    pose, computed from the foot, exceeded |k| = 1 by 1e-14..1e-13 and was refused."""
+    p = np.array(p)
+    m = ah.foot_ik(p)
+    assert np.linalg.norm(ah.foot_position(*m) - p) < REPRO
+
+
 def test_unreachable_arc_message_is_consistent():
     """Defect 2: the message said '3.14042 m from the centre; the arc reaches [0.140417, 3.14042] m'."""
     hi = ah._LL0 + ah._H
@@ -793,6 +809,7 @@ def _build(case):
 @example(("fold", 0.0, -10.0, 0.0))  # forward-singularity band
 @example(("box", 0.3, 0.0, 0.0))  # exactly on the roll axis, no roll of 0 / pi in the mode
 @example(("box", 0.0, 0.0, 0.0))  # the centre
+@example(("axis", 0.0, -0.5, -1.0))  # AssemblyModeError whose valid modes include branch (1, 1), assembly -1
 def test_ik_contract_property(case):
     p, made = _build(case)
     try:

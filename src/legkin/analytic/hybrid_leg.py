@@ -14,7 +14,11 @@ Conventions (closed-chain frame ``CCS``; metres, radians):
   equation (R_P = I at theta1 = -theta2 = -82.217 deg);
 * open sub-chain (eqs 17, 18, 20): joint ``LL`` at :data:`LL_ORIGIN` in P, ``Ry(theta_LL)``, foot ``FCS`` at
   ``(FOOT_X, 0, 0)`` in the LL frame; ``theta_LL = -RATIO * theta0 + starting_value`` (eq 19 without its
-  OCR artefact) with ``theta0`` the leg-extension motor angle.
+  OCR artefact) with ``theta0`` the leg-extension motor angle;
+* assembly modes: the forward kinematics (:func:`platform_orientation`, :func:`foot_position`,
+  :func:`foot_jacobian`) and the IK (:func:`foot_ik`) take ``branch`` and ``assembly`` (:func:`assembly_mode`),
+  by default ``(1, 1)`` and ``+1``, the mode of the SRDF reference pose ``neutral``; the IK-only branches
+  ``ll_branch``, ``roll_branch`` are searched in :data:`FOOT_IK_ORDER` (docs/hybrid_leg.md, "IK contract").
 
 Every function takes arrays with leading batch dimensions. A single input (the core shape exactly)
 returns plain arrays and raises on failure; a batch returns NaN where an item fails, and
@@ -167,7 +171,7 @@ def _wrap(a):
     return np.pi - np.mod(np.pi - a, 2.0 * np.pi)
 
 
-class _ArgumentError(InvalidParameterError, InvalidInputError):
+class InvalidArgumentError(InvalidParameterError, InvalidInputError):
     """A keyword argument of the wrong kind or out of range.
 
     Both an :class:`InvalidParameterError` and an :class:`InvalidInputError` (hence a ``ValueError``).
@@ -203,7 +207,7 @@ def _check_branch(branch) -> np.ndarray:
         if raw is not None and raw.dtype.kind in "iuf" and raw.shape == (2,) and np.all(np.abs(raw) == 1):
             b = raw.astype(float)
     if b is None:
-        raise _ArgumentError(
+        raise InvalidArgumentError(
             f"branch must be one of {', '.join(map(str, MOTOR_BRANCHES))} (b1, b2: the motor branch of each chain), "
             f"got {branch!r}"
         )
@@ -217,13 +221,13 @@ def _check_sign(value, name: str, allow_none: bool = False):
     if _is_real(value) and value in (1, -1):
         return float(value)
     valid = "+1 or -1" + (" (or None: try both, see FOOT_IK_ORDER)" if allow_none else "")
-    raise _ArgumentError(f"{name} must be {valid}, got {value!r}")
+    raise InvalidArgumentError(f"{name} must be {valid}, got {value!r}")
 
 
 def _check_assembly(value) -> float:
     if _is_real(value) and value in (1, -1):
         return float(value)
-    raise _ArgumentError(
+    raise InvalidArgumentError(
         f"assembly must be +1 (the assembly mode of the neutral pose, R_P = I, on the given branch) or -1 (the other "
         f"sign of det(dtheta/d(roll, pitch))), got {value!r}"
     )
@@ -232,7 +236,7 @@ def _check_assembly(value) -> float:
 def _check_offset(starting_value) -> float:
     x = _to_float(starting_value)
     if not (math.isfinite(x) and abs(x) <= math.pi):
-        raise _ArgumentError(
+        raise InvalidArgumentError(
             f"starting_value must be a finite real number in [-pi, pi] rad (the LL zero offset of eq 19, the xacro "
             f"argument's range), got {starting_value!r}"
         )
@@ -241,20 +245,20 @@ def _check_offset(starting_value) -> float:
 
 def _check_flag(value, name: str) -> bool:
     if not isinstance(value, (bool, np.bool_)):
-        raise _ArgumentError(f"{name} must be True or False, got {value!r}")
+        raise InvalidArgumentError(f"{name} must be True or False, got {value!r}")
     return bool(value)
 
 
 def _check_real(value, name: str, lo: float, hi: float, what: str) -> float:
     x = _to_float(value)
     if not (math.isfinite(x) and lo < x <= hi):
-        raise _ArgumentError(f"{name} must be a finite real number in ({lo:g}, {hi:g}] ({what}), got {value!r}")
+        raise InvalidArgumentError(f"{name} must be a finite real number in ({lo:g}, {hi:g}] ({what}), got {value!r}")
     return x
 
 
 def _check_count(value, name: str, lo: int, hi: int, what: str) -> int:
     if not (_is_int(value) and lo <= value <= hi):
-        raise _ArgumentError(f"{name} must be an integer in [{lo}, {hi}] ({what}), got {value!r}")
+        raise InvalidArgumentError(f"{name} must be an integer in [{lo}, {hi}] ({what}), got {value!r}")
     return int(value)
 
 

@@ -76,6 +76,7 @@ __all__ = [
     "spherical_free_axis",
     "K_TOL",
     "IK_K_TOL",
+    "CLIP_FOOT_TOL",
     "BOUNDARY_TOL",
     "LL_TOL",
     "RHO_TOL",
@@ -136,8 +137,11 @@ _H = abs(FOOT_X)
 #: |k| = 1 +- a few 1e-16; clipping 1e-14 leaves a rod-length error of ~1e-15 m).
 K_TOL = 1e-14
 #: The same for foot_ik: its platform pose, computed from a foot target, carries ~1e-14 of rounding in k (the
-#: foot is up to 3 m from the centre); clipping 1e-11 leaves ~1e-12 m of rod-length error.
+#: foot is up to 3 m from the centre). Clipping leaves a rod-length error; foot_ik keeps a clipped candidate only if
+#: the foot error it implies (one Newton step of the rod equations, times the lever of the foot) is at most
+#: CLIP_FOOT_TOL.
 IK_K_TOL = 1e-11
+CLIP_FOOT_TOL = 1e-10
 #: The forward kinematics labels a chain with 1 - |k| <= BOUNDARY_TOL (acos(k) <= 1.4e-5 rad) as on its reach
 #: boundary, matching both motor branches: the motor angles foot_ik clips there give FK poses that close the chain
 #: within ~1e-11 of |k| = 1 on either side.
@@ -1103,7 +1107,7 @@ def _ik_candidate(u: np.ndarray, sv: float, llb, rb, b: np.ndarray) -> dict:
     inlim = np.all(near, -1)
     x[:, 1:] = np.where(near, np.clip(x[:, 1:], -PLATFORM_LIMIT, PLATFORM_LIMIT), x[:, 1:])  # rounding at a limit
     rot = _rot(x[:, 1], x[:, 2])
-    th, _, ok2 = _chains(rot, b, IK_K_TOL)
+    th, k, ok2 = _chains(rot, b, IK_K_TOL)
     exists = reach & np.all(ok2, -1)  # on the roll axis (rho = 0) roll is 0 or pi, see _platform_ik
     th = np.where(exists[:, None], th, np.nan)
     ths = np.where(exists[:, None], th, 0.0)
@@ -1111,6 +1115,12 @@ def _ik_candidate(u: np.ndarray, sv: float, llb, rb, b: np.ndarray) -> dict:
     ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
     d = CENTER + ra - tip
     nm = _n_matrix(ra, d, x[:, 1])
+    # a chain clipped at its reach boundary (|k| up to 1 + IK_K_TOL) leaves its rod off by g: the FK pose of these
+    # motor angles moves by ~N^-1 g and the foot by at most |u| sqrt(2) times that
+    g = 0.5 * (np.sum(d * d, -1) - ROD_LENGTH**2)
+    with np.errstate(over="ignore", invalid="ignore"):
+        shift = np.linalg.norm(_solve2(nm, g), axis=-1) * math.sqrt(2.0) * np.linalg.norm(u, axis=-1)
+    exists &= ~(np.abs(np.abs(k) - 1.0).min(-1) <= IK_K_TOL) | (shift <= CLIP_FOOT_TOL)
     mode = np.where(exists, np.sign(_det2(nm)) * _assembly_ref(b), 0.0)
     gain = np.where(exists, _gain(rot, nm, np.sum(d * dtip, -1), x[:, 1], x[:, 0]), np.inf)
     motors = np.concatenate([th, ((sv - x[:, 0]) / RATIO)[:, None]], -1)

@@ -83,20 +83,24 @@ LIMIT_SLACK = 1e-7
 CLIP_TOL = 1e-12
 
 
-def _number(value, name: str, valid: str) -> float:
-    """A real scalar parameter (int, float, numpy real, 0-d real array; not bool, str, complex) as float."""
+def _number(value, name: str, valid) -> float:
+    """A real scalar parameter (int, float, numpy real, 0-d real array; not bool, str, complex) as float.
+    ``valid``: the range text for the message (or a callable making it)."""
+    if type(value) is float:  # the common case, fast
+        return value
     ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
     if not ok and isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
         ok, value = True, value.item()
     if not ok:
-        raise InvalidParameterError(f"{name} must be a real number, got {value!r}; valid range {valid}")
+        text = valid() if callable(valid) else valid
+        raise InvalidParameterError(f"{name} must be a real number, got {value!r}; valid range {text}")
     return float(value)
 
 
 def _checked_foot_z(foot_z) -> float:
     """``foot_z`` checked against the registry's range (:data:`legkin.models.quadruped.SPEC`)."""
     param = _SPEC.params["foot_z"]
-    return param.check("foot_z", _number(foot_z, "foot_z", param.range_text()))
+    return param.check("foot_z", _number(foot_z, "foot_z", param.range_text))
 
 
 def _flag(value, name: str) -> bool:
@@ -414,10 +418,16 @@ def foot_ik(p, leg: str, q_ref=None, *, foot_z: float = 0.0, return_mask: bool =
         for b in range(len(sol.branches)):
             qb = sol.q[..., b, :].copy()
             qb[..., 1] = _toward_limits(qb[..., 1], 1)  # q1 and q3 limits are far from +-pi
-            inside = np.array(ok & np.all((qb >= lo - LIMIT_SLACK) & (qb <= hi + LIMIT_SLACK), axis=-1))
-            clipped = np.minimum(np.maximum(qb, lo), hi)
-            moved = inside & np.any(clipped != qb, axis=-1)
-            if np.any(moved):  # a branch just outside the limits: clip it and re-solve the other joints
+            inside, strict = ok, True
+            for k in range(3):  # column by column: cheaper than comparisons and reductions over (..., 3)
+                x = qb[..., k]
+                inside = inside & (x >= lo[k] - LIMIT_SLACK) & (x <= hi[k] + LIMIT_SLACK)
+                strict = strict & (x >= lo[k]) & (x <= hi[k])
+            moved = inside & ~strict
+            clipped = qb
+            if moved.any():  # a branch just outside the limits: clip it and re-solve the other joints
+                inside = np.array(inside)
+                clipped = np.minimum(np.maximum(qb, lo), hi)
                 fixed, good = _clip_repair(clipped[moved], qb[moved], np.broadcast_to(p, qb.shape)[moved], leg, foot_z)
                 clipped[moved] = fixed
                 inside[moved] = good

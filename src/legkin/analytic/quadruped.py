@@ -352,21 +352,27 @@ def foot_ik_all(p, leg: str, *, foot_z: float = 0.0, return_mask: bool = False):
 def _clip_repair(qc: np.ndarray, q: np.ndarray, p: np.ndarray, leg: str, foot_z: float):
     """Branches ``q`` (k, 3) clipped into the limits (``qc``): re-solve the unclipped joints for the foot ``p``.
 
-    Two Gauss-Newton steps on the foot position over the joints that clipping left alone (the clipped ones stay
-    on their limit). Near the abduction singularity the branch's error lies along the singular direction of
-    the Jacobian, which the free joints absorb exactly. Returns the joints and whether they are inside the limits
-    and reproduce ``p`` within :data:`CLIP_TOL`.
+    Up to three Gauss-Newton steps on the foot position over the joints that clipping left alone (the clipped ones
+    stay on their limit), keeping the best iterate (the clipped branch itself when clipping moved it by a rounding
+    error only). Near the abduction singularity the branch's error lies along the singular direction of the
+    Jacobian, which the free joints absorb. Returns the joints (inside the limits) and whether they reproduce
+    ``p`` within :data:`CLIP_TOL`.
     """
     lo, hi = JOINT_LIMITS[:, 0], JOINT_LIMITS[:, 1]
     free = qc == q
-    for _ in range(3):
+    best, best_err = qc, np.full(len(qc), np.inf)
+    for it in range(4):
         r = p - _foot(qc, leg, foot_z)
+        err = np.linalg.norm(r, axis=-1)
+        better = err < best_err  # keep the best iterate: near rho -> 0 a step can only add rounding
+        best, best_err = np.where(better[:, None], qc, best), np.where(better, err, best_err)
+        if it == 3 or np.all(best_err <= 0.5 * CLIP_TOL):
+            break
         step = (np.linalg.pinv(_jacobian(qc, leg, foot_z) * free[:, None, :], rcond=1e-10) @ r[..., None])[..., 0]
         moved = qc + step
         qc = np.minimum(np.maximum(moved, lo), hi)
         free &= qc == moved  # a joint pushed onto its limit by the step stays there
-    err = np.linalg.norm(_foot(qc, leg, foot_z) - p, axis=-1)
-    return qc, err <= CLIP_TOL
+    return best, best_err <= CLIP_TOL
 
 
 def foot_ik(p, leg: str, q_ref=None, *, foot_z: float = 0.0, return_mask: bool = False) -> np.ndarray:

@@ -486,7 +486,7 @@ def test_fk_mode_is_explicit():
         assert isinstance(exc.value, UnreachableError)
         _, _, _, ok = at.fk(q[[0]], q[[4]], q[[8]], return_mask=True)
         assert not ok[0]
-        ys, zs, incs, oks = at.fk(q[0], q[4], q[8], mode="all", return_mask=True)
+        ys, _, _, oks = at.fk(q[0], q[4], q[8], mode="all", return_mask=True)
         assert ys.shape == (16,) and oks.tolist() == [mm == m for mm in at.MODES]
         assert np.isnan(ys[~oks]).all() and np.isfinite(ys[oks]).all()
 
@@ -639,7 +639,7 @@ def test_contract_fk_from_in_limit_motors(qa, qb, branch, s_c, alpha):
         return
     u, mode, qc = made
     try:
-        y, z, inc = at.fk(qa, qb, qc, alpha=alpha, mode=mode)
+        y, z, _ = at.fk(qa, qb, qc, alpha=alpha, mode=mode)
     except (SingularityError, UnreachableError) as exc:  # the guards, the flip, a boundary: refused by ik as well
         assert not isinstance(exc, legkin.AssemblyModeError)
         _, ok = at.ik(np.array([u[0]]), np.array([u[1]]), alpha=alpha, mode=mode, return_mask=True)
@@ -713,7 +713,7 @@ def test_contract_random_orientations(kind, alpha, a, b, phi, log_small, sign, i
         return
     assert ok.all() and np.array_equal(qb[0], q)
     assert np.all(np.abs(q) <= math.pi)  # the URDF limits of every joint
-    y, z, inc = at.fk(q[0], q[4], q[8], alpha=alpha, mode=mode)
+    y, z, _ = at.fk(q[0], q[4], q[8], alpha=alpha, mode=mode)
     assert ct.pose_error(ay, az, y, z) <= CONTRACT_TOL
     at.ik(y, z, alpha=alpha, mode=mode)  # and fk's answer is solved by ik (b)
 

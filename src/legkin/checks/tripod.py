@@ -331,29 +331,38 @@ def made_targets(n: int, rng: np.random.Generator, alpha: float = at.ALPHA) -> t
 
 
 def _det_curve_points(rng: np.random.Generator, alpha: float, grid: int = 121) -> np.ndarray:
-    """Points (alpha_y, alpha_z) on the actuation-singular curves det M = 0 of the home mode's motors, by
-    bisection along alpha_y between grid neighbours where det M changes sign."""
-    ay = np.linspace(-np.pi / 2, np.pi / 2, grid)
-    az = rng.uniform(-np.pi, np.pi, grid)
-    gy, gz = np.meshgrid(ay, az, indexing="ij")
+    """Points (alpha_y, alpha_z) on the actuation-singular curves det M = 0 of the home mode's motors: bisection
+    between grid neighbours where det M changes sign, along alpha_y (random alpha_z) and along alpha_z (random
+    alpha_y; at alpha = pi/2 det M vanishes on the lines alpha_z = +-pi/2)."""
+    geo = at._geometry(at.D, alpha, np.asarray(at.ETA))
 
     def det_of(y, z):
         trig = tuple(f(v)[..., None] for v in (y, z) for f in (np.cos, np.sin))
-        trig = (trig[0], trig[1], trig[2], trig[3])
         with np.errstate(invalid="ignore", divide="ignore"):
-            q1, _, c2, _, nb2, sn, cn = at._ik_eval(*trig, at._geometry(at.D, alpha, np.asarray(at.ETA)), with_sc=True)
-            return np.where(at._inside(c2, nb2)[..., 0], at._det_planes(sn, cn, at._geometry(at.D, alpha, np.asarray(at.ETA))), np.nan)
+            _, _, c2, _, nb2, sn, cn = at._ik_eval(*trig, geo, with_sc=True)
+            return np.where(at._inside(c2, nb2)[..., 0], at._det_planes(sn, cn, geo), np.nan)
 
-    dm = det_of(gy, gz)
-    i, j = np.nonzero((np.sign(dm[1:]) * np.sign(dm[:-1]) < 0))
-    lo, hi, z = ay[i], ay[i + 1], az[j]
-    flo = det_of(lo, z)
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        fm = det_of(mid, z)
-        left = np.sign(fm) == np.sign(flo)
-        lo, flo, hi = np.where(left, mid, lo), np.where(left, fm, flo), np.where(left, hi, mid)
-    return np.stack([0.5 * (lo + hi), z], axis=-1)
+    out = []
+    for along_y in (True, False):
+        line = np.linspace(-np.pi / 2, np.pi / 2, grid) if along_y else np.linspace(-np.pi, np.pi, 2 * grid)
+        other = rng.uniform(-np.pi, np.pi, grid) if along_y else rng.uniform(-np.pi / 2, np.pi / 2, grid)
+        g1, g2 = np.meshgrid(line, other, indexing="ij")
+
+        def det_on(v, w, along_y=along_y):
+            return det_of(v, w) if along_y else det_of(w, v)
+
+        dm = det_on(g1, g2)
+        i, j = np.nonzero(np.sign(dm[1:]) * np.sign(dm[:-1]) < 0)
+        lo, hi, w = line[i], line[i + 1], other[j]
+        flo = det_on(lo, w)
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            fm = det_on(mid, w)
+            left = np.sign(fm) == np.sign(flo)
+            lo, flo, hi = np.where(left, mid, lo), np.where(left, fm, flo), np.where(left, hi, mid)
+        v = 0.5 * (lo + hi)
+        out.append(np.stack([v, w] if along_y else [w, v], axis=-1))
+    return np.concatenate(out)
 
 
 def random_orientations(n: int, rng: np.random.Generator, alpha: float = at.ALPHA) -> tuple[np.ndarray, np.ndarray]:

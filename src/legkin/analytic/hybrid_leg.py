@@ -1179,8 +1179,7 @@ def _fmt(p) -> str:
 
 
 def _arc_error(p: np.ndarray, kk: float) -> UnreachableError:
-    with np.errstate(over="ignore"):
-        r = float(np.linalg.norm(p - CENTER))
+    r = math.hypot(*(float(v) for v in p - CENTER))  # no overflow for |p| near the float limit
     lo, hi = _LL0 - _H, _LL0 + _H
     side = f"{r - hi:.3g} m beyond its outer end" if r > hi else f"{lo - r:.3g} m inside its inner end"
     return UnreachableError(

@@ -2,7 +2,7 @@
 
 Targets: Pinocchio's ``FCS`` frame at closed configurations (``checks.hybrid_leg.closed_configuration``) of
 random platform poses of the neutral assembly mode (``checks.hybrid_leg.sample_workspace``, motor Jacobian
-sigma_min >= 1e-2) and theta_LL uniform on the extension side [-0.3, delta] (foot_ik's default ``ll_branch``).
+sigma_min >= 1e-2) and theta_LL uniform on the extension side [-0.3, delta] (the ``ll_branch`` foot_ik tries first).
 Every answer (three motor angles) is scored the same way: the foot that those motors give in the neutral
 assembly mode (:func:`legkin.analytic.hybrid_leg.foot_position`, validated against Pinocchio) vs the target.
 """
@@ -102,7 +102,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
     ]
     notes = [
         f"targets: Pinocchio FCS of {n_batch} closed configurations, platform poses of the neutral assembly mode "
-        "(sigma_min(dtheta/dx) >= 1e-2), theta_LL uniform in [-0.3, delta] (foot_ik's default ll_branch); the "
+        "(sigma_min(dtheta/dx) >= 1e-2), theta_LL uniform in [-0.3, delta] (the ll_branch foot_ik tries first); the "
         f"scalar loop solves the first {n_scalar}, Pinocchio the first {n_iter}",
         "err = foot of the answer's motors (theta1, theta2, theta0) in the neutral assembly mode (foot_position) vs "
         "target (m); loop |r| = Pinocchio loop residual of the Pinocchio answer; a Pinocchio answer closing the "

@@ -219,3 +219,20 @@ def test_bench_progress_bar(capsys, monkeypatch):
     monkeypatch.setattr(bench, "run_bench", fake)
     assert main(["bench", "--quiet", "--n", "5", "--seed", "2"]) == 0
     assert seen == {"quiet": True, "seed": 2, "n": 5}
+
+
+def test_generate_out_writes_the_committed_files(tmp_path):
+    """``legkin generate --out DIR`` (what an installed legkin needs) writes the same bytes as urdf/."""
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    run = subprocess.run([sys.executable, "-m", "legkin", "generate", "tripod", "--out", str(tmp_path)],
+                         capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr
+    for name in ("tripod.urdf", "tripod.srdf"):
+        assert (tmp_path / name).read_bytes() == (root / "urdf" / name).read_bytes()
+    bad = subprocess.run([sys.executable, "-m", "legkin", "generate", "tripod", "--out", str(tmp_path / "tripod.urdf")],
+                         capture_output=True, text=True, timeout=300)
+    assert bad.returncode != 0 and "Traceback" not in bad.stderr and "not a directory" in bad.stderr

@@ -123,7 +123,7 @@ def _cmd_generate(args) -> int:
             return 1
         print("urdf/ matches xacro/")
         return 0
-    for path in generate_all(models):
+    for path in generate_all(models, out_dir=args.out):
         print(f"wrote {path}")
     return 0
 
@@ -215,6 +215,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("generate", help="run xacro on xacro/*.urdf.xacro and write urdf/")
     p.add_argument("models", nargs="*", help="models (default: all)")
     p.add_argument("--check", action="store_true", help="write nothing; exit 1 if urdf/ differs from xacro/")
+    p.add_argument("--out", metavar="DIR", default=None,
+                   help="write into DIR instead of the source tree's urdf/ (required for an installed legkin)")
     p.set_defaults(func=_cmd_generate)
 
     p = sub.add_parser("check", help="validate the analytic kinematics against Pinocchio")

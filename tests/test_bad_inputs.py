@@ -1,0 +1,104 @@
+"""The bad-input catalogue: every entry must raise the legkin error it names (docs/robustness.md lists them).
+
+``python scripts/robustness.py`` prints the table of docs/robustness.md from this catalogue, with the class
+and the message each entry actually gets. A new mechanism adds its rows here.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+import legkin
+from legkin.analytic import hybrid_leg as hl
+from legkin.analytic import quadruped as aq
+from legkin.analytic import tripod as at
+from legkin.analytic import wheel_leg as wl
+
+P_LF = aq.foot_position([0.1, 1.0, 1.0], "LF")
+T_FL = wl.contact_point([1.0, 0.1, 0.0], 0.0, 0.0, "FL")
+NAN = float("nan")
+
+#: (mechanism, call as written, thunk, expected legkin error class)
+CASES = [
+    # ---- quadruped
+    ("quadruped", "foot_ik(zeros((2, 3)), 'LF', q_ref=zeros((3, 3)))",
+     lambda: aq.foot_ik(np.zeros((2, 3)), "LF", q_ref=np.zeros((3, 3))), legkin.InvalidInputError),
+    ("quadruped", "within_limits('abc')", lambda: aq.within_limits("abc"), legkin.InvalidInputError),
+    ("quadruped", "within_limits(q, tol=-1e-9)", lambda: aq.within_limits(np.zeros(3), tol=-1e-9),
+     legkin.InvalidParameterError),
+    ("quadruped", "foot_position(q, 'LF', foot_z=nan)", lambda: aq.foot_position(np.zeros(3), "LF", foot_z=NAN),
+     legkin.InvalidParameterError),
+    ("quadruped", "foot_position(q, 'LF', foot_z=5)", lambda: aq.foot_position(np.zeros(3), "LF", foot_z=5),
+     legkin.InvalidParameterError),
+    ("quadruped", "foot_ik(p, 'LF', foot_z='0.01')", lambda: aq.foot_ik(P_LF, "LF", foot_z="0.01"),
+     legkin.InvalidParameterError),
+    ("quadruped", "foot_ik(p, 'LF', return_mask='yes')", lambda: aq.foot_ik(P_LF, "LF", return_mask="yes"),
+     legkin.InvalidParameterError),
+    ("quadruped", "foot_ik(p + 0j, 'LF')", lambda: aq.foot_ik(P_LF + 0j, "LF"), legkin.InvalidInputError),
+    ("quadruped", "foot_ik([[0.1], [0.2, 0.3]], 'LF')", lambda: aq.foot_ik([[0.1], [0.2, 0.3]], "LF"),
+     legkin.InvalidInputError),
+    ("quadruped", "foot_ik(p, 'XX')", lambda: aq.foot_ik(P_LF, "XX"), legkin.InvalidParameterError),
+    ("quadruped", "foot_ik(full(3, 1e300), 'LF')", lambda: aq.foot_ik(np.full(3, 1e300), "LF"),
+     legkin.UnreachableError),
+    ("quadruped", "textbook_ik(p, Y12, 0, L2)", lambda: aq.textbook_ik(P_LF, aq.Y12, 0.0, 0.3),
+     legkin.InvalidParameterError),
+    # ---- tripod
+    ("tripod", "ik(0.2, -0.1, d=nan)", lambda: at.ik(0.2, -0.1, d=NAN), legkin.InvalidParameterError),
+    ("tripod", "ik(0.2, -0.1, alpha='pi')", lambda: at.ik(0.2, -0.1, alpha="pi"), legkin.InvalidParameterError),
+    ("tripod", "ik(0.2, -0.1, eta=[0, nan, 1])", lambda: at.ik(0.2, -0.1, eta=[0.0, NAN, 1.0]),
+     legkin.InvalidParameterError),
+    ("tripod", "ik(0.2, -0.1, mode='-+')", lambda: at.ik(0.2, -0.1, mode="-+"), legkin.InvalidParameterError),
+    ("tripod", "fk(0.1, 0.2, 0.3, tol=nan)", lambda: at.fk(0.1, 0.2, 0.3, tol=NAN), legkin.InvalidParameterError),
+    ("tripod", "fk(0.1, 0.2, 0.3, max_iter=2.5)", lambda: at.fk(0.1, 0.2, 0.3, max_iter=2.5),
+     legkin.InvalidParameterError),
+    ("tripod", "orientation_from_axis(zeros(3))", lambda: at.orientation_from_axis(np.zeros(3)),
+     legkin.InvalidInputError),
+    ("tripod", "ik(0, pi)  (the flip)", lambda: at.ik(0.0, math.pi), legkin.SingularityError),
+    ("tripod", "ik(0.2 + 1j, 0)", lambda: at.ik(0.2 + 1j, 0.0), legkin.InvalidInputError),
+    # ---- wheel_leg
+    ("wheel_leg", "ik(t, 0, 0, 'FL', tol=nan)", lambda: wl.ik(T_FL, 0.0, 0.0, "FL", tol=NAN),
+     legkin.InvalidParameterError),
+    ("wheel_leg", "ik(t, 0, 0, 'FL', max_iter=0)", lambda: wl.ik(T_FL, 0.0, 0.0, "FL", max_iter=0),
+     legkin.InvalidParameterError),
+    ("wheel_leg", "ik(t, 0, 0, 'FL', method=array(['radial']))",
+     lambda: wl.ik(T_FL, 0.0, 0.0, "FL", method=np.array(["radial"])), legkin.InvalidParameterError),
+    ("wheel_leg", "contact_point(q, 0, 0, 'FL', radius=nan)",
+     lambda: wl.contact_point([1.0, 0.1, 0.0], 0.0, 0.0, "FL", radius=NAN), legkin.InvalidParameterError),
+    ("wheel_leg", "Geometry(R=-0.1)", lambda: wl.Geometry(R=-0.1), legkin.InvalidParameterError),
+    ("wheel_leg", "ik(t, 0, 0, 'FL', geometry={'R': 0.1})", lambda: wl.ik(T_FL, 0.0, 0.0, "FL", geometry={"R": 0.1}),
+     legkin.InvalidParameterError),
+    ("wheel_leg", "ik(zeros((3, 3)), 0, 0, 'FL', q0=zeros((2, 3)))",
+     lambda: wl.ik(np.zeros((3, 3)), 0.0, 0.0, "FL", q0=np.zeros((2, 3))), legkin.InvalidInputError),
+    ("wheel_leg", "ik([1+1j, 0.2, -0.2], 0, 0, 'FL')", lambda: wl.ik([1 + 1j, 0.2, -0.2], 0.0, 0.0, "FL"),
+     legkin.InvalidInputError),
+    ("wheel_leg", "ik(t, 0, 0.05, 'FL')  (w beyond T/2)", lambda: wl.ik(T_FL, 0.0, 0.05, "FL"),
+     legkin.InvalidInputError),
+    ("wheel_leg", "ik(t, 0, 0, 'FL') for a foot turned up (gamma ~ 162 deg)",
+     lambda: wl.ik(wl.contact_point([0.39896854737191256, 2.6257815016632486, 2.829530947384123], 0.0, 0.0, "FL"),
+                   0.0, 0.0, "FL"), legkin.JointLimitError),
+    ("wheel_leg", "ik([0.3, 0.2, -0.6], 0, 0, 'FL')  (too far)", lambda: wl.ik([0.3, 0.2, -0.6], 0.0, 0.0, "FL"),
+     legkin.UnreachableError),
+    # ---- hybrid_leg
+    ("hybrid_leg", "foot_ik(p, ll_branch=array([1, -1]))",
+     lambda: hl.foot_ik(np.array([0.0, 0.0, -0.3]), ll_branch=np.array([1, -1])), legkin.InvalidParameterError),
+    ("hybrid_leg", "foot_ik([nan, 0, -0.3])", lambda: hl.foot_ik([NAN, 0.0, -0.3]), legkin.InvalidInputError),
+    # ---- framework
+    ("framework", "load('nope')", lambda: legkin.load("nope"), legkin.UnknownModelError),
+    ("framework", "load('tripod', alpha=nan)", lambda: legkin.load("tripod", alpha=NAN), legkin.InvalidParameterError),
+    ("framework", "load('tripod').solve_loops(q0, fixed={'A_q1': nan})",
+     lambda: legkin.load("tripod").solve_loops(legkin.load("tripod").q0, fixed={"A_q1": NAN}),
+     legkin.InvalidInputError),
+]
+
+
+@pytest.mark.parametrize("mechanism, text, call, expected", CASES, ids=[f"{c[0]}: {c[1]}" for c in CASES])
+def test_bad_input_gets_its_legkin_error(mechanism, text, call, expected):
+    with pytest.raises(expected) as info:
+        call()
+    assert isinstance(info.value, legkin.LegkinError)
+    if issubclass(expected, (legkin.InvalidInputError, legkin.InvalidParameterError)):
+        assert isinstance(info.value, ValueError)
+    assert str(info.value)  # a message, naming the value

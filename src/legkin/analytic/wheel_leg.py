@@ -32,6 +32,7 @@ from typing import Mapping, NamedTuple
 import numpy as np
 
 from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
+from ._kernels import OK, as_rows, batch_kernel, kernel, prange
 from ._batch import as_angles, as_input, check_choice, check_flag, check_integer, check_number, finish
 
 __all__ = [
@@ -207,63 +208,117 @@ def _factors(c: _Const, foot_radius: float) -> tuple[complex, ...]:
     )
 
 
-def _closed_form(theta: np.ndarray, c: _Const, foot_radius: float, want_der: bool = True,
-                 full: bool = True) -> tuple[dict, dict | None]:
-    """Left-half points (complex, leg axis +x, before the beta rotation) and their theta-derivatives.
+#: Order of the left-half points in the closed-form kernel's output (:func:`_k_closed`).
+_CF_NAMES = ("A", "B", "C", "D", "E", "F", "G", "U", "L", "H", "O_r", "J")
+_IA, _IB, _IC, _ID, _IE, _IF, _IG, _IU, _IL, _IH, _IOR, _IJ = range(12)
 
-    Implements the closed form of the design notes (reference "Closed form of the left half"),
-    differentiated by hand (forward mode). ``foot_radius`` only scales J (whose direction alone is used).
-    ``want_der=False`` skips the derivatives (``der`` is None); ``full=False`` skips H, J and O_r (the seed
-    rim's points), which the continuous rim does not use.
+
+@lru_cache(maxsize=16)
+def _kconst(R: float, foot_radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """The kernels' constants: ``K`` (13,) = :class:`_Const` as floats, ``KC`` (5,) = :func:`_factors`."""
+    c = _constants(R)
+    K = np.array(c, dtype=np.float64)
+    KC = np.array(_factors(c, foot_radius), dtype=np.complex128)
+    K.setflags(write=False)
+    KC.setflags(write=False)
+    return K, KC
+
+
+@kernel
+def _k_closed(theta, K, KC, want_der):
+    """The closed form of the left half (design notes, "Closed form of the left half"), one theta.
+
+    Left-half points (complex, leg axis +x, before the beta rotation), in the order of :data:`_CF_NAMES`,
+    and their theta-derivatives (forward mode by hand; zeros when ``want_der`` is False)::
+
+        A = l1 e^{i theta}, B = R e^{i theta}, sin(OEA) = l1 sin(theta) / l_AE, E = Re A - l_AE cos(OEA),
+        D = E + l6 e^{i OEA}, cos(DBC) = (|BD|^2 + l3^2 - l4^2) / (2 |BD| l3), C = B + l3 e^{-i DBC} BD/|BD|,
+        F = C + (B - C) kF, sin(OGF) = Im F / l8, G = Re F - l8 cos(OGF), U = B + (C - B) kU,
+        L = F + (G - F) kL, H = U + (B - U) e0, O_r = G + R, J = U + (H - U) kJ
+
+    with ``kF = e^{-i BCF} l7/l3``, ``kU = e^{i UBC} R/l3``, ``kL = e^{i LFG} R/l8``, ``e0 = e^{-i theta0}``,
+    ``kJ = e^{i 140 deg} r_foot/R``. Outside the linkage's domain the square roots give NaN.
     """
-    R = c.R
-    kF, kU, kL, e0, kJ = _factors(c, foot_radius)
-    eth = _cis(theta)
-    A = c.l1 * eth
+    R, l1, l3, l4, l6, l_AE, l8 = K[0], K[1], K[2], K[3], K[5], K[6], K[8]
+    kF, kU, kL, e0, kJ = KC[0], KC[1], KC[2], KC[3], KC[4]
+    ct_, st_ = math.cos(theta), math.sin(theta)
+    eth = complex(ct_, st_)
+    A = l1 * eth
     B = R * eth
-    s = c.l1 * eth.imag / c.l_AE  # sin(OEA)
-    cs = np.sqrt(1.0 - s * s)
-    E = A.real - c.l_AE * cs
-    eo = cs + 1j * s  # exp(i OEA)
-    D = E + c.l6 * eo
+    s = l1 * st_ / l_AE
+    cs = math.sqrt(1.0 - s * s)
+    E = A.real - l_AE * cs
+    eo = complex(cs, s)
+    D = E + l6 * eo
     BD = D - B
-    lBD = np.abs(BD)
-    cosg = (lBD**2 + c.l3**2 - c.l4**2) / (2 * lBD * c.l3)  # cos(DBC)
-    sing = np.sqrt(1.0 - cosg * cosg)
-    eg = cosg - 1j * sing  # exp(-i DBC)
+    lBD = abs(BD)
+    cosg = (lBD * lBD + l3 * l3 - l4 * l4) / (2 * lBD * l3)
+    sing = math.sqrt(1.0 - cosg * cosg)
+    eg = complex(cosg, -sing)
     u = BD / lBD
-    C = B + c.l3 * u * eg
+    C = B + l3 * u * eg
     F = C + (B - C) * kF
-    t = F.imag / c.l8  # sin(OGF)
-    ct = np.sqrt(1.0 - t * t)
-    G = F.real - c.l8 * ct + 0j
+    t = F.imag / l8
+    ct = math.sqrt(1.0 - t * t)
+    G = complex(F.real - l8 * ct, 0.0)
     U = B + (C - B) * kU
     L = F + (G - F) * kL
-    pts = dict(O=np.zeros_like(A), A=A, B=B, C=C, D=D, E=E + 0j, F=F, G=G, U=U, L=L)
-    if full:
-        H = U + (B - U) * e0
-        pts.update(H=H, O_r=G + R, J=U + (H - U) * kJ)
+    H = U + (B - U) * e0
+    Or = G + R
+    J = U + (H - U) * kJ
+    pts = (A, B, C, D, complex(E, 0.0), F, G, U, L, H, Or, J)
     if not want_der:
-        return pts, None
+        z = 0j
+        return pts, (z, z, z, z, z, z, z, z, z, z, z, z)
     dA, dB = 1j * A, 1j * B
-    ds = c.l1 * eth.real / c.l_AE
-    dE = dA.real + c.l_AE * s * ds / cs
-    dD = dE + 1j * c.l6 * eo * (ds / cs)
+    ds = l1 * ct_ / l_AE
+    dE = dA.real + l_AE * s * ds / cs
+    dD = dE + 1j * l6 * eo * (ds / cs)
     dBD = dD - dB
-    dlBD = (np.conj(BD) * dBD).real / lBD
-    dcosg = (1.0 / (2 * c.l3) - (c.l3**2 - c.l4**2) / (2 * c.l3 * lBD**2)) * dlBD
+    dlBD = (BD.conjugate() * dBD).real / lBD
+    dcosg = (1.0 / (2 * l3) - (l3 * l3 - l4 * l4) / (2 * l3 * lBD * lBD)) * dlBD
     dg = -dcosg / sing
     du = (dBD - u * dlBD) / lBD
-    dC = dB + c.l3 * eg * (du - 1j * dg * u)
+    dC = dB + l3 * eg * (du - 1j * dg * u)
     dF = dC + (dB - dC) * kF
-    dG = dF.real + t * dF.imag / ct + 0j
+    dG = complex(dF.real + t * dF.imag / ct, 0.0)
     dU = dB + (dC - dB) * kU
     dL = dF + (dG - dF) * kL
-    der = dict(O=pts["O"], A=dA, B=dB, C=dC, D=dD, E=dE + 0j, F=dF, G=dG, U=dU, L=dL)
-    if full:
-        dH = dU + (dB - dU) * e0
-        der.update(H=dH, O_r=dG, J=dU + (dH - dU) * kJ)
-    return pts, der
+    dH = dU + (dB - dU) * e0
+    dJ = dU + (dH - dU) * kJ
+    return pts, (dA, dB, dC, dD, complex(dE, 0.0), dF, dG, dU, dL, dH, dG, dJ)
+
+
+@batch_kernel
+def _k_closed_batch(theta, K, KC, want_der, P, DP):
+    """:func:`_k_closed` over theta (n,) into P, DP (n, 12)."""
+    for i in prange(theta.shape[0]):
+        pts, der = _k_closed(theta[i], K, KC, want_der)
+        for j in range(12):
+            P[i, j] = pts[j]
+            DP[i, j] = der[j]
+
+
+def _closed_form(theta: np.ndarray, c: _Const, foot_radius: float, want_der: bool = True,
+                 full: bool = True) -> tuple[dict, dict | None]:
+    """Left-half points (complex, leg axis +x, before the beta rotation) and their theta-derivatives, as
+    dicts of arrays of theta's shape: the batch of the kernel :func:`_k_closed` (which states the math).
+
+    ``want_der=False``: ``der`` is None; ``full=False`` leaves out H, J and O_r (the seed rim's points).
+    """
+    theta = np.asarray(theta, dtype=np.float64)
+    K, KC = _kconst(c.R, float(foot_radius))
+    flat = np.ascontiguousarray(theta.reshape(-1))
+    n = flat.size
+    P = np.empty((n, 12), dtype=np.complex128)
+    DP = np.empty((n, 12), dtype=np.complex128)
+    _k_closed_batch(flat, K, KC, bool(want_der), P, DP)
+    names = _CF_NAMES if full else _CF_NAMES[:9]
+    zero = np.zeros(theta.shape, dtype=complex)
+    pts = {"O": zero, **{k: P[:, j].reshape(theta.shape) for j, k in enumerate(names)}}
+    if not want_der:
+        return pts, None
+    return pts, {"O": zero, **{k: DP[:, j].reshape(theta.shape) for j, k in enumerate(names)}}
 
 
 _ON_AXIS = ("O", "E", "G", "O_r")
@@ -485,6 +540,122 @@ def _plane(pts: dict, der: dict | None, sel: _Sel, want_der: bool, conj: bool = 
     return y, dy
 
 
+@kernel
+def _k_select(alpha, seed, rho, R):
+    """:func:`_select` for one alpha: (upper, right, e) (``e`` conjugated on the right half)."""
+    if seed:
+        if alpha > PSI_FG:
+            upper, right, a0 = True, True, PSI_FG
+        elif alpha < -PSI_FG:
+            upper, right, a0 = True, False, -PSI_FG
+        else:
+            upper, right, a0 = False, False, 0.0
+        k = rho
+    else:
+        if alpha < -_ARC_FG:
+            upper, right, a0 = True, False, -_ARC_FG
+        elif alpha < 0.0:
+            upper, right, a0 = False, False, 0.0
+        elif alpha <= _ARC_FG:
+            upper, right, a0 = False, True, 0.0
+        else:
+            upper, right, a0 = True, True, _ARC_FG
+        k = rho / R
+    e = complex(math.cos(alpha - a0) * k, math.sin(alpha - a0) * k)
+    return upper, right, (e.conjugate() if right else e)
+
+
+@kernel
+def _k_plane(theta, upper, right, e, seed, K, KC, want_der, conj):
+    """:func:`_plane` for one item: the contact point in the leg plane (before the beta rotation) and its
+    theta-derivative, ``y = ctr + e v`` (seed rim: ``ctr + e v / |v|``), ``v = ref - ctr``."""
+    pts, der = _k_closed(theta, K, KC, want_der)
+    if upper:
+        ic, ir = _IU, (_IJ if seed else _IF)
+    else:
+        ic, ir = (_IOR if seed else _IL), _IG
+    ctr = pts[ic]
+    v = pts[ir] - ctr
+    dc = der[ic]
+    dv = der[ir] - dc
+    if seed:
+        nv = abs(v)
+        y = ctr + e * v / nv
+        dnv = (v.conjugate() * dv).real / nv
+        dy = dc + e * (dv - v * dnv / nv) / nv
+    else:
+        y = ctr + e * v
+        dy = dc + e * dv
+    if conj and right:
+        return y.conjugate(), dy.conjugate()
+    return y, dy
+
+
+#: Kernel status codes (besides :data:`OK`): NaN/inf input or result, theta / alpha / w out of range.
+_NONFINITE, _THETA_RANGE, _ALPHA_RANGE, _W_RANGE = 1, 2, 3, 4
+
+
+@kernel
+def _k_fk(theta, beta, gamma, upper, right, e, seed, K, KC, s, a, o0, o1, o2, want_jac, p, J):
+    """The contact FK for one item (:func:`_fk` states the map) into ``p`` (3,) and ``J`` (9,) (row-major
+    d p / d(theta, beta, gamma)); returns :data:`OK` or :data:`_NONFINITE`."""
+    z, dz = _k_plane(theta, upper, right, e, seed, K, KC, want_jac, True)
+    rot = complex(math.cos(beta + math.pi / 2), math.sin(beta + math.pi / 2))
+    zr = rot * z
+    x, y = zr.real, zr.imag
+    cg, sg = math.cos(gamma), math.sin(gamma)
+    m0 = cg * a - sg * y
+    m1 = sg * a + cg * y
+    p[0] = o0 - x
+    p[1] = o1 + s * m0
+    p[2] = o2 + m1
+    status = OK if (math.isfinite(p[0]) and math.isfinite(p[1]) and math.isfinite(p[2])) else _NONFINITE
+    if want_jac:
+        dzr = rot * dz
+        dx, dy = dzr.real, dzr.imag
+        ssg = s * sg
+        J[0], J[1], J[2] = -dx, y, 0.0
+        J[3], J[4], J[5] = -ssg * dy, -ssg * x, -s * m1
+        J[6], J[7], J[8] = cg * dy, cg * x, m0
+        for k in range(9):
+            if not math.isfinite(J[k]):
+                status = _NONFINITE
+    return status
+
+
+@kernel
+def _k_contact(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac, p, J):
+    """:func:`contact_point` / :func:`contact_jacobian` for one item, inputs range-checked (status codes)."""
+    theta = q[0]
+    if not (math.isfinite(theta) and math.isfinite(q[1]) and math.isfinite(q[2]) and math.isfinite(alpha)
+            and math.isfinite(w)):
+        return _NONFINITE
+    if theta < THETA_MIN - 1e-12 or theta > THETA_MAX + 1e-12:
+        return _THETA_RANGE
+    if abs(alpha) > math.pi + 1e-12:
+        return _ALPHA_RANGE
+    if abs(w) > half_T + 1e-15:
+        return _W_RANGE
+    upper, right, e = _k_select(alpha, seed, rho, K[0])
+    return _k_fk(theta, q[1], q[2], upper, right, e, seed, K, KC, s, dwheel + s * w, o0, o1, o2, want_jac, p, J)
+
+
+@batch_kernel
+def _k_contact_batch(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac, P, J, status):
+    """:func:`_k_contact` over q (n, 3), alpha, w (n,) into P (n, 3), J (n, 9), status (n,)."""
+    for i in prange(q.shape[0]):
+        status[i] = _k_contact(q[i], alpha[i], w[i], seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac,
+                               P[i], J[i])
+
+
+@batch_kernel
+def _k_fk_batch(q, upper, right, e, a, seed, K, KC, s, o0, o1, o2, want_jac, P, J):
+    """:func:`_k_fk` over q (n, 3) and the prepared arc choice (:class:`_Sel`) into P (n, 3), J (n, 9)."""
+    for i in prange(q.shape[0]):
+        _k_fk(q[i, 0], q[i, 1], q[i, 2], upper[i], right[i], e[i], seed, K, KC, s, a[i], o0, o1, o2, want_jac,
+              P[i], J[i])
+
+
 def _rim(theta, beta, alpha, geo: Geometry, radius: float, want_der: bool, seed: bool):
     sel = _select(alpha, seed, radius, geo.R)
     pts, der = _closed_form(theta, _constants(geo.R), geo.R + FOOT_OFFSET, want_der, full=seed)
@@ -664,33 +835,31 @@ def _context(alpha, w, leg, rim, geo, radius) -> _Ctx:
 
 
 def _fk(q: np.ndarray, ctx: _Ctx, want_jac: bool):
-    """Contact point in {R} (..., 3) and, if asked, d/d(theta, beta, gamma) (..., 3, 3).
+    """Contact point in {R} (..., 3) and, if asked, d/d(theta, beta, gamma) (..., 3, 3): the batch of the
+    kernel :func:`_k_fk`.
 
     Same map as :func:`leg_frame_to_robot` written out for the signed permutation ``R0``: with the rotated
     leg-plane point ``x + i y``, ``a = d_wheel + s w`` (s = +1 left, -1 right), ``m0 = cos(gamma) a -
     sin(gamma) y``, ``m1 = sin(gamma) a + cos(gamma) y``: ``p = o + (-x, s m0, m1)``.
     """
-    theta, beta, gamma = q[..., 0], q[..., 1], q[..., 2]
-    pts, der = _closed_form(theta, ctx.c, ctx.geo.R + FOOT_OFFSET, want_jac, full=ctx.seed)
-    z, dz = _plane(pts, der, ctx.sel, want_jac)
-    rot = _rot(beta)
-    zr = rot * z
-    x, y = zr.real, zr.imag
-    cg, sg = np.cos(gamma), np.sin(gamma)
-    s, o = ctx.s, ctx.origin
-    a = ctx.geo.d_wheel + s * ctx.w
-    m0 = cg * a - sg * y
-    m1 = sg * a + cg * y
-    p = np.stack(np.broadcast_arrays(o[0] - x, o[1] + s * m0, o[2] + m1), axis=-1)
-    if not want_jac:
-        return p, None
-    dzr = rot * dz
-    dx, dy = dzr.real, dzr.imag
-    ssg = s * sg
-    zero = np.zeros(p.shape[:-1])
-    cols = (-dx, y, zero, -ssg * dy, -ssg * x, -s * m1, cg * dy, cg * x, m0)
-    J = np.stack(np.broadcast_arrays(*cols), axis=-1).reshape(p.shape[:-1] + (3, 3))
-    return p, J
+    q = np.asarray(q, dtype=np.float64)
+    shape = np.broadcast_shapes(q.shape[:-1], ctx.sel.e.shape, ctx.w.shape)
+    flat = as_rows(np.broadcast_to(q, shape + (3,)), 3)
+    n = flat.shape[0]
+
+    def items(x, dtype):
+        return np.ascontiguousarray(np.broadcast_to(x, shape).reshape(n), dtype=dtype)
+
+    sel = ctx.sel
+    a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)
+    K, KC = _kconst(ctx.c.R, ctx.geo.R + FOOT_OFFSET)
+    P = np.empty((n, 3))
+    J = np.empty((n, 9) if want_jac else (n, 0))
+    o = ctx.origin
+    _k_fk_batch(flat, items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128), a,
+                ctx.seed, K, KC, ctx.s, float(o[0]), float(o[1]), float(o[2]), bool(want_jac), P, J)
+    p = P.reshape(shape + (3,))
+    return p, (J.reshape(shape + (3, 3)) if want_jac else None)
 
 
 def _contact(q, alpha, w, leg, rim, geo, want_jac, radius):
@@ -715,6 +884,59 @@ def _q_inputs(q, alpha, w, geo):
     return q, alpha, w
 
 
+@lru_cache(maxsize=64)
+def _kctx_cached(leg, rim, radius, geo: Geometry):
+    ctx = _context(np.zeros(()), 0.0, leg, rim, geo, radius)
+    if radius is None:
+        rho = geo.R + FOOT_OFFSET if ctx.seed else geo.R
+    else:
+        rho = float(radius)
+    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    o = ctx.origin
+    return (ctx.seed, rho, K, KC, ctx.s, geo.d_wheel, geo.T / 2, float(o[0]), float(o[1]), float(o[2]))
+
+
+def _kctx(leg, rim, radius, geo: Geometry):
+    """The contact kernels' per-call constants (validated: leg, rim, radius), cached per keyword set."""
+    try:
+        return _kctx_cached(leg, rim, radius, geo)
+    except TypeError:  # unhashable: let the checks name it
+        _context(np.zeros(()), 0.0, leg, rim, geo, radius)
+        raise
+
+
+_SCALARS = (float, int)
+
+
+def _contact_call(q, alpha, w, leg, rim, radius, geometry, want_jac):
+    """The wrapper of :func:`contact_point` / :func:`contact_jacobian`: kernel for a single item (fast path:
+    a float64 (3,) q and number alpha, w), batch kernel otherwise; any failure status -> the checks' error."""
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    if (type(q) is np.ndarray and q.shape == (3,) and q.dtype == np.float64 and type(alpha) in _SCALARS
+            and type(w) in _SCALARS):
+        try:
+            kc = _kctx(leg, rim, radius, geo)
+        except Exception:  # noqa: BLE001 - the full checks below raise the documented error in order
+            kc = None
+        if kc is not None:
+            p = np.empty(3)
+            J = np.empty(9) if want_jac else _NO_JAC
+            if _k_contact(q, float(alpha), float(w), *kc, want_jac, p, J) == OK:
+                return J.reshape(3, 3) if want_jac else p
+    q, alpha, w = _q_inputs(q, alpha, w, geo)  # raises the documented error for a bad input
+    kc = _kctx(leg, rim, radius, geo)
+    shape = q.shape[:-1]
+    n = int(np.prod(shape, dtype=int))
+    P = np.empty((n, 3))
+    J = np.empty((n, 9) if want_jac else (n, 0))
+    status = np.empty(n, dtype=np.int64)
+    _k_contact_batch(as_rows(q, 3), as_rows(alpha, 1)[:, 0], as_rows(w, 1)[:, 0], *kc, want_jac, P, J, status)
+    return J.reshape(shape + (3, 3)) if want_jac else P.reshape(shape + (3,))
+
+
+_NO_JAC = np.empty(0)
+
+
 def contact_point(q, alpha, w, leg, *, rim: str = "continuous", radius: float | None = None,
                   geometry: Geometry | None = None) -> np.ndarray:
     """Contact point in the robot frame {R} for q = (theta, beta, gamma) (seed section 1, FK).
@@ -730,9 +952,7 @@ def contact_point(q, alpha, w, leg, *, rim: str = "continuous", radius: float | 
     Returns:
         (..., 3) point in {R}.
     """
-    geo = _geometry(geometry)
-    q, alpha, w = _q_inputs(q, alpha, w, geo)
-    return _contact(q, alpha, w, leg, rim, geo, False, radius)[0]
+    return _contact_call(q, alpha, w, leg, rim, radius, geometry, False)
 
 
 def contact_jacobian(q, alpha, w, leg, *, rim: str = "continuous", radius: float | None = None,
@@ -743,9 +963,7 @@ def contact_jacobian(q, alpha, w, leg, *, rim: str = "continuous", radius: float
     theta-derivatives are carried through every step (forward mode by hand, :func:`_closed_form`),
     d/dbeta is ``i z`` in the leg plane and d/dgamma is ``R0 Rz(gamma) (e_z x p_M)``.
     """
-    geo = _geometry(geometry)
-    q, alpha, w = _q_inputs(q, alpha, w, geo)
-    return _contact(q, alpha, w, leg, rim, geo, True, radius)[1]
+    return _contact_call(q, alpha, w, leg, rim, radius, geometry, True)
 
 
 # ---------------------------------------------------------------- inverse kinematics

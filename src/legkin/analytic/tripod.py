@@ -34,6 +34,7 @@ from ..errors import (
 )
 from ..models.tripod import SPEC as _SPEC
 from ._batch import as_angles, as_input, finish
+from ._kernels import OK, batch_kernel, kernel, prange
 
 __all__ = [
     "LEGS",
@@ -799,142 +800,430 @@ def _det_planes(s: np.ndarray, c: np.ndarray, g: _Geometry) -> np.ndarray:
     return np.add.reduce(s * x - c * (g.ce * y + g.se * z), axis=-1) / 3.0
 
 
-def _shrunk(ay: np.ndarray, az: np.ndarray, f: float) -> tuple[np.ndarray, np.ndarray]:
-    """The orientation of tilt ``(1 - f) theta`` in the same direction as (ay, az) (towards home)."""
-    cy = np.cos(ay)
-    r = np.stack([np.cos(az) * cy, np.sin(az) * cy, -np.sin(ay)], axis=-1)
-    theta = np.arccos(np.clip(r[..., 0], -1.0, 1.0)) * (1.0 - f)
-    side = np.hypot(r[..., 1], r[..., 2])
-    side = np.where(side > 0, side, 1.0)
-    st = np.sin(theta) / side
-    return -np.arcsin(np.clip(r[..., 2] * st, -1.0, 1.0)), np.arctan2(r[..., 1] * st, np.cos(theta))
+
+# ------------------------------------------------------------------------------------------ compiled kernels
+# The one implementation (issue 16, see :mod:`legkin.analytic._kernels`): scalar kernels beside the equations
+# they implement (the docstrings of the numpy-era helpers above and below give the derivations), batch loops
+# over them, and status codes. Geometry: a float64 vector (see :func:`_geometry_vector`):
+_G_D, _G_CA, _G_SA, _G_K, _G_K2, _G_OPC, _G_DSA, _G_ML, _G_TH, _G_CE, _G_SE, _G_W = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 12, 15
+#: Kernel status codes of fk (those of :func:`_fk_mode`) and of the closed forms.
+_ST_SINGULAR_PLANES, _ST_LEFT, _ST_NOT_CONVERGED, _ST_INCONSISTENT, _ST_OUTSIDE, _ST_GAIN = 1, 2, 3, 4, 5, 6
+_ST_NONFINITE = 7  # an input is NaN or inf (the wrapper raises InvalidInputError with as_input's message)
+_ST_FAIL = 8  # closed forms: the pose is outside / singular (the wrapper diagnoses it)
+_TWO_PI = 2.0 * math.pi
 
 
-def _normal_residual(a1: np.ndarray, a2: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """|r - A A^+ r| for ``A = [a1 a2]`` (n, 3, 2) given as its columns: the part of r off the range of A, (n, 1);
-    and |A|_F (n, 1).
+def _geometry_vector(g: "_Geometry") -> np.ndarray:
+    """The kernels' geometry: (d, c_alpha, s_alpha, k, k^2, 1 + c_alpha, d s_alpha, -L, tan(alpha/2), c_eta (3),
+    s_eta (3), sin(eta_{K+2} - eta_{K+1}) (3))."""
+    head = [g.d, g.ca, g.sa, g.k, g.k2, g.opc, g.dsa, g.minus_l, g.tan_half]
+    return np.ascontiguousarray(np.concatenate([head, g.ce, g.se, g.w]), dtype=np.float64)
 
-    Rank 2: ``|r . n| / |n|`` with ``n = a1 x a2``; where ``sigma_2 <= STEP_RCOND sigma_1`` (as in
-    :func:`_gauss_newton_step`) the rank-1 projection ``A A^T r / |A|_F^2``.
-    """
-    n = a1[:, _NEXT] * a2[:, _PREV] - a1[:, _PREV] * a2[:, _NEXT]
-    nn = np.add.reduce(n * n, axis=-1, keepdims=True)
-    f = np.add.reduce(a1 * a1 + a2 * a2, axis=-1, keepdims=True)
-    out = np.abs(np.add.reduce(r * n, axis=-1, keepdims=True)) / np.sqrt(nn)
-    rank1 = ~(nn > (STEP_RCOND * STEP_RCOND) * f * f)
-    if rank1.any():
-        fs = np.where(f > 0, f, 1.0)
-        p = r - (a1 * np.add.reduce(a1 * r, axis=-1, keepdims=True) + a2 * np.add.reduce(a2 * r, axis=-1, keepdims=True)) / fs
-        out = np.where(rank1, np.sqrt(np.add.reduce(p * p, axis=-1, keepdims=True)), out)
+
+@kernel
+def _k_wrap(a):
+    """:func:`_wrap` on a float: ``(a + pi) mod 2 pi - pi`` (Python's floor modulo, as np.remainder)."""
+    return (a + math.pi) % _TWO_PI - math.pi
+
+
+@kernel
+def _k_one_plus_cc(cy, sy, cz, sz):
+    """:func:`_one_plus_cc` on floats."""
+    p = cy * cz
+    out = 1.0 + p
+    if p < -0.5:
+        if cy >= 0.0:
+            a, b, sa, sb = cy, cz, sy, sz
+        else:
+            a, b, sa, sb = cz, cy, sz, sy
+        out = sb * sb / (1.0 - b) - b * (sa * sa) / (1.0 + a)
+    return out
+
+
+@kernel
+def _k_centre(cy, sy, cz, sz, G, home, e):
+    """Platform centre E = e L b / |b| (:func:`_ik_eval`, :func:`platform_position`): (x, y, z, 1 + c_y c_z);
+    NaN where 1 + c_y c_z <= SINGULAR_TOL."""
+    nb2 = _k_one_plus_cc(cy, sy, cz, sz)
+    lead = G[_G_ML] if home else -e * G[_G_ML]
+    scale = lead / np.sqrt(2.0 * nb2) if nb2 > SINGULAR_TOL else np.nan
+    return nb2 * scale, sz * cy * scale, -sy * scale, nb2
+
+
+@kernel
+def _k_leg(K, x, y, z, G, home, s):
+    """Seed eqs (98), (102) for leg K at E = (x, y, z): (q1, q2, cos q2, sin q2, sin q1 (unnormalised), cos q1).
+    ``s``: the sign of sin q_K2 (ignored in the home mode)."""
+    ce, se = G[_G_CE + K], G[_G_SE + K]
+    c2 = (ce * z - se * y) / G[_G_DSA]  # eq (98)
+    q2 = np.arccos(c2)  # NaN where |c2| > 1
+    if not home:
+        q2 = s * q2
+    s2 = np.sin(q2)
+    w = -(ce * y + se * z)
+    s2sa = s2 * G[_G_SA]
+    det = G[_G_D] * (G[_G_K2] + s2sa * s2sa)
+    sn = (G[_G_K] * x + s2sa * w) / det
+    cn = (-s2sa * x + G[_G_K] * w) / det
+    return np.arctan2(sn, cn), q2, c2, s2, sn, cn  # eq (102)
+
+
+@kernel
+def _k_inside(c2a, c2b, c2c, nb2):
+    """:func:`_inside` on floats (False on NaN)."""
+    return (nb2 > SINGULAR_TOL) and (1.0 - abs(c2a) > BOUNDARY_TOL) and (1.0 - abs(c2b) > BOUNDARY_TOL) and (
+        1.0 - abs(c2c) > BOUNDARY_TOL
+    )
+
+
+@kernel
+def _k_jac_home(K, cy, sy, cz, sz, s2, n, G):
+    """Seed eqs (103)-(105), row K of A_u (home mode): (A_K1, A_K2) (see :func:`actuation_jacobian`)."""
+    ck, sk = G[_G_CE + K], G[_G_SE + K]
+    cpc = cy + cz
+    ck_cpc, sk_cpc = ck * cpc, sk * cpc
+    ck_sy, sk_sy, ck_cy = ck * sy, sk * sy, ck * cy
+    ck_sy_sz, sk_sy_sz = ck_sy * sz, sk_sy * sz
+    f = G[_G_TH] * (ck_sy + sk * cy * sz)  # eq (105)
+    m = G[_G_OPC] * (s2 * s2) + 1 - G[_G_CA]
+    t = ck_cy * sz - sk_sy
+    p = n * n + t * t
+    den = 2 * s2 * (n * n) * m
+    mf = -f
+    a1 = mf * (ck_cpc - sk_sy_sz + (ck_cy - sk_sy_sz) * n) / den - (ck_sy_sz + sk_cpc) / p
+    a2 = mf * cy * (sk_cpc + ck_sy_sz + sk * cz * n) / den + cy * (ck_cpc - sk_sy_sz) / p
+    return a1, a2
+
+
+@kernel
+def _k_jac_general(K, cy, sy, cz, sz, c2, s2, n, G, e):
+    """Row K of A_u in any assembly mode (:func:`_jac_general`, the chain rule through the mode's IK)."""
+    ce, se, k, sa = G[_G_CE + K], G[_G_SE + K], G[_G_K], G[_G_SA]
+    lead = -e * G[_G_ML] / np.sqrt(2.0 * n)
+    bx, by, bz = n, sz * cy, -sy
+    x, y, z = lead * bx, lead * by, lead * bz
+    w = -(ce * y + se * z)
+    sig = sa * s2
+    p_, q_ = k * x + sig * w, -sig * x + k * w
+    pq = p_ * p_ + q_ * q_
+    out0 = 0.0
+    out1 = 0.0
+    for col in range(2):
+        if col == 0:
+            dn, dbx, dby, dbz = -sy * cz, -sy * cz, -sz * sy, -cy
+        else:
+            dn, dbx, dby, dbz = -cy * sz, -cy * sz, cz * cy, 0.0 * cy
+        h = dn / (2.0 * n)
+        dx, dy, dz = lead * (dbx - bx * h), lead * (dby - by * h), lead * (dbz - bz * h)
+        dc2 = (ce * dz - se * dy) / G[_G_DSA]
+        dsig = sa * (-c2 * dc2 / s2)
+        dw = -(ce * dy + se * dz)
+        dp = k * dx + sig * dw + w * dsig
+        dq = -sig * dx - x * dsig + k * dw
+        v = (q_ * dp - p_ * dq) / pq
+        if col == 0:
+            out0 = v
+        else:
+            out1 = v
+    return out0, out1
+
+
+@kernel
+def _k_pose(cy, sy, cz, sz, G, home, e, s, q1, c2, s2, sn, cn):
+    """IK at the trig of u: fills q1, c2, s2, sn, cn (3,) per leg; returns 1 + c_y c_z."""
+    x, y, z, nb2 = _k_centre(cy, sy, cz, sz, G, home, e)
+    for K in range(3):
+        q1[K], _q2, c2[K], s2[K], sn[K], cn[K] = _k_leg(K, x, y, z, G, home, s[K])
+    return nb2
+
+
+@kernel
+def _k_jac(cy, sy, cz, sz, c2, s2, nb2, G, home, e, a1, a2):
+    """Both columns of A_u (3,) each, in place."""
+    for K in range(3):
+        if home:
+            a1[K], a2[K] = _k_jac_home(K, cy, sy, cz, sz, s2[K], nb2, G)
+        else:
+            a1[K], a2[K] = _k_jac_general(K, cy, sy, cz, sz, c2[K], s2[K], nb2, G, e)
+
+
+@kernel
+def _k_det_planes(sa_, sb_, sc_, ca_, cb_, cc_, G):
+    """det M of the motor planes (:func:`_det_planes`), from sin / cos of the three motors (scalars)."""
+    s = (sa_, sb_, sc_)
+    c = (ca_, cb_, cc_)
+    tot = 0.0
+    for K in range(3):
+        J, L = (K + 1) % 3, (K + 2) % 3
+        p, q = c[J] * s[L], s[J] * c[L]
+        x = c[J] * c[L] * G[_G_W + K]
+        y = q * G[_G_SE + L] - p * G[_G_SE + J]
+        z = p * G[_G_CE + J] - q * G[_G_CE + L]
+        tot += s[K] * x - c[K] * (G[_G_CE + K] * y + G[_G_SE + K] * z)
+    return tot / 3.0
+
+
+@kernel
+def _k_initial_guess(qa, qb, qc, G):
+    """Closed-form start of fk (:func:`_initial_guess`) from the motors: (alpha_y, alpha_z, det M).
+    Only the adjugate intersection (regular planes, ``|det M| > PLANES_DET_MIN`` and 1 - c_alpha > 0); fk refuses
+    ``|det M| < DET_GUARD`` before iterating, so the parallel-planes fallback is never needed there; with
+    ``1 - c_alpha = 0`` (E = 0) the start is the home direction, as the fallback gives."""
+    s = (np.sin(qa), np.sin(qb), np.sin(qc))
+    c = (np.cos(qa), np.cos(qb), np.cos(qc))
+    det3 = 0.0
+    ex = 0.0
+    ey = 0.0
+    ez = 0.0
+    for K in range(3):
+        J, L = (K + 1) % 3, (K + 2) % 3
+        p, q = c[J] * s[L], s[J] * c[L]
+        x = c[J] * c[L] * G[_G_W + K]
+        y = q * G[_G_SE + L] - p * G[_G_SE + J]
+        z = p * G[_G_CE + J] - q * G[_G_CE + L]
+        det3 += s[K] * x - c[K] * (G[_G_CE + K] * y + G[_G_SE + K] * z)
+        ex += x
+        ey += y
+        ez += z
+    if G[_G_K] == 0.0:
+        ex, ey, ez = -1.0, 0.0, 0.0
+    ee = ex * ex + ey * ey + ez * ez
+    t = ex + ex
+    ay = -np.arcsin(min(max(t * ez / ee, -1.0), 1.0))
+    az = np.arctan2(t * ey, t * ex - ee)
+    return ay, az, det3 / 3.0
+
+
+@kernel
+def _k_gn_step(a1, a2, r):
+    """``-pinv([a1 a2]) r`` in closed form (:func:`_gauss_newton_step`) for (3,) columns: (s0, s1)."""
+    nn = 0.0
+    t0 = 0.0
+    t1 = 0.0
+    f = 0.0
+    for K in range(3):
+        I, J = (K + 1) % 3, (K + 2) % 3
+        n = a1[I] * a2[J] - a1[J] * a2[I]
+        nn += n * n
+        t0 += (a2[I] * r[J] - a2[J] * r[I]) * n
+        t1 += (r[I] * a1[J] - r[J] * a1[I]) * n
+        f += a1[K] * a1[K] + a2[K] * a2[K]
+    s0, s1 = t0 / nn, t1 / nn
+    if nn <= (STEP_RCOND * STEP_RCOND) * f * f:
+        fs = f if f > 0 else 1.0
+        u0 = 0.0
+        u1 = 0.0
+        for K in range(3):
+            u0 += a1[K] * r[K]
+            u1 += a2[K] * r[K]
+        s0, s1 = -u0 / fs, -u1 / fs
+    return s0, s1
+
+
+@kernel
+def _k_normal_residual(a1, a2, r):
+    """|r - A A^+ r| and |A|_F for A = [a1 a2] (the part of r off the range of A: rank 2 ``|r . n| / |n|``, n = a1 x a2; rank-1 projection where ``sigma_2 <= STEP_RCOND sigma_1``)."""
+    nn = 0.0
+    f = 0.0
+    rn = 0.0
+    for K in range(3):
+        I, J = (K + 1) % 3, (K + 2) % 3
+        n = a1[I] * a2[J] - a1[J] * a2[I]
+        nn += n * n
+        rn += r[K] * n
+        f += a1[K] * a1[K] + a2[K] * a2[K]
+    out = abs(rn) / np.sqrt(nn)
+    if not nn > (STEP_RCOND * STEP_RCOND) * f * f:
+        fs = f if f > 0 else 1.0
+        u0 = 0.0
+        u1 = 0.0
+        for K in range(3):
+            u0 += a1[K] * r[K]
+            u1 += a2[K] * r[K]
+        pp = 0.0
+        for K in range(3):
+            p = r[K] - (a1[K] * u0 + a2[K] * u1) / fs
+            pp += p * p
+        out = np.sqrt(pp)
     return out, np.sqrt(f)
 
 
-def _fk_core(qm: np.ndarray, g: _Geometry, tol: float, max_iter: int, signs=None, det_out=None):
-    """Unchecked :func:`fk` on motors (n, 3) in one assembly mode (call under ``np.errstate(invalid, divide)``).
+@kernel
+def _k_shrunk(ay, az, f):
+    """The orientation of tilt (1 - f) theta in the direction of (ay, az) (towards home)."""
+    cy = np.cos(ay)
+    r0, r1, r2 = np.cos(az) * cy, np.sin(az) * cy, -np.sin(ay)
+    theta = np.arccos(min(max(r0, -1.0), 1.0)) * (1.0 - f)
+    side = np.hypot(r1, r2)
+    side = side if side > 0 else 1.0
+    st = np.sin(theta) / side
+    return -np.arcsin(min(max(r2 * st, -1.0), 1.0)), np.arctan2(r1 * st, np.cos(theta))
 
-    Gauss-Newton from :func:`_initial_guess`. The iterates stay inside the workspace (where :func:`ik` is
-    defined): a step that lands outside is halved (from the last iterate inside), and a start outside (the
-    planes' intersection carries a rounding error ~1e-16 / |det M|, which matters a hair from the boundary) is
-    pulled in towards home by shrinking its tilt by 1e-12, 1e-10, ... (the workspace is star-shaped about home).
 
-    Returns:
-        alpha_y, alpha_z, inconsistency, converged, active, inside, floor: (n, 1) each; ``inside``: the
-        :func:`ik` success test (:func:`_inside`) at the reported pose; ``floor``: the inconsistency that the
-        rounding of the pose alone can cause (:data:`ROUNDING_FLOOR` |A_u|_F). ``det_out`` (a list), if given,
-        receives det M.
+@kernel
+def _k_fk_report(ay, az, qm, G, home, e, s, a1, a2, q1, c2, s2, sn, cn, r):
+    """The reported pose (alpha_y in [-pi/2, pi/2]), its inconsistency, ik's success test and the rounding floor."""
+    if np.cos(ay) < 0:
+        ay, az = math.pi - ay, az + math.pi
+    ay, az = _k_wrap(ay), _k_wrap(az)
+    nb2 = _k_pose(np.cos(ay), np.sin(ay), np.cos(az), np.sin(az), G, home, e, s, q1, c2, s2, sn, cn)
+    for K in range(3):
+        r[K] = _k_wrap(q1[K] - qm[K])
+    inc, norm_a = _k_normal_residual(a1, a2, r)
+    return ay, az, inc, _k_inside(c2[0], c2[1], c2[2], nb2), ROUNDING_FLOOR * norm_a
+
+
+@kernel
+def _k_fk(qa, qb, qc, G, home, e, s, tol, max_iter, max_inc, out):
+    """fk of one motor triple in one assembly mode: writes (alpha_y, alpha_z, inconsistency) into ``out`` (3,)
+    and returns the status (0 ok, else the codes of :func:`_fk_mode`; :data:`_ST_NONFINITE` for NaN / inf motors).
+
+    Gauss-Newton from the planes' intersection (:func:`_initial_guess`), kept inside the workspace (a step that
+    lands outside is halved, a start outside is pulled in towards home); early exit per target. See :func:`fk`.
     """
-    ay, az, det = _initial_guess(qm, g, with_det=True)
-    if det_out is not None:
-        det_out.append(det)
+    if not (np.isfinite(qa) and np.isfinite(qb) and np.isfinite(qc)):
+        out[0] = out[1] = out[2] = np.nan
+        return _ST_NONFINITE
+    qm = np.empty(3)
+    qm[0], qm[1], qm[2] = qa, qb, qc
+    scratch = np.empty((8, 3))
+    q1, c2, s2, sn, cn, r, a1, a2 = (scratch[0], scratch[1], scratch[2], scratch[3], scratch[4], scratch[5],
+                                     scratch[6], scratch[7])
+    ay, az, det = _k_initial_guess(qa, qb, qc, G)
+    if not abs(det) >= DET_GUARD:
+        out[0] = out[1] = out[2] = np.nan
+        return _ST_SINGULAR_PLANES
     y0, z0 = ay, az
-    converged = np.zeros(ay.shape, dtype=bool)
-    active = np.ones(ay.shape, dtype=bool)
-    rn_prev = np.full(ay.shape, np.inf)
-    py = pz = np.full(ay.shape, np.nan)  # the last iterate evaluated inside the workspace (NaN: none yet)
-    tries = None
+    converged = False
+    active = True
+    rn_prev = np.inf
+    py = pz = np.nan
+    tries = 0
+    a1[:] = np.nan
+    a2[:] = np.nan
     for _ in range(max_iter):
         cy, sy, cz, sz = np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
-        q1, _, c2, s2, nb2 = _ik_eval(cy, sy, cz, sz, g, signs)
-        r = _wrap(q1 - qm)
-        rn = np.sqrt(np.add.reduce(r * r, axis=-1, keepdims=True))
-        good = _inside(c2, nb2) & np.isfinite(rn)  # A_u and r are finite there
-        out = active & ~converged & ~good
-        if out.any():
-            tries = np.where(out, 1.0, 0.0) if tries is None else tries + out
-            active &= ~(out & (tries > 6))
-            seen = np.isfinite(py)
-            back = out & active & seen  # halve the step from the last iterate inside
-            ay, az = np.where(back, 0.5 * (py + ay), ay), np.where(back, 0.5 * (pz + az), az)
-            pull = out & active & ~seen  # pull the start in
-            if pull.any():
-                ay, az = ay.copy(), az.copy()
-                ay[pull], az[pull] = _shrunk(y0[pull], z0[pull], 10.0 ** (-14 + 2 * tries[pull]))
-        work = active & ~converged & good
-        if signs is None:
-            a1, a2 = _jac_eval(cy, sy, cz, sz, s2, nb2, g)
-        else:
-            a1, a2 = _jac_general(cy, sy, cz, sz, c2, s2, nb2, g, signs[0])
+        nb2 = _k_pose(cy, sy, cz, sz, G, home, e, s, q1, c2, s2, sn, cn)
+        rr = 0.0
+        for K in range(3):
+            r[K] = _k_wrap(q1[K] - qm[K])
+            rr += r[K] * r[K]
+        rn = np.sqrt(rr)
+        good = _k_inside(c2[0], c2[1], c2[2], nb2) and np.isfinite(rn)
+        if active and not converged and not good:
+            tries += 1
+            if tries > 6:
+                active = False
+            elif np.isfinite(py):  # halve the step from the last iterate inside
+                ay, az = 0.5 * (py + ay), 0.5 * (pz + az)
+            else:  # pull the start in
+                ay, az = _k_shrunk(y0, z0, 10.0 ** (-14.0 + 2.0 * tries))
+        work = active and not converged and good
+        _k_jac(cy, sy, cz, sz, c2, s2, nb2, G, home, e, a1, a2)
         stalled = rn >= rn_prev  # no progress: at the (least-squares) minimum to rounding
-        rn_prev = np.where(work, rn, rn_prev)
-        # at the rounding floor (|r| no larger than the rounding of u alone can make it) the pose is as good as
-        # the motors can tell: no step (a step would only add the noise of r, amplified by pinv(A_u))
-        at_floor = rn <= ROUNDING_FLOOR * np.sqrt(np.add.reduce(a1 * a1 + a2 * a2, axis=-1, keepdims=True))
-        s0, s1 = _gauss_newton_step(a1, a2, r)
-        # converged when the step, or its effect on the motors (the step is ill-determined near the
-        # parametrisation singularity c_y = 0 and near 1 + c_y c_z = 0), is below tol
-        motor_step = np.maximum.reduce(np.abs(a1 * s0 + a2 * s1), axis=-1, keepdims=True)
-        small = (np.maximum(np.abs(s0), np.abs(s1)) <= tol) | (motor_step <= tol) | stalled | at_floor
-        py, pz = np.where(work, ay, py), np.where(work, az, pz)
-        move = work & ~at_floor
-        ay = np.where(move, ay + s0, ay)
-        az = np.where(move, az + s1, az)
-        converged |= work & small
-        if (converged | ~active).all():
+        if work:
+            rn_prev = rn
+        f = 0.0
+        for K in range(3):
+            f += a1[K] * a1[K] + a2[K] * a2[K]
+        at_floor = rn <= ROUNDING_FLOOR * np.sqrt(f)
+        s0, s1 = _k_gn_step(a1, a2, r)
+        motor_step = 0.0
+        for K in range(3):
+            v = abs(a1[K] * s0 + a2[K] * s1)
+            if not v <= motor_step:  # NaN propagates, as np.maximum
+                motor_step = v
+        big = abs(s0)
+        if not abs(s1) <= big:
+            big = abs(s1)
+        small = (big <= tol) or (motor_step <= tol) or stalled or at_floor
+        if work:
+            py, pz = ay, az
+            if not at_floor:
+                ay, az = ay + s0, az + s1
+            if small:
+                converged = True
+        if converged or not active:
             break
-    active &= np.isfinite(py)
-    # the inconsistency uses the last A_u evaluated (at most a step of size <= tol away): its range is what matters
-    rep = _fk_report(ay, az, qm, g, signs, a1, a2)
-    if (converged & ~rep[3]).any():  # the last (tiny) step left the workspace: report the iterate before it
-        alt = _fk_report(py, pz, qm, g, signs, a1, a2)
-        use = converged & ~rep[3] & alt[3]
-        rep = tuple(np.where(use, a, b) for a, b in zip(alt, rep))
-    ay, az, inconsistency, inside, floor = rep
-    return ay, az, inconsistency, converged, active, inside, floor
+    if not np.isfinite(py):
+        active = False
+    ry, rz, inc, inside, floor = _k_fk_report(ay, az, qm, G, home, e, s, a1, a2, q1, c2, s2, sn, cn, r)
+    if converged and not inside:  # the last (tiny) step left the workspace: report the iterate before it
+        by, bz, binc, binside, bfloor = _k_fk_report(py, pz, qm, G, home, e, s, a1, a2, q1, c2, s2, sn, cn, r)
+        if binside:
+            ry, rz, inc, inside, floor = by, bz, binc, binside, bfloor
+    out[0], out[1], out[2] = ry, rz, inc
+    consistent = inc <= max_inc + floor
+    tame = floor <= ROUNDING_FLOOR * GAIN_GUARD
+    if not active:
+        return _ST_LEFT
+    if not converged:
+        return _ST_NOT_CONVERGED
+    if not inside:
+        return _ST_OUTSIDE
+    if not tame:
+        return _ST_GAIN
+    if not consistent:
+        return _ST_INCONSISTENT
+    return OK
 
 
-def _fk_report(ay, az, qm, g: _Geometry, signs, a1, a2):
-    """The reported pose (alpha_y in [-pi/2, pi/2], alpha_z in [-pi, pi)), its inconsistency and ik's success test.
+@batch_kernel
+def _k_fk_batch(qm, G, homes, es, ss, tol, max_iter, max_inc, out, status):
+    """fk over motors (n, 3) in the modes given (homes (m,), es (m,), ss (m, 3)): out (n, m, 3), status (n, m);
+    NaN where an item fails."""
+    n, m = qm.shape[0], homes.shape[0]
+    for i in prange(n):
+        for j in range(m):
+            st = _k_fk(qm[i, 0], qm[i, 1], qm[i, 2], G, homes[j], es[j], ss[j], tol, max_iter, max_inc, out[i, j])
+            status[i, j] = st
+            if st != OK:
+                out[i, j, 0] = out[i, j, 1] = out[i, j, 2] = np.nan
 
-    The inconsistency is the distance of the motors from the tangent plane of the consistent set at the pose:
-    the residual r less its part in the range of A_u (:func:`_normal_residual`). At a least-squares solution r
-    is orthogonal to that range already, so this is |r| there; for consistent motors it drops the A_u-amplified
-    rounding of the pose (|A_u| ~ 1 / sqrt(1 + c_y c_z) near the flip), which |r| would report.
-    """
-    flip = np.cos(ay) < 0
-    ay = _wrap(np.where(flip, np.pi - ay, ay))
-    az = _wrap(np.where(flip, az + np.pi, az))
-    q1, _, c2, _, nb2 = _ik_eval(np.cos(ay), np.sin(ay), np.cos(az), np.sin(az), g, signs)
-    inconsistency, norm_a = _normal_residual(a1, a2, _wrap(q1 - qm))
-    return ay, az, inconsistency, _inside(c2, nb2), ROUNDING_FLOOR * norm_a
+
+#: Per assembly mode (:data:`MODES` order): home flag, side of E, signs of sin q_K2 (the kernels' mode arguments).
+_MODE_HOME = np.array([m == HOME_MODE for m in MODES])
+_MODE_E = np.array([-1.0 if m[0] == "-" else 1.0 for m in MODES])
+_MODE_S = np.array([[-1.0 if c == "-" else 1.0 for c in m[1:]] for m in MODES])
+_MODE_INDEX = {m: i for i, m in enumerate(MODES)}
+_GEO_CACHE: dict = {}
+
+
+def _geo(d, alpha, eta):
+    """Validated geometry: (_Geometry, the kernels' vector), cached for plain-float d, alpha and the default eta."""
+    if eta is None and type(d) is float and type(alpha) is float:
+        hit = _GEO_CACHE.get((d, alpha))
+        if hit is not None:
+            return hit
+        g = _geometry(*_params(d, alpha, None))
+        if len(_GEO_CACHE) > 64:
+            _GEO_CACHE.clear()
+        hit = _GEO_CACHE[(d, alpha)] = (g, _geometry_vector(g))
+        return hit
+    g = _geometry(*_params(d, alpha, eta))
+    return g, _geometry_vector(g)
+
+
+def _fk_one(qa: float, qb: float, qc: float, G, mode: str, tol: float, max_iter: int, max_inc: float):
+    """The fk kernel on one motor triple in one mode: (alpha_y, alpha_z, inconsistency) (raw, also on failure), status."""
+    j = _MODE_INDEX[mode]
+    out = np.empty(3)
+    st = _k_fk(qa, qb, qc, G, bool(_MODE_HOME[j]), float(_MODE_E[j]), _MODE_S[j], tol, max_iter, max_inc, out)
+    return out, st
 
 
 def _fk_mode(qm: np.ndarray, g: _Geometry, tol: float, max_iter: int, max_inconsistency: float, mode: str):
     """:func:`fk` on motors (n, 3) in one mode: alpha_y, alpha_z, inconsistency (n,), ok (n,), status (n,)
     (0 ok, 1 actuation singular, 2 left the workspace, 3 not converged, 4 inconsistent, 5 ended outside,
-    6 motor gain above GAIN_GUARD)."""
-    dets = []
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        ay, az, inc, converged, active, inside, floor = (
-            a[:, 0] for a in _fk_core(qm, g, tol, max_iter, _mode_signs(mode), dets)
-        )
-        consistent = inc <= max_inconsistency + floor
-        tame = floor <= ROUNDING_FLOOR * GAIN_GUARD  # |A_u|_F <= GAIN_GUARD (at the last iterate)
-    regular = np.abs(dets[0]) >= DET_GUARD
-    ok = regular & active & converged & consistent & inside & tame
-    if ok.all():
-        return ay, az, inc, ok, np.zeros(ok.shape, dtype=int)
-    status = np.select([~regular, ~active, ~converged, ~inside, ~tame, ~consistent], [1, 2, 3, 5, 6, 4], default=0)
-    return ay, az, inc, ok, status
+    6 motor gain above GAIN_GUARD); the raw values (not NaN) also where an item fails."""
+    G = _geometry_vector(g)
+    n = qm.shape[0]
+    ay, az, inc, status = np.empty(n), np.empty(n), np.empty(n), np.empty(n, dtype=np.int64)
+    for i in range(n):
+        out, status[i] = _fk_one(float(qm[i, 0]), float(qm[i, 1]), float(qm[i, 2]), G, mode, tol, max_iter,
+                                 max_inconsistency)
+        ay[i], az[i], inc[i] = out
+    return ay, az, inc, status == OK, status
 
 
 def fk(
@@ -958,7 +1247,7 @@ def fk(
     from the closed-form start of :func:`_initial_guess` (the motor planes; not in the seed), until the step
     (or its image ``A_u du`` in the motors) is below ``tol``; from consistent motors the start is already
     exact to rounding and one iteration confirms it. The iterates are kept inside the workspace (a step that
-    leaves it is halved, see :func:`_fk_core`). The result is reported with ``alpha_y`` in [-pi/2, pi/2]
+    leaves it is halved, see :func:`_k_fk`). The result is reported with ``alpha_y`` in [-pi/2, pi/2]
     (``(pi - alpha_y, alpha_z + pi)`` is the same orientation). Inputs are checked once here; the iteration
     runs on the unchecked private functions (a single call is a batch of one).
 
@@ -1000,47 +1289,87 @@ def fk(
         InvalidInputError: non-finite, complex or non-broadcastable motors; InvalidParameterError: bad geometry,
             mode, tol, max_iter, max_inconsistency or return_mask.
     """
-    d, alpha, eta_arr = _params(d, alpha, eta)
-    mode = _checked_mode(mode, allow_all=True)
-    tol = _in_range(tol, "tol", 0.0, 0.1, "[0, 0.1] (rad)")
-    max_iter = _integer(max_iter, "max_iter", 1, 10000)
-    max_inconsistency = _in_range(max_inconsistency, "max_inconsistency", 0.0, math.inf, "[0, inf] (rad)")
-    return_mask = _flag(return_mask, "return_mask")
-    a1, b1, c1 = as_angles(q_A1, q_B1, q_C1, names=("q_A1", "q_B1", "q_C1"))
-    shape = a1.shape
-    qm = np.stack([a1, b1, c1], axis=-1).reshape(-1, 3)
-    g = _geometry(d, alpha, eta_arr)
+    g, G = _geo(d, alpha, eta)
+    if type(mode) is not str or mode != HOME_MODE:
+        mode = _checked_mode(mode, allow_all=True)
+    if type(tol) is not float or not 0.0 <= tol <= 0.1:
+        tol = _in_range(tol, "tol", 0.0, 0.1, "[0, 0.1] (rad)")
+    if type(max_iter) is not int or not 1 <= max_iter <= 10000:
+        max_iter = _integer(max_iter, "max_iter", 1, 10000)
+    if type(max_inconsistency) is not float or not 0.0 <= max_inconsistency <= math.inf:
+        max_inconsistency = _in_range(max_inconsistency, "max_inconsistency", 0.0, math.inf, "[0, inf] (rad)")
+    if return_mask is not False and return_mask is not True:
+        return_mask = _flag(return_mask, "return_mask")
+    if isinstance(q_A1, float) and isinstance(q_B1, float) and isinstance(q_C1, float):
+        qs = (float(q_A1), float(q_B1), float(q_C1))
+    else:
+        a1, b1, c1 = as_angles(q_A1, q_B1, q_C1, names=("q_A1", "q_B1", "q_C1"))
+        if a1.ndim:
+            return _fk_batch(a1, b1, c1, g, G, mode, tol, max_iter, max_inconsistency, return_mask)
+        qs = (float(a1), float(b1), float(c1))
+    return _fk_single(qs, g, G, mode, tol, max_iter, max_inconsistency, return_mask, (q_A1, q_B1, q_C1))
 
-    def motors() -> str:
-        return f"(q_A1, q_B1, q_C1) = ({float(a1.flat[0]):.17g}, {float(b1.flat[0]):.17g}, {float(c1.flat[0]):.17g})"
 
-    def solve(m: str):
-        return _fk_mode(qm, g, tol, max_iter, max_inconsistency, m)
-
+def _fk_single(qs, g, G, mode, tol, max_iter, max_inconsistency, return_mask, raw):
+    """A single fk call: np.float64 outputs, a legkin error on failure."""
+    motors = f"(q_A1, q_B1, q_C1) = ({qs[0]:.17g}, {qs[1]:.17g}, {qs[2]:.17g})"
+    qm = np.array([qs])
     if mode == "all":
-        res = [solve(m) for m in MODES]
-        ok = np.stack([r[3] for r in res], axis=-1).reshape(shape + (len(MODES),))
-        outs = tuple(
-            np.where(ok, np.stack([r[k] for r in res], axis=-1).reshape(ok.shape), np.nan) for k in range(3)
-        )
-        if a1.ndim == 0 and not ok.any():
-            raise _fk_error(motors(), qm, res[0], HOME_MODE, [], max_iter, max_inconsistency, g)
-        return (*outs, ok) if return_mask else outs
-    ay, az, inconsistency, ok, status = solve(mode)
-    nan = np.where(ok, 0.0, np.nan)
-
-    def error() -> Exception:
+        outs = np.full((3, len(MODES)), np.nan)
+        ok = np.zeros(len(MODES), dtype=bool)
+        first = None
+        for j, m in enumerate(MODES):
+            out, st = _fk_one(*qs, G, m, tol, max_iter, max_inconsistency)
+            if st == _ST_NONFINITE:
+                as_angles(*raw, names=("q_A1", "q_B1", "q_C1"))  # raises InvalidInputError
+            if j == 0:
+                first = (out[0], out[1], out[2], False, st)
+            if st == OK:
+                outs[:, j], ok[j] = out, True
+        if not ok.any():
+            raise _fk_error(motors, qm, first, HOME_MODE, [], max_iter, max_inconsistency, g)
+        res = (outs[0], outs[1], outs[2])
+        return (*res, ok) if return_mask else res
+    out, st = _fk_one(*qs, G, mode, tol, max_iter, max_inconsistency)
+    if st != OK:
+        if st == _ST_NONFINITE:
+            as_angles(*raw, names=("q_A1", "q_B1", "q_C1"))  # raises InvalidInputError
         others = []
-        if status[0] != 1:  # consistent motors fit the mode their planes' intersection E points to
+        if st != _ST_SINGULAR_PLANES:  # consistent motors fit the mode their planes' intersection E points to
             likely = _motor_mode(qm[0], g)
             for m in [likely] if likely else MODES:
-                if m != mode and bool(solve(m)[3][0]):
+                if m != mode and _fk_one(*qs, G, m, tol, max_iter, max_inconsistency)[1] == OK:
                     others.append(m)
                     break
-        return _fk_error(motors(), qm, (ay, az, inconsistency, ok, status), mode, others, max_iter, max_inconsistency, g)
+        raise _fk_error(motors, qm, (out[0], out[1], out[2], False, st), mode, others, max_iter, max_inconsistency, g)
+    res = (np.float64(out[0]), np.float64(out[1]), np.float64(out[2]))
+    return (*res, np.asarray(True)) if return_mask else res
 
-    out = tuple(v.reshape(shape) + nan.reshape(shape) for v in (ay, az, inconsistency))
-    return finish(out, ok.reshape(shape), a1.ndim == 0, return_mask, error)
+
+def _fk_batch(a1, b1, c1, g, G, mode, tol, max_iter, max_inconsistency, return_mask):
+    """A batch fk call: the compiled loop, NaN where an item fails."""
+    shape = a1.shape
+    qm = np.empty(shape + (3,))
+    qm[..., 0], qm[..., 1], qm[..., 2] = a1, b1, c1
+    qm = qm.reshape(-1, 3)
+    if mode == "all":
+        sel = slice(None)
+    else:
+        j = _MODE_INDEX[mode]
+        sel = slice(j, j + 1)
+    homes, es, ss = _MODE_HOME[sel], _MODE_E[sel], _MODE_S[sel]
+    n, m = qm.shape[0], homes.shape[0]
+    out = np.empty((n, m, 3))
+    status = np.empty((n, m), dtype=np.int64)
+    _k_fk_batch(qm, G, homes, es, ss, tol, max_iter, max_inconsistency, out, status)
+    ok = status == OK
+    if mode == "all":
+        res = tuple(out[:, :, k].reshape(shape + (m,)) for k in range(3))
+        ok = ok.reshape(shape + (m,))
+    else:
+        res = tuple(out[:, 0, k].reshape(shape) for k in range(3))
+        ok = ok.reshape(shape)
+    return (*res, ok) if return_mask else res
 
 
 def _motor_mode(qm: np.ndarray, g: _Geometry) -> str | None:

@@ -1186,6 +1186,7 @@ _MODE_HOME = np.array([m == HOME_MODE for m in MODES])
 _MODE_E = np.array([-1.0 if m[0] == "-" else 1.0 for m in MODES])
 _MODE_S = np.array([[-1.0 if c == "-" else 1.0 for c in m[1:]] for m in MODES])
 _MODE_INDEX = {m: i for i, m in enumerate(MODES)}
+_MODE_ARGS = {m: (bool(_MODE_HOME[i]), float(_MODE_E[i]), _MODE_S[i]) for i, m in enumerate(MODES)}
 _GEO_CACHE: dict = {}
 
 
@@ -1206,10 +1207,9 @@ def _geo(d, alpha, eta):
 
 def _fk_one(qa: float, qb: float, qc: float, G, mode: str, tol: float, max_iter: int, max_inc: float):
     """The fk kernel on one motor triple in one mode: (alpha_y, alpha_z, inconsistency) (raw, also on failure), status."""
-    j = _MODE_INDEX[mode]
+    home, e, s = _MODE_ARGS[mode]
     out = np.empty(3)
-    st = _k_fk(qa, qb, qc, G, bool(_MODE_HOME[j]), float(_MODE_E[j]), _MODE_S[j], tol, max_iter, max_inc, out)
-    return out, st
+    return out, _k_fk(qa, qb, qc, G, home, e, s, tol, max_iter, max_inc, out)
 
 
 def _fk_mode(qm: np.ndarray, g: _Geometry, tol: float, max_iter: int, max_inconsistency: float, mode: str):
@@ -1310,10 +1310,12 @@ def fk(
     return _fk_single(qs, g, G, mode, tol, max_iter, max_inconsistency, return_mask, (q_A1, q_B1, q_C1))
 
 
+def _motors_text(qs) -> str:
+    return f"(q_A1, q_B1, q_C1) = ({qs[0]:.17g}, {qs[1]:.17g}, {qs[2]:.17g})"
+
+
 def _fk_single(qs, g, G, mode, tol, max_iter, max_inconsistency, return_mask, raw):
     """A single fk call: np.float64 outputs, a legkin error on failure."""
-    motors = f"(q_A1, q_B1, q_C1) = ({qs[0]:.17g}, {qs[1]:.17g}, {qs[2]:.17g})"
-    qm = np.array([qs])
     if mode == "all":
         outs = np.full((3, len(MODES)), np.nan)
         ok = np.zeros(len(MODES), dtype=bool)
@@ -1327,13 +1329,14 @@ def _fk_single(qs, g, G, mode, tol, max_iter, max_inconsistency, return_mask, ra
             if st == OK:
                 outs[:, j], ok[j] = out, True
         if not ok.any():
-            raise _fk_error(motors, qm, first, HOME_MODE, [], max_iter, max_inconsistency, g)
+            raise _fk_error(_motors_text(qs), np.array([qs]), first, HOME_MODE, [], max_iter, max_inconsistency, g)
         res = (outs[0], outs[1], outs[2])
         return (*res, ok) if return_mask else res
     out, st = _fk_one(*qs, G, mode, tol, max_iter, max_inconsistency)
     if st != OK:
         if st == _ST_NONFINITE:
             as_angles(*raw, names=("q_A1", "q_B1", "q_C1"))  # raises InvalidInputError
+        qm = np.array([qs])
         others = []
         if st != _ST_SINGULAR_PLANES:  # consistent motors fit the mode their planes' intersection E points to
             likely = _motor_mode(qm[0], g)
@@ -1341,7 +1344,7 @@ def _fk_single(qs, g, G, mode, tol, max_iter, max_inconsistency, return_mask, ra
                 if m != mode and _fk_one(*qs, G, m, tol, max_iter, max_inconsistency)[1] == OK:
                     others.append(m)
                     break
-        raise _fk_error(motors, qm, (out[0], out[1], out[2], False, st), mode, others, max_iter, max_inconsistency, g)
+        raise _fk_error(_motors_text(qs), qm, (out[0], out[1], out[2], False, st), mode, others, max_iter, max_inconsistency, g)
     res = (np.float64(out[0]), np.float64(out[1]), np.float64(out[2]))
     return (*res, np.asarray(True)) if return_mask else res
 

@@ -188,3 +188,31 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         summary=summary,
         secondary="loop |r|",
     )
+
+
+def single_calls() -> list:
+    """One single call per public function of :mod:`legkin.analytic.tripod` (issue 16), inputs bound: a pose inside
+    the workspace and its motors. Closed forms are compared with the quadruped's forward kinematics, ``fk``
+    (iterative) with ``Robot.solve_loops`` on the tripod."""
+    from ._single import SingleCall
+
+    ay, az = 0.3, -0.4
+    q = at.ik(ay, az)
+    qa, qb, qc = (float(q[i]) for i in (0, 4, 8))
+    leg = np.array([float(q[0]), float(q[1]), float(q[2]) + 0.1, float(q[3]) - 0.2])
+    axis = at.platform_axis(ay, az)
+    closed = [
+        ("leg_transform", lambda: at.leg_transform(leg, at.ETA[1])),
+        ("leg_transform_cv", lambda: at.leg_transform_cv(float(q[4]), float(q[5]), at.ETA[1])),
+        ("alpha_x", lambda: at.alpha_x(ay, az)),
+        ("platform_rotation", lambda: at.platform_rotation(ay, az)),
+        ("platform_position", lambda: at.platform_position(ay, az)),
+        ("platform_axis", lambda: at.platform_axis(ay, az)),
+        ("orientation_from_axis", lambda: at.orientation_from_axis(axis)),
+        ("ik", lambda: at.ik(ay, az)),
+        ("actuation_jacobian", lambda: at.actuation_jacobian(ay, az)),
+        ("workspace", lambda: at.workspace(n=2, m=2)),
+    ]
+    calls = [SingleCall(name, call, "quadruped_fk") for name, call in closed]
+    calls.insert(9, SingleCall("fk", lambda: at.fk(qa, qb, qc), "solve_loops", iterative=True))
+    return calls

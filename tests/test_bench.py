@@ -132,3 +132,109 @@ def test_run_model_statistics_and_ratio():
     assert fast.iterations_median == 3.0
     table = bench.format_table("toy", mb, rows)
     assert "absent peer" in table and "skipped: not installed" in table and "fail" in table
+
+
+# ------------------------------------------------------------------------------------------- single calls
+def _bench_modules():
+    return {name: bench._load_bench_module(name) for name in legkin.list_models()}
+
+
+def test_single_call_entries_run_and_name_known_yardsticks():
+    from legkin.benches._single import YARDSTICKS, SingleCall
+
+    for name, module in _bench_modules().items():
+        if module is None or not hasattr(module, "single_calls"):
+            continue
+        entries = module.single_calls()
+        assert entries, name
+        for e in entries:
+            assert isinstance(e, SingleCall), (name, e)
+            assert e.yardstick in YARDSTICKS, (name, e.name, e.yardstick)
+            e.call()  # every entry's call runs
+
+
+def test_yardstick_calls_every_key_every_model():
+    from legkin.benches._single import YARDSTICKS
+
+    for name in legkin.list_models():
+        calls = bench.yardstick_calls(name, list(YARDSTICKS))
+        assert set(calls) == set(YARDSTICKS)
+        for call, label in calls.values():
+            call()
+            assert label
+    with pytest.raises(KeyError, match="unknown yardstick"):
+        bench.yardstick_calls("quadruped", ["no_such_yardstick"])
+
+
+def test_single_call_table_built_for_every_model_with_single_calls(monkeypatch):
+    # no timing assertions: only that the table has one row per entry, with positive times
+    monkeypatch.setattr(bench, "time_call", lambda call, repeats, min_time: (call(), 1e-6, 1)[1:])
+    for name, module in _bench_modules().items():
+        if module is None:
+            continue
+        table = bench.single_call_table(name, module, quick=True)
+        if not hasattr(module, "single_calls"):
+            assert table["rows"] == [] and table["skipped"] == "no single-call entries yet"
+            assert "no single-call entries yet" in bench.format_single_table(name, table)
+            continue
+        entries = module.single_calls()
+        assert [r.name for r in table["rows"]] == [e.name for e in entries]
+        assert set(table["yardsticks"]) == {e.yardstick for e in entries}
+        for r in table["rows"]:
+            assert not r.error, (name, r.name, r.error)
+            assert r.time_per_call_s > 0 and r.yardstick_time_s > 0
+        assert name in bench.format_single_table(name, table)
+
+
+def test_single_call_table_with_a_toy_module_and_json(tmp_path, monkeypatch):
+    import types
+
+    from legkin.benches._single import SingleCall
+
+    def boom():
+        raise RuntimeError("broken entry")
+
+    toy = types.SimpleNamespace(
+        single_calls=lambda: [
+            SingleCall("sum", lambda: sum(range(10)), "fk"),
+            SingleCall("solver", lambda: sum(range(100)), "solve_loops", iterative=True),
+            SingleCall("broken", boom, "jacobian"),
+        ]
+    )
+    table = bench.single_call_table("tripod", toy, quick=True)
+    rows = {r.name: r for r in table["rows"]}
+    assert set(rows) == {"sum", "solver", "broken"}
+    assert rows["sum"].time_per_call_s > 0 and rows["sum"].number >= 1 and rows["sum"].repeats == 3
+    assert np.isfinite(rows["solver"].ratio) and rows["solver"].iterative
+    assert "broken entry" in rows["broken"].error and np.isnan(rows["broken"].time_per_call_s)
+    assert set(table["yardsticks"]) == {"fk", "solve_loops", "jacobian"}
+    text = bench.format_single_table("tripod", table)
+    assert "failed: RuntimeError: broken entry" in text and "iterative" in text
+    run = {"models": {}, "single": {"tripod": table}, "skipped": {}}
+    run["models"]["tripod"] = (bench.ModelBench(methods=[]), [])
+    doc = bench.to_json(run, machine={"cpu": "x"})
+    rows_json = doc["models"]["tripod"]["single_calls"]["rows"]
+    assert {"name", "yardstick", "time_per_call_s", "yardstick_time_per_call_s", "ratio"} <= set(rows_json[0])
+    json.dumps(bench._finite(doc), allow_nan=False)
+
+
+def test_time_call_counts_calls():
+    calls = []
+    per_call, number = bench.time_call(lambda: calls.append(1), repeats=3, min_time=1e-4)
+    assert per_call > 0 and number >= 1
+    assert len(calls) >= 1 + 3 * number  # the warm-up call, then 3 loops of `number`
+
+
+def test_quick_cli_has_single_call_section_and_peer_rows(tmp_path, capsys):
+    code, doc = _run(tmp_path, "quadruped")
+    assert code == 0
+    text = capsys.readouterr().out
+    assert "single calls" in text
+    single = doc["models"]["quadruped"]["single_calls"]
+    assert "rows" in single and "yardsticks" in single
+    from legkin.benches import peers
+
+    names = [m["name"] for m in doc["models"]["quadruped"]["methods"]]
+    skipped = doc["models"]["quadruped"]["skipped_methods"]
+    for peer_name, *_ in peers.PEERS:
+        assert peer_name in names or peer_name in skipped, peer_name

@@ -6,6 +6,12 @@ same random reachable targets for every method of a group), a ``run`` callable (
 ``score`` callable (untimed: turns the output into per-target errors measured the same way for every
 method, by Pinocchio). This module times each method (median of ``repeats`` runs over the same inputs,
 in one process), scores it, and prints one table per model; ``--json`` writes the same numbers.
+
+The single-call table (issue 16): a bench module may also define ``single_calls() -> list[SingleCall]``
+(:mod:`legkin.benches._single`), one entry per public analytic function with its inputs bound. Each is timed
+``timeit``-style (loops of ``number`` calls, median over repeats) next to its yardstick, the Pinocchio call
+for the same quantity (:data:`legkin.benches._single.YARDSTICKS`) timed the same way in the same run on the
+same model. For the quadruped the bench also runs the peer IK libraries of :mod:`legkin.benches.peers`.
 """
 
 from __future__ import annotations
@@ -16,6 +22,7 @@ import os
 import platform
 import sys
 import time
+import timeit
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable
@@ -35,6 +42,11 @@ __all__ = [
     "machine_info",
     "to_json",
     "run_bench_cli",
+    "SingleCallResult",
+    "time_call",
+    "yardstick_calls",
+    "single_call_table",
+    "format_single_table",
 ]
 
 
@@ -303,12 +315,13 @@ def run_bench(
     """Build and run the benches of ``models`` (default: all registered); ``quiet``: no progress bar.
 
     Returns:
-        ``{"models": {name: (ModelBench, [MethodResult])}, "skipped": {name: reason}}``.
+        ``{"models": {name: (ModelBench, [MethodResult])}, "single": {name: single_call_table(...)},
+        "skipped": {name: reason}}``.
     """
     names = models or list_models()
     for name in names:
         get_spec(name)  # unknown names raise UnknownModelError
-    out: dict = {"models": {}, "skipped": {}}
+    out: dict = {"models": {}, "single": {}, "skipped": {}}
     for name in names:
         module = _load_bench_module(name)
         if module is None:
@@ -316,8 +329,212 @@ def run_bench(
             continue
         rng = np.random.default_rng(seed)
         bench = module.build(n, rng, quick)
+        if name == "quadruped":
+            from .benches import peers
+
+            peers.add_quadruped_peers(bench)
         out["models"][name] = (bench, run_model(bench, label=name, quiet=quiet))
+        out["single"][name] = single_call_table(name, module, quick=quick, seed=seed)
     return out
+
+
+# ------------------------------------------------------------------------------------------- single calls
+#: The frame each yardstick uses, per model (a foot / platform / rim frame); other models: their last frame.
+YARDSTICK_FRAMES = {"quadruped": "LF_FOOT", "tripod": "platform", "wheel_leg": "FL_rim_upper_L", "hybrid_leg": "FCS"}
+#: Perturbation (rad or m, normal) of the passive coordinates the ``solve_loops`` yardstick starts from.
+SOLVE_LOOPS_PERTURBATION = 1e-2
+
+
+@dataclass
+class SingleCallResult:
+    """One row of the single-call table: a public function's time per call next to its yardstick's."""
+
+    name: str
+    yardstick: str
+    time_per_call_s: float
+    yardstick_time_s: float
+    number: int
+    repeats: int
+    iterative: bool = False
+    error: str = ""
+
+    @property
+    def ratio(self) -> float:
+        """Function time / yardstick time (< 1: faster than Pinocchio)."""
+        return self.time_per_call_s / self.yardstick_time_s
+
+    def as_dict(self) -> dict:
+        d = {
+            "name": self.name,
+            "yardstick": self.yardstick,
+            "time_per_call_s": self.time_per_call_s,
+            "yardstick_time_per_call_s": self.yardstick_time_s,
+            "ratio": self.ratio,
+            "number": self.number,
+            "repeats": self.repeats,
+            "iterative": self.iterative,
+        }
+        if self.error:
+            d["error"] = self.error
+        return d
+
+
+def time_call(call: Callable[[], object], repeats: int, min_time: float) -> tuple[float, int]:
+    """Median time of one call of ``call`` (no argument), ``timeit``-style.
+
+    ``call()`` runs once untimed first (numba compiles on it). The loop size ``number`` doubles until a loop
+    lasts at least ``min_time`` seconds; then ``repeats`` loops of ``number`` calls are timed and the median
+    loop time divided by ``number`` is returned, with ``number``. Nothing is subtracted: the time includes the
+    Python call of ``call`` itself (a few tens of ns), the same for the function and its yardstick.
+    """
+    call()
+    timer = timeit.Timer(call)
+    number = 1
+    while True:
+        t = timer.timeit(number)
+        if t >= min_time or number >= 1 << 24:
+            break
+        number *= 2 if t <= 0 else max(2, min(10, int(1.2 * min_time / t)))
+    times = timer.repeat(repeats, number)
+    return float(np.median(times)) / number, number
+
+
+def _closed_configuration(robot) -> np.ndarray:
+    """``q0`` with every loop closed, the actuated joints held (``q0`` if it does not close)."""
+    from .errors import LegkinError
+
+    try:
+        return robot.solve_loops(fixed=list(robot.actuated_joints))
+    except LegkinError:
+        return robot.q0.copy()
+
+
+def _frame_name(name: str, robot) -> str:
+    return YARDSTICK_FRAMES.get(name) or robot.model.frames[len(robot.model.frames) - 1].name
+
+
+def yardstick_calls(name: str, keys, seed: int = 0) -> dict[str, tuple[Callable[[], object], str]]:
+    """The yardstick calls of model ``name`` for ``keys`` (keys of ``YARDSTICKS``): ``{key: (call, label)}``.
+
+    fk: ``forwardKinematics`` + ``updateFramePlacement`` of the model's representative frame at its closed
+    ``q0``; jacobian: ``computeFrameJacobian`` of that frame (LOCAL_WORLD_ALIGNED); solve_loops:
+    ``Robot.solve_loops`` from the closed ``q0`` with its passive coordinates perturbed, the actuated joints
+    held; quadruped_fk: fk on ``legkin.load("quadruped")`` (LF_FOOT). Inputs are bound outside the calls.
+    """
+    import pinocchio as pin
+
+    from . import load
+    from .benches._single import YARDSTICKS
+
+    out: dict[str, tuple[Callable[[], object], str]] = {}
+    robots: dict[str, Any] = {}
+
+    def robot_of(model_name: str):
+        if model_name not in robots:
+            robots[model_name] = load(model_name)
+        return robots[model_name]
+
+    def fk_call(model_name: str):
+        robot = robot_of(model_name)
+        frame = _frame_name(model_name, robot)
+        model, data, fid = robot.model, robot.model.createData(), robot.frame_id(frame)
+        q = _closed_configuration(robot)
+        fk, upd = pin.forwardKinematics, pin.updateFramePlacement
+
+        def call():
+            fk(model, data, q)
+            return upd(model, data, fid)
+
+        return call, f"{model_name}: forwardKinematics + updateFramePlacement({frame})"
+
+    for key in dict.fromkeys(keys):
+        if key not in YARDSTICKS:
+            raise KeyError(f"unknown yardstick {key!r} (known: {', '.join(YARDSTICKS)})")
+        if key == "fk":
+            out[key] = fk_call(name)
+        elif key == "quadruped_fk":
+            out[key] = fk_call("quadruped")
+        elif key == "jacobian":
+            robot = robot_of(name)
+            frame = _frame_name(name, robot)
+            model, data, fid = robot.model, robot.model.createData(), robot.frame_id(frame)
+            q = _closed_configuration(robot)
+            jac, lwa = pin.computeFrameJacobian, pin.LOCAL_WORLD_ALIGNED
+
+            def call(model=model, data=data, q=q, fid=fid):
+                return jac(model, data, q, fid, lwa)
+
+            out[key] = (call, f"{name}: computeFrameJacobian({frame}, LOCAL_WORLD_ALIGNED)")
+        elif key == "solve_loops":
+            robot = robot_of(name)
+            act = list(robot.actuated_joints)
+            q = _closed_configuration(robot)
+            held = {robot.idx_q(j) for j in act}
+            free = np.array([i for i in range(robot.model.nq) if i not in held], dtype=int)
+            q_start = q.copy()
+            q_start[free] += np.random.default_rng(seed).normal(0.0, SOLVE_LOOPS_PERTURBATION, len(free))
+            solve = robot.solve_loops
+
+            def call(solve=solve, q_start=q_start, act=act):
+                return solve(q_start, fixed=act)
+
+            out[key] = (call, f"{name}: solve_loops(q0 closed + N(0, {SOLVE_LOOPS_PERTURBATION:g}) on the "
+                              f"{len(free)} passive coordinates, {len(act)} actuated joints held)")
+    return out
+
+
+def single_call_table(name: str, module, quick: bool = False, seed: int = 0) -> dict:
+    """The single-call table of one model: ``{"rows": [SingleCallResult], "yardsticks": {key: {...}}}``.
+
+    ``{"rows": [], "skipped": reason}`` when the bench module has no ``single_calls``. An entry whose call
+    raises gets a row with ``error`` set and NaN times (the rest of the table is still measured).
+    """
+    make = getattr(module, "single_calls", None)
+    if make is None:
+        return {"rows": [], "yardsticks": {}, "skipped": "no single-call entries yet"}
+    entries = list(make())
+    repeats, min_time = (3, 0.01) if quick else (7, 0.1)
+    sticks = yardstick_calls(name, [e.yardstick for e in entries], seed=seed)
+    stick_times = {}
+    for key, (call, label) in sticks.items():
+        t, number = time_call(call, repeats, min_time)
+        stick_times[key] = {"label": label, "time_per_call_s": t, "number": number, "repeats": repeats}
+    rows = []
+    for e in entries:
+        ref = stick_times[e.yardstick]["time_per_call_s"]
+        try:
+            t, number = time_call(e.call, repeats, min_time)
+            rows.append(SingleCallResult(e.name, e.yardstick, t, ref, number, repeats, bool(e.iterative)))
+        except Exception as exc:  # noqa: BLE001 - reported in the table, the bench goes on
+            rows.append(SingleCallResult(e.name, e.yardstick, float("nan"), ref, 0, repeats, bool(e.iterative),
+                                         error=f"{type(exc).__name__}: {exc}"))
+    return {"rows": rows, "yardsticks": stick_times}
+
+
+def format_single_table(name: str, table: dict) -> str:
+    """The printed single-call table of one model."""
+    if table.get("skipped"):
+        return f"{name} single calls: {table['skipped']}\n"
+    rows = table["rows"]
+    width = max([len(r.name) for r in rows] + [8])
+    lines = [f"{name} single calls (median of {rows[0].repeats if rows else 0} timeit loops; "
+             "ratio = function / yardstick, < 1 is faster than Pinocchio)"]
+    lines.append(f"  {'function':<{width}}  {'time/call':>10}  {'yardstick':<12}  {'yardstick/call':>14}  {'ratio':>8}")
+    for r in rows:
+        if r.error:
+            lines.append(f"  {r.name:<{width}}  failed: {r.error}")
+            continue
+        mark = ""
+        if r.iterative:
+            mark = "  (iterative: target ratio <= 0.1"
+            if r.yardstick == "solve_loops":
+                mark += ", met" if r.ratio <= 0.1 else ", NOT met"
+            mark += ")"
+        lines.append(f"  {r.name:<{width}}  {_fmt_time(r.time_per_call_s):>10}  {r.yardstick:<12}  "
+                     f"{_fmt_time(r.yardstick_time_s):>14}  {r.ratio:>8.3g}{mark}")
+    for key, y in table["yardsticks"].items():
+        lines.append(f"  * {key}: {y['label']}")
+    return "\n".join(lines) + "\n"
 
 
 # ------------------------------------------------------------------------------------------- output
@@ -424,8 +641,26 @@ def machine_info() -> dict:
         "ikpy": _version("ikpy"),
         "pytracik": _version("pytracik"),
         "scipy": _version("scipy"),
+        "numba": _version("numba"),
+        "numba_threads": _numba_threads(),
+        "roboticstoolbox-python": _version("roboticstoolbox-python"),
+        "mink": _version("mink"),
+        "mujoco": _version("mujoco"),
+        "pin-pink": _version("pin-pink"),
+        "pytorch-kinematics": _version("pytorch-kinematics"),
+        "torch": _version("torch"),
         "load_average_1min": _loadavg(),
     }
+
+
+def _numba_threads() -> int | None:
+    """numba's thread count for parallel batch kernels (``NUMBA_NUM_THREADS`` / ``numba.set_num_threads``)."""
+    try:
+        import numba
+
+        return int(numba.get_num_threads())
+    except Exception:
+        return None
 
 
 def _loadavg() -> float | None:
@@ -449,6 +684,14 @@ def to_json(run: dict, settings: dict | None = None, machine: dict | None = None
             "notes": list(bench.notes),
             "summary": _summary(bench, results),
         }
+    for name, table in run.get("single", {}).items():
+        if name in models:
+            models[name]["single_calls"] = {
+                "rows": [r.as_dict() for r in table["rows"]],
+                "yardsticks": table["yardsticks"],
+            }
+            if table.get("skipped"):
+                models[name]["single_calls"]["skipped"] = table["skipped"]
     return {
         "machine": machine or machine_info(),
         "settings": settings or {},
@@ -486,6 +729,10 @@ def run_bench_cli(args) -> int:
     print("time/target = median over repeats of (wall time of the whole call) / targets\n")
     for name, (bench, results) in run["models"].items():
         print(format_table(name, bench, results))
+    print("single calls: time/call = median over repeats of (loop wall time) / calls per loop; each yardstick "
+          "timed the same way in this run")
+    for name, table in run["single"].items():
+        print(format_single_table(name, table))
     for name, reason in run["skipped"].items():
         print(f"{name}: skipped ({reason})")
     print(f"total {time.perf_counter() - t0:.1f} s")

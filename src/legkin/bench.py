@@ -723,7 +723,8 @@ def run_bench_cli(args) -> int:
     )
     print(
         f"legkin bench on {info['cpu']} ({info['cpu_count']} cores), Python {info['python']}, "
-        f"numpy {info['numpy']}, pin {info['pin']}, load average {info['load_average_1min']:.2f}"
+        f"numpy {info['numpy']}, pin {info['pin']}, numba {info['numba']} ({info['numba_threads']} threads), "
+        f"load average {info['load_average_1min']:.2f}"
         + ("  [--quick]" if args.quick else "")
     )
     print("time/target = median over repeats of (wall time of the whole call) / targets\n")

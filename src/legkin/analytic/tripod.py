@@ -536,41 +536,50 @@ def _checked_u(alpha_y, alpha_z, d, alpha, eta):
     return ay, az, (np.cos(yc), np.sin(yc), np.cos(zc), np.sin(zc)), _geometry(d, alpha, eta_arr)
 
 
-def _motor_gain(trig, c2, s2, nb2, g: _Geometry, signs) -> np.ndarray:
-    """|A_u|_F (...), from the cheap bound sqrt(3/2) / (min |sin q_K2| sqrt(1 + c_y c_z)) (measured to hold, with
-    1.3 for sqrt(3/2)), and exactly where that bound exceeds :data:`GAIN_GUARD`."""
-    gain = 1.3 / (np.minimum.reduce(np.abs(s2), axis=-1) * np.sqrt(nb2[..., 0]))
-    near = gain > GAIN_GUARD
-    if near.any():
-        sub = tuple(np.broadcast_to(t, nb2.shape)[near] for t in trig)
-        if signs is None:
-            a1, a2 = _jac_eval(*sub, s2[near], nb2[near], g)
-        else:
-            a1, a2 = _jac_general(*sub, c2[near], s2[near], nb2[near], g, signs[0])
-        gain = np.array(gain, dtype=float)
-        gain[near] = np.sqrt(np.add.reduce(a1 * a1 + a2 * a2, axis=-1))
-    return gain
+def _modes_sel(mode: str):
+    """The kernels' mode arrays (homes, es, ss) for one mode or ``"all"``."""
+    if mode == "all":
+        return _MODE_HOME, _MODE_E, _MODE_S
+    j = _MODE_INDEX[mode]
+    return _MODE_HOME[j:j + 1], _MODE_E[j:j + 1], _MODE_S[j:j + 1]
 
 
-def _ik_mode(trig, g: _Geometry, mode: str):
-    """Unchecked :func:`ik` in one mode: joints (..., 12) (NaN where not ok), ok, cos q_K2, 1 + c_y c_z, det M,
-    motor gain |A_u|_F (exact only where large)."""
-    signs = _mode_signs(mode)
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        q1, q2, c2, s2, nb2, sn, cn = _ik_eval(*trig, g, signs, with_sc=True)
-        det = _det_planes(sn, cn, g)
-        inside = _inside(c2, nb2)[..., 0]
-        gain = _motor_gain(trig, c2, s2, np.where(inside[..., None], nb2, 1.0), g, signs)
-        ok = inside & (np.abs(det) >= DET_GUARD) & (gain <= GAIN_GUARD)
-    out = np.where(ok[..., None, None], np.stack([q1, q2, q2, q1], axis=-1), np.nan).reshape(ok.shape + (12,))
-    return out, ok, c2, nb2, det, gain
+def _ik_run(ay: np.ndarray, az: np.ndarray, G: np.ndarray, mode: str):
+    """The ik batch kernel on broadcast orientations: q (shape, m, 12), aux (shape, m, 6), status (shape, m)."""
+    shape = ay.shape
+    y, z = np.ascontiguousarray(ay, dtype=np.float64).reshape(-1), np.ascontiguousarray(az, dtype=np.float64).reshape(-1)
+    homes, es, ss = _modes_sel(mode)
+    n, m = y.shape[0], homes.shape[0]
+    q, aux, status = np.empty((n, m, 12)), np.empty((n, m, 6)), np.empty((n, m), dtype=np.int64)
+    _k_ik_batch(y, z, G, homes, es, ss, q, aux, status)
+    return q.reshape(shape + (m, 12)), aux.reshape(shape + (m, 6)), status.reshape(shape + (m,))
 
 
-def _ik_single_error(ay, az, trig, g: _Geometry, mode: str, c2, nb2, det, gain) -> Exception:
-    sing, unreachable, leg_sing = _ik_status(c2, nb2[..., 0])
+def _ik_mode(ay, az, g: _Geometry, mode: str):
+    """Unchecked :func:`ik` in one mode (the kernel): joints (..., 12) (NaN where not ok), ok, cos q_K2 (..., 3),
+    1 + c_y c_z (..., 1), det M, motor gain |A_u|_F (exact only where large)."""
+    ay, az = np.broadcast_arrays(np.asarray(ay, dtype=float), np.asarray(az, dtype=float))
+    q, aux, status = _ik_run(ay, az, _geometry_vector(g), mode)
+    aux = aux[..., 0, :]
+    return q[..., 0, :], status[..., 0] == OK, aux[..., :3], aux[..., 3:4], aux[..., 4], aux[..., 5]
+
+
+def _ik_one(ay: float, az: float, G: np.ndarray, mode: str):
+    """The ik kernel on one orientation in one mode: joints (12,), aux (6,), status."""
+    home, e, s = _MODE_ARGS[mode]
+    q, aux = np.empty(12), np.empty(6)
+    return q, aux, _k_ik(ay, az, G, home, e, s, q, aux)
+
+
+def _ik_single_error(ay, az, g: _Geometry, mode: str, c2, nb2, det, gain) -> Exception:
+    """The exception of a failed single :func:`ik` call at (ay, az) in ``mode`` (c2 (3,), nb2, det, gain: the
+    kernel's aux)."""
+    c2, nb2 = np.asarray(c2, dtype=float), np.asarray(nb2, dtype=float).reshape(())
+    sing, unreachable, leg_sing = _ik_status(c2, nb2)
     if sing or unreachable.any() or leg_sing.any():
         return _ik_error(ay, az, c2, sing, unreachable, leg_sing)
-    others = [m for m in MODES if m != mode and bool(_ik_mode(trig, g, m)[1])]
+    G = _geometry_vector(g)
+    others = [m for m in MODES if m != mode and _ik_one(float(ay), float(az), G, m)[2] == OK]
     if not gain <= GAIN_GUARD:
         return SingularityError(
             f"(alpha_y, alpha_z) = ({float(ay):.17g}, {float(az):.17g}): its motors are too sensitive to the "
@@ -629,19 +638,35 @@ def ik(
         InvalidInputError: non-finite, complex or non-broadcastable angles; InvalidParameterError: bad geometry,
             mode or return_mask.
     """
-    mode = _checked_mode(mode, allow_all=True)
-    return_mask = _flag(return_mask, "return_mask")
-    ay, az, trig, g = _checked_u(alpha_y, alpha_z, d, alpha, eta)
+    g, G = _geo(d, alpha, eta)
+    if type(mode) is not str or mode != HOME_MODE:
+        mode = _checked_mode(mode, allow_all=True)
+    if return_mask is not False and return_mask is not True:
+        return_mask = _flag(return_mask, "return_mask")
+    if isinstance(alpha_y, float) and isinstance(alpha_z, float):
+        ay, az = float(alpha_y), float(alpha_z)
+    else:
+        ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))
+        if ay.ndim:
+            q, aux, status = _ik_run(ay, az, G, mode)
+            ok = status == OK
+            if mode != "all":
+                q, ok = q[..., 0, :], ok[..., 0]
+            return (q, ok) if return_mask else q
+        ay, az = float(ay), float(az)
     if mode == "all":
-        res = [_ik_mode(trig, g, m) for m in MODES]
-        out, ok = np.stack([r[0] for r in res], axis=-2), np.stack([r[1] for r in res], axis=-1)
-        if ay.ndim == 0 and not ok.any():
-            raise _ik_single_error(ay, az, trig, g, HOME_MODE, *res[0][2:])  # c2, nb2, det, gain
-        return (out, ok) if return_mask else out
-    out, ok, c2, nb2, det, gain = _ik_mode(trig, g, mode)
-    return finish(
-        out, ok, ay.ndim == 0, return_mask, lambda: _ik_single_error(ay, az, trig, g, mode, c2, nb2, det, gain)
-    )
+        q, aux, status = _ik_run(np.array(ay), np.array(az), G, mode)
+        ok = status == OK
+        if not ok.any():
+            a = aux[0]
+            raise _ik_single_error(ay, az, g, HOME_MODE, a[:3], a[3], a[4], a[5])
+        return (q, ok) if return_mask else q
+    q, aux, st = _ik_one(ay, az, G, mode)
+    if st != OK:
+        if st == _ST_NONFINITE:
+            as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))  # raises InvalidInputError
+        raise _ik_single_error(np.float64(ay), np.float64(az), g, mode, aux[:3], aux[3], aux[4], aux[5])
+    return (q, np.asarray(True)) if return_mask else q
 
 
 def _jac_eval(cy, sy, cz, sz, s2, nb2, g: _Geometry) -> tuple[np.ndarray, np.ndarray]:
@@ -1181,6 +1206,60 @@ def _k_fk_batch(qm, G, homes, es, ss, tol, max_iter, max_inc, out, status):
                 out[i, j, 0] = out[i, j, 1] = out[i, j, 2] = np.nan
 
 
+@kernel
+def _k_ik(ay, az, G, home, e, s, q, aux):
+    """ik of one orientation in one assembly mode (seed eqs (98), (102); see :func:`ik`): writes the 12 joints into
+    ``q`` (NaN unless ok) and (cos q_A2, cos q_B2, cos q_C2, 1 + c_y c_z, det M, |A_u|_F) into ``aux`` (6,); the
+    motor gain |A_u|_F is the cheap bound sqrt(3/2) / (min |sin q_K2| sqrt(1 + c_y c_z)) (1.3 for sqrt(3/2),
+    measured to hold), exact where that bound exceeds GAIN_GUARD. Returns OK, _ST_FAIL or _ST_NONFINITE."""
+    if not (np.isfinite(ay) and np.isfinite(az)):
+        q[:] = np.nan
+        aux[:] = np.nan
+        return _ST_NONFINITE
+    cy, sy, cz, sz = np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
+    x, y, z, nb2 = _k_centre(cy, sy, cz, sz, G, home, e)
+    q1a, q2a, c2a, s2a, sna, cna = _k_leg(0, x, y, z, G, home, s[0])
+    q1b, q2b, c2b, s2b, snb, cnb = _k_leg(1, x, y, z, G, home, s[1])
+    q1c, q2c, c2c, s2c, snc, cnc = _k_leg(2, x, y, z, G, home, s[2])
+    det = _k_det_planes(sna, snb, snc, cna, cnb, cnc, G)
+    inside = _k_inside(c2a, c2b, c2c, nb2)
+    n = nb2 if inside else 1.0
+    m = abs(s2a)
+    for v in (abs(s2b), abs(s2c)):
+        if not v >= m:  # NaN propagates, as np.minimum
+            m = v
+    gain = 1.3 / (m * np.sqrt(n))
+    if gain > GAIN_GUARD:
+        tot = 0.0
+        for K in range(3):
+            c2k = c2a if K == 0 else (c2b if K == 1 else c2c)
+            s2k = s2a if K == 0 else (s2b if K == 1 else s2c)
+            if home:
+                j1, j2 = _k_jac_home(K, cy, sy, cz, sz, s2k, n, G)
+            else:
+                j1, j2 = _k_jac_general(K, cy, sy, cz, sz, c2k, s2k, n, G, e)
+            tot += j1 * j1 + j2 * j2
+        gain = np.sqrt(tot)
+    aux[0], aux[1], aux[2], aux[3], aux[4], aux[5] = c2a, c2b, c2c, nb2, det, gain
+    if inside and abs(det) >= DET_GUARD and gain <= GAIN_GUARD:
+        q[0], q[1], q[2], q[3] = q1a, q2a, q2a, q1a
+        q[4], q[5], q[6], q[7] = q1b, q2b, q2b, q1b
+        q[8], q[9], q[10], q[11] = q1c, q2c, q2c, q1c
+        return OK
+    q[:] = np.nan
+    return _ST_FAIL
+
+
+@batch_kernel
+def _k_ik_batch(ay, az, G, homes, es, ss, q, aux, status):
+    """ik over orientations (n,) in the modes given (homes (m,), es (m,), ss (m, 3)): q (n, m, 12), aux (n, m, 6),
+    status (n, m)."""
+    n, m = ay.shape[0], homes.shape[0]
+    for i in prange(n):
+        for j in range(m):
+            status[i, j] = _k_ik(ay[i], az[i], G, homes[j], es[j], ss[j], q[i, j], aux[i, j])
+
+
 #: Per assembly mode (:data:`MODES` order): home flag, side of E, signs of sin q_K2 (the kernels' mode arguments).
 _MODE_HOME = np.array([m == HOME_MODE for m in MODES])
 _MODE_E = np.array([-1.0 if m[0] == "-" else 1.0 for m in MODES])
@@ -1404,12 +1483,11 @@ def _fk_error(motors: str, qm, res, mode: str, others, max_iter: int, max_incons
             "(nearly sharing a line): the motor angles do not determine the pose"
         )
     if status == 2:  # diagnose at the planes' intersection (the start), as ik would there
-        with np.errstate(invalid="ignore", divide="ignore"):
-            y0, z0 = (v.ravel()[:1] for v in _initial_guess(qm.reshape(1, 3), g))
-        trig = tuple(f(v)[..., None] for v in (y0, z0) for f in (np.cos, np.sin))
-        res0 = _ik_mode(trig, g, mode)
-        if not res0[1][0]:
-            exc = _ik_single_error(y0[0], z0[0], tuple(t[0] for t in trig), g, mode, *(r[0] for r in res0[2:]))
+        G = _geometry_vector(g)
+        y0, z0, _ = _k_initial_guess(*(float(v) for v in qm.reshape(3)), G)
+        _, aux, st = _ik_one(y0, z0, G, mode)
+        if st != OK:
+            exc = _ik_single_error(np.float64(y0), np.float64(z0), g, mode, aux[:3], aux[3], aux[4], aux[5])
             return type(exc)(f"{motors}: no pose found; their planes meet at {exc}", *exc.args[1:])
         return UnreachableError(f"{motors}: the solver left the workspace; no pose was found", target=target)
     if status == 3:
@@ -1498,8 +1576,7 @@ def workspace(
     az = np.linspace(-np.pi, np.pi, n)
     gy, gz = np.meshgrid(ay, az, indexing="ij")
     _, c2, _ = _ik_core(gy, gz, d, alpha, eta_arr)
-    yc, zc = gy[..., None], gz[..., None]
-    reachable = _ik_mode((np.cos(yc), np.sin(yc), np.cos(zc), np.sin(zc)), _geometry(d, alpha, eta_arr), HOME_MODE)[1]
+    reachable = _ik_mode(gy, gz, _geometry(d, alpha, eta_arr), HOME_MODE)[1]
     phi = np.linspace(-np.pi, np.pi, m)
     ch = math.cos(alpha / 2.0)
     with np.errstate(divide="ignore", invalid="ignore"):

@@ -199,11 +199,13 @@ def test_single_call_table_with_a_toy_module_and_json(tmp_path, monkeypatch):
             SingleCall("sum", lambda: sum(range(10)), "fk"),
             SingleCall("solver", lambda: sum(range(100)), "solve_loops", iterative=True),
             SingleCall("broken", boom, "jacobian"),
+            SingleCall("unknown yardstick", lambda: None, "no_such_yardstick"),
         ]
     )
     table = bench.single_call_table("tripod", toy, quick=True)
     rows = {r.name: r for r in table["rows"]}
-    assert set(rows) == {"sum", "solver", "broken"}
+    assert set(rows) == {"sum", "solver", "broken", "unknown yardstick"}
+    assert "unknown yardstick" in rows["unknown yardstick"].error
     assert rows["sum"].time_per_call_s > 0 and rows["sum"].number >= 1 and rows["sum"].repeats == 3
     assert np.isfinite(rows["solver"].ratio) and rows["solver"].iterative
     assert "broken entry" in rows["broken"].error and np.isnan(rows["broken"].time_per_call_s)

@@ -494,13 +494,21 @@ def single_call_table(name: str, module, quick: bool = False, seed: int = 0) -> 
         return {"rows": [], "yardsticks": {}, "skipped": "no single-call entries yet"}
     entries = list(make())
     repeats, min_time = (3, 0.01) if quick else (7, 0.1)
-    sticks = yardstick_calls(name, [e.yardstick for e in entries], seed=seed)
-    stick_times = {}
-    for key, (call, label) in sticks.items():
-        t, number = time_call(call, repeats, min_time)
+    stick_times, stick_errors = {}, {}
+    for key in dict.fromkeys(e.yardstick for e in entries):
+        try:
+            ((call, label),) = yardstick_calls(name, [key], seed=seed).values()
+            t, number = time_call(call, repeats, min_time)
+        except Exception as exc:  # noqa: BLE001 - an unknown or failing yardstick fails its rows only
+            stick_errors[key] = f"yardstick {key!r}: {type(exc).__name__}: {exc}"
+            continue
         stick_times[key] = {"label": label, "time_per_call_s": t, "number": number, "repeats": repeats}
     rows = []
     for e in entries:
+        if e.yardstick in stick_errors:
+            rows.append(SingleCallResult(e.name, e.yardstick, float("nan"), float("nan"), 0, repeats,
+                                         bool(e.iterative), error=stick_errors[e.yardstick]))
+            continue
         ref = stick_times[e.yardstick]["time_per_call_s"]
         try:
             t, number = time_call(e.call, repeats, min_time)

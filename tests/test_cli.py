@@ -214,7 +214,7 @@ def test_bench_progress_bar(capsys, monkeypatch):
 
     def fake(models=None, n=None, seed=0, quick=False, quiet=False):
         seen.update(quiet=quiet, seed=seed, n=n)
-        return {"models": {}, "skipped": {}}
+        return {"models": {}, "single": {}, "skipped": {}}
 
     monkeypatch.setattr(bench, "run_bench", fake)
     assert main(["bench", "--quiet", "--n", "5", "--seed", "2"]) == 0

@@ -74,7 +74,6 @@ def test_unclosable_raises_with_residual(fourbar):
 
 # ---------------------------------------------------------------- bad inputs
 from legkin import InvalidInputError  # noqa: E402
-from legkin.loops import check_count, check_real  # noqa: E402
 
 FREE = np.array([False, True, True])
 
@@ -130,6 +129,8 @@ def test_breakdown_becomes_loop_closure_error(fourbar, monkeypatch):
 
 
 def test_check_real_and_check_count():
+    from legkin.loops import check_count, check_real
+
     assert check_real("x", np.float32(0.5), 0.0, 1.0) == 0.5
     assert check_real("x", np.array(0.25), 0.0, 1.0) == 0.25
     assert check_count("n", np.int64(3)) == 3

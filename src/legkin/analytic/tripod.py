@@ -718,21 +718,33 @@ def actuation_jacobian(
     Undefined where the pose is outside the workspace or singular (NaN / the exceptions of :func:`ik`); the
     actuation-singularity guard of :func:`ik` (:data:`DET_GUARD`) does not apply: A_u is defined there.
     """
-    mode = _checked_mode(mode)
-    return_mask = _flag(return_mask, "return_mask")
-    ay, az, trig, g = _checked_u(alpha_y, alpha_z, d, alpha, eta)
-    signs = _mode_signs(mode)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        _, _, c2, s2, nb2 = _ik_eval(*trig, g, signs)
-        if signs is None:
-            a1, a2 = _jac_eval(*trig, s2, nb2, g)
-        else:
-            a1, a2 = _jac_general(*trig, c2, s2, nb2, g, signs[0])
-    ok = _inside(c2, nb2)[..., 0]
-    out = np.where(ok[..., None, None], np.stack([a1, a2], axis=-1), np.nan)
-    return finish(
-        out, ok, ay.ndim == 0, return_mask, lambda: _ik_error(ay, az, c2, *_ik_status(c2, nb2[..., 0]))
-    )
+    g, G = _geo(d, alpha, eta)
+    if type(mode) is not str or mode != HOME_MODE:
+        mode = _checked_mode(mode)
+    if return_mask is not False and return_mask is not True:
+        return_mask = _flag(return_mask, "return_mask")
+    home, e, s = _MODE_ARGS[mode]
+    if isinstance(alpha_y, float) and isinstance(alpha_z, float):
+        ay, az = float(alpha_y), float(alpha_z)
+    else:
+        ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))
+        if ay.ndim:
+            shape = ay.shape
+            y, z = np.ascontiguousarray(ay).reshape(-1), np.ascontiguousarray(az).reshape(-1)
+            n = y.shape[0]
+            a, aux, status = np.empty((n, 3, 2)), np.empty((n, 4)), np.empty(n, dtype=np.int64)
+            _k_actuation_jacobian_batch(y, z, G, home, e, s, a, aux, status)
+            a, ok = a.reshape(shape + (3, 2)), (status == OK).reshape(shape)
+            return (a, ok) if return_mask else a
+        ay, az = float(ay), float(az)
+    a, aux = np.empty((3, 2)), np.empty(4)
+    st = _k_actuation_jacobian(ay, az, G, home, e, s, a, aux)
+    if st != OK:
+        if st == _ST_NONFINITE:
+            as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))  # raises InvalidInputError
+        c2 = aux[:3].copy()
+        raise _ik_error(np.float64(ay), np.float64(az), c2, *_ik_status(c2, np.asarray(aux[3])))
+    return (a, np.asarray(True)) if return_mask else a
 
 
 # ------------------------------------------------------------------------------------------ forward kinematics
@@ -1258,6 +1270,37 @@ def _k_ik_batch(ay, az, G, homes, es, ss, q, aux, status):
     for i in prange(n):
         for j in range(m):
             status[i, j] = _k_ik(ay[i], az[i], G, homes[j], es[j], ss[j], q[i, j], aux[i, j])
+
+
+@kernel
+def _k_actuation_jacobian(ay, az, G, home, e, s, a, aux):
+    """A_u (3, 2) of one orientation in one mode into ``a`` (NaN unless inside the workspace), (cos q_K2 (3),
+    1 + c_y c_z) into ``aux``; returns OK, _ST_FAIL or _ST_NONFINITE (see :func:`actuation_jacobian`)."""
+    if not (np.isfinite(ay) and np.isfinite(az)):
+        a[:, :] = np.nan
+        aux[:] = np.nan
+        return _ST_NONFINITE
+    cy, sy, cz, sz = np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
+    x, y, z, nb2 = _k_centre(cy, sy, cz, sz, G, home, e)
+    for K in range(3):
+        _q1, _q2, c2, s2, _sn, _cn = _k_leg(K, x, y, z, G, home, s[K])
+        aux[K] = c2
+        if home:
+            a[K, 0], a[K, 1] = _k_jac_home(K, cy, sy, cz, sz, s2, nb2, G)
+        else:
+            a[K, 0], a[K, 1] = _k_jac_general(K, cy, sy, cz, sz, c2, s2, nb2, G, e)
+    aux[3] = nb2
+    if _k_inside(aux[0], aux[1], aux[2], nb2):
+        return OK
+    a[:, :] = np.nan
+    return _ST_FAIL
+
+
+@batch_kernel
+def _k_actuation_jacobian_batch(ay, az, G, home, e, s, a, aux, status):
+    """A_u over orientations (n,): a (n, 3, 2), aux (n, 4), status (n,)."""
+    for i in prange(ay.shape[0]):
+        status[i] = _k_actuation_jacobian(ay[i], az[i], G, home, e, s, a[i], aux[i])
 
 
 #: Per assembly mode (:data:`MODES` order): home flag, side of E, signs of sin q_K2 (the kernels' mode arguments).

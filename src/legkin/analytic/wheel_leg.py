@@ -1438,110 +1438,140 @@ def _radial_table(R: float, seed: bool):
     return grid, table, m2, fine, fine_rows
 
 
-def _radial_eval(theta: np.ndarray, sel: _Sel, ctx: _Ctx) -> tuple[np.ndarray, np.ndarray]:
-    """The contact point ``c(theta, alpha)`` in the leg plane (right halves left unconjugated: same modulus)
-    and ``dc/dtheta``, from the closed form: the radial IK's only evaluation of the linkage (kept apart so
-    the bench can count its rows)."""
-    pts, der = _closed_form(theta, ctx.c, ctx.geo.R + FOOT_OFFSET, True, full=ctx.seed)
-    return _plane(pts, der, sel, True, conj=False)
+@kernel
+def _k_f_and_slope(theta, upper, right, e, seed, K, KC, r2):
+    """``f = |c(theta)|^2 - r2`` and ``f' = 2 Re(conj(c) dc/dtheta)``, ``c`` the contact point in the leg plane
+    (right halves unconjugated: same modulus), and ``c, dc``: the radial IK's only linkage evaluation."""
+    y, dy = _k_plane(theta, upper, right, e, seed, K, KC, True, False)
+    return y.real * y.real + y.imag * y.imag - r2, 2.0 * (y.real * dy.real + y.imag * dy.imag), y, dy
 
 
-def _f_and_slope(y, dy, r2):
-    """``f = |y|^2 - r2`` and ``f' = 2 Re(conj(y) dy)``."""
-    return y.real * y.real + y.imag * y.imag - r2, 2.0 * (y.real * dy.real + y.imag * dy.imag)
+@kernel
+def _k_clip(x, lo, hi):
+    """``np.clip`` for one float (NaN passes through)."""
+    if x < lo:
+        return lo
+    if x > hi:
+        return hi
+    return x
 
 
-def _lower_bound(Fa, Fb, Ga, Gb, h, M):
+@kernel
+def _k_max(a, b):
+    """``np.maximum`` for floats (NaN propagates)."""
+    if a != a or b != b:
+        return math.nan
+    return a if a >= b else b
+
+
+@kernel
+def _k_min(a, b):
+    """``np.minimum`` for floats (NaN propagates)."""
+    if a != a or b != b:
+        return math.nan
+    return a if a <= b else b
+
+
+@kernel
+def _k_lower_bound(Fa, Fb, Ga, Gb, h, M):
     """Lower bound of f on a cell of width h from its ends (f oriented positive there: Fa, Fb > 0; slopes
     Ga, Gb) and a bound M of |f''|: the larger of the Taylor bounds from the two ends,
     ``Fa + Ga t - M t^2/2`` and ``Fb - Gb (h - t) - M (h - t)^2/2``, at the t where they cross."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        tc = np.clip((Fa - Fb + Gb * h + M * h * h / 2) / (Gb - Ga + M * h), 0.0, h)
-    tc = np.where(np.isfinite(tc), tc, 0.5 * h)
-    return np.maximum(Fa + Ga * tc - M * tc * tc / 2, Fb - Gb * (h - tc) - M * (h - tc) ** 2 / 2)
+    tc = _k_clip((Fa - Fb + Gb * h + M * h * h / 2) / (Gb - Ga + M * h), 0.0, h)
+    if not math.isfinite(tc):
+        tc = 0.5 * h
+    return _k_max(Fa + Ga * tc - M * tc * tc / 2, Fb - Gb * (h - tc) - M * (h - tc) ** 2 / 2)
 
 
-def _hermite_root(h, flo, fhi, glo, ghi):
+@kernel
+def _k_hermite_root(h, flo, fhi, glo, ghi):
     """Root (offset from the lower end, in [0, h]) of the cubic Hermite model of f on a bracket of width h
     (values flo, fhi of opposite signs, slopes glo, ghi): four Newton steps on the cubic from the regula
     falsi point, clipped to the bracket."""
-    with np.errstate(divide="ignore", invalid="ignore"):
-        df = fhi - flo
-        c2 = (3 * df / h - 2 * glo - ghi) / h
-        c3 = (glo + ghi - 2 * df / h) / (h * h)
-        t = np.clip(-flo / df, 0.0, 1.0) * h
-        for _ in range(4):
-            t = np.clip(t - (flo + t * (glo + t * (c2 + t * c3))) / (glo + t * (2 * c2 + 3 * t * c3)), 0.0, h)
+    df = fhi - flo
+    c2 = (3 * df / h - 2 * glo - ghi) / h
+    c3 = (glo + ghi - 2 * df / h) / (h * h)
+    t = _k_clip(-flo / df, 0.0, 1.0) * h
+    for _ in range(4):
+        t = _k_clip(t - (flo + t * (glo + t * (c2 + t * c3))) / (glo + t * (2 * c2 + 3 * t * c3)), 0.0, h)
     return t
 
 
-def _radial_extremum(lo, hi, flo, fhi, glo, ghi, M, sel, ctx, r2, ftol, max_iter):
+@kernel
+def _k_radial_extremum(lo, hi, flo, fhi, glo, ghi, M, upper, right, e, seed, K, KC, r2, ftol, max_iter):
     """Decide whether f (of one sign at both ends of [lo, hi]) reaches 0 near the extremum inside.
 
     Regula falsi (Illinois) on f' from the extremum of the cubic Hermite model, until: f changes sign at
     the new point (two roots: split the bracket there), ``|f| <= 4 eps r^2`` (a double root at rounding
-    level), :func:`_lower_bound` on the shrunk bracket is above ftol (no root), or the bracket is 1e-11
+    level), :func:`_k_lower_bound` on the shrunk bracket is above ftol (no root), or the bracket is 1e-11
     wide (the extremum: a double root if ``|f| <= ftol`` there, else none). Returns (theta, f and f'
     there, status: 1 split / 2 double root / 0 none, f'' estimated by the secant of f' over the last
     bracket, iterations).
     """
-    m = lo.size
-    sig = np.where(flo > 0, 1.0, -1.0)
+    sig = 1.0 if flo > 0 else -1.0
     Fa, Fb, Ga, Gb = sig * flo, sig * fhi, sig * glo, sig * ghi  # oriented: Fa, Fb > 0, Ga < 0 < Gb
     h = hi - lo
-    with np.errstate(divide="ignore", invalid="ignore"):  # extremum of the cubic model p'(t) = 0
-        c2 = (3 * (Fb - Fa) / h - 2 * Ga - Gb) / h
-        c3 = (Ga + Gb - 2 * (Fb - Fa) / h) / (h * h)
-        disc = np.sqrt(np.maximum(c2 * c2 - 3 * c3 * Ga, 0.0))
-        t0 = -Ga / (c2 + disc)  # the root of Ga + 2 c2 t + 3 c3 t^2 between the slopes' sign change
-    th = np.where((t0 > 0) & (t0 < h), lo + t0, lo - Ga * h / (Gb - Ga))
-    ga, gb = Ga.copy(), Gb.copy()  # Illinois-modified slopes
-    f_out, g_out = np.full(m, np.nan), np.full(m, np.nan)
-    status = np.zeros(m, dtype=int)
-    its = np.zeros(m, dtype=int)
-    kept = np.zeros(m, dtype=int)  # +1: the upper end was kept last time, -1: the lower end
-    act = np.arange(m)
+    c2 = (3 * (Fb - Fa) / h - 2 * Ga - Gb) / h  # extremum of the cubic model p'(t) = 0
+    c3 = (Ga + Gb - 2 * (Fb - Fa) / h) / (h * h)
+    disc = math.sqrt(_k_max(c2 * c2 - 3 * c3 * Ga, 0.0))
+    t0 = -Ga / (c2 + disc)  # the root of Ga + 2 c2 t + 3 c3 t^2 between the slopes' sign change
+    th = lo + t0 if (t0 > 0 and t0 < h) else lo - Ga * h / (Gb - Ga)
+    ga, gb = Ga, Gb  # Illinois-modified slopes
+    f_out, g_out = math.nan, math.nan
+    status = 0
+    its = 0
+    kept = 0  # +1: the upper end was kept last time, -1: the lower end
     for _ in range(max_iter):
-        if act.size == 0:
-            break
-        t = th[act]
-        f, g = _f_and_slope(*_radial_eval(t, sel.take(act), ctx), r2[act])
-        its[act] += 1
-        s_ = sig[act]
-        F, G = s_ * f, s_ * g
-        f_out[act], g_out[act] = f, g
+        t = th
+        f, g, _y, _dy = _k_f_and_slope(t, upper, right, e, seed, K, KC, r2)
+        its += 1
+        F, G = sig * f, sig * g
+        f_out, g_out = f, g
         split = F < 0
-        double = ~split & (F <= 4 * _EPS * r2[act])  # at rounding level: a double root
-        left = G < 0  # t replaces the lower end
-        k = kept[act]
-        lo[act], hi[act] = np.where(left, t, lo[act]), np.where(left, hi[act], t)
-        Fa[act], Fb[act] = np.where(left, F, Fa[act]), np.where(left, Fb[act], F)
-        Ga[act], Gb[act] = np.where(left, G, Ga[act]), np.where(left, Gb[act], G)
-        ga[act] = np.where(left, G, np.where(k == -1, 0.5 * ga[act], ga[act]))
-        gb[act] = np.where(left, np.where(k == 1, 0.5 * gb[act], gb[act]), G)
-        kept[act] = np.where(left, 1, -1)
-        a_lo, a_hi = lo[act], hi[act]
-        none = _lower_bound(Fa[act], Fb[act], Ga[act], Gb[act], a_hi - a_lo, M[act]) > ftol[act]
-        narrow = (a_hi - a_lo <= 1e-11) | (G == 0)  # the extremum found: a double root if within tolerance
-        double |= ~split & narrow & (F <= ftol[act])
-        status[act] = np.where(split, 1, np.where(double, 2, 0))
-        done = split | double | none | narrow
-        with np.errstate(divide="ignore", invalid="ignore"):
-            nxt = (a_lo * gb[act] - a_hi * ga[act]) / (gb[act] - ga[act])
-        th[act] = np.where((nxt > a_lo) & (nxt < a_hi), nxt, 0.5 * (a_lo + a_hi))
-        th[act[done]] = t[done]
-        act = act[~done]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        curv = sig * (Gb - Ga) / (hi - lo)
+        double = (not split) and F <= 4 * _EPS * r2  # at rounding level: a double root
+        if G < 0:  # t replaces the lower end
+            lo, Fa, Ga = t, F, G
+            ga = G
+            if kept == 1:
+                gb = 0.5 * gb
+            kept = 1
+        else:
+            hi, Fb, Gb = t, F, G
+            if kept == -1:
+                ga = 0.5 * ga
+            gb = G
+            kept = -1
+        none = _k_lower_bound(Fa, Fb, Ga, Gb, hi - lo, M) > ftol
+        narrow = (hi - lo <= 1e-11) or G == 0  # the extremum found: a double root if within tolerance
+        if (not split) and narrow and F <= ftol:
+            double = True
+        status = 1 if split else (2 if double else 0)
+        if split or double or none or narrow:
+            th = t
+            break
+        nxt = (lo * gb - hi * ga) / (gb - ga)
+        th = nxt if (nxt > lo and nxt < hi) else 0.5 * (lo + hi)
+    curv = sig * (Gb - Ga) / (hi - lo)
     return th, f_out, g_out, status, curv, its
 
 
-def _radial_newton(lo, hi, flo, fhi, glo, ghi, guess, coef, sel, ctx, r2, mb, max_iter):
-    """Safeguarded Newton on ``f(theta) = |c(theta)|^2 - r2`` in brackets [lo, hi] where f changes sign.
+@kernel
+def _k_fine_f(fine_rows, i, coef):
+    """f (f' for rows kf + i) from the fine table at node i: ``fine_rows[i] . coef``."""
+    acc = 0.0
+    for j in range(9):
+        acc += fine_rows[i, j] * coef[j]
+    return acc
+
+
+@kernel
+def _k_radial_newton(lo, hi, flo, fhi, glo, ghi, guess, coef, fine, fine_rows, upper, right, e, seed, K, KC, r2,
+                     mb, max_iter):
+    """Safeguarded Newton on ``f(theta) = |c(theta)|^2 - r2`` in a bracket [lo, hi] where f changes sign.
 
     Start (no linkage evaluation): the root of the cubic Hermite model of f on the bracket
-    (:func:`_hermite_root`) picks a sub-cell of the fine table (0.14 deg); if f (from the table and
-    ``coef`` (m, 9), each bracket's :func:`_arc_coefficients`) does not change sign there, bisection on the
+    (:func:`_k_hermite_root`) picks a sub-cell of the fine table (0.14 deg); if f (from the table and
+    ``coef`` (9,), the target's :func:`_arc_coefficients`) does not change sign there, bisection on the
     table's nodes inside the bracket finds one; the start is then the root of the cubic model on that
     sub-cell, which becomes the bracket (if the table's signs do not bracket the root, e.g. a root at a
     node, the start on the whole bracket is kept). ``guess`` (NaN: none) overrides the start (the
@@ -1554,74 +1584,272 @@ def _radial_newton(lo, hi, flo, fhi, glo, ghi, guess, coef, sel, ctx, r2, mb, ma
     rotation, from the last evaluation's Taylor step ``c + (theta - t) dc``, at rounding level since
     the last step is), iterations, converged).
     """
-    m = lo.size
-    _, _, _, fine, fine_rows = _radial_table(ctx.geo.R, ctx.seed)
-    kf = fine.size
+    kf = fine.shape[0]
     hf = fine[1] - fine[0]
-
-    def fine_f(i, c=coef):  # f (and f' at column kf + i) from the fine table
-        return np.einsum("mk,mk->m", fine_rows[i], c)
-
-    # the sub-cell of the fine table where f changes sign: the one holding the cubic model's root on the
-    # bracket if f changes sign there, else bisection on the table's nodes inside the bracket
-    start = lo + _hermite_root(hi - lo, flo, fhi, glo, ghi)
-    i_lo = np.clip(((start - THETA_MIN) / hf).astype(int), 0, kf - 2)
+    start = lo + _k_hermite_root(hi - lo, flo, fhi, glo, ghi)
+    x = (start - THETA_MIN) / hf
+    i_lo = int(x) if math.isfinite(x) else 0
+    i_lo = min(max(i_lo, 0), kf - 2)
     i_hi = i_lo + 1
-    f_lo, f_hi = fine_f(i_lo), fine_f(i_hi)
-    ok = ((f_lo > 0) != (f_hi > 0)) & (fine[i_lo] >= lo) & (fine[i_hi] <= hi)
-    miss = np.flatnonzero(~ok & np.isnan(guess))
-    if miss.size:
-        coef_m = coef[miss]
-        b_lo = np.clip(np.ceil((lo[miss] - THETA_MIN) / hf - 1e-6).astype(int), 0, kf - 1)
-        b_hi = np.clip(np.floor((hi[miss] - THETA_MIN) / hf + 1e-6).astype(int), 0, kf - 1)
-        b_p = fine_f(b_lo, coef_m) > 0
-        b_ok = (b_p != (fine_f(b_hi, coef_m) > 0)) & (b_lo < b_hi)
-        while True:
-            wide = b_ok & (b_hi - b_lo > 1)
-            if not wide.any():
-                break
-            mid = (b_lo + b_hi) // 2
-            left = (fine_f(mid, coef_m) > 0) == b_p
-            b_lo, b_hi = np.where(wide & left, mid, b_lo), np.where(wide & ~left, mid, b_hi)
-        i_lo[miss], i_hi[miss], ok[miss] = b_lo, b_hi, b_ok
-        f_lo[miss], f_hi[miss] = fine_f(b_lo, coef_m), fine_f(b_hi, coef_m)
-    lo, hi = np.where(ok, fine[i_lo], lo), np.where(ok, fine[i_hi], hi)
-    flo, fhi = np.where(ok, f_lo, flo), np.where(ok, f_hi, fhi)
-    glo, ghi = np.where(ok, fine_f(kf + i_lo), glo), np.where(ok, fine_f(kf + i_hi), ghi)
-    start = np.where(ok, lo + _hermite_root(hi - lo, flo, fhi, glo, ghi), start)  # the cubic model on the sub-cell
-    start = np.where(np.isnan(guess), start, guess)
-    th = np.where((start > lo) & (start < hi), start, 0.5 * (lo + hi))
-    root = np.full(m, np.nan)
-    z = np.full(m, np.nan, dtype=complex)
-    its = np.zeros(m, dtype=int)
-    conv = np.zeros(m, dtype=bool)
+    f_lo, f_hi = _k_fine_f(fine_rows, i_lo, coef), _k_fine_f(fine_rows, i_hi, coef)
+    ok = ((f_lo > 0) != (f_hi > 0)) and fine[i_lo] >= lo and fine[i_hi] <= hi
+    if not ok and guess != guess:  # bisection on the table's nodes inside the bracket
+        b_lo = min(max(int(math.ceil((lo - THETA_MIN) / hf - 1e-6)), 0), kf - 1)
+        b_hi = min(max(int(math.floor((hi - THETA_MIN) / hf + 1e-6)), 0), kf - 1)
+        b_p = _k_fine_f(fine_rows, b_lo, coef) > 0
+        ok = (b_p != (_k_fine_f(fine_rows, b_hi, coef) > 0)) and b_lo < b_hi
+        if ok:
+            while b_hi - b_lo > 1:
+                mid = (b_lo + b_hi) // 2
+                if (_k_fine_f(fine_rows, mid, coef) > 0) == b_p:
+                    b_lo = mid
+                else:
+                    b_hi = mid
+        i_lo, i_hi = b_lo, b_hi
+        f_lo, f_hi = _k_fine_f(fine_rows, b_lo, coef), _k_fine_f(fine_rows, b_hi, coef)
+    if ok:  # the cubic model on the sub-cell
+        lo, hi, flo, fhi = fine[i_lo], fine[i_hi], f_lo, f_hi
+        glo, ghi = _k_fine_f(fine_rows, kf + i_lo, coef), _k_fine_f(fine_rows, kf + i_hi, coef)
+        start = lo + _k_hermite_root(hi - lo, flo, fhi, glo, ghi)
+    if guess == guess:
+        start = guess
+    th = start if (start > lo and start < hi) else 0.5 * (lo + hi)
+    root = math.nan
+    z = complex(math.nan, math.nan)
+    its = 0
+    conv = False
     pos_lo = flo > 0
     tol_step = 4 * _EPS * r2 / mb  # step^2 below this: the Newton update is at rounding level
     tol_f = 4 * _EPS * r2
-    act = np.arange(m)
     for _ in range(max_iter):
-        if act.size == 0:
-            break
-        t = th[act]
-        y, dy = _radial_eval(t, sel if act.size == m else sel.take(act), ctx)
-        f, g = _f_and_slope(y, dy, r2[act])
-        its[act] += 1
-        left = (f > 0) == pos_lo[act]
-        a_lo = lo[act] = np.where(left, t, lo[act])
-        a_hi = hi[act] = np.where(left, hi[act], t)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            step = f / g
+        t = th
+        f, g, y, dy = _k_f_and_slope(t, upper, right, e, seed, K, KC, r2)
+        its += 1
+        if (f > 0) == pos_lo:
+            lo = t
+        else:
+            hi = t
+        step = f / g
         new = t - step
-        newton = (new > a_lo) & (new < a_hi)
-        new = np.where(newton, new, 0.5 * (a_lo + a_hi))
-        small = np.abs(f) <= tol_f[act]
-        done = small | (newton & (step * step <= tol_step[act])) | (a_hi - a_lo <= 4 * _EPS * a_hi)
-        new = np.where(small, t, new)
-        root[act], z[act] = new, y + (new - t) * dy
-        conv[act] = done
-        th[act] = new
-        act = act[~done]
-    return root, np.where(sel.right, np.conj(z), z), its, conv
+        newton = new > lo and new < hi
+        if not newton:
+            new = 0.5 * (lo + hi)
+        small = abs(f) <= tol_f
+        done = small or (newton and step * step <= tol_step) or (hi - lo <= 4 * _EPS * hi)
+        if small:
+            new = t
+        root, z = new, y + (new - t) * dy
+        conv = done
+        th = new
+        if done:
+            break
+    if right:
+        z = z.conjugate()
+    return root, z, its, conv
+
+
+#: Most roots of one target kept by the radial kernel (16 cells, two per split cell, the ends, doubles).
+_RADIAL_CAP = 64
+
+
+@kernel
+def _k_phase(z):
+    return math.atan2(z.imag, z.real)
+
+
+@kernel
+def _k_ik_radial(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, table, m2, fine, fine_rows, tol,
+                 max_iter, q0, use_q0, limits, q, sols):
+    """The radial IK for one target (:func:`_ik_radial` states the math) into ``q`` (3,) and ``sols``
+    (S, 3) (NaN-padded, as many as fit). Returns (iterations, error, reason, roots, solutions)."""
+    K_ = grid.shape[0]
+    d0, d1, d2 = tgt[0] - o0, tgt[1] - o1, tgt[2] - o2
+    x_L = -d0
+    m = complex(s * d1, d2)
+    yabs = math.sqrt(_k_max(m.real * m.real + m.imag * m.imag - a * a, 0.0))
+    r2 = x_L * x_L + yabs * yabs
+    ftol = 2.0 * math.sqrt(r2) * tol
+    coef = np.zeros(9)
+    base = 0 if upper else 4
+    ee = e.real * e.real + e.imag * e.imag
+    coef[base] = 1.0
+    coef[base + 1] = ee
+    coef[base + 2] = 2.0 * e.real
+    coef[base + 3] = -2.0 * e.imag
+    coef[8] = -r2
+    kind = 0 if upper else 1
+    ea = math.sqrt(ee)
+    f = np.empty(K_)
+    g = np.empty(K_)
+    for k in range(K_):
+        fk, gk = 0.0, 0.0
+        for j in range(9):
+            fk += coef[j] * table[j, k]
+            gk += coef[j] * table[j, K_ + k]
+        f[k], g[k] = fk, gk
+    h = grid[1] - grid[0]
+    # brackets: (lo, hi, flo, fhi, glo, ghi, curvature bound, start guess)
+    jobs = np.empty((3 * K_, 8))
+    nj = 0
+    for k in range(K_ - 1):
+        if (f[k] > 0) != (f[k + 1] > 0):
+            M = m2[kind, 0, k] + ee * m2[kind, 1, k] + 2.0 * ea * m2[kind, 2, k]
+            jobs[nj, 0], jobs[nj, 1], jobs[nj, 2], jobs[nj, 3] = grid[k], grid[k + 1], f[k], f[k + 1]
+            jobs[nj, 4], jobs[nj, 5], jobs[nj, 6], jobs[nj, 7] = g[k], g[k + 1], M, math.nan
+            nj += 1
+    its = 0
+    rth = np.empty(_RADIAL_CAP)
+    rz = np.empty(_RADIAL_CAP, dtype=np.complex128)
+    nx = 0  # roots found without Newton (ends of the range, double roots)
+    xth = np.empty(K_ + 2)
+    for end in range(2):
+        col, inward, cell = (0, 1.0, 0) if end == 0 else (K_ - 1, -1.0, K_ - 2)
+        # An end of [17, 160] deg with |f| <= ftol is a root within rounding (issue 15; see _ik_radial).
+        near = abs(f[col]) <= ftol
+        same_side = (inward * g[col] > 0) == (f[col] > 0)
+        change = (f[cell] > 0) != (f[cell + 1] > 0)
+        if near and (not change or same_side):
+            xth[nx] = grid[col]
+            nx += 1
+    n_change = nj
+    split_lo = np.empty((K_, 8))
+    split_hi = np.empty((K_, 8))
+    ns = 0
+    for k in range(K_ - 1):
+        if ((g[k] > 0) != (g[k + 1] > 0)) and ((f[k] > 0) == (f[k + 1] > 0)):  # extremum, no sign change
+            sig = 1.0 if f[k] > 0 else -1.0
+            Fa, Fb, Ga, Gb = sig * f[k], sig * f[k + 1], sig * g[k], sig * g[k + 1]
+            M = m2[kind, 0, k] + ee * m2[kind, 1, k] + 2.0 * ea * m2[kind, 2, k]
+            # |f| falls into the cell from both ends and the curvature bound allows it to reach 0
+            if Ga < 0 and Gb > 0 and _k_lower_bound(Fa, Fb, Ga, Gb, h, M) <= ftol:
+                th_e, f_e, g_e, status, k_e, its_e = _k_radial_extremum(
+                    grid[k], grid[k + 1], f[k], f[k + 1], g[k], g[k + 1], M, upper, right, e, seed, K, KC, r2,
+                    ftol, max_iter)
+                its += its_e
+                if status == 2:
+                    xth[nx] = th_e
+                    nx += 1
+                elif status == 1:
+                    # start both roots from the parabola f_s + f'_s d + k d^2 / 2 through the split point
+                    sq = math.sqrt(_k_max(g_e * g_e - 2 * k_e * f_e, 0.0))
+                    dd1, dd2 = (-g_e - sq) / k_e, (-g_e + sq) / k_e
+                    row = split_lo[ns]
+                    row[0], row[1], row[2], row[3] = grid[k], th_e, f[k], f_e
+                    row[4], row[5], row[6], row[7] = g[k], g_e, M, th_e + _k_min(dd1, dd2)
+                    row = split_hi[ns]
+                    row[0], row[1], row[2], row[3] = th_e, grid[k + 1], f_e, f[k + 1]
+                    row[4], row[5], row[6], row[7] = g_e, g[k + 1], M, th_e + _k_max(dd1, dd2)
+                    ns += 1
+    for i in range(ns):
+        jobs[nj] = split_lo[i]
+        nj += 1
+    for i in range(ns):
+        jobs[nj] = split_hi[i]
+        nj += 1
+    nr = 0
+    for j in range(nj):
+        root, zr, its_n, conv = _k_radial_newton(jobs[j, 0], jobs[j, 1], jobs[j, 2], jobs[j, 3], jobs[j, 4],
+                                                 jobs[j, 5], jobs[j, 7], coef, fine, fine_rows, upper, right, e,
+                                                 seed, K, KC, r2, jobs[j, 6], max_iter)
+        its += its_n
+        if conv and nr < _RADIAL_CAP:
+            rth[nr], rz[nr] = root, zr
+            nr += 1
+    for i in range(nx):  # roots without a Newton evaluation: the contact point from the closed form
+        if nr < _RADIAL_CAP:
+            y, _dy = _k_plane(xth[i], upper, right, e, seed, K, KC, False, True)
+            rth[nr], rz[nr] = xth[i], y
+            nr += 1
+    if nx > 0 or ns > 0:  # stable sort by theta, then one root found twice is listed once
+        for i in range(1, nr):
+            tv, zv = rth[i], rz[i]
+            j = i - 1
+            while j >= 0 and rth[j] > tv:
+                rth[j + 1], rz[j + 1] = rth[j], rz[j]
+                j -= 1
+            rth[j + 1], rz[j + 1] = tv, zv
+        keep = 1 if nr > 0 else 0
+        prev = rth[0] if nr > 0 else 0.0
+        for i in range(1, nr):
+            cur = rth[i]
+            if not (abs(cur - prev) <= 1e-10):
+                rth[keep], rz[keep] = cur, rz[i]
+                keep += 1
+            prev = cur
+        nr = keep
+    # solutions: branch y_L <= 0 by increasing theta, then branch y_L > 0
+    tau = complex(x_L, -yabs)  # exp(i (beta + pi/2)) c = tau on the branch y_L <= 0
+    gamma1 = _k_phase(m * complex(a, yabs))
+    gamma2 = _k_phase(m * complex(a, -yabs))
+    nsol = nr * (2 if yabs > 0 else 1)
+    S = sols.shape[0]
+    for i in range(S):
+        sols[i, 0], sols[i, 1], sols[i, 2] = math.nan, math.nan, math.nan
+    best = -1
+    best_d2 = math.inf
+    sq0 = np.empty(3)
+    sel = np.empty(3)
+    for i in range(nsol):
+        r = i if i < nr else i - nr
+        ccz = rz[r].conjugate() * -1j
+        sq0[0] = rth[r]
+        if i < nr:
+            sq0[1], sq0[2] = _k_phase(tau * ccz), gamma1
+        else:
+            sq0[1], sq0[2] = _k_phase(tau.conjugate() * ccz), gamma2
+        usable = sq0[0] == sq0[0]
+        if limits:  # the ABAD joint's URDF limits; within rounding of a limit counts as on it
+            usable = usable and abs(sq0[2]) <= ABAD_LIMIT + _LIMIT_ROUNDING
+            if usable:
+                sq0[2] = _k_clip(sq0[2], -ABAD_LIMIT, ABAD_LIMIT)
+        if i < S:
+            sols[i, 0], sols[i, 1], sols[i, 2] = sq0[0], sq0[1], sq0[2]
+        if i == 0:
+            sel[0], sel[1], sel[2] = sq0[0], sq0[1], sq0[2]  # kept for the out-of-limits answer
+        if usable:
+            if not use_q0:
+                if best < 0:
+                    best = i
+                    q[0], q[1], q[2] = sq0[0], sq0[1], sq0[2]
+            else:
+                dist = (sq0[0] - q0[0]) ** 2
+                w1 = _k_phase(complex(math.cos(sq0[1] - q0[1]), math.sin(sq0[1] - q0[1])))
+                w2 = _k_phase(complex(math.cos(sq0[2] - q0[2]), math.sin(sq0[2] - q0[2])))
+                dist += w1 * w1 + w2 * w2
+                if dist < best_d2 or best < 0:
+                    best, best_d2 = i, dist
+                    q[0], q[1], q[2] = sq0[0], q0[1] + w1, (q0[2] + w2 if not limits else sq0[2])
+    if best >= 0:
+        reason = _SOLVED
+    elif nr > 0:  # reachable only outside the ABAD limits: the first solution, for the error message
+        q[0], q[1], q[2] = sel[0], sel[1], sel[2]
+        reason = _LIMITS
+    else:  # no root: the grid node of smallest |f|, as the point reached
+        kb = 0
+        for k in range(1, K_):
+            if abs(f[k]) < abs(f[kb]):
+                kb = k
+        cz, _dz = _k_plane(grid[kb], upper, right, e, seed, K, KC, False, True)
+        q[0], q[1], q[2] = grid[kb], _k_phase(tau * cz.conjugate() * -1j), gamma1
+        reason = _UNREACHABLE
+    p = np.empty(3)
+    _k_fk(q[0], q[1], q[2], upper, right, e, seed, K, KC, s, a, o0, o1, o2, False, p, p)
+    err = math.sqrt((p[0] - tgt[0]) ** 2 + (p[1] - tgt[1]) ** 2 + (p[2] - tgt[2]) ** 2)
+    if reason == _SOLVED and not (err <= tol):
+        reason = _UNREACHABLE  # (does not happen: each root is checked against tol by the FK)
+    return its, err, reason, nr, nsol
+
+
+@batch_kernel
+def _k_ik_radial_batch(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, table, m2, fine, fine_rows, tol,
+                       max_iter, q0, use_q0, limits, q, sols, its, err, reason, nsol):
+    """:func:`_k_ik_radial` over targets (n, 3) (q0 (n, 3) or (1, 3) unused) into q, sols, its, err, reason,
+    nsol (solutions found per target, possibly more than sols holds)."""
+    for i in prange(tgt.shape[0]):
+        iq0 = i if use_q0 else i - i  # (same integer type as i)
+        its[i], err[i], reason[i], _nr, nsol[i] = _k_ik_radial(
+            tgt[i], upper[i], right[i], e[i], a[i], seed, K, KC, s, o0, o1, o2, grid, table, m2, fine, fine_rows,
+            tol, max_iter, q0[iq0], use_q0, limits, q[i], sols[i])
 
 
 def _ik_radial(target, ctx, tol, max_iter, q0, limits=True):
@@ -1660,7 +1888,7 @@ def _ik_radial(target, ctx, tol, max_iter, q0, limits=True):
     for each root by increasing theta the branch ``y_L <= 0``, then the same roots on the branch ``y_L > 0``
     (absent when ``y_L = 0``). The answer is the first solution in that order whose gamma is inside the ABAD
     joint's URDF limits ``[-pi/2, pi/2]`` (``limits=False``: the first), or with ``q0`` the usable solution
-    nearest ``q0``. It is checked with the forward kinematics (:func:`_fk_flat`): converged means
+    nearest ``q0``. It is checked with the forward kinematics (:func:`_k_fk`): converged means
     ``|contact_point(q) - target| <= tol``. ``reason`` per target: 0 solved, 1 no root (out of reach),
     2 every root outside the ABAD limits. A target without a root gets, as its (unconverged) q, the grid
     node of smallest ``|f|`` with beta, gamma from the branch ``y_L <= 0``; one reachable only outside the
@@ -1668,142 +1896,42 @@ def _ik_radial(target, ctx, tol, max_iter, q0, limits=True):
     """
     max_iter = 60 if max_iter is None else max_iter
     n = target.shape[0]
-    x_L, yabs, a, m = _out_of_plane(target, ctx)
-    r2 = x_L * x_L + yabs * yabs
-    ftol = 2.0 * np.sqrt(r2) * tol
-    grid, table, m2, _, _ = _radial_table(ctx.geo.R, ctx.seed)
-    K = grid.size
-    coef = _arc_coefficients(ctx.sel, r2)
-    fg = coef @ table
-    f, g = fg[:, :K], fg[:, K:]
-    kind = ctx.sel.upper.astype(int) ^ 1  # 0: upper rim, 1: lower rim / toe
-    e = ctx.sel.e
-    ee = e.real * e.real + e.imag * e.imag
-    ea = np.sqrt(ee)
+    grid, table, m2, fine, fine_rows = _radial_table(ctx.geo.R, ctx.seed)
+    K, KC = _kconst(ctx.c.R, ctx.geo.R + FOOT_OFFSET)
+    sel = ctx.sel
 
-    def curvature(t, cell):  # bound of |f''| in that cell for target t
-        kt = kind[t]
-        return m2[kt, 0, cell] + ee[t] * m2[kt, 1, cell] + 2.0 * ea[t] * m2[kt, 2, cell]
+    def items(x, dtype):
+        return np.ascontiguousarray(np.broadcast_to(x, (n,)), dtype=dtype)
 
-    h = grid[1] - grid[0]
-    pos = f > 0
-    change = pos[:, 1:] != pos[:, :-1]
-    jt, jk = divmod(np.flatnonzero(change), K - 1)  # a sign change: one root (at most one extremum per cell)
-    jobs = [(jt, grid[jk], grid[jk + 1], f[jt, jk], f[jt, jk + 1], g[jt, jk], g[jt, jk + 1], curvature(jt, jk),
-             np.full(jt.size, np.nan))]
-    its = np.zeros(n, dtype=int)
-    extra_t, extra_th = [], []  # roots found without Newton (ends of the range, double roots)
-    for col, inward in ((0, 1.0), (-1, -1.0)):
-        # An end of [17, 160] deg with |f| <= ftol is a root within rounding. The Newton bracket of the end
-        # cell finds it only when f really crosses zero there: if f approaches the end from the side that
-        # the rounded end value has (slope sign: inward * g == sign f), the cell's sign change belongs to an
-        # interior root and the end root must be added here (issue 15: theta = 160 deg, alpha = 2).
-        near = np.abs(f[:, col]) <= ftol
-        same_side = (inward * g[:, col] > 0) == (f[:, col] > 0)
-        end = np.flatnonzero(near & (~change[:, col] | same_side))
-        if end.size:
-            extra_t.append(end)
-            extra_th.append(np.full(end.size, grid[col]))
-    gpos = g > 0
-    et, ek = divmod(np.flatnonzero((gpos[:, 1:] != gpos[:, :-1]) & ~change), K - 1)  # extremum, no sign change
-    if et.size:
-        sig = np.where(pos[et, ek], 1.0, -1.0)
-        Fa, Fb, Ga, Gb = sig * f[et, ek], sig * f[et, ek + 1], sig * g[et, ek], sig * g[et, ek + 1]
-        M = curvature(et, ek)
-        # |f| falls into the cell from both ends and the curvature bound allows it to reach 0
-        r = np.flatnonzero((Ga < 0) & (Gb > 0) & (_lower_bound(Fa, Fb, Ga, Gb, h, M) <= ftol[et]))
-        if r.size:
-            rt, rk = et[r], ek[r]
-            th_e, f_e, g_e, status, k_e, its_e = _radial_extremum(
-                grid[rk], grid[rk + 1], f[rt, rk], f[rt, rk + 1], g[rt, rk], g[rt, rk + 1], M[r],
-                ctx.sel.take(rt), ctx, r2[rt], ftol[rt], max_iter)
-            its += np.bincount(rt, weights=its_e, minlength=n).astype(int)
-            double = status == 2
-            if double.any():
-                extra_t.append(rt[double])
-                extra_th.append(th_e[double])
-            split = status == 1
-            st, sk, se, sf, sg, mc = rt[split], rk[split], th_e[split], f_e[split], g_e[split], M[r][split]
-            # start both roots from the parabola f_s + f'_s d + k d^2 / 2 through the split point
-            with np.errstate(divide="ignore", invalid="ignore"):
-                ks = k_e[split]
-                sq = np.sqrt(np.maximum(sg * sg - 2 * ks * sf, 0.0))
-                d1, d2 = (-sg - sq) / ks, (-sg + sq) / ks
-            jobs.append((st, grid[sk], se, f[st, sk], sf, g[st, sk], sg, mc, se + np.minimum(d1, d2)))
-            jobs.append((st, se, grid[sk + 1], sf, f[st, sk + 1], sg, g[st, sk + 1], mc, se + np.maximum(d1, d2)))
-    if len(jobs) > 1:
-        jt, lo, hi, flo, fhi, glo, ghi, mb, guess = (np.concatenate(col) for col in zip(*jobs))
-    else:
-        jt, lo, hi, flo, fhi, glo, ghi, mb, guess = jobs[0]
-    sel_j = ctx.sel.take(jt)
-    roots, zr, its_n, conv = _radial_newton(lo, hi, flo, fhi, glo, ghi, guess, coef[jt], sel_j, ctx, r2[jt],
-                                            mb, max_iter)
-    its += np.bincount(jt, weights=its_n, minlength=n).astype(int)
-    rt, rth, rz = jt, roots, zr
-    if not conv.all():
-        rt, rth, rz = jt[conv], roots[conv], zr[conv]
-    if extra_t:  # roots without a Newton evaluation: the contact point from the closed form
-        xt, xth = np.concatenate(extra_t), np.concatenate(extra_th)
-        pts, _ = _closed_form(xth, ctx.c, ctx.geo.R + FOOT_OFFSET, False, full=ctx.seed)
-        xz, _ = _plane(pts, None, ctx.sel.take(xt), False)
-        rt, rth, rz = np.concatenate([rt, xt]), np.concatenate([rth, xth]), np.concatenate([rz, xz])
-    if extra_t or len(jobs) > 1:  # else already by target, then theta
-        order = np.lexsort((rth, rt))
-        rt, rth, rz = rt[order], rth[order], rz[order]
-        # one root found twice (an end root that a split bracket also reaches) is listed once
-        dup = np.zeros(rt.size, dtype=bool)
-        dup[1:] = (rt[1:] == rt[:-1]) & (np.abs(rth[1:] - rth[:-1]) <= 1e-10)
-        if dup.any():
-            rt, rth, rz = rt[~dup], rth[~dup], rz[~dup]
-    counts = np.bincount(rt, minlength=n)
-    first = np.cumsum(counts) - counts  # index of each target's first root (sorted)
-    tau = x_L[rt] - 1j * yabs[rt]  # branch y_L <= 0; exp(i (beta + pi/2)) c = tau
-    ccz = np.conj(rz) * -1j
-    beta1 = np.angle(tau * ccz)
-    gamma1 = np.angle(m * (a + 1j * yabs))
-    has = counts > 0
-    q = np.full((n, 3), np.nan)
-    rank = np.arange(rt.size) - first[rt]
-    S = int((counts * np.where(yabs > 0, 2, 1)).max()) if n else 0
-    sols = np.full((n, S, 3), np.nan)
-    sols[rt, rank] = np.stack([rth, beta1, gamma1[rt]], -1)
-    two = np.flatnonzero(yabs[rt] > 0)
-    if two.size:
-        t2 = rt[two]
-        sols[t2, counts[t2] + rank[two]] = np.stack(
-            [rth[two], np.angle(np.conj(tau[two]) * ccz[two]), np.angle(m[t2] * (a[t2] - 1j * yabs[t2]))], -1)
-    usable = ~np.isnan(sols[..., 0])
-    if limits:  # the ABAD joint's URDF limits; within rounding of a limit counts as on it
-        g = sols[..., 2]
-        with np.errstate(invalid="ignore"):
-            usable &= np.abs(g) <= ABAD_LIMIT + _LIMIT_ROUNDING
-            sols[..., 2] = np.where(usable, np.clip(g, -ABAD_LIMIT, ABAD_LIMIT), g)
-    in_lim = usable.any(axis=1)
-    if not S:  # no target has a root
-        pass
-    elif q0 is None:  # the first usable solution in the documented order
-        k = np.argmax(usable, axis=1)
-        q[in_lim] = sols[in_lim, k[in_lim]]
-    else:
-        diff = sols - q0[:, None, :]
-        diff[..., 1:] = np.angle(_cis(diff[..., 1:]))  # wrapped angle differences
-        d2 = np.where(usable, np.sum(diff * diff, axis=-1), np.inf)
-        k = np.argmin(d2, axis=1)[:, None, None]
-        q[in_lim] = np.take_along_axis(sols, k, 1)[in_lim, 0]
-        c = 2 if limits else 3  # beta (and without limits gamma) within pi of q0's
-        q[in_lim, 1:c] = (q0[:, 1:c] + np.take_along_axis(diff, k, 1)[:, 0, 1:c])[in_lim]
-    limited = np.flatnonzero(has & ~in_lim)
-    if limited.size:  # reachable only outside the ABAD limits: the first solution, for the error message
-        q[limited] = sols[limited, 0]
-    miss = np.flatnonzero(~has)
-    if miss.size:  # no root: the grid node of smallest |f|, as the point reached
-        k = np.argmin(np.abs(f[miss]), axis=1)
-        pts, _ = _closed_form(grid[k], ctx.c, ctx.geo.R + FOOT_OFFSET, False, full=ctx.seed)
-        cz, _ = _plane(pts, None, ctx.sel.take(miss), False)
-        q[miss] = np.stack([grid[k], np.angle((x_L[miss] - 1j * yabs[miss]) * np.conj(cz) * -1j), gamma1[miss]], -1)
-    p = _fk_flat(q, ctx, False)[0]
-    err = np.linalg.norm(p - target, axis=1)
-    reason = np.where(~has, _UNREACHABLE, np.where(in_lim, _SOLVED, _LIMITS))
-    ok = in_lim & (err <= tol)
-    reason[in_lim & ~ok] = _UNREACHABLE  # (does not happen: each root is checked against tol by the FK)
-    return q, its, err, ok, sols, reason
+    upper, right, e = items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128)
+    a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)
+    tgt = as_rows(target, 3)
+    q0a = _NO_Q0 if q0 is None else as_rows(q0, 3)
+    o = ctx.origin
+    q = np.empty((n, 3))
+    its, reason, nsol = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    err = np.empty(n)
+    cap = _RADIAL_SOLS
+    sols = np.empty((n, cap, 3))
+    args = (ctx.seed, K, KC, ctx.s, float(o[0]), float(o[1]), float(o[2]), grid, table, m2, fine, fine_rows, tol,
+            max_iter)
+    _k_ik_radial_batch(tgt, upper, right, e, a, *args, q0a, q0 is not None, bool(limits), q, sols, its, err,
+                       reason, nsol)
+    S = int(nsol.max()) if n else 0
+    if S > cap:  # a target with more solutions than the first pass kept: solve those again, keeping all
+        big = np.flatnonzero(nsol > cap)
+        wide = np.full((n, S, 3), np.nan)
+        wide[:, :cap] = sols
+        qb, sb = np.empty((big.size, 3)), np.empty((big.size, S, 3))
+        tmp = [np.empty(big.size, dtype=np.int64) for _ in range(3)]
+        _k_ik_radial_batch(tgt[big], upper[big], right[big], e[big], a[big], *args,
+                           q0a if q0 is None else q0a[big], q0 is not None, bool(limits), qb, sb, tmp[0],
+                           np.empty(big.size), tmp[1], tmp[2])
+        wide[big] = sb
+        sols = wide
+    return q, its, err, reason == _SOLVED, sols[:, :S], reason
+
+
+#: Solutions per target kept by the first pass of the radial batch (more: that target is solved again).
+_RADIAL_SOLS = 8
+_NO_Q0 = np.zeros((1, 3))

@@ -113,6 +113,8 @@ _BAD_REF = 4  # a NaN/inf entry in q_ref
 _LEG_INDEX = {leg: i for i, leg in enumerate(LEGS)}
 _F64 = np.dtype(np.float64)
 _S3 = (3,)
+_S33 = (3, 3)
+_S43 = (4, 3)
 _NAN3 = np.full(3, np.nan)
 
 
@@ -337,9 +339,16 @@ def foot_position(q, leg: str, *, foot_z: float = 0.0) -> np.ndarray:
     Returns:
         Positions (..., 3) in metres.
     """
-    if type(foot_z) is not float or not _FZ_LO <= foot_z <= _FZ_HI:
+    if foot_z.__class__ is not float or not _FZ_LO <= foot_z <= _FZ_HI:
         foot_z = _checked_foot_z(foot_z)
-    li = _leg_index(leg)
+    li = _LEG_INDEX.get(leg, -1) if leg.__class__ is str else _leg_index(leg)
+    if li < 0:
+        _leg_index(leg)
+    if q.__class__ is np.ndarray and q.shape == _S3 and q.dtype is _F64:  # the single call, fast
+        out = np.empty(3)
+        if _foot_position_k(q, li, foot_z, out):
+            _raise_bad(q, "q")
+        return out
     arr = _rows(q, "q")
     if arr.ndim == 1:
         out = np.empty(3)
@@ -358,9 +367,16 @@ def foot_jacobian(q, leg: str, *, foot_z: float = 0.0) -> np.ndarray:
     Differentiates :func:`foot_position` (seed 004's product) factor by factor:
     ``dp/dq1 = s_y R_x' u``, ``dp/dq2 = R_x (-u_z, 0, u_x)``, ``dp/dq3 = R_x R_y(-q_2) dv/dq_3``.
     """
-    if type(foot_z) is not float or not _FZ_LO <= foot_z <= _FZ_HI:
+    if foot_z.__class__ is not float or not _FZ_LO <= foot_z <= _FZ_HI:
         foot_z = _checked_foot_z(foot_z)
-    li = _leg_index(leg)
+    li = _LEG_INDEX.get(leg, -1) if leg.__class__ is str else _leg_index(leg)
+    if li < 0:
+        _leg_index(leg)
+    if q.__class__ is np.ndarray and q.shape == _S3 and q.dtype is _F64:  # the single call, fast
+        out = np.empty(_S33)
+        if _foot_jacobian_k(q, li, foot_z, out):
+            _raise_bad(q, "q")
+        return out
     arr = _rows(q, "q")
     if arr.ndim == 1:
         out = np.empty((3, 3))
@@ -417,9 +433,27 @@ def within_limits(q, tol: float = LIMIT_TOL) -> np.ndarray:
 
 
 # ----------------------------------------------------------------------------- seed 004: the closed-form IK
+def _leg_plane(foot_z: float):
+    offset = math.atan2(foot_z, X34) - _ALPHA
+    return math.hypot(X34, foot_z), offset, math.cos(offset), math.sin(offset)
+
+
+_L2_0, _OFFSET_0, _CO_0, _SO_0 = _leg_plane(0.0)  # foot_z = 0 (the default), the same libm calls
+
+
 @kernel
-def _reach_k(p, li, foot_z):
-    """The target's leg-plane quantities: (dx, dy, dz, rho, K, sqrt(1 - K^2), l2, reachable).
+def _leg_plane_k(foot_z):
+    """What the IK needs of ``foot_z`` (the same for every target of a call): ``L2 = |t34|``, the knee angle
+    offset ``beta - alpha`` with ``alpha = atan2(z23, x23)``, ``beta = atan2(z34, x34)``, and its cosine and sine."""
+    if foot_z == 0.0:
+        return _L2_0, _OFFSET_0, _CO_0, _SO_0
+    offset = math.atan2(foot_z, X34) - _ALPHA  # q3 = offset + k acos K
+    return math.hypot(X34, foot_z), offset, math.cos(offset), math.sin(offset)
+
+
+@kernel
+def _reach_k(p, li, l2):
+    """The target's leg-plane quantities: (dx, dy, dz, rho, K, sqrt(1 - K^2), acos K, reachable).
 
     ``d = p - h``; ``rho^2 = d_y^2 + d_z^2 - y12^2``; ``K = (|d|^2 - y12^2 - L1^2 - L2^2) / (2 L1 L2)`` clipped
     to [-1, 1]. Targets on the workspace boundary, built in floating point, may land a rounding error outside
@@ -431,7 +465,6 @@ def _reach_k(p, li, foot_z):
     rho2 = axis2 - _Y12_SQ
     rho = np.sqrt(max(rho2, 0.0))
     r2 = dx * dx + rho2
-    l2 = math.hypot(X34, foot_z)
     kk = min(max((r2 - _L1 * _L1 - l2 * l2) * (0.5 / (_L1 * l2)), -1.0), 1.0)
     sk = np.sqrt(1.0 - kk * kk)
     reachable = (
@@ -439,22 +472,25 @@ def _reach_k(p, li, foot_z):
         and r2 <= (_L1 + l2 + REACH_TOL) ** 2
         and r2 >= (abs(_L1 - l2) - REACH_TOL) ** 2
     )
-    return dx, dy, dz, rho, kk, sk, reachable
+    return dx, dy, dz, rho, kk, sk, np.arccos(kk), reachable
 
 
 @kernel
-def _knee_branch_k(kk, sk, k, foot_z):
-    """Knee branch ``k``: ``q3 = (beta - alpha) + k acos K`` wrapped to (-pi, pi], and ``v`` (vx, vz) from the
-    cosine and sine of q3 built without trig calls of q3."""
-    offset = math.atan2(foot_z, X34) - _ALPHA
-    co, so = math.cos(offset), math.sin(offset)
-    q3 = offset + k * np.arccos(kk)  # within 3 pi of 0: one shift wraps it (cheaper than a modulo)
+def _knee_angle_k(acos_k, k, offset):
+    """Knee branch ``k``: ``q3 = (beta - alpha) + k acos K`` wrapped to (-pi, pi]."""
+    q3 = offset + k * acos_k  # within 3 pi of 0: one shift wraps it (cheaper than a modulo)
     if q3 > _PI:
-        q3 = q3 - _TWO_PI
-    elif q3 <= -_PI:
-        q3 = q3 + _TWO_PI
+        return q3 - _TWO_PI
+    if q3 <= -_PI:
+        return q3 + _TWO_PI
+    return q3
+
+
+@kernel
+def _knee_branch_k(kk, sk, k, co, so, foot_z):
+    """``v`` (vx, vz) of knee branch ``k``, from the cosine and sine of q3 built without trig calls."""
     c3, s3 = co * kk - k * so * sk, so * kk + k * co * sk
-    return q3, X23 + X34 * c3 + foot_z * s3, Z23 - X34 * s3 + foot_z * c3
+    return X23 + X34 * c3 + foot_z * s3, Z23 - X34 * s3 + foot_z * c3
 
 
 @kernel
@@ -469,32 +505,40 @@ def _branch_k(dx, dy, dz, rho, s_u, vx, vz, li):
 
 
 @kernel
-def _foot_ik_all_k(p, li, foot_z, out) -> int:
+def _foot_ik_all_core(p, li, foot_z, l2, offset, co, so, out) -> int:
     """Every branch of :func:`foot_ik_all` for one target ``p`` (3,) into ``out`` (4, 3) (NaN if unreachable)."""
     if not _finite3(p):
         return _BAD_INPUT
-    dx, dy, dz, rho, kk, sk, reachable = _reach_k(p, li, foot_z)
+    dx, dy, dz, rho, kk, sk, acos_k, reachable = _reach_k(p, li, l2)
     if not reachable:
         out[:, :] = np.nan
         return _UNREACHABLE
     for b in range(4):
-        q3, vx, vz = _knee_branch_k(kk, sk, _KS[b], foot_z)
+        k = _KS[b]
+        vx, vz = _knee_branch_k(kk, sk, k, co, so, foot_z)
         q1, q2 = _branch_k(dx, dy, dz, rho, _SU[b], vx, vz, li)
-        out[b, 0], out[b, 1], out[b, 2] = q1, q2, q3
+        out[b, 0], out[b, 1], out[b, 2] = q1, q2, _knee_angle_k(acos_k, k, offset)
     return OK
+
+
+@kernel
+def _foot_ik_all_k(p, li, foot_z, out) -> int:
+    l2, offset, co, so = _leg_plane_k(foot_z)
+    return _foot_ik_all_core(p, li, foot_z, l2, offset, co, so, out)
 
 
 @batch_kernel
 def _foot_ik_all_batch(p, li, foot_z, out, ok) -> int:
     n, bad = p.shape[0], 0
+    l2, offset, co, so = _leg_plane_k(foot_z)
     if n < SERIAL_BELOW:
         for i in range(n):
-            s = _foot_ik_all_k(p[i], li, foot_z, out[i])
+            s = _foot_ik_all_core(p[i], li, foot_z, l2, offset, co, so, out[i])
             ok[i] = s == OK
             bad += s == _BAD_INPUT
     else:
         for i in prange(n):
-            s = _foot_ik_all_k(p[i], li, foot_z, out[i])
+            s = _foot_ik_all_core(p[i], li, foot_z, l2, offset, co, so, out[i])
             ok[i] = s == OK
             bad += s == _BAD_INPUT
     return bad
@@ -541,14 +585,16 @@ def foot_ik_all(p, leg: str, *, foot_z: float = 0.0, return_mask: bool = False):
         UnreachableError: single target out of reach (message says why and by how much).
         InvalidInputError: ``p`` not a finite real array (..., 3). InvalidParameterError: bad ``leg``/``foot_z``.
     """
-    if type(foot_z) is not float or not _FZ_LO <= foot_z <= _FZ_HI:
+    if foot_z.__class__ is not float or not _FZ_LO <= foot_z <= _FZ_HI:
         foot_z = _checked_foot_z(foot_z)
     if return_mask is not False and return_mask is not True:
         return_mask = _flag(return_mask, "return_mask")
-    li = _leg_index(leg)
-    arr = _rows(p, "p")
+    li = _LEG_INDEX.get(leg, -1) if leg.__class__ is str else _leg_index(leg)
+    if li < 0:
+        _leg_index(leg)
+    arr = p if p.__class__ is np.ndarray and p.shape == _S3 and p.dtype is _F64 else _rows(p, "p")
     if arr.ndim == 1:
-        out = np.empty((4, 3))
+        out = np.empty(_S43)
         status = _foot_ik_all_k(arr, li, foot_z, out)
         if status:
             if status == _BAD_INPUT:
@@ -659,7 +705,21 @@ def _clip_repair_k(qc, q, p, li, foot_z, best) -> bool:
 
 
 @kernel
-def _foot_ik_k(p, li, foot_z, has_ref, q_ref, out) -> int:
+def _clipped_k(q1, q2, q3, p, li, foot_z):
+    """A branch a hair outside the limits, clipped into them and repaired (:func:`_clip_repair_k`):
+    (kept, q1, q2, q3). The rare path: its scratch arrays are allocated here."""
+    q = np.empty(3)
+    q[0], q[1], q[2] = q1, q2, q3
+    qc = np.empty(3)
+    for j in range(3):
+        qc[j] = min(max(q[j], _LO[j]), _HI[j])
+    fixed = np.empty(3)
+    good = _clip_repair_k(qc, q, p, li, foot_z, fixed)
+    return good, fixed[0], fixed[1], fixed[2]
+
+
+@kernel
+def _foot_ik_core(p, li, foot_z, l2, offset, co, so, has_ref, q_ref, out) -> int:
     """:func:`foot_ik` of one target ``p`` (3,) into ``out`` (3,): the branch inside the limits (nearest ``q_ref``
     when ``has_ref``), or NaN and the failure code (unreachable, or only outside the limits).
 
@@ -671,49 +731,49 @@ def _foot_ik_k(p, li, foot_z, has_ref, q_ref, out) -> int:
     if has_ref and not _finite3(q_ref):
         return _BAD_REF
     out[0] = out[1] = out[2] = np.nan
-    dx, dy, dz, rho, kk, sk, reachable = _reach_k(p, li, foot_z)
+    dx, dy, dz, rho, kk, sk, acos_k, reachable = _reach_k(p, li, l2)
     if not reachable:
         return _UNREACHABLE
     best = np.inf
-    qb = np.empty(3)
-    qc = np.empty(3)
-    fixed = np.empty(3)
-    for b in range(4):
-        q3, vx, vz = _knee_branch_k(kk, sk, _KS[b], foot_z)
+    for b in range(4):  # scalars only on this path: no heap allocation per target
+        k = _KS[b]
+        q3 = _knee_angle_k(acos_k, k, offset)
         if not (q3 >= _LO[2] - LIMIT_TOL and q3 <= _HI[2] + LIMIT_TOL):
             continue
+        vx, vz = _knee_branch_k(kk, sk, k, co, so, foot_z)
         q1, q2 = _branch_k(dx, dy, dz, rho, _SU[b], vx, vz, li)
-        qb[0], qb[1], qb[2] = q1, _toward_limits_k(q2, 1), q3  # q1 and q3 limits are far from +-pi
-        inside, strict = True, True
-        for k in range(3):
-            x = qb[k]
-            inside = inside and x >= _LO[k] - LIMIT_SLACK and x <= _HI[k] + LIMIT_SLACK
-            strict = strict and x >= _LO[k] and x <= _HI[k]
-        if not inside:
+        q2 = _toward_limits_k(q2, 1)  # q1 and q3 limits are far from +-pi
+        if not (
+            q1 >= _LO[0] - LIMIT_SLACK and q1 <= _HI[0] + LIMIT_SLACK
+            and q2 >= _LO[1] - LIMIT_SLACK and q2 <= _HI[1] + LIMIT_SLACK
+            and q3 >= _LO[2] - LIMIT_SLACK and q3 <= _HI[2] + LIMIT_SLACK
+        ):
             continue
-        if strict:
-            cand = qb
-        else:  # a branch just outside the limits: clip it and re-solve the other joints
-            for k in range(3):
-                qc[k] = min(max(qb[k], _LO[k]), _HI[k])
-            if not _clip_repair_k(qc, qb, p, li, foot_z, fixed):
+        if not (
+            q1 >= _LO[0] and q1 <= _HI[0] and q2 >= _LO[1] and q2 <= _HI[1] and q3 >= _LO[2] and q3 <= _HI[2]
+        ):  # a branch just outside the limits: clip it and re-solve the other joints
+            good, q1, q2, q3 = _clipped_k(q1, q2, q3, p, li, foot_z)
+            if not good:
                 continue
-            cand = fixed
         if has_ref:
-            d0 = _wrap_k(cand[0] - q_ref[0])
-            d1 = _wrap_k(cand[1] - q_ref[1])
-            d2 = _wrap_k(cand[2] - q_ref[2])
+            d0 = _wrap_k(q1 - q_ref[0])
+            d1 = _wrap_k(q2 - q_ref[1])
+            d2 = _wrap_k(q3 - q_ref[2])
             cost = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
-            take = cost < best
+            if cost < best:
+                best = cost
+                out[0], out[1], out[2] = q1, q2, q3
         else:
-            cost = 0.0
-            take = best == np.inf
-        if take:
-            best = cost
-            out[0], out[1], out[2] = cand[0], cand[1], cand[2]
-            if not has_ref:
-                break  # the first branch inside the limits
+            best = 0.0
+            out[0], out[1], out[2] = q1, q2, q3
+            break  # the first branch inside the limits
     return OK if best < np.inf else _JOINT_LIMIT
+
+
+@kernel
+def _foot_ik_k(p, li, foot_z, has_ref, q_ref, out) -> int:
+    l2, offset, co, so = _leg_plane_k(foot_z)
+    return _foot_ik_core(p, li, foot_z, l2, offset, co, so, has_ref, q_ref, out)
 
 
 @batch_kernel
@@ -721,14 +781,15 @@ def _foot_ik_batch(p, li, foot_z, has_ref, q_ref, out, ok) -> int:
     """:func:`_foot_ik_k` over rows ``p`` (n, 3), ``q_ref`` (n, 3) (ignored unless ``has_ref``); returns the
     number of rows with a NaN/inf entry."""
     n, bad = p.shape[0], 0
+    l2, offset, co, so = _leg_plane_k(foot_z)
     if n < SERIAL_BELOW:
         for i in range(n):
-            s = _foot_ik_k(p[i], li, foot_z, has_ref, q_ref[i], out[i])
+            s = _foot_ik_core(p[i], li, foot_z, l2, offset, co, so, has_ref, q_ref[i], out[i])
             ok[i] = s == OK
             bad += s >= _BAD_INPUT
     else:
         for i in prange(n):
-            s = _foot_ik_k(p[i], li, foot_z, has_ref, q_ref[i], out[i])
+            s = _foot_ik_core(p[i], li, foot_z, l2, offset, co, so, has_ref, q_ref[i], out[i])
             ok[i] = s == OK
             bad += s >= _BAD_INPUT
     return bad
@@ -777,11 +838,26 @@ def foot_ik(p, leg: str, q_ref=None, *, foot_z: float = 0.0, return_mask: bool =
         InvalidInputError: ``p`` or ``q_ref`` not finite real arrays (..., 3), or not broadcastable.
         InvalidParameterError: bad ``leg``, ``foot_z`` or ``return_mask``.
     """
-    if type(foot_z) is not float or not _FZ_LO <= foot_z <= _FZ_HI:
+    if foot_z.__class__ is not float or not _FZ_LO <= foot_z <= _FZ_HI:
         foot_z = _checked_foot_z(foot_z)
     if return_mask is not False and return_mask is not True:
         return_mask = _flag(return_mask, "return_mask")
-    li = _leg_index(leg)
+    li = _LEG_INDEX.get(leg, -1) if leg.__class__ is str else _leg_index(leg)
+    if li < 0:
+        _leg_index(leg)
+    if p.__class__ is np.ndarray and p.shape == _S3 and p.dtype is _F64:  # the single call, fast
+        if q_ref is None:
+            out = np.empty(3)
+            status = _foot_ik_k(p, li, foot_z, False, p, out)
+            if status:
+                raise _foot_ik_error(status, leg, li, p, foot_z, p, q_ref)
+            return (out, np.array(True)) if return_mask else out
+        if q_ref.__class__ is np.ndarray and q_ref.shape == _S3 and q_ref.dtype is _F64:
+            out = np.empty(3)
+            status = _foot_ik_k(p, li, foot_z, True, q_ref, out)
+            if status:
+                raise _foot_ik_error(status, leg, li, p, foot_z, p, q_ref)
+            return (out, np.array(True)) if return_mask else out
     arr = _rows(p, "p")
     has_ref = q_ref is not None
     if has_ref:

@@ -4,6 +4,11 @@ Targets: Pinocchio's forward kinematics of the ``LF_FOOT`` frame for joint vecto
 inside its joint limits (other legs at ``q0``), so every target is reachable inside the limits. Every
 method's answer is scored the same way: Pinocchio's foot position at the returned joints (taken mod 2 pi
 into the limits) against the target; solved = error <= SOLVE_TOL and joints inside the limits.
+
+The floor of the batch closed form is its transcendental calls alone (:func:`transcendental_floor`: per
+target the 2 sqrt, 1 acos and 2 atan2 calls of ``foot_ik``'s first branch, in the same compiled ``prange``
+loop shape), not ``foot_position`` (which needs no inverse trig). :func:`single_calls` gives the single-call
+table (one entry per public function of :mod:`legkin.analytic.quadruped`).
 """
 
 from __future__ import annotations
@@ -18,6 +23,7 @@ from ..analytic import quadruped as aq
 from ..bench import Method, MethodResult, ModelBench, Score
 from ..errors import UnreachableError
 from . import SOLVE_TOL, missing, pinocchio_positions, quiet_stdout, sizes
+from ._single import SingleCall
 
 LEG = "LF"
 #: CLIK settings of Pinocchio's examples/inverse-kinematics.py, with the issue's tolerance 1e-10.
@@ -35,6 +41,61 @@ def _into_limits(q: np.ndarray) -> np.ndarray:
     """Angles shifted by multiples of 2 pi to start at the lower limit (same pose, comparable to the limits)."""
     lo = aq.JOINT_LIMITS[:, 0]
     return lo + np.mod(q - lo, 2.0 * math.pi)
+
+
+#: The single-call inputs: leg LF at the SRDF ``standing`` pose (q0), its foot as the IK target.
+SINGLE_Q = np.array([0.0, 0.75, 1.5])
+
+
+def single_calls() -> list[SingleCall]:
+    """One single call per public function of :mod:`legkin.analytic.quadruped`, inputs bound (leg LF, q0).
+
+    Yardsticks: Pinocchio ``forwardKinematics`` + ``updateFramePlacement`` on the 12-DOF quadruped
+    (``quadruped_fk``), and ``computeFrameJacobian`` (``jacobian``) for ``foot_jacobian``.
+    """
+    q = SINGLE_Q.copy()
+    p = aq.foot_position(q, LEG)
+    q_ref = q + 0.01
+    pf = aq.textbook_frame(p, LEG)
+    a, b, c = aq.Y12, math.hypot(aq.X23, aq.Z23), aq.X34
+    theta = aq.textbook_ik(pf, a, b, c)
+    fp, fj, fi, fa, wl = aq.foot_position, aq.foot_jacobian, aq.foot_ik, aq.foot_ik_all, aq.within_limits
+    hp, tf, ti, tj = aq.hip_position, aq.textbook_frame, aq.textbook_ik, aq.textbook_to_joints
+    return [
+        SingleCall("foot_position", lambda: fp(q, LEG), "quadruped_fk"),
+        SingleCall("foot_jacobian", lambda: fj(q, LEG), "jacobian"),
+        SingleCall("foot_ik", lambda: fi(p, LEG), "quadruped_fk"),
+        SingleCall("foot_ik (q_ref)", lambda: fi(p, LEG, q_ref), "quadruped_fk"),
+        SingleCall("foot_ik_all", lambda: fa(p, LEG), "quadruped_fk"),
+        SingleCall("within_limits", lambda: wl(q), "quadruped_fk"),
+        SingleCall("hip_position", lambda: hp(LEG), "quadruped_fk"),
+        SingleCall("textbook_frame", lambda: tf(p, LEG), "quadruped_fk"),
+        SingleCall("textbook_ik", lambda: ti(pf, a, b, c), "quadruped_fk"),
+        SingleCall("textbook_to_joints", lambda: tj(theta, LEG), "quadruped_fk"),
+    ]
+
+
+_FLOOR = None
+
+
+def transcendental_floor():
+    """The compiled floor loop ``floor(p, out)``: per target row of ``p`` (n, 3), the transcendental calls of
+    ``foot_ik``'s closed form alone (2 sqrt, 1 acos, 2 atan2, on the target's coordinates), written to ``out``
+    (n, 3); a ``prange`` loop like the batch kernels (numba's thread count), compiled on first use."""
+    global _FLOOR
+    if _FLOOR is None:
+        import numba
+
+        @numba.njit(cache=True, error_model="numpy", parallel=True)
+        def floor(p, out):
+            for i in numba.prange(p.shape[0]):
+                x, y, z = p[i, 0], p[i, 1], p[i, 2]
+                out[i, 0] = np.arctan2(x, y) + np.sqrt(abs(x))
+                out[i, 1] = np.arctan2(y, z) + np.sqrt(abs(y))
+                out[i, 2] = np.arccos(min(max(z, -1.0), 1.0))
+
+        _FLOOR = floor
+    return _FLOOR
 
 
 def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
@@ -67,6 +128,16 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
     def fk_score(q: np.ndarray, pos: np.ndarray) -> Score:
         err = np.linalg.norm(pos - targets[: len(q)], axis=-1)
         return Score(error=err, solved=err <= SOLVE_TOL)
+
+    floor_loop = transcendental_floor()
+
+    def floor_run(p):
+        out = np.empty_like(p)
+        floor_loop(p, out)
+        return out
+
+    def floor_score(p: np.ndarray, out) -> Score:  # no answer to score: time only
+        return Score(error=np.full(len(p), np.nan), solved=np.zeros(len(p), dtype=bool))
 
     # ---------------------------------------------------------------- legkin
     def batch_ik(p):
@@ -110,8 +181,10 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
 
     methods = [
         Method(f"legkin batch closed form (foot_ik, {n_batch} at once)", targets, batch_ik, joints_score, repeats=7),
-        Method("legkin batch FK (foot_position), the floor", q_gen, lambda q: aq.foot_position(q, LEG), fk_score,
+        Method("legkin batch FK (foot_position)", q_gen, lambda q: aq.foot_position(q, LEG), fk_score,
                repeats=7),
+        Method("floor: foot_ik's transcendental calls alone (2 sqrt, acos, 2 atan2)", targets, floor_run,
+               floor_score, group="floor", repeats=7),
         Method("legkin scalar closed form, Python loop", targets, scalar_ik, joints_score, max_targets=n_scalar,
                repeats=3),
         Method("pinocchio CLIK (example settings, DT=0.1)", targets, clik(CLIK_DT), joints_score,
@@ -173,6 +246,9 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         f"targets: Pinocchio FK of {LEG}_FOOT for {n_batch} joint vectors of leg {LEG} uniform in its limits "
         f"(the other legs at q0); slow methods solve the first {n_scalar} (scalar loop) or {n_iter} (iterative) "
         "of the same targets",
+        "floor: a compiled prange loop making, per target, the transcendental calls of foot_ik's closed form "
+        "(first branch: 2 sqrt, 1 acos, 2 atan2) and nothing else; no answer to score (time only); threads: "
+        "numba's setting (numba.set_num_threads / NUMBA_NUM_THREADS), the same for the batch rows",
         "errors: Pinocchio FK of the returned joints vs the target; FK/solve = mean forward-kinematics "
         "evaluations per target; reached = error <= "
         f"{SOLVE_TOL:g} m; solved = reached with the joints inside the limits (angles mod 2 pi)",
@@ -189,15 +265,19 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
     ]
 
     def summary(results: list[MethodResult]) -> list[str]:
+        import numba
+
         by = {r.name: r for r in results}
         batch = next(r for r in results if "batch closed form" in r.name)
         fk = next(r for r in results if "batch FK" in r.name)
+        floor = next(r for r in results if r.group == "floor")
         lines = [
-            f"batch closed form: {1.0 / batch.time_per_target_s / 1e6:.2f} M targets/s on one core; "
-            f"IK/FK = {batch.time_per_target_s / fk.time_per_target_s:.1f} (target <= 3)"
+            f"batch closed form: {1.0 / batch.time_per_target_s / 1e6:.2f} M targets/s on "
+            f"{numba.get_num_threads()} thread(s); IK/floor = {batch.time_per_target_s / floor.time_per_target_s:.1f}"
+            f" (floor = its transcendental calls alone); IK/FK = {batch.time_per_target_s / fk.time_per_target_s:.1f}"
         ]
         for r in by.values():
-            if r is batch or r is fk:
+            if r is batch or r is fk or r is floor:
                 continue
             speedup = r.time_per_target_s / batch.time_per_target_s
             lines.append(f"batch closed form is {speedup:,.0f}x faster than {r.name}")
@@ -205,7 +285,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
 
     return ModelBench(
         methods=methods,
-        units={"ik": "m"},
+        units={"ik": "m", "floor": "- (time only)"},
         tolerance=f"position error <= {SOLVE_TOL:g} m and joints inside the limits",
         notes=notes,
         summary=summary,

@@ -227,16 +227,20 @@ def leg_transform(q, eta: float, d: float = D, alpha: float = ALPHA) -> np.ndarr
     Returns:
         (..., 4, 4) homogeneous transforms.
     """
-    d, alpha, _ = _params(d, alpha)
+    if not (d is D and alpha is ALPHA):
+        d, alpha, _ = _params(d, alpha)
     eta = _angle(eta, "eta")
+    G = _geo(d, alpha, None)[1] if type(d) is float and type(alpha) is float else _geo(float(d), float(alpha), None)[1]
+    if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (4,) and np.isfinite(q).all():
+        T = np.empty((4, 4))
+        _k_leg_transform(q[0], q[1], q[2], q[3], eta, alpha, G, T)
+        return T
     q = as_input(q, "q", (4,))
-    q1, q2, q3, q4 = (q[..., i] for i in range(4))
-    shape = q1.shape
-    rot = (
-        _rx(np.full(shape, eta)) @ _rz(np.full(shape, np.pi)) @ _rz(q1) @ _ry(q2) @ _rx(np.full(shape, -alpha))
-        @ _ry(q3) @ _rz(-q4) @ _rx(np.full(shape, np.pi - eta))
-    )
-    return _homogeneous(rot, _leg_position(q1, q2, np.float64(eta), d, alpha))
+    shape = q.shape[:-1]
+    rows = np.ascontiguousarray(q.reshape(-1, 4))
+    T = np.empty((rows.shape[0], 4, 4))
+    _k_leg_transform_batch(rows, eta, alpha, G, T)
+    return T.reshape(shape + (4, 4))
 
 
 def leg_transform_cv(q1, q2, eta: float, d: float = D, alpha: float = ALPHA) -> np.ndarray:
@@ -257,29 +261,19 @@ def leg_transform_cv(q1, q2, eta: float, d: float = D, alpha: float = ALPHA) -> 
     Returns:
         (..., 4, 4) homogeneous transforms.
     """
-    d, alpha, _ = _params(d, alpha)
+    if not (d is D and alpha is ALPHA):
+        d, alpha, _ = _params(d, alpha)
     eta = _angle(eta, "eta")
+    G = _geo(d, alpha, None)[1] if type(d) is float and type(alpha) is float else _geo(float(d), float(alpha), None)[1]
+    if isinstance(q1, float) and isinstance(q2, float) and math.isfinite(q1) and math.isfinite(q2):
+        T = np.empty((4, 4))
+        _k_leg_transform_cv(float(q1), float(q2), eta, G, T)
+        return T
     q1, q2 = as_angles(q1, q2, names=("q1", "q2"))
-    c1, s1, c2, s2 = np.cos(q1), np.sin(q1), np.cos(q2), np.sin(q2)
-    ca, sa = math.cos(alpha), math.sin(alpha)
-    ce, se = math.cos(eta), math.sin(eta)
-    g1 = c1**2 * (c2**2 - s2**2 * ca) + s1**2 * ca + 2 * c1 * s1 * s2 * sa
-    g2 = c2 * (s1 * sa - c1 * s2 * (1 + ca))
-    g3 = (c1**2 - s1**2) * s2 * sa + c1 * s1 * (2 * ca - c2**2 * (1 + ca))
-    g4 = c2 * (c1 * sa + s1 * s2 * (1 + ca))
-    g5 = c1**2 * ca + s1**2 * (c2**2 - s2**2 * ca) - 2 * c1 * s1 * s2 * sa
-    g6 = s2**2 - c2**2 * ca
-    g7 = (c2**2 - s2**2) * (1 + ca) + c1**2 * (s2**2 * (1 + ca) - (1 - ca)) - 2 * c1 * s1 * s2 * sa
-    t23 = ce * se * g7 + (ce**2 - se**2) * g4
-    rot = np.stack(
-        [
-            -g1, se * g2 - ce * g3, -ce * g2 - se * g3,
-            -se * g2 + ce * g3, -2 * ce * se * g4 + ce**2 * g5 + se**2 * g6, t23,
-            se * g3 + ce * g2, t23, 2 * ce * se * g4 + se**2 * g5 + ce**2 * g6,
-        ],
-        axis=-1,
-    ).reshape(q1.shape + (3, 3))
-    return _homogeneous(rot, _leg_position(q1, q2, np.float64(eta), d, alpha))
+    shape = q1.shape
+    T = np.empty((q1.size, 4, 4))
+    _k_leg_transform_cv_batch(np.ascontiguousarray(q1).reshape(-1), np.ascontiguousarray(q2).reshape(-1), eta, G, T)
+    return T.reshape(shape + (4, 4))
 
 
 # ------------------------------------------------------------------------------------------ platform
@@ -291,8 +285,9 @@ def alpha_x(alpha_y, alpha_z) -> np.ndarray:
     not the one the legs produce (rotation error up to 2 in matrix entries, see docs/tripod.md).
     The value is undefined at ``c_y + c_z = 0 = s_y s_z``, which is the singular set 1 + c_y c_z = 0.
     """
-    ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))
-    return np.arctan2(np.sin(ay) * np.sin(az), np.cos(ay) + np.cos(az))
+    if isinstance(alpha_y, float) and isinstance(alpha_z, float) and math.isfinite(alpha_y) and math.isfinite(alpha_z):
+        return np.float64(_k_alpha_x(float(alpha_y), float(alpha_z)))
+    return _uv_closed(0, alpha_y, alpha_z, (), None)
 
 
 def platform_rotation(alpha_y, alpha_z) -> np.ndarray:
@@ -301,15 +296,12 @@ def platform_rotation(alpha_y, alpha_z) -> np.ndarray:
     This is the zero-torsion (constant-velocity) family: R is the rotation by the tilt angle theta about an
     axis perpendicular to x (the mechanism's base axis), where ``cos theta = c_y c_z``.
     """
-    ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))
-    return _rz(az) @ _ry(ay) @ _rx(alpha_x(ay, az))
+    return _uv_closed(3, alpha_y, alpha_z, (3, 3), None)
 
 
 def platform_axis(alpha_y, alpha_z) -> np.ndarray:
     """The platform axis ``R e_x = (c_z c_y, s_z c_y, -s_y)`` (first column of eq 5), shape (..., 3)."""
-    ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))
-    cy, sy, cz, sz = np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
-    return np.stack([cz * cy, sz * cy, -sy], axis=-1)
+    return _uv_closed(1, alpha_y, alpha_z, (3,), None)
 
 
 def orientation_from_axis(axis) -> tuple[np.ndarray, np.ndarray]:
@@ -318,16 +310,20 @@ def orientation_from_axis(axis) -> tuple[np.ndarray, np.ndarray]:
     The platform orientation is fixed by its axis (zero torsion), so this also inverts
     :func:`platform_rotation`; at ``c_y = 0`` (axis = -+z) alpha_z is arbitrary and 0 is returned.
     """
+    if type(axis) is np.ndarray and axis.dtype == np.float64 and axis.shape == (3,):
+        st, ay, az = _k_orientation_from_axis(axis[0], axis[1], axis[2])
+        if st == OK:
+            return np.float64(ay), np.float64(az)
     r = as_input(axis, "axis", (3,))
-    with np.errstate(over="ignore"):
-        scale = np.max(np.abs(r), axis=-1, keepdims=True)
-    if not np.all(scale > 0):
+    shape = r.shape[:-1]
+    rows = np.ascontiguousarray(r.reshape(-1, 3))
+    out, status = np.empty((rows.shape[0], 2)), np.empty(rows.shape[0], dtype=np.int64)
+    _k_orientation_from_axis_batch(rows, out, status)
+    if not (status == OK).all():
         raise InvalidInputError("axis must be a nonzero vector (every row)")
-    r = r / scale  # no overflow / underflow in the norm
-    r = r / np.linalg.norm(r, axis=-1, keepdims=True)
-    ay = -np.arcsin(np.clip(r[..., 2], -1.0, 1.0))
-    az = np.arctan2(r[..., 1], r[..., 0])
-    return ay, az
+    if not shape:
+        return np.float64(out[0, 0]), np.float64(out[0, 1])
+    return out[:, 0].reshape(shape), out[:, 1].reshape(shape)
 
 
 def platform_position(alpha_y, alpha_z, d: float = D, alpha: float = ALPHA) -> np.ndarray:
@@ -349,14 +345,8 @@ def platform_position(alpha_y, alpha_z, d: float = D, alpha: float = ALPHA) -> n
     Checked against Pinocchio's platform frame at configurations from :func:`ik` (``legkin check tripod``).
     Undefined on ``1 + c_y c_z = 0`` (NaN there).
     """
-    d, alpha, _ = _params(d, alpha)
-    ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))
-    b = platform_axis(ay, az)
-    nb2 = _one_plus_cc(np.cos(ay), np.sin(ay), np.cos(az), np.sin(az))
-    b[..., 0] = nb2
-    with np.errstate(invalid="ignore", divide="ignore"):
-        scale = np.where(nb2 > SINGULAR_TOL, -d * np.sqrt(2.0 * (1.0 - math.cos(alpha))) / np.sqrt(2.0 * nb2), np.nan)
-    return b * scale[..., None]
+    G = _geo(d, alpha, None)[1]
+    return _uv_closed(2, alpha_y, alpha_z, (3,), G)
 
 
 # ------------------------------------------------------------------------------------------ inverse kinematics
@@ -1301,6 +1291,194 @@ def _k_actuation_jacobian_batch(ay, az, G, home, e, s, a, aux, status):
     """A_u over orientations (n,): a (n, 3, 2), aux (n, 4), status (n,)."""
     for i in prange(ay.shape[0]):
         status[i] = _k_actuation_jacobian(ay[i], az[i], G, home, e, s, a[i], aux[i])
+
+
+@kernel
+def _k_alpha_x(ay, az):
+    """Seed eq (15), two-argument form (:func:`alpha_x`)."""
+    return np.arctan2(np.sin(ay) * np.sin(az), np.cos(ay) + np.cos(az))
+
+
+@kernel
+def _k_rot(axis, t, M):
+    """The elementary rotation about axis 0 (x), 1 (y) or 2 (z) by t, into M (3, 3)."""
+    c, s = np.cos(t), np.sin(t)
+    M[:, :] = 0.0
+    if axis == 0:
+        M[0, 0], M[1, 1], M[1, 2], M[2, 1], M[2, 2] = 1.0, c, -s, s, c
+    elif axis == 1:
+        M[0, 0], M[0, 2], M[1, 1], M[2, 0], M[2, 2] = c, s, 1.0, -s, c
+    else:
+        M[0, 0], M[0, 1], M[1, 0], M[1, 1], M[2, 2] = c, -s, s, c, 1.0
+
+
+@kernel
+def _k_matmul3(A, B, C):
+    """C = A @ B for 3 x 3 (C distinct from A and B)."""
+    for i in range(3):
+        for j in range(3):
+            C[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
+
+
+@kernel
+def _k_rot_chain(axes, angles, out):
+    """out = prod_i R_{axes[i]}(angles[i]) (3, 3), multiplied left to right."""
+    M = np.empty((3, 3))
+    T = np.empty((3, 3))
+    _k_rot(axes[0], angles[0], out)
+    for i in range(1, axes.shape[0]):
+        _k_rot(axes[i], angles[i], M)
+        _k_matmul3(out, M, T)
+        out[:, :] = T
+
+
+@kernel
+def _k_platform_rotation(ay, az, R):
+    """Seed eqs (5), (15): R = Rz(alpha_z) Ry(alpha_y) Rx(alpha_x) into R (3, 3)."""
+    axes = np.array([2, 1, 0])
+    angles = np.array([az, ay, _k_alpha_x(ay, az)])
+    _k_rot_chain(axes, angles, R)
+
+
+@kernel
+def _k_platform_axis(ay, az, out):
+    """R e_x = (c_z c_y, s_z c_y, -s_y) into out (3,)."""
+    cy = np.cos(ay)
+    out[0], out[1], out[2] = np.cos(az) * cy, np.sin(az) * cy, -np.sin(ay)
+
+
+@kernel
+def _k_platform_position(ay, az, G, out):
+    """E = -L b / |b| (:func:`platform_position`) into out (3,); NaN where 1 + c_y c_z <= SINGULAR_TOL."""
+    cy, sy, cz, sz = np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
+    nb2 = _k_one_plus_cc(cy, sy, cz, sz)
+    scale = G[_G_ML] / np.sqrt(2.0 * nb2) if nb2 > SINGULAR_TOL else np.nan
+    out[0], out[1], out[2] = nb2 * scale, sz * cy * scale, -sy * scale
+
+
+@kernel
+def _k_orientation_from_axis(r0, r1, r2):
+    """(status, alpha_y, alpha_z) of a platform axis (:func:`orientation_from_axis`): _ST_NONFINITE, _ST_FAIL
+    (zero vector) or OK."""
+    if not (np.isfinite(r0) and np.isfinite(r1) and np.isfinite(r2)):
+        return _ST_NONFINITE, np.nan, np.nan
+    scale = max(abs(r0), abs(r1), abs(r2))
+    if not scale > 0:
+        return _ST_FAIL, np.nan, np.nan
+    r0, r1, r2 = r0 / scale, r1 / scale, r2 / scale
+    n = np.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
+    r0, r1, r2 = r0 / n, r1 / n, r2 / n
+    return OK, -np.arcsin(min(max(r2, -1.0), 1.0)), np.arctan2(r1, r0)
+
+
+@kernel
+def _k_leg_position(q1, q2, eta, G, T):
+    """Eqs (10) last column and (12): T[:3, 3] = d (-h1, -(c_eta h2 + s_eta h3), c_eta h3 - s_eta h2), T[3] = (0 0 0 1)."""
+    c1, s1, c2, s2 = np.cos(q1), np.sin(q1), np.cos(q2), np.sin(q2)
+    ca, sa, d = G[_G_CA], G[_G_SA], G[_G_D]
+    ce, se = np.cos(eta), np.sin(eta)
+    h1 = c1 * s2 * sa - s1 * (1 - ca)
+    h2 = c1 * (1 - ca) + s1 * s2 * sa
+    h3 = c2 * sa
+    T[0, 3], T[1, 3], T[2, 3] = -d * h1, -d * (ce * h2 + se * h3), d * (ce * h3 - se * h2)
+    T[3, 0], T[3, 1], T[3, 2], T[3, 3] = 0.0, 0.0, 0.0, 1.0
+
+
+@kernel
+def _k_leg_transform(q1, q2, q3, q4, eta, alpha, G, T):
+    """:func:`leg_transform` of one joint vector into T (4, 4)."""
+    axes = np.array([0, 2, 2, 1, 0, 1, 2, 0])
+    angles = np.array([eta, math.pi, q1, q2, -alpha, q3, -q4, math.pi - eta])
+    _k_rot_chain(axes, angles, T[:3, :3])
+    _k_leg_position(q1, q2, eta, G, T)
+
+
+@kernel
+def _k_leg_transform_cv(q1, q2, eta, G, T):
+    """Seed eqs (10)-(12) (:func:`leg_transform_cv`, T33 sign corrected) into T (4, 4)."""
+    c1, s1, c2, s2 = np.cos(q1), np.sin(q1), np.cos(q2), np.sin(q2)
+    ca, sa = G[_G_CA], G[_G_SA]
+    ce, se = np.cos(eta), np.sin(eta)
+    g1 = c1**2 * (c2**2 - s2**2 * ca) + s1**2 * ca + 2 * c1 * s1 * s2 * sa
+    g2 = c2 * (s1 * sa - c1 * s2 * (1 + ca))
+    g3 = (c1**2 - s1**2) * s2 * sa + c1 * s1 * (2 * ca - c2**2 * (1 + ca))
+    g4 = c2 * (c1 * sa + s1 * s2 * (1 + ca))
+    g5 = c1**2 * ca + s1**2 * (c2**2 - s2**2 * ca) - 2 * c1 * s1 * s2 * sa
+    g6 = s2**2 - c2**2 * ca
+    g7 = (c2**2 - s2**2) * (1 + ca) + c1**2 * (s2**2 * (1 + ca) - (1 - ca)) - 2 * c1 * s1 * s2 * sa
+    t23 = ce * se * g7 + (ce**2 - se**2) * g4
+    T[0, 0], T[0, 1], T[0, 2] = -g1, se * g2 - ce * g3, -ce * g2 - se * g3
+    T[1, 0], T[1, 1], T[1, 2] = -se * g2 + ce * g3, -2 * ce * se * g4 + ce**2 * g5 + se**2 * g6, t23
+    T[2, 0], T[2, 1], T[2, 2] = se * g3 + ce * g2, t23, 2 * ce * se * g4 + se**2 * g5 + ce**2 * g6
+    _k_leg_position(q1, q2, eta, G, T)
+
+
+@batch_kernel
+def _k_uv_batch(kind, ay, az, G, out):
+    """The per-orientation closed forms over (n,) orientations: kind 0 alpha_x (out (n, 1)), 1 platform_axis (n, 3),
+    2 platform_position (n, 3), 3 platform_rotation (n, 3, 3) (out flattened to (n, 9))."""
+    for i in prange(ay.shape[0]):
+        if kind == 0:
+            out[i, 0] = _k_alpha_x(ay[i], az[i])
+        elif kind == 1:
+            _k_platform_axis(ay[i], az[i], out[i])
+        elif kind == 2:
+            _k_platform_position(ay[i], az[i], G, out[i])
+        else:
+            _k_platform_rotation(ay[i], az[i], out[i].reshape((3, 3)))
+
+
+@batch_kernel
+def _k_orientation_from_axis_batch(r, out, status):
+    """orientation_from_axis over axes (n, 3): out (n, 2), status (n,)."""
+    for i in prange(r.shape[0]):
+        status[i], out[i, 0], out[i, 1] = _k_orientation_from_axis(r[i, 0], r[i, 1], r[i, 2])
+
+
+@batch_kernel
+def _k_leg_transform_batch(q, eta, alpha, G, T):
+    """leg_transform over joint vectors (n, 4): T (n, 4, 4)."""
+    for i in prange(q.shape[0]):
+        _k_leg_transform(q[i, 0], q[i, 1], q[i, 2], q[i, 3], eta, alpha, G, T[i])
+
+
+@batch_kernel
+def _k_leg_transform_cv_batch(q1, q2, eta, G, T):
+    """leg_transform_cv over (n,) joint pairs: T (n, 4, 4)."""
+    for i in prange(q1.shape[0]):
+        _k_leg_transform_cv(q1[i], q2[i], eta, G, T[i])
+
+
+_NO_GEOMETRY = np.zeros(18)
+
+
+def _uv_closed(kind: int, alpha_y, alpha_z, core: tuple, G):
+    """A closed form of the orientation (see :func:`_k_uv_batch`) on checked, broadcast angles; (..., *core)."""
+    if G is None:
+        G = _NO_GEOMETRY
+    size = 1
+    for c in core:
+        size *= c
+    if isinstance(alpha_y, float) and isinstance(alpha_z, float) and math.isfinite(alpha_y) and math.isfinite(alpha_z):
+        y, z, shape = np.array([float(alpha_y)]), np.array([float(alpha_z)]), ()
+    else:
+        ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))
+        shape = ay.shape
+        y, z = np.ascontiguousarray(ay).reshape(-1), np.ascontiguousarray(az).reshape(-1)
+    out = np.empty((y.shape[0], size))
+    if y.shape[0] == 1:  # one item: the scalar kernel, no thread pool
+        if kind == 0:
+            out[0, 0] = _k_alpha_x(y[0], z[0])
+        elif kind == 1:
+            _k_platform_axis(y[0], z[0], out[0])
+        elif kind == 2:
+            _k_platform_position(y[0], z[0], G, out[0])
+        else:
+            _k_platform_rotation(y[0], z[0], out[0].reshape(3, 3))
+    else:
+        _k_uv_batch(kind, y, z, G, out)
+    res = out.reshape(shape + core)
+    return res[()] if not core else res
 
 
 #: Per assembly mode (:data:`MODES` order): home flag, side of E, signs of sin q_K2 (the kernels' mode arguments).

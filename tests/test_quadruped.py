@@ -459,3 +459,70 @@ def test_ik_robustness_row_passes():
     assert row.counts.made == 5000 and row.counts.wrong == 0 and row.counts.missed == 0
     assert row.counts.exceptions == 0 and row.max_error <= 1e-9
     assert time.perf_counter() - t0 < 10
+
+
+# ----------------------------------------------------------------------------- compiled kernels (issue 16)
+def test_batch_is_the_single_call_kernel_item_by_item(rng):
+    """The batch is a compiled loop over the single-call kernel: identical answers, bit for bit, on both
+    the serial (small) and the parallel (large) path, with and without q_ref, and on non-contiguous input."""
+    from legkin.analytic._kernels import SERIAL_BELOW
+
+    lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
+    n = SERIAL_BELOW + 44
+    q = rng.uniform(lo - 0.05, hi + 0.05, (n, 3))
+    p = aq.foot_position(q, "RH", foot_z=-0.015)
+    q_ref = rng.uniform(lo, hi, (n, 3))
+    for rows in (p[:7], p):
+        qb, ok = aq.foot_ik(rows, "RH", foot_z=-0.015, return_mask=True)
+        qr = aq.foot_ik(rows, "RH", q_ref[: len(rows)], foot_z=-0.015)
+        for i in range(len(rows)):
+            try:
+                single = aq.foot_ik(rows[i], "RH", foot_z=-0.015)
+                assert ok[i] and np.array_equal(single, qb[i])
+                assert np.array_equal(aq.foot_ik(rows[i], "RH", q_ref[i], foot_z=-0.015), qr[i])
+            except legkin.UnreachableError:
+                assert not ok[i] and np.isnan(qb[i]).all()
+        np.testing.assert_array_equal(aq.foot_ik(np.asfortranarray(rows), "RH", foot_z=-0.015), qb)
+    fp = aq.foot_position(q, "LF")
+    assert all(np.array_equal(aq.foot_position(q[i], "LF"), fp[i]) for i in range(0, n, 37))
+    jac = aq.foot_jacobian(q[::2], "LF")
+    assert np.array_equal(jac[3], aq.foot_jacobian(q[6], "LF"))
+
+
+def test_list_input_and_float64_fast_path_agree():
+    q = [0.1, 0.75, 1.5]
+    p = aq.foot_position(np.array(q), "LF")
+    np.testing.assert_array_equal(aq.foot_position(q, "LF"), p)
+    strided = np.repeat(np.array(q), 2)[::2]  # a non-contiguous (3,) view
+    np.testing.assert_array_equal(aq.foot_position(strided, "LF"), p)
+    np.testing.assert_array_equal(aq.foot_position(np.array(q, dtype=np.float32), "LF"),
+                                  aq.foot_position(np.array(q, dtype=np.float32).astype(np.float64), "LF"))
+    np.testing.assert_array_equal(aq.foot_ik(p.tolist(), "LF"), aq.foot_ik(p, "LF"))
+    np.testing.assert_array_equal(aq.foot_ik_all([p.tolist()], "LF")[0], aq.foot_ik_all(p, "LF"))
+    assert aq.within_limits(np.array(q)) == aq.within_limits(q) == True  # noqa: E712
+    q3d = np.tile(np.array(q), (2, 3, 1))
+    assert aq.foot_position(q3d, "LF").shape == (2, 3, 3) and aq.foot_jacobian(q3d, "LF").shape == (2, 3, 3, 3)
+    assert aq.foot_ik(np.zeros((0, 3)), "LF").shape == (0, 3)
+
+
+def test_thread_count_does_not_change_results(rng):
+    import numba
+
+    lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
+    p = aq.foot_position(rng.uniform(lo, hi, (2000, 3)), "LF")
+    before = numba.get_num_threads()
+    try:
+        numba.set_num_threads(1)
+        one = aq.foot_ik(p, "LF")
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+        np.testing.assert_array_equal(aq.foot_ik(p, "LF"), one)
+    finally:
+        numba.set_num_threads(before)
+
+
+def test_importing_legkin_does_not_import_numba():
+    import subprocess
+    import sys
+
+    code = "import sys, legkin; assert 'numba' not in sys.modules, 'numba imported by import legkin'"
+    subprocess.run([sys.executable, "-c", code], check=True)

@@ -461,7 +461,7 @@ def yardstick_calls(name: str, keys, seed: int = 0) -> dict[str, tuple[Callable[
             q = _closed_configuration(robot)
             jac, lwa = pin.computeFrameJacobian, pin.LOCAL_WORLD_ALIGNED
 
-            def call(model=model, data=data, q=q, fid=fid):
+            def call(model=model, data=data, q=q, fid=fid, jac=jac, lwa=lwa):
                 return jac(model, data, q, fid, lwa)
 
             out[key] = (call, f"{name}: computeFrameJacobian({frame}, LOCAL_WORLD_ALIGNED)")
@@ -478,8 +478,9 @@ def yardstick_calls(name: str, keys, seed: int = 0) -> dict[str, tuple[Callable[
             def call(solve=solve, q_start=q_start, act=act):
                 return solve(q_start, fixed=act)
 
-            out[key] = (call, f"{name}: solve_loops(q0 closed + N(0, {SOLVE_LOOPS_PERTURBATION:g}) on the "
-                              f"{len(free)} passive coordinates, {len(act)} actuated joints held)")
+            label = (f"{name}: solve_loops(q0 closed + N(0, {SOLVE_LOOPS_PERTURBATION:g}) on the "
+                     f"{len(free)} passive coordinates, {len(act)} actuated joints held)")
+            out[key] = (call, label)
     return out
 
 
@@ -525,8 +526,8 @@ def format_single_table(name: str, table: dict) -> str:
         return f"{name} single calls: {table['skipped']}\n"
     rows = table["rows"]
     width = max([len(r.name) for r in rows] + [8])
-    lines = [f"{name} single calls (median of {rows[0].repeats if rows else 0} timeit loops; "
-             "ratio = function / yardstick, < 1 is faster than Pinocchio)"]
+    lines = [(f"{name} single calls (median of {rows[0].repeats if rows else 0} timeit loops; "
+              "ratio = function / yardstick, < 1 is faster than Pinocchio)")]
     lines.append(f"  {'function':<{width}}  {'time/call':>10}  {'yardstick':<12}  {'yardstick/call':>14}  {'ratio':>8}")
     for r in rows:
         if r.error:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import math
 import numbers
+import types
 from dataclasses import dataclass
 from typing import NamedTuple, Sequence
 
@@ -239,7 +240,7 @@ def leg_transform(q, eta: float, d: float = D, alpha: float = ALPHA) -> np.ndarr
     shape = q.shape[:-1]
     rows = np.ascontiguousarray(q.reshape(-1, 4))
     T = np.empty((rows.shape[0], 4, 4))
-    _k_leg_transform_batch(rows, eta, alpha, G, T)
+    _pick(_k_leg_transform_batch, rows.shape[0], "closed")(rows, eta, alpha, G, T)
     return T.reshape(shape + (4, 4))
 
 
@@ -272,7 +273,7 @@ def leg_transform_cv(q1, q2, eta: float, d: float = D, alpha: float = ALPHA) -> 
     q1, q2 = as_angles(q1, q2, names=("q1", "q2"))
     shape = q1.shape
     T = np.empty((q1.size, 4, 4))
-    _k_leg_transform_cv_batch(np.ascontiguousarray(q1).reshape(-1), np.ascontiguousarray(q2).reshape(-1), eta, G, T)
+    _pick(_k_leg_transform_cv_batch, q1.size, "closed")(np.ascontiguousarray(q1).reshape(-1), np.ascontiguousarray(q2).reshape(-1), eta, G, T)
     return T.reshape(shape + (4, 4))
 
 
@@ -318,7 +319,7 @@ def orientation_from_axis(axis) -> tuple[np.ndarray, np.ndarray]:
     shape = r.shape[:-1]
     rows = np.ascontiguousarray(r.reshape(-1, 3))
     out, status = np.empty((rows.shape[0], 2)), np.empty(rows.shape[0], dtype=np.int64)
-    _k_orientation_from_axis_batch(rows, out, status)
+    _pick(_k_orientation_from_axis_batch, rows.shape[0], "closed")(rows, out, status)
     if not (status == OK).all():
         raise InvalidInputError("axis must be a nonzero vector (every row)")
     if not shape:
@@ -541,7 +542,7 @@ def _ik_run(ay: np.ndarray, az: np.ndarray, G: np.ndarray, mode: str):
     homes, es, ss = _modes_sel(mode)
     n, m = y.shape[0], homes.shape[0]
     q, aux, status = np.empty((n, m, 12)), np.empty((n, m, 6)), np.empty((n, m), dtype=np.int64)
-    _k_ik_batch(y, z, G, homes, es, ss, q, aux, status)
+    _pick(_k_ik_batch, n * m, "ik")(y, z, G, homes, es, ss, q, aux, status)
     return q.reshape(shape + (m, 12)), aux.reshape(shape + (m, 6)), status.reshape(shape + (m,))
 
 
@@ -723,7 +724,7 @@ def actuation_jacobian(
             y, z = np.ascontiguousarray(ay).reshape(-1), np.ascontiguousarray(az).reshape(-1)
             n = y.shape[0]
             a, aux, status = np.empty((n, 3, 2)), np.empty((n, 4)), np.empty(n, dtype=np.int64)
-            _k_actuation_jacobian_batch(y, z, G, home, e, s, a, aux, status)
+            _pick(_k_actuation_jacobian_batch, n, "jac")(y, z, G, home, e, s, a, aux, status)
             a, ok = a.reshape(shape + (3, 2)), (status == OK).reshape(shape)
             return (a, ok) if return_mask else a
         ay, az = float(ay), float(az)
@@ -1195,7 +1196,6 @@ def _k_fk(qa, qb, qc, G, home, e, s, tol, max_iter, max_inc, out):
     return OK
 
 
-@batch_kernel
 def _k_fk_batch(qm, G, homes, es, ss, tol, max_iter, max_inc, out, status):
     """fk over motors (n, 3) in the modes given (homes (m,), es (m,), ss (m, 3)): out (n, m, 3), status (n, m);
     NaN where an item fails."""
@@ -1252,7 +1252,6 @@ def _k_ik(ay, az, G, home, e, s, q, aux):
     return _ST_FAIL
 
 
-@batch_kernel
 def _k_ik_batch(ay, az, G, homes, es, ss, q, aux, status):
     """ik over orientations (n,) in the modes given (homes (m,), es (m,), ss (m, 3)): q (n, m, 12), aux (n, m, 6),
     status (n, m)."""
@@ -1286,7 +1285,6 @@ def _k_actuation_jacobian(ay, az, G, home, e, s, a, aux):
     return _ST_FAIL
 
 
-@batch_kernel
 def _k_actuation_jacobian_batch(ay, az, G, home, e, s, a, aux, status):
     """A_u over orientations (n,): a (n, 3, 2), aux (n, 4), status (n,)."""
     for i in prange(ay.shape[0]):
@@ -1413,7 +1411,6 @@ def _k_leg_transform_cv(q1, q2, eta, G, T):
     _k_leg_position(q1, q2, eta, G, T)
 
 
-@batch_kernel
 def _k_uv_batch(kind, ay, az, G, out):
     """The per-orientation closed forms over (n,) orientations: kind 0 alpha_x (out (n, 1)), 1 platform_axis (n, 3),
     2 platform_position (n, 3), 3 platform_rotation (n, 3, 3) (out flattened to (n, 9))."""
@@ -1428,21 +1425,18 @@ def _k_uv_batch(kind, ay, az, G, out):
             _k_platform_rotation(ay[i], az[i], out[i].reshape((3, 3)))
 
 
-@batch_kernel
 def _k_orientation_from_axis_batch(r, out, status):
     """orientation_from_axis over axes (n, 3): out (n, 2), status (n,)."""
     for i in prange(r.shape[0]):
         status[i], out[i, 0], out[i, 1] = _k_orientation_from_axis(r[i, 0], r[i, 1], r[i, 2])
 
 
-@batch_kernel
 def _k_leg_transform_batch(q, eta, alpha, G, T):
     """leg_transform over joint vectors (n, 4): T (n, 4, 4)."""
     for i in prange(q.shape[0]):
         _k_leg_transform(q[i, 0], q[i, 1], q[i, 2], q[i, 3], eta, alpha, G, T[i])
 
 
-@batch_kernel
 def _k_leg_transform_cv_batch(q1, q2, eta, G, T):
     """leg_transform_cv over (n,) joint pairs: T (n, 4, 4)."""
     for i in prange(q1.shape[0]):
@@ -1476,9 +1470,45 @@ def _uv_closed(kind: int, alpha_y, alpha_z, core: tuple, G):
         else:
             _k_platform_rotation(y[0], z[0], out[0].reshape(3, 3))
     else:
-        _k_uv_batch(kind, y, z, G, out)
+        _pick(_k_uv_batch, y.shape[0], "closed")(kind, y, z, G, out)
     res = out.reshape(shape + core)
     return res[()] if not core else res
+
+
+def _serial(fn):
+    """The serial twin of a batch loop (the same loop compiled without threads, ``prange`` as ``range``): the wrappers
+    use it below :data:`_PARALLEL_MIN` items, where waking numba's thread pool costs more than the loop (on a busy
+    machine, milliseconds)."""
+    twin = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + "_serial", fn.__defaults__, fn.__closure__)
+    twin.__qualname__ = fn.__qualname__ + "_serial"
+    twin.__doc__ = fn.__doc__
+    return kernel(twin)
+
+
+#: Batches smaller than this (items x modes, per function) run the serial twin of the batch loop.
+_PARALLEL_MIN = {"fk": 64, "ik": 2048, "jac": 2048, "closed": 4096}
+
+_k_fk_batch, _k_fk_batch_serial = batch_kernel(_k_fk_batch), _serial(_k_fk_batch)
+_k_ik_batch, _k_ik_batch_serial = batch_kernel(_k_ik_batch), _serial(_k_ik_batch)
+_k_actuation_jacobian_batch, _k_actuation_jacobian_batch_serial = (batch_kernel(_k_actuation_jacobian_batch), _serial(_k_actuation_jacobian_batch))
+_k_uv_batch, _k_uv_batch_serial = batch_kernel(_k_uv_batch), _serial(_k_uv_batch)
+_k_orientation_from_axis_batch, _k_orientation_from_axis_batch_serial = (batch_kernel(_k_orientation_from_axis_batch), _serial(_k_orientation_from_axis_batch))
+_k_leg_transform_batch, _k_leg_transform_batch_serial = (batch_kernel(_k_leg_transform_batch), _serial(_k_leg_transform_batch))
+_k_leg_transform_cv_batch, _k_leg_transform_cv_batch_serial = (batch_kernel(_k_leg_transform_cv_batch), _serial(_k_leg_transform_cv_batch))
+_SERIAL = {
+    _k_fk_batch: _k_fk_batch_serial,
+    _k_ik_batch: _k_ik_batch_serial,
+    _k_actuation_jacobian_batch: _k_actuation_jacobian_batch_serial,
+    _k_uv_batch: _k_uv_batch_serial,
+    _k_orientation_from_axis_batch: _k_orientation_from_axis_batch_serial,
+    _k_leg_transform_batch: _k_leg_transform_batch_serial,
+    _k_leg_transform_cv_batch: _k_leg_transform_cv_batch_serial,
+}
+
+
+def _pick(par, n: int, kind: str):
+    """The parallel batch loop ``par`` for n >= _PARALLEL_MIN[kind] items, else its serial twin."""
+    return par if n >= _PARALLEL_MIN[kind] else _SERIAL[par]
 
 
 #: Per assembly mode (:data:`MODES` order): home flag, side of E, signs of sin q_K2 (the kernels' mode arguments).
@@ -1664,7 +1694,7 @@ def _fk_batch(a1, b1, c1, g, G, mode, tol, max_iter, max_inconsistency, return_m
     n, m = qm.shape[0], homes.shape[0]
     out = np.empty((n, m, 3))
     status = np.empty((n, m), dtype=np.int64)
-    _k_fk_batch(qm, G, homes, es, ss, tol, max_iter, max_inconsistency, out, status)
+    _pick(_k_fk_batch, n * m, "fk")(qm, G, homes, es, ss, tol, max_iter, max_inconsistency, out, status)
     ok = status == OK
     if mode == "all":
         res = tuple(out[:, :, k].reshape(shape + (m,)) for k in range(3))

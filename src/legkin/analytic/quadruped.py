@@ -776,6 +776,13 @@ def _foot_ik_k(p, li, foot_z, has_ref, q_ref, out) -> int:
     return _foot_ik_core(p, li, foot_z, l2, offset, co, so, has_ref, q_ref, out)
 
 
+@kernel
+def _foot_ik_noref_k(p, li, foot_z, out) -> int:
+    """:func:`_foot_ik_k` without ``q_ref`` (fewer arguments: a cheaper single call)."""
+    l2, offset, co, so = _leg_plane_k(foot_z)
+    return _foot_ik_core(p, li, foot_z, l2, offset, co, so, False, p, out)
+
+
 @batch_kernel
 def _foot_ik_batch(p, li, foot_z, has_ref, q_ref, out, ok) -> int:
     """:func:`_foot_ik_k` over rows ``p`` (n, 3), ``q_ref`` (n, 3) (ignored unless ``has_ref``); returns the
@@ -848,7 +855,7 @@ def foot_ik(p, leg: str, q_ref=None, *, foot_z: float = 0.0, return_mask: bool =
     if p.__class__ is np.ndarray and p.shape == _S3 and p.dtype is _F64:  # the single call, fast
         if q_ref is None:
             out = np.empty(3)
-            status = _foot_ik_k(p, li, foot_z, False, p, out)
+            status = _foot_ik_noref_k(p, li, foot_z, out)
             if status:
                 raise _foot_ik_error(status, leg, li, p, foot_z, p, q_ref)
             return (out, np.array(True)) if return_mask else out
@@ -889,11 +896,13 @@ def foot_ik(p, leg: str, q_ref=None, *, foot_z: float = 0.0, return_mask: bool =
         ref_rows = as_rows(np.broadcast_to(ref, batch + _S3), 3)
     else:
         batch = arr.shape[:-1]
-        rows = as_rows(arr, 3)
-        ref_rows = as_rows(ref, 3) if has_ref else rows
+        rows = arr if arr.ndim == 2 and arr.flags.c_contiguous else as_rows(arr, 3)
+        ref_rows = (ref if ref.ndim == 2 and ref.flags.c_contiguous else as_rows(ref, 3)) if has_ref else rows
     out = np.empty(batch + _S3)
     ok = np.empty(batch, dtype=np.bool_)
-    if _foot_ik_batch(rows, li, foot_z, has_ref, ref_rows, out.reshape(-1, 3), ok.reshape(-1)):
+    flat = len(batch) == 1
+    if _foot_ik_batch(rows, li, foot_z, has_ref, ref_rows, out if flat else out.reshape(-1, 3),
+                      ok if flat else ok.reshape(-1)):
         as_input(p, "p", _S3)
         as_input(q_ref, "q_ref", _S3)
         raise AssertionError("foot_ik: a kernel reported a non-finite entry that as_input accepts")  # pragma: no cover

@@ -1298,44 +1298,38 @@ def _k_alpha_x(ay, az):
 
 
 @kernel
-def _k_rot(axis, t, M):
-    """The elementary rotation about axis 0 (x), 1 (y) or 2 (z) by t, into M (3, 3)."""
+def _k_rot(axis, t):
+    """The elementary rotation about axis 0 (x), 1 (y) or 2 (z) by t, as a row-major 9-tuple."""
     c, s = np.cos(t), np.sin(t)
-    M[:, :] = 0.0
     if axis == 0:
-        M[0, 0], M[1, 1], M[1, 2], M[2, 1], M[2, 2] = 1.0, c, -s, s, c
-    elif axis == 1:
-        M[0, 0], M[0, 2], M[1, 1], M[2, 0], M[2, 2] = c, s, 1.0, -s, c
-    else:
-        M[0, 0], M[0, 1], M[1, 0], M[1, 1], M[2, 2] = c, -s, s, c, 1.0
+        return (1.0, 0.0, 0.0, 0.0, c, -s, 0.0, s, c)
+    if axis == 1:
+        return (c, 0.0, s, 0.0, 1.0, 0.0, -s, 0.0, c)
+    return (c, -s, 0.0, s, c, 0.0, 0.0, 0.0, 1.0)
 
 
 @kernel
-def _k_matmul3(A, B, C):
-    """C = A @ B for 3 x 3 (C distinct from A and B)."""
-    for i in range(3):
-        for j in range(3):
-            C[i, j] = A[i, 0] * B[0, j] + A[i, 1] * B[1, j] + A[i, 2] * B[2, j]
-
-
-@kernel
-def _k_rot_chain(axes, angles, out):
-    """out = prod_i R_{axes[i]}(angles[i]) (3, 3), multiplied left to right."""
-    M = np.empty((3, 3))
-    T = np.empty((3, 3))
-    _k_rot(axes[0], angles[0], out)
-    for i in range(1, axes.shape[0]):
-        _k_rot(axes[i], angles[i], M)
-        _k_matmul3(out, M, T)
-        out[:, :] = T
+def _k_matmul3(A, B):
+    """A @ B for 3 x 3 matrices given as row-major 9-tuples (no heap arrays)."""
+    return (
+        A[0] * B[0] + A[1] * B[3] + A[2] * B[6], A[0] * B[1] + A[1] * B[4] + A[2] * B[7],
+        A[0] * B[2] + A[1] * B[5] + A[2] * B[8],
+        A[3] * B[0] + A[4] * B[3] + A[5] * B[6], A[3] * B[1] + A[4] * B[4] + A[5] * B[7],
+        A[3] * B[2] + A[4] * B[5] + A[5] * B[8],
+        A[6] * B[0] + A[7] * B[3] + A[8] * B[6], A[6] * B[1] + A[7] * B[4] + A[8] * B[7],
+        A[6] * B[2] + A[7] * B[5] + A[8] * B[8],
+    )
 
 
 @kernel
 def _k_platform_rotation(ay, az, R):
     """Seed eqs (5), (15): R = Rz(alpha_z) Ry(alpha_y) Rx(alpha_x) into R (3, 3)."""
-    axes = np.array([2, 1, 0])
-    angles = np.array([az, ay, _k_alpha_x(ay, az)])
-    _k_rot_chain(axes, angles, R)
+    cy, sy, cz, sz = np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
+    ax = _k_alpha_x(ay, az)
+    cx, sx = np.cos(ax), np.sin(ax)
+    R[0, 0], R[0, 1], R[0, 2] = cz * cy, cz * sy * sx - sz * cx, cz * sy * cx + sz * sx
+    R[1, 0], R[1, 1], R[1, 2] = sz * cy, sz * sy * sx + cz * cx, sz * sy * cx - cz * sx
+    R[2, 0], R[2, 1], R[2, 2] = -sy, cy * sx, cy * cx
 
 
 @kernel
@@ -1385,9 +1379,15 @@ def _k_leg_position(q1, q2, eta, G, T):
 @kernel
 def _k_leg_transform(q1, q2, q3, q4, eta, alpha, G, T):
     """:func:`leg_transform` of one joint vector into T (4, 4)."""
-    axes = np.array([0, 2, 2, 1, 0, 1, 2, 0])
-    angles = np.array([eta, math.pi, q1, q2, -alpha, q3, -q4, math.pi - eta])
-    _k_rot_chain(axes, angles, T[:3, :3])
+    R = _k_matmul3(_k_rot(0, eta), _k_rot(2, math.pi))  # Rx(eta) Rz(pi) Rz(q1) Ry(q2) Rx(-alpha) Ry(q3) Rz(-q4) Rx(pi - eta)
+    R = _k_matmul3(R, _k_rot(2, q1))
+    R = _k_matmul3(R, _k_rot(1, q2))
+    R = _k_matmul3(R, _k_rot(0, -alpha))
+    R = _k_matmul3(R, _k_rot(1, q3))
+    R = _k_matmul3(R, _k_rot(2, -q4))
+    R = _k_matmul3(R, _k_rot(0, math.pi - eta))
+    for i in range(3):
+        T[i, 0], T[i, 1], T[i, 2] = R[3 * i], R[3 * i + 1], R[3 * i + 2]
     _k_leg_position(q1, q2, eta, G, T)
 
 
@@ -1485,8 +1485,10 @@ def _serial(fn):
     return kernel(twin)
 
 
-#: Batches smaller than this (items x modes, per function) run the serial twin of the batch loop.
-_PARALLEL_MIN = {"fk": 64, "ik": 2048, "jac": 2048, "closed": 4096}
+#: Batches smaller than this (items x modes, per function) run the serial twin of the batch loop. Chosen on a busy
+#: 2-core machine, where waking the pool costs up to ~10 ms: fk (~3 us an item) from 4096 items, the closed forms
+#: (~0.1-1 us an item) from 50000.
+_PARALLEL_MIN = {"fk": 4096, "ik": 50000, "jac": 50000, "closed": 50000}
 
 _k_fk_batch, _k_fk_batch_serial = batch_kernel(_k_fk_batch), _serial(_k_fk_batch)
 _k_ik_batch, _k_ik_batch_serial = batch_kernel(_k_ik_batch), _serial(_k_ik_batch)

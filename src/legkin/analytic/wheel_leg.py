@@ -208,6 +208,26 @@ def _factors(c: _Const, foot_radius: float) -> tuple[complex, ...]:
     )
 
 
+class _Loop:
+    """A batch loop compiled from one body twice: serially (:func:`kernel`, ``prange`` runs as ``range``) for
+    fewer than ``min_parallel`` items, where starting numba's threads costs more than the loop, and in
+    parallel (:func:`batch_kernel`) from there on. Called like the body; the first argument's length is the
+    item count."""
+
+    def __init__(self, fn, min_parallel: int):
+        self.serial = kernel(fn)
+        self.parallel = batch_kernel(fn)
+        self.min_parallel = min_parallel
+        self.__doc__, self.__name__ = fn.__doc__, fn.__name__
+
+    def __call__(self, *args):
+        return (self.parallel if args[0].shape[0] >= self.min_parallel else self.serial)(*args)
+
+
+def _loop(min_parallel: int):
+    return lambda fn: _Loop(fn, min_parallel)
+
+
 #: Order of the left-half points in the closed-form kernel's output (:func:`_k_closed`).
 _CF_NAMES = ("A", "B", "C", "D", "E", "F", "G", "U", "L", "H", "O_r", "J")
 _IA, _IB, _IC, _ID, _IE, _IF, _IG, _IU, _IL, _IH, _IOR, _IJ = range(12)
@@ -289,7 +309,7 @@ def _k_closed(theta, K, KC, want_der):
     return pts, (dA, dB, dC, dD, complex(dE, 0.0), dF, dG, dU, dL, dH, dG, dJ)
 
 
-@batch_kernel
+@_loop(4096)
 def _k_closed_batch(theta, K, KC, want_der, P, DP):
     """:func:`_k_closed` over theta (n,) into P, DP (n, 12)."""
     for i in prange(theta.shape[0]):
@@ -640,7 +660,7 @@ def _k_contact(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, wan
     return _k_fk(theta, q[1], q[2], upper, right, e, seed, K, KC, s, dwheel + s * w, o0, o1, o2, want_jac, p, J)
 
 
-@batch_kernel
+@_loop(4096)
 def _k_contact_batch(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac, P, J, status):
     """:func:`_k_contact` over q (n, 3), alpha, w (n,) into P (n, 3), J (n, 9), status (n,)."""
     for i in prange(q.shape[0]):
@@ -648,7 +668,7 @@ def _k_contact_batch(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o
                                P[i], J[i])
 
 
-@batch_kernel
+@_loop(4096)
 def _k_fk_batch(q, upper, right, e, a, seed, K, KC, s, o0, o1, o2, want_jac, P, J):
     """:func:`_k_fk` over q (n, 3) and the prepared arc choice (:class:`_Sel`) into P (n, 3), J (n, 9)."""
     for i in prange(q.shape[0]):
@@ -971,12 +991,17 @@ class IKInfo(NamedTuple):
     """What :func:`ik` did, per target: iterations used and final position error (m).
 
     ``solutions`` (``method="radial"`` only, else None): shape (..., S, 3), every solution found for each
-    target, NaN-padded (see :func:`ik`).
+    target, NaN-padded (see :func:`ik`). ``evaluations``: linkage evaluations per target (below).
     """
 
     iterations: np.ndarray
     error: np.ndarray
     solutions: np.ndarray | None = None
+    #: Linkage evaluations per target: rows of the contact FK (with or without its Jacobian) for the
+    #: iterative methods; radial: evaluations of the leg-plane closed form with its theta-derivative (Newton
+    #: and extremum steps) plus the final contact FK that checks the answer (the grid and start tables are
+    #: not counted).
+    evaluations: np.ndarray | None = None
 
 
 @lru_cache(maxsize=32)
@@ -1114,6 +1139,41 @@ def _guesses(target, ctx: _Ctx, count: int, branch: float = -1.0):
     return np.stack(out)
 
 
+@lru_cache(maxsize=64)
+def _radial_ctx(leg, rim, radius, geo: Geometry):
+    """:func:`_kctx` and the radial tables for one keyword set (the single-call fast path of :func:`ik`)."""
+    kc = _kctx_cached(leg, rim, radius, geo)
+    return kc, _radial_table(geo.R, kc[0])
+
+
+def _ik_radial_single(target, alpha, w, leg, rim, radius, geo, tol, return_mask, return_info):
+    """:func:`ik`'s fast path for one target with the default method and keywords: the kernel
+    :func:`_k_ik_radial` called directly. None (the general path then decides, and raises) unless solved."""
+    if not (abs(alpha) <= math.pi + 1e-12 and abs(w) <= geo.T / 2 + 1e-15):
+        return None
+    try:
+        kc, tables = _radial_ctx(leg, rim, radius, geo)
+    except Exception:  # noqa: BLE001 - the general path raises the documented error
+        return None
+    seed, rho, K, KC, s, dwheel, _half_T, o0, o1, o2 = kc
+    upper, right, e = _k_select(alpha, seed, rho, K[0])
+    q = np.empty(3)
+    sols = np.empty((_RADIAL_SOLS, 3))
+    its, err, reason, _nr, nsol = _k_ik_radial(target, upper, right, e, dwheel + s * w, seed, K, KC, s, o0, o1, o2,
+                                               *tables, tol, 60, _NO_Q0[0], False, True, q, sols)
+    if reason != _SOLVED:
+        return None
+    out = (q, np.array(True)) if return_mask else q
+    if not return_info:
+        return out
+    if nsol > _RADIAL_SOLS:
+        sols = np.empty((nsol, 3))
+        _k_ik_radial(target, upper, right, e, dwheel + s * w, seed, K, KC, s, o0, o1, o2, *tables, tol, 60,
+                     _NO_Q0[0], False, True, np.empty(3), sols)
+    info = IKInfo(np.array(its), np.array(err), sols[:nsol], np.array(its + 1))
+    return (*out, info) if return_mask else (out, info)
+
+
 def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "radial", rim: str = "continuous",
        tol: float = 1e-12, max_iter: int | None = None, delta: float = 1e-6, radius: float | None = None,
        limits: bool = True, geometry: Geometry | None = None, return_mask: bool = False,
@@ -1167,7 +1227,14 @@ def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "radial", r
         InvalidInputError: NaN/inf, complex or wrong shapes, alpha or w out of range.
         InvalidParameterError: unknown ``method``, ``rim`` or ``leg``; a keyword out of its range.
     """
-    geo = _geometry(geometry)
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    if (type(method) is str and method == "radial" and q0 is None and max_iter is None and limits is True and type(target) is np.ndarray
+            and target.shape == (3,) and target.dtype == np.float64 and type(alpha) in _SCALARS
+            and type(w) in _SCALARS and type(tol) is float and 0.0 < tol <= 1e-3 and type(delta) is float
+            and 0.0 < delta <= 0.1):
+        out = _ik_radial_single(target, float(alpha), float(w), leg, rim, radius, geo, tol, return_mask, return_info)
+        if out is not None:
+            return out
     target = as_input(target, "target", (3,))
     alpha, w = as_input(alpha, "alpha"), as_input(w, "w")
     q0 = None if q0 is None else as_input(q0, "q0", (3,))
@@ -1203,10 +1270,12 @@ def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "radial", r
     if method == "radial":
         q, it, err, ok, solutions, reason = _ik_radial(flat, ctx, tol, max_iter, q0, limits)
         solutions = solutions.reshape(shape + solutions.shape[1:]) if return_info else None
+        ev = it + 1
     else:
-        q, it, err, ok, reason = _ik_iterative(flat, ctx, q0, method, tol, max_iter, delta, limits)
+        q, it, err, ok, reason, ev = _ik_iterative(flat, ctx, q0, method, tol, max_iter, delta, limits)
     q = q.reshape(shape + (3,))
     it, err, ok, reason = it.reshape(shape), err.reshape(shape), ok.reshape(shape), reason.reshape(shape)
+    ev = ev.reshape(shape)
     closest = None
     if scalar and not bool(ok):
         with np.errstate(invalid="ignore"):
@@ -1214,7 +1283,7 @@ def ik(target, alpha=0.0, w=0.0, leg="FL", q0=None, *, method: str = "radial", r
             qc[0] = np.clip(qc[0], THETA_MIN, THETA_MAX)
             closest = _fk(qc, ctx.take(0), False)[0] if np.all(np.isfinite(qc)) else None
     q_out = np.where(ok[..., None], q, np.nan)
-    info = IKInfo(it, err, solutions)
+    info = IKInfo(it, err, solutions, ev)
 
     def error():
         where = (f"target {np.asarray(target).reshape(3).tolist()} for leg {leg!r} (alpha={float(alpha)!r}, "
@@ -1269,15 +1338,17 @@ def _ik_iterative(flat, ctx, q0, method, tol, max_iter, delta, limits):
     n = flat.shape[0]
     q = np.full((n, 3), np.nan)
     it, err = np.zeros(n, dtype=int), np.full(n, np.inf)
+    ev = np.zeros(n, dtype=int)
     ok = np.zeros(n, dtype=bool)
     converged_outside = np.zeros(n, dtype=bool)
     for start in starts:
         f = np.flatnonzero(~ok)
         if f.size == 0:
             break
-        qf, itf, errf, okf = solver(start[f].copy(), flat[f], ctx if f.size == n else ctx.take(f), tol, max_iter,
-                                    delta)
+        qf, itf, errf, okf, evf = solver(start[f].copy(), flat[f], ctx if f.size == n else ctx.take(f), tol,
+                                         max_iter, delta)
         it[f] += itf
+        ev[f] += evf
         inside = _in_limits(qf, limits)
         good = okf & inside
         converged_outside[f] |= okf & ~inside
@@ -1285,14 +1356,15 @@ def _ik_iterative(flat, ctx, q0, method, tol, max_iter, delta, limits):
         q[f[take]], err[f[take]] = qf[take], errf[take]
         ok[f] = good
     reason = np.where(ok, _SOLVED, np.where(converged_outside, _LIMITS, _UNREACHABLE))
-    return q, it, err, ok, reason
+    return q, it, err, ok, reason, ev
 
 
 _METHODS = ("damped", "seed", "radial")
 
 
-def _fk_flat(q, ctx: _Ctx, jac: bool):
-    """The IK solvers' forward kinematics (one place, so the bench can count its rows)."""
+def _fk_flat(q, ctx: _Ctx, jac: bool, ev: np.ndarray, rows=slice(None)):
+    """The IK solvers' forward kinematics; counts one evaluation in ``ev[rows]`` (``IKInfo.evaluations``)."""
+    ev[rows] += 1
     return _fk(q, ctx, jac)
 
 
@@ -1300,10 +1372,11 @@ def _ik_seed(q, target, ctx, tol, max_iter, delta):
     max_iter = 100 if max_iter is None else max_iter
     n = q.shape[0]
     it = np.zeros(n, dtype=int)
+    ev = np.zeros(n, dtype=int)
     active = np.ones(n, dtype=bool)
     ok = np.zeros(n, dtype=bool)
     with np.errstate(invalid="ignore", divide="ignore"):
-        p = _fk_flat(q, ctx, False)[0]
+        p = _fk_flat(q, ctx, False, ev)[0]
         err = np.linalg.norm(p - target, axis=1)
         for _ in range(max_iter + 1):
             ok |= active & (err <= tol)
@@ -1318,7 +1391,7 @@ def _ik_seed(q, target, ctx, tol, max_iter, delta):
             for k in range(3):
                 qk = qa.copy()
                 qk[:, k] += delta
-                J[:, :, k] = (_fk_flat(qk, ctx_a, False)[0] - pa) / delta
+                J[:, :, k] = (_fk_flat(qk, ctx_a, False, ev, a)[0] - pa) / delta
             JtJ = np.einsum("nji,njk->nik", J, J)
             JtE = np.einsum("nji,nj->ni", J, E)
             good = np.abs(np.linalg.det(JtJ)) > 1e-300
@@ -1327,9 +1400,9 @@ def _ik_seed(q, target, ctx, tol, max_iter, delta):
                 dq[good] = -np.linalg.solve(JtJ[good], JtE[good][..., None])[..., 0]
             q[a] = qa + dq
             it[a] += 1
-            p[a] = _fk_flat(q[a], ctx_a, False)[0]
+            p[a] = _fk_flat(q[a], ctx_a, False, ev, a)[0]
             err[a] = np.linalg.norm(p[a] - target[a], axis=1)
-    return q, it, err, ok
+    return q, it, err, ok, ev
 
 
 def _solve3(M: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -1358,8 +1431,9 @@ def _ik_damped(q, target, ctx, tol, max_iter, delta):
     q = q.copy()
     q[:, 0] = np.clip(q[:, 0], THETA_MIN, THETA_MAX)
     it = np.zeros(n, dtype=int)
+    ev = np.zeros(n, dtype=int)
     mu = np.full(n, 1e-16)
-    p, J = _fk_flat(q, ctx, True)
+    p, J = _fk_flat(q, ctx, True, ev)
     err = np.linalg.norm(p - target, axis=1)
     active = err > tol
     polish = ~active  # one more (kept only if it helps) Gauss-Newton step after reaching tol
@@ -1388,7 +1462,7 @@ def _ik_damped(q, target, ctx, tol, max_iter, delta):
             qn = q[a[t]] + dq
             qn[:, 0] = np.clip(qn[:, 0], THETA_MIN, THETA_MAX)
             with np.errstate(invalid="ignore"):  # NaN steps (singular systems) give NaN errors: not better
-                pn = _fk_flat(qn, ctx_a if t.size == a.size else ctx_a.take(t), False)[0]
+                pn = _fk_flat(qn, ctx_a if t.size == a.size else ctx_a.take(t), False, ev, a[t])[0]
                 en = np.linalg.norm(pn - target[a[t]], axis=1)
             better = en < err[a[t]]
             improved[t[better]] = True
@@ -1397,11 +1471,11 @@ def _ik_damped(q, target, ctx, tol, max_iter, delta):
             lam[t[better]] = np.maximum(lam[t[better]] / 10.0, 1e-16)
         q[a], err[a], mu[a] = best_q, best_err, lam
         it[a] += 1
-        p[a], J[a] = _fk_flat(q[a], ctx_a, True)
+        p[a], J[a] = _fk_flat(q[a], ctx_a, True, ev, a)
         done = err[a] <= tol
         active[a] = (~done | ~polish[a]) & improved
         polish[a] |= done
-    return q, it, err, err <= tol
+    return q, it, err, err <= tol, ev
 
 
 # ---------------------------------------------------------------- radial IK (method="radial")
@@ -1840,7 +1914,7 @@ def _k_ik_radial(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, tabl
     return its, err, reason, nr, nsol
 
 
-@batch_kernel
+@_loop(256)
 def _k_ik_radial_batch(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, table, m2, fine, fine_rows, tol,
                        max_iter, q0, use_q0, limits, q, sols, its, err, reason, nsol):
     """:func:`_k_ik_radial` over targets (n, 3) (q0 (n, 3) or (1, 3) unused) into q, sols, its, err, reason,

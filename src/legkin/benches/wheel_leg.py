@@ -9,8 +9,6 @@ its loop residual, and theta inside [17, 160] deg.
 
 from __future__ import annotations
 
-import contextlib
-
 import numpy as np
 
 from .. import load
@@ -19,6 +17,7 @@ from ..bench import Method, MethodResult, ModelBench, Score
 from ..checks.wheel_leg import SEGMENT_LINKS, configuration, leg_joint_names, local_contact_point, sample_leg_q
 from ..errors import UnreachableError
 from . import SOLVE_TOL, levenberg_marquardt, sizes
+from ._single import SingleCall
 
 LEG = "FL"
 #: Every iterative method is asked for the same position tolerance (m) (wl.ik's default).
@@ -31,27 +30,44 @@ def _sizes(n: int | None, quick: bool) -> tuple[int, int, int]:
     return sizes(n, quick, full=(5_000, 300, 100), small=(300, 20, 5))
 
 
-@contextlib.contextmanager
-def _count_fk(counter: list):
-    """Count the rows of every linkage evaluation of :mod:`legkin.analytic.wheel_leg`'s IK (untimed runs): the
-    contact FK (``_fk_flat``, with or without the Jacobian) and the radial method's evaluation of the leg-plane
-    closed form with its theta-derivative (``_radial_eval``), each row counted as one evaluation."""
-    originals = {name: getattr(wl, name) for name in ("_fk_flat", "_radial_eval")}
+#: The single-call inputs: q = (theta, beta, gamma) of leg FL, rim parameter alpha, lateral coordinate w.
+SINGLE_Q = np.array([1.2, 0.3, 0.2])
+SINGLE_ALPHA, SINGLE_W = 0.5, 0.01
 
-    def counting(original):
-        def wrapped(q, *args, **kwargs):
-            counter[0] += len(q)
-            return original(q, *args, **kwargs)
 
-        return wrapped
+def single_calls() -> list[SingleCall]:
+    """One single call per public function of :mod:`legkin.analytic.wheel_leg`, inputs bound (leg FL,
+    :data:`SINGLE_Q`, :data:`SINGLE_ALPHA`, :data:`SINGLE_W`; the IK target is that configuration's contact point).
 
-    for name, original in originals.items():
-        setattr(wl, name, counting(original))
-    try:
-        yield
-    finally:
-        for name, original in originals.items():
-            setattr(wl, name, original)
+    Yardsticks: Pinocchio ``forwardKinematics`` + ``updateFramePlacement`` on the quadruped (``quadruped_fk``)
+    for the closed forms; ``Robot.solve_loops`` on the wheel-leg (``solve_loops``, ``iterative=True``) for
+    ``ik`` (every method).
+    """
+    q = SINGLE_Q.copy()
+    theta, beta, gamma = (float(v) for v in q)
+    alpha, w = SINGLE_ALPHA, SINGLE_W
+    phi_L, phi_R = (float(v) for v in wl.motor_angles(theta, beta))
+    target = wl.contact_point(q, alpha, w, LEG)
+    p_L = wl.rim_point(theta, beta, alpha, w)
+    cf, it = "quadruped_fk", "solve_loops"
+    return [
+        SingleCall("linkage_constants", lambda: wl.linkage_constants(), cf),
+        SingleCall("linkage_points", lambda: wl.linkage_points(theta, beta), cf),
+        SingleCall("passive_angles", lambda: wl.passive_angles(theta, beta), cf),
+        SingleCall("motor_angles", lambda: wl.motor_angles(theta, beta), cf),
+        SingleCall("theta_beta", lambda: wl.theta_beta(phi_L, phi_R), cf),
+        SingleCall("rim_point", lambda: wl.rim_point(theta, beta, alpha, w), cf),
+        SingleCall("rim_point_seed", lambda: wl.rim_point_seed(theta, beta, alpha, w), cf),
+        SingleCall("rim_jump_seed", lambda: wl.rim_jump_seed(theta), cf),
+        SingleCall("rim_segment", lambda: wl.rim_segment(alpha), cf),
+        SingleCall("contact_point", lambda: wl.contact_point(q, alpha, w, LEG), cf),
+        SingleCall("contact_jacobian", lambda: wl.contact_jacobian(q, alpha, w, LEG), cf),
+        SingleCall("leg_frame_to_robot", lambda: wl.leg_frame_to_robot(p_L, gamma, LEG), cf),
+        SingleCall("module_origin", lambda: wl.module_origin(LEG), cf),
+        SingleCall("ik", lambda: wl.ik(target, alpha, w, LEG), it, iterative=True),
+        SingleCall("ik (method='damped')", lambda: wl.ik(target, alpha, w, LEG, method="damped"), it, iterative=True),
+        SingleCall("ik (method='seed')", lambda: wl.ik(target, alpha, w, LEG, method="seed"), it, iterative=True),
+    ]
 
 
 def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
@@ -108,21 +124,19 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
             if not scalar:
                 return wl.ik(t, a, ww, LEG, method=method, tol=TOL, geometry=geo, return_info=True)
             q, its = np.full((len(t), 3), np.nan), np.zeros(len(t), dtype=int)
+            evals = np.full(len(t), np.nan)
             for i in range(len(t)):
                 try:
                     q[i], info = wl.ik(t[i], a[i], ww[i], LEG, method=method, tol=TOL, geometry=geo, return_info=True)
-                    its[i] = info.iterations
+                    its[i], evals[i] = info.iterations, info.evaluations
                 except UnreachableError:
                     pass
-            return q, wl.IKInfo(its, np.full(len(t), np.nan))
+            return q, wl.IKInfo(its, np.full(len(t), np.nan), None, evals)
 
         def score(inp, out) -> Score:
             q, info = out
-            counter = [0]
-            with _count_fk(counter):  # an untimed rerun, to count the forward-kinematics evaluations
-                run(inp)
             k = len(q)
-            evals = np.full(k, counter[0] / k)
+            evals = np.full(k, np.nanmean(info.evaluations))  # IKInfo.evaluations: linkage evaluations per target
             finite = np.all(np.isfinite(q), axis=-1)
             qs = np.full((k, model.nq), np.nan)
             if finite.any():
@@ -193,7 +207,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         f"first {n_iter}",
         "err = Pinocchio contact point of the answer vs target (m); loop |r| = Pinocchio loop residual; "
         "solved also needs theta in [17, 160] deg; iters = median; FK/solve = mean forward-kinematics "
-        "evaluations per target (legkin: rows passed to the contact FK, counted in an untimed rerun; the damped "
+        "evaluations per target (legkin: IKInfo.evaluations, rows passed to the contact FK; the damped "
         "method's FK also returns the Jacobian; radial: rows of its leg-plane closed form with theta-derivative "
         "(Newton steps) plus the final contact FK that checks the answer, its 17-node grid and start table "
         "look-ups are not counted; Pinocchio: residual + Jacobian evaluations)",

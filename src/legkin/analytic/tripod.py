@@ -1475,6 +1475,66 @@ def _uv_closed(kind: int, alpha_y, alpha_z, core: tuple, G):
     return res[()] if not core else res
 
 
+@kernel
+def _k_linspace(a, b, out):
+    """np.linspace(a, b, len(out)) into out (the same operations: start + i * step, the last point exactly b)."""
+    n = out.shape[0]
+    step = (b - a) / (n - 1)
+    for i in range(n):
+        out[i] = i * step + a
+    out[n - 1] = b
+
+
+@kernel
+def _k_tilt_curve(theta, phi, pts):
+    """The curve of tilts theta (m,) in directions phi (m,) as (alpha_y, alpha_z) rows into pts (2m, 2), a NaN row
+    wherever alpha_z wraps around (|jump| > pi); returns the row count."""
+    k = 0
+    prev = np.nan
+    for i in range(theta.shape[0]):
+        st = np.sin(theta[i])
+        ay = -np.arcsin(min(max(st * np.sin(phi[i]), -1.0), 1.0))
+        az = np.arctan2(st * np.cos(phi[i]), np.cos(theta[i]))
+        if i > 0 and abs(az - prev) > math.pi:
+            pts[k, 0] = pts[k, 1] = np.nan
+            k += 1
+        pts[k, 0], pts[k, 1] = ay, az
+        k += 1
+        prev = az
+    return k
+
+
+@kernel
+def _k_workspace(G, eta, ch, ay, az, cos_q2, reachable, phi, theta_k, tilt_max, curves, counts):
+    """:func:`workspace` on preallocated outputs: the grid (ik's kernel, home mode: cos q_K2 and success), the
+    singular curves theta_K(phi) = 2 asin(cos(alpha/2) / |sin(phi - eta_K)|), their minimum and the four curves
+    (boundary, legs A, B, C) as (alpha_y, alpha_z) rows with their counts."""
+    _k_linspace(-math.pi / 2, math.pi / 2, ay)
+    _k_linspace(-math.pi, math.pi, az)
+    _k_linspace(-math.pi, math.pi, phi)
+    q, aux, s = np.empty(12), np.empty(6), np.ones(3)
+    for i in range(ay.shape[0]):
+        for j in range(az.shape[0]):
+            reachable[i, j] = _k_ik(ay[i], az[j], G, True, -1.0, s, q, aux) == OK
+            cos_q2[0, i, j], cos_q2[1, i, j], cos_q2[2, i, j] = aux[0], aux[1], aux[2]
+    m = phi.shape[0]
+    for i in range(m):
+        t = math.pi
+        for K in range(3):
+            ratio = ch / abs(np.sin(phi[i] - eta[K]))
+            v = 2.0 * np.arcsin(min(ratio, 1.0)) if ratio <= 1.0 else np.nan
+            theta_k[K, i] = v
+            if v < t:
+                t = v
+        tilt_max[i] = t
+    bound = np.empty(m)
+    for i in range(m):
+        bound[i] = tilt_max[i] if tilt_max[i] < math.pi else np.nan
+    counts[0] = _k_tilt_curve(bound, phi, curves[0])
+    for K in range(3):
+        counts[K + 1] = _k_tilt_curve(theta_k[K], phi, curves[K + 1])
+
+
 def _serial(fn):
     """The serial twin of a batch loop (the same loop compiled without threads, ``prange`` as ``range``): the wrappers
     use it below :data:`_PARALLEL_MIN` items, where waking numba's thread pool costs more than the loop (on a busy
@@ -1822,28 +1882,25 @@ def workspace(
         d, alpha, eta: geometry. n: grid size per axis, an integer in [2, 1001]. m: samples of phi along the
             curves, an integer in [2, 100001].
     """
-    d, alpha, eta_arr = _params(d, alpha, eta)
-    n = _integer(n, "n", 2, 1001)
-    m = _integer(m, "m", 2, 100001)
-    ay = np.linspace(-np.pi / 2, np.pi / 2, n)
-    az = np.linspace(-np.pi, np.pi, n)
-    gy, gz = np.meshgrid(ay, az, indexing="ij")
-    _, c2, _ = _ik_core(gy, gz, d, alpha, eta_arr)
-    reachable = _ik_mode(gy, gz, _geometry(d, alpha, eta_arr), HOME_MODE)[1]
-    phi = np.linspace(-np.pi, np.pi, m)
-    ch = math.cos(alpha / 2.0)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = ch / np.abs(np.sin(phi[:, None] - eta_arr))  # (m, 3)
-        theta_k = np.where(ratio <= 1.0, 2.0 * np.arcsin(np.minimum(ratio, 1.0)), np.nan)
-    tilt_max = np.nanmin(np.where(np.isnan(theta_k), np.pi, theta_k), axis=-1)
-    on_curve = tilt_max < np.pi
-    boundary = _tilt_to_u(np.where(on_curve, tilt_max, np.nan), phi)
-    leg_singular = {leg: _tilt_to_u(theta_k[:, k], phi) for k, leg in enumerate(LEGS)}
+    G = _geo(d, alpha, eta)[1]  # validates the geometry
+    alpha = float(alpha)
+    eta_arr = np.asarray(ETA) if eta is None else as_input(eta, "eta", (3,))
+    if type(n) is not int or not 2 <= n <= 1001:
+        n = _integer(n, "n", 2, 1001)
+    if type(m) is not int or not 2 <= m <= 100001:
+        m = _integer(m, "m", 2, 100001)
+    ay, az, phi, tilt_max = np.empty(n), np.empty(n), np.empty(m), np.empty(m)
+    cos_q2, reachable = np.empty((3, n, n)), np.empty((n, n), dtype=np.bool_)
+    theta_k, curves, counts = np.empty((3, m)), np.empty((4, 2 * m, 2)), np.empty(4, dtype=np.int64)
+    _k_workspace(G, np.ascontiguousarray(eta_arr, dtype=np.float64), math.cos(alpha / 2.0), ay, az, cos_q2, reachable,
+                 phi, theta_k, tilt_max, curves, counts)
+    boundary = curves[0, : counts[0]]
+    leg_singular = {leg: curves[k + 1, : counts[k + 1]] for k, leg in enumerate(LEGS)}
     platform_singular = np.array([[0.0, -np.pi], [0.0, np.pi]])
     return Workspace(
         alpha_y=ay,
         alpha_z=az,
-        cos_q2=np.moveaxis(c2, -1, 0),
+        cos_q2=cos_q2,
         reachable=reachable,
         boundary=boundary,
         leg_singular=leg_singular,

@@ -42,6 +42,7 @@ from ..errors import (
     UnreachableError,
 )
 from ._batch import as_angles, as_input, finish
+from ._kernels import OK, batch_kernel, kernel, prange
 
 __all__ = [
     "CENTER",
@@ -266,6 +267,47 @@ def _check_count(value, name: str, lo: int, hi: int, what: str) -> int:
     return int(value)
 
 
+#: Scalar types a single-call fast path passes straight to a kernel (anything else takes the checked path).
+_SCALARS = (float, np.float64)
+
+
+#: Batches smaller than this run the serial loop: starting numba's threads costs more than they save.
+_PARALLEL_MIN = 64
+
+
+def _loop(parallel, serial, n: int):
+    """The compiled batch loop to run for n items: the prange one (parallel) or the plain one (serial)."""
+    return parallel if n >= _PARALLEL_MIN else serial
+
+
+def _flat(a: np.ndarray) -> np.ndarray:
+    """A checked input as a fresh, writeable, C-contiguous float64 vector (for a kernel)."""
+    return np.array(a, dtype=np.float64).reshape(-1)
+
+
+def _fast_branch(branch):
+    """(b1, b2) as floats for a plain tuple of two ints +-1, else None (the checked path then)."""
+    if type(branch) is tuple and len(branch) == 2:
+        b1, b2 = branch
+        if type(b1) is int and type(b2) is int and (b1 == 1 or b1 == -1) and (b2 == 1 or b2 == -1):
+            return float(b1), float(b2)
+    return None
+
+
+def _fast_sign(value):
+    """+-1.0 for a plain int +-1, else None."""
+    if type(value) is int and (value == 1 or value == -1):
+        return float(value)
+    return None
+
+
+def _fast_offset(value):
+    """starting_value as a float for a plain float in [-pi, pi], else None."""
+    if type(value) is float and -math.pi <= value <= math.pi:
+        return value
+    return None
+
+
 def _rotz(t):
     c, s = np.cos(t), np.sin(t)
     z, o = np.zeros_like(t), np.ones_like(t)
@@ -355,22 +397,23 @@ def rod_spans(theta1, theta2, roll=0.0, pitch=0.0) -> np.ndarray:
 
 
 def _chains(rot: np.ndarray, b: np.ndarray, tol: float = K_TOL):
-    """Closed form of both rod-length equations for rotations (..., 3, 3).
+    """Closed form of both rod-length equations for rotations (..., 3, 3) (the kernel :func:`_chain_k`).
 
-    Returns theta (..., 2) (NaN where unreachable), the reach ratio k (..., 2), and ok (..., 2) (|k| <= 1 + tol).
+    b (2,) or (n, 2) per rotation. Returns theta (..., 2) (NaN where unreachable), the reach ratio k (..., 2),
+    and ok (..., 2) (|k| <= 1 + tol).
     """
-    w = MOTOR_POS - _attach_world(rot)  # w_i = p_i - A_i  so  S_i - A_i = w_i + Rz(phi_i) l
-    lx, lz = LEVER[0], LEVER[2]
-    a = lx * w[..., 0]
-    bb = lx * w[..., 1]
-    c = 0.5 * (ROD_LENGTH**2 - np.sum(w * w, axis=-1) - lx * lx - lz * lz - 2.0 * lz * w[..., 2])
-    rho = np.hypot(a, bb)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k = c / rho
-    ok = np.isfinite(k) & (np.abs(k) <= 1.0 + tol)
-    phi = np.arctan2(bb, a) - _SIGMA * b * np.arccos(np.clip(k, -1.0, 1.0))
-    theta = np.where(ok, _wrap(phi - MOTOR_YAW), np.nan)
-    return theta, k, ok
+    shape = rot.shape[:-2]
+    rr = np.array(rot.reshape(-1, 3, 3), dtype=np.float64)
+    n = len(rr)
+    bb = np.asarray(b, dtype=np.float64)
+    if bb.ndim == 1:
+        b1, b2 = np.full(n, bb[0]), np.full(n, bb[1])
+    else:
+        bb = bb.reshape(-1, 2)
+        b1, b2 = np.array(bb[:, 0], dtype=np.float64), np.array(bb[:, 1], dtype=np.float64)
+    theta, k, ok = np.empty((n, 2)), np.empty((n, 2)), np.empty((n, 2), dtype=np.bool_)
+    _loop(_chains_b, _chains_s, n)(rr, b1, b2, float(tol), theta, k, ok)
+    return theta.reshape(shape + (2,)), k.reshape(shape + (2,)), ok.reshape(shape + (2,))
 
 
 def _unreachable(what: str, k: np.ndarray) -> UnreachableError:
@@ -408,6 +451,13 @@ def motor_angles_from_rotation(rotation, branch: Sequence[int] = (1, 1), *, retu
     Raises:
         UnreachableError: single rotation out of reach.
     """
+    if return_mask is False and type(rotation) is np.ndarray and rotation.shape == (3, 3) \
+            and rotation.dtype == np.float64:
+        fb = _fast_branch(branch)
+        if fb is not None:
+            theta, k = np.empty(2), np.empty(2)
+            if _motor_angles_rot_k(rotation, fb[0], fb[1], theta, k) == OK:
+                return theta
     rot = _check_rotation(rotation)
     b = _check_branch(branch)
     _check_flag(return_mask, "return_mask")
@@ -427,12 +477,20 @@ def motor_angles(roll, pitch, branch: Sequence[int] = (1, 1), *, return_mask: bo
     Raises:
         UnreachableError: single (roll, pitch) out of reach (message names the chain and its |k|).
     """
+    if return_mask is False and type(roll) in _SCALARS and type(pitch) in _SCALARS:
+        fb = _fast_branch(branch)
+        if fb is not None:
+            theta, k = np.empty(2), np.empty(2)
+            if _motor_angles_k(roll, pitch, fb[0], fb[1], theta, k) == OK:
+                return theta
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
     b = _check_branch(branch)
     _check_flag(return_mask, "return_mask")
-    theta, k, ok2 = _chains(_rot(r, p), b)
-    ok = np.all(ok2, axis=-1)
-    theta = np.where(ok[..., None], theta, np.nan)
+    n = r.size
+    theta, k, ok = np.empty((n, 2)), np.empty((n, 2)), np.empty(n, dtype=np.bool_)
+    _loop(_motor_angles_b, _motor_angles_s, n)(_flat(r), _flat(p), float(b[0]), float(b[1]),
+                    theta, k, ok)
+    theta, k, ok = theta.reshape(r.shape + (2,)), k.reshape(r.shape + (2,)), ok.reshape(r.shape)
     what = f"(roll, pitch) = ({float(r):.6g}, {float(p):.6g})" if r.ndim == 0 else ""
     return finish(theta, ok, r.ndim == 0, return_mask, lambda: _unreachable(what, k))
 
@@ -521,72 +579,6 @@ def sphere_joint_angles(rotation, branch: Sequence[int] = (1, 1), *, return_mask
 # two linear equations in (cos pitch, sin pitch): Cramer gives cos = C / D, sin = S / D, and cos^2 + sin^2 = 1
 # is C^2 + S^2 - D^2 = 0, a trigonometric polynomial of degree 4 in roll. With t = tan(roll / 2) (times
 # (1 + t^2)^4) it is a polynomial of degree 8: up to 8 poses; roll in the joint limits is |t| <= 1.
-_T_C = np.array([1.0, 0.0, -1.0])  # cos(roll) (1 + t^2), ascending powers of t
-_T_S = np.array([0.0, 2.0, 0.0])  # sin(roll) (1 + t^2)
-_T_1 = np.array([1.0, 0.0, 1.0])  # 1 + t^2
-
-
-def _pmul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Product of polynomials (ascending coefficients along the last axis)."""
-    out = np.zeros(np.broadcast_shapes(a.shape[:-1], b.shape[:-1]) + (a.shape[-1] + b.shape[-1] - 1,))
-    for i in range(a.shape[-1]):
-        out[..., i : i + b.shape[-1]] += a[..., i : i + 1] * b
-    return out
-
-
-def _pval(c: np.ndarray, t: np.ndarray) -> np.ndarray:
-    """Evaluate polynomials c (..., m) at t (broadcast against c[..., 0]) by Horner's rule."""
-    out = c[..., -1]
-    for j in range(c.shape[-1] - 2, -1, -1):
-        out = out * t + c[..., j]
-    return out
-
-
-def _roll_polynomial(tip: np.ndarray):
-    """Degree-8 polynomial (n, 9) in t = tan(roll/2) of the platform poses closing both rods, and the
-    per-rod quadratics alpha, beta, gamma (n, 2, 3) of the pitch equation (all times 1 + t^2)."""
-    w = CENTER - tip
-    kap = 0.5 * (ROD_LENGTH**2 - np.sum(w * w, -1) - np.sum(ATTACH * ATTACH, -1))
-    ax, ay, az = ATTACH[:, 0, None], ATTACH[:, 1, None], ATTACH[:, 2, None]
-    wx, wy, wz = w[..., 0, None], w[..., 1, None], w[..., 2, None]
-    qz = -wy * _T_S + wz * _T_C
-    qy = wy * _T_C + wz * _T_S
-    al = wx * ax * _T_1 + az * qz
-    be = wx * az * _T_1 - ax * qz
-    ga = ay * qy - kap[..., None] * _T_1
-    det = _pmul(al[:, 0], be[:, 1]) - _pmul(al[:, 1], be[:, 0])
-    cc = _pmul(be[:, 0], ga[:, 1]) - _pmul(be[:, 1], ga[:, 0])
-    ss = _pmul(al[:, 1], ga[:, 0]) - _pmul(al[:, 0], ga[:, 1])
-    return _pmul(cc, cc) + _pmul(ss, ss) - _pmul(det, det), al, be, ga
-
-
-def _poly_roots(poly: np.ndarray) -> np.ndarray:
-    """Complex roots (n, 8) of polynomials (n, 9) (ascending), NaN-padded; companion-matrix eigenvalues."""
-    n = len(poly)
-    z = np.full((n, 8), np.nan + 0j)
-    lead = poly[:, -1]
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        mon = poly[:, :-1] / lead[:, None]
-    good = np.all(np.isfinite(mon), -1) & (np.abs(mon).max(-1, initial=0.0) < 1e150)
-    if good.any():
-        comp = np.zeros((int(good.sum()), 8, 8))
-        comp[:, 1:, :-1] = np.eye(7)
-        comp[:, :, -1] = -mon[good]
-        try:
-            z[good] = np.linalg.eigvals(comp)
-        except np.linalg.LinAlgError:  # pragma: no cover - eigvals of finite matrices converges in practice
-            good[:] = False
-    for i in np.flatnonzero(~good):  # leading coefficient (near) zero: a pose at roll = pi; measure zero
-        if not np.all(np.isfinite(poly[i])):
-            continue
-        try:
-            r = np.roots(poly[i, ::-1])
-        except np.linalg.LinAlgError:  # pragma: no cover
-            continue
-        z[i, : min(len(r), 8)] = r[:8]
-    return z
-
-
 def _n_matrix(ra: np.ndarray, d: np.ndarray, roll: np.ndarray) -> np.ndarray:
     """N (..., 2, 2), N_ik = d_i . dA_i/dx_k, for R a_i = ra (..., 2, 3), d_i = A_i - S_i, x = (roll, pitch).
 
@@ -597,13 +589,6 @@ def _n_matrix(ra: np.ndarray, d: np.ndarray, roll: np.ndarray) -> np.ndarray:
     n_roll = -d[..., 1] * az + d[..., 2] * ay
     n_pitch = d[..., 0] * (c * az - s * ay) + (d[..., 1] * s - d[..., 2] * c) * ax
     return np.stack([n_roll, n_pitch], -1)
-
-
-def _rod_system(x: np.ndarray, tip: np.ndarray):
-    """Rod equations g_i = (|A_i - S_i|^2 - L^2) / 2 (m, 2) and their Jacobian N (m, 2, 2) at poses x (m, 2)."""
-    ra = np.einsum("...jk,ik->...ij", _rot(x[:, 0], x[:, 1]), ATTACH)
-    d = CENTER + ra - tip
-    return 0.5 * (np.sum(d * d, -1) - ROD_LENGTH**2), _n_matrix(ra, d, x[:, 0])
 
 
 def _det2(m: np.ndarray) -> np.ndarray:
@@ -618,140 +603,800 @@ def _solve2(m: np.ndarray, r: np.ndarray) -> np.ndarray:
                          m[..., 0, 0] * r[..., 1] - m[..., 1, 0] * r[..., 0]], -1) / det[..., None]
 
 
-def _rod_newton(x: np.ndarray, tip: np.ndarray, max_iter: int, keep_sign: bool = False):
-    """Damped Newton on both rod equations from poses x (m, 2) for lever tips (m, 2, 3).
-
-    Each accepted step decreases max|g|; with ``keep_sign`` it must also keep the sign of det N of the start
-    (the forward-singularity curve det N = 0 is then a barrier). Returns x and the rod-length error (m).
-    """
-    x = np.array(x, dtype=float)
-    g, nm = _rod_system(x, tip)
-    cur = np.abs(g).max(-1)
-    sign = np.sign(_det2(nm)) if keep_sign else None
-    act = np.isfinite(cur)
-    for it_ in range(max_iter):
-        if it_ == 8:  # Newton from a seed near a pose has converged by now (quadratically; linearly at a fold)
-            act &= cur <= 1e-4 * ROD_LENGTH
-        ia = np.flatnonzero(act)
-        if not len(ia):
-            break
-        step = -_solve2(nm[ia], g[ia])
-        fin = np.all(np.isfinite(step), -1)
-        step = np.where(fin[:, None], np.clip(step, -0.3, 0.3), 0.0)
-        # a step at rounding level: converged (trying it would only cost backtracking)
-        fin &= np.abs(step).max(-1) > 1e-16 * (1.0 + np.abs(x[ia]).max(-1))
-        lam = np.ones(len(ia))
-        acc = np.zeros(len(ia), dtype=bool)
-        for _ in range(16):
-            tr = fin & ~acc
-            if not tr.any():
-                break
-            it = ia[tr]
-            xt = x[it] + lam[tr, None] * step[tr]
-            gt, nt = _rod_system(xt, tip[it])
-            ct = np.abs(gt).max(-1)
-            ok = ct < cur[it]
-            if keep_sign:
-                ok &= np.sign(_det2(nt)) == sign[it]
-            j = np.flatnonzero(tr)
-            acc[j[ok]] = True
-            x[it[ok]], g[it[ok]], nm[it[ok]], cur[it[ok]] = xt[ok], gt[ok], nt[ok], ct[ok]
-            lam[j[~ok]] *= 0.5
-        # stop where no step decreases the residual (converged to the rounding floor, or stuck) or the
-        # step is at rounding level
-        act[ia[~acc | (np.abs(step).max(-1) * lam <= 1e-16)]] = False
-    with np.errstate(invalid="ignore"):
-        err = np.abs(g).max(-1) * 2.0 / (ROD_LENGTH + np.sqrt(np.maximum(2.0 * np.abs(g).max(-1) + ROD_LENGTH**2, 0.0)))
-    return x, np.where(np.isfinite(err), err, np.inf)
-
-
-def _pose_seeds(z: np.ndarray, al, be, ga):
-    """Starting poses (item index, (roll, pitch)) from the (near-)real roots z (n, 8) with |roll| <= ~pi/2."""
-    cand = np.isfinite(z) & (np.abs(z.imag) <= 1e-2 * (1.0 + np.abs(z))) & (np.abs(z.real) <= 1.0 + 1e-3)
-    item, j = np.nonzero(cand)
-    t = z.real[item, j]
-    a, b, g = _pval(al[item], t[:, None]), _pval(be[item], t[:, None]), _pval(ga[item], t[:, None])
-    det = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        cp = (b[:, 0] * g[:, 1] - b[:, 1] * g[:, 0]) / det
-        sp = (a[:, 1] * g[:, 0] - a[:, 0] * g[:, 1]) / det
-    roll = 2.0 * np.arctan(t)
-    pitch = np.arctan2(sp, cp)
-    seeds = [np.stack([roll, pitch], -1)]
-    items = [item]
-    # the two rod equations (nearly) parallel in (cos, sin) - e.g. at roll = 0 for mirror-symmetric motor angles,
-    # a double root in t - leave the pitch to the stronger equation alone: both of its solutions are seeds
-    with np.errstate(invalid="ignore", over="ignore"):
-        bad = ~(np.abs(det) > 1e-6 * (np.abs(a[:, 0] * b[:, 1]) + np.abs(a[:, 1] * b[:, 0])))
-    if bad.any():
-        k = np.argmax(np.hypot(a[bad], b[bad]), -1)
-        rows = np.arange(int(bad.sum()))
-        ab, bb, gb = a[bad][rows, k], b[bad][rows, k], g[bad][rows, k]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            c = np.arccos(np.clip(-gb / np.hypot(ab, bb), -1.0, 1.0))
-        base = np.arctan2(bb, ab)
-        for sgn in (1.0, -1.0):
-            seeds.append(np.stack([roll[bad], base + sgn * c], -1))
-            items.append(item[bad])
-    x = np.concatenate(seeds)
-    im = np.abs(z.imag[item, j])
-    imag = np.concatenate([im] + [im[bad]] * (len(seeds) - 1))
-    return np.concatenate(items), np.where(np.isfinite(x), x, 0.0), imag
-
-
 #: Offsets (rad) of the extra starting poses on either side of a near-singular solution (along the null vector of
 #: N), from which Newton runs with the forward-singularity barrier: near det N = 0 two poses of opposite modes are
 #: close together, and the plain Newton iteration from the roots may find only one of them.
 _FOLD_OFFSETS = (1e-9, 1e-7, 1e-5, 1e-3)
 
 
-def _platform_solutions(theta: np.ndarray, tol: float = 1e-12, max_iter: int = 50):
-    """Every platform pose within the joint limits closing both rods for motor angles theta (n, 2).
+# ----------------------------------------------------------------------------- compiled kernels (issue 16)
+# Each kinematic quantity below is written once, as a scalar numba kernel (the seed equations it implements are
+# cited); the batch functions are compiled prange loops over the same kernels. Status codes: _OK and the _ST_*.
+_ST_INPUT = 1  # a non-finite input: the wrapper's checks raise the InvalidInputError
+_ST_REACH = 2  # a chain out of the motors' reach (|k| > 1 + tol)
+_ST_ASSEMBLE = 3  # the closed sub-chain does not assemble in the mode asked for
+_ST_BAND = 4  # the forward-singularity band (foot gain >= FK_GAIN_MAX)
+_ST_SINGULAR = 5  # N singular / reach boundary
 
-    Returns (item (m,), x (m, 2), branch (m, 2) in {+1, -1, 0}, sign det N (m,)): branch 0 for a chain on its
-    reach boundary (|k| within BOUNDARY_TOL of 1), where both motor branches meet. Duplicates are possible.
+_CX, _CY, _CZ = float(CENTER[0]), float(CENTER[1]), float(CENTER[2])
+_LX, _LZ = float(LEVER[0]), float(LEVER[2])
+_PX0, _PY0, _PZ0 = (float(v) for v in MOTOR_POS[0])
+_PX1, _PY1, _PZ1 = (float(v) for v in MOTOR_POS[1])
+_AX0, _AY0, _AZ0 = (float(v) for v in ATTACH[0])
+_AX1, _AY1, _AZ1 = (float(v) for v in ATTACH[1])
+_OX, _OZ = float(LL_ORIGIN[0]), float(LL_ORIGIN[2])
+_L = ROD_LENGTH
+_TWO_PI = 2.0 * math.pi
+
+
+@kernel
+def _wrap_k(a):
+    """Wrap an angle to (-pi, pi] (as :func:`_wrap`)."""
+    return math.pi - np.mod(math.pi - a, _TWO_PI)
+
+
+@kernel
+def _rot_k(r, p, m):
+    """m (3, 3) = Rx(r) Ry(p), the universal centre (seed eq 2 with the universal joint)."""
+    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
+    m[0, 0], m[0, 1], m[0, 2] = cp, 0.0, sp
+    m[1, 0], m[1, 1], m[1, 2] = sr * sp, cr, -sr * cp
+    m[2, 0], m[2, 1], m[2, 2] = -cr * sp, sr, cr * cp
+
+
+@kernel
+def _chain_k(m, i, bi, tol, theta, kout):
+    """Chain i's rod-length equation (seed eqs 3-9, 10-16) for the platform rotation m (3, 3), branch bi.
+
+    ``A cos(phi) + B sin(phi) = C`` with ``w = p_i - A_i``, ``A = l_x w_x``, ``B = l_x w_y``,
+    ``C = (L^2 - |w|^2 - l_x^2 - l_z^2 - 2 l_z w_z) / 2``; ``phi = atan2(B, A) - sigma_i b_i acos(k)``,
+    ``k = C / sqrt(A^2 + B^2)``. Writes theta[i] (wrapped; NaN when unreachable) and kout[i]; returns reachable.
     """
-    tip, dtip = _lever_tips(theta)
-    poly, al, be, ga = _roll_polynomial(tip)
-    item, x0, imag = _pose_seeds(_poly_roots(poly), al, be, ga)
-    x, err = _rod_newton(x0, tip[item], max_iter)
-    # near the forward singularity (two poses of opposite modes close together: a near-double root, or a nearly
-    # real complex pair): seeds on both sides of each near-singular solution, or of an unconverged nearly real root
-    xs = np.where((err <= 1e-6)[:, None], x, x0)
-    _, nm = _rod_system(xs, tip[item])
-    sv = np.linalg.svd(np.where(np.isfinite(nm), nm, 0.0), compute_uv=False) if len(nm) else np.zeros((0, 2))
-    near = np.where(err <= tol, sv[:, 1] < 1e-3 * np.maximum(sv[:, 0], 1e-300), imag <= 1e-4)
-    if near.any():
-        _, _, vt = np.linalg.svd(np.where(np.isfinite(nm[near]), nm[near], 0.0))
-        v = vt[:, -1]
-        extra = [xs[near] + sgn * h * v for h in _FOLD_OFFSETS for sgn in (1.0, -1.0)]
-        xi = np.tile(item[near], 2 * len(_FOLD_OFFSETS))
-        xe, ee = _rod_newton(np.concatenate(extra), tip[xi], max_iter, keep_sign=True)
-        item, x, err = np.concatenate([item, xi]), np.concatenate([x, xe]), np.concatenate([err, ee])
-    x = _wrap(x)
-    keep = (err <= tol) & np.all(np.abs(x) <= PLATFORM_LIMIT + _LIMIT_TOL, -1)
-    item, x = item[keep], np.clip(x[keep], -PLATFORM_LIMIT, PLATFORM_LIMIT)
-    rot = _rot(x[:, 0], x[:, 1])
-    _, k, _ = _chains(rot, np.ones(2))
-    ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
-    d = CENTER + ra - tip[item]
-    dd = np.sum(d * dtip[item], -1)
-    bl = np.where(np.abs(np.abs(k) - 1.0) <= BOUNDARY_TOL, 0.0, -_SIGMA * np.sign(dd))
-    sdet = np.sign(_det2(_n_matrix(ra, d, x[:, 0])))
-    return item, x, bl, sdet
+    if i == 0:
+        ax, ay, az, px, py, pz, sg, yaw = _AX0, _AY0, _AZ0, _PX0, _PY0, _PZ0, 1.0, BETA
+    else:
+        ax, ay, az, px, py, pz, sg, yaw = _AX1, _AY1, _AZ1, _PX1, _PY1, _PZ1, -1.0, -BETA
+    wx = px - (_CX + (m[0, 0] * ax + m[0, 1] * ay + m[0, 2] * az))
+    wy = py - (_CY + (m[1, 0] * ax + m[1, 1] * ay + m[1, 2] * az))
+    wz = pz - (_CZ + (m[2, 0] * ax + m[2, 1] * ay + m[2, 2] * az))
+    a = _LX * wx
+    b = _LX * wy
+    c = 0.5 * (_L * _L - (wx * wx + wy * wy + wz * wz) - _LX * _LX - _LZ * _LZ - 2.0 * _LZ * wz)
+    k = c / math.hypot(a, b)
+    kout[i] = k
+    if not (math.isfinite(k) and abs(k) <= 1.0 + tol):
+        theta[i] = math.nan
+        return False
+    kc = min(max(k, -1.0), 1.0)
+    theta[i] = _wrap_k(math.atan2(b, a) - sg * bi * math.acos(kc) - yaw)
+    return True
 
 
-def _neutral_sign(b: tuple) -> float:
-    """Sign of det N at the neutral pose (R_P = I) on motor branch b."""
-    bv = np.array(b, dtype=float)
-    rot = np.eye(3)[None]
-    th, _, _ = _chains(rot, bv)
-    tip, _ = _lever_tips(th)
-    ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
-    return float(np.sign(_det2(_n_matrix(ra, CENTER + ra - tip, np.zeros(1)))[0]))
+@kernel
+def _chains_k(m, b1, b2, tol, theta, kout):
+    """Both chains (:func:`motor_angles_from_rotation`); returns _OK or _ST_REACH (theta NaN then)."""
+    ok1 = _chain_k(m, 0, b1, tol, theta, kout)
+    ok2 = _chain_k(m, 1, b2, tol, theta, kout)
+    if ok1 and ok2:
+        return OK
+    theta[0] = math.nan
+    theta[1] = math.nan
+    return _ST_REACH
 
 
-_REF_SIGN = {b: _neutral_sign(b) for b in MOTOR_BRANCHES}
+@kernel
+def _motor_angles_k(r, p, b1, b2, theta, kout):
+    """:func:`motor_angles`: the chains at R_P = Rx(r) Ry(p)."""
+    if not (math.isfinite(r) and math.isfinite(p)):
+        theta[0] = math.nan
+        theta[1] = math.nan
+        return _ST_INPUT
+    m = np.empty((3, 3))
+    _rot_k(r, p, m)
+    return _chains_k(m, b1, b2, K_TOL, theta, kout)
+
+
+@batch_kernel
+def _motor_angles_b(r, p, b1, b2, theta, kout, ok):
+    for j in prange(r.shape[0]):
+        ok[j] = _motor_angles_k(r[j], p[j], b1, b2, theta[j], kout[j]) == OK
+
+
+@kernel
+def _motor_angles_s(r, p, b1, b2, theta, kout, ok):
+    for j in range(r.shape[0]):
+        ok[j] = _motor_angles_k(r[j], p[j], b1, b2, theta[j], kout[j]) == OK
+
+
+@batch_kernel
+def _chains_b(rot, b1, b2, tol, theta, kout, ok):
+    for j in prange(rot.shape[0]):
+        ok[j, 0] = _chain_k(rot[j], 0, b1[j], tol, theta[j], kout[j])
+        ok[j, 1] = _chain_k(rot[j], 1, b2[j], tol, theta[j], kout[j])
+
+
+@kernel
+def _chains_s(rot, b1, b2, tol, theta, kout, ok):
+    for j in range(rot.shape[0]):
+        ok[j, 0] = _chain_k(rot[j], 0, b1[j], tol, theta[j], kout[j])
+        ok[j, 1] = _chain_k(rot[j], 1, b2[j], tol, theta[j], kout[j])
+
+
+@kernel
+def _motor_angles_rot_k(m, b1, b2, theta, kout):
+    """:func:`motor_angles_from_rotation` of one matrix m (3, 3): _ST_INPUT unless finite and a rotation (as
+    :func:`_check_rotation`: |R^T R - I| <= 1e-9, det >= 0), else the chains."""
+    err = 0.0
+    for i in range(3):
+        for j in range(3):
+            if not math.isfinite(m[i, j]):
+                return _ST_INPUT
+            v = m[0, i] * m[0, j] + m[1, i] * m[1, j] + m[2, i] * m[2, j] - (1.0 if i == j else 0.0)
+            err = max(err, abs(v))
+    det = (m[0, 0] * (m[1, 1] * m[2, 2] - m[1, 2] * m[2, 1]) - m[0, 1] * (m[1, 0] * m[2, 2] - m[1, 2] * m[2, 0])
+           + m[0, 2] * (m[1, 0] * m[2, 1] - m[1, 1] * m[2, 0]))
+    if not (err <= 1e-9 and det >= 0.0):
+        return _ST_INPUT
+    return _chains_k(m, b1, b2, K_TOL, theta, kout)
+
+
+@kernel
+def _foot_k(r, p, t, out):
+    """Foot FCS in CCS (seed eqs 1, 17, 18, 20): ``CENTER + R_P (o_LL + Ry(t) (FOOT_X, 0, 0))``."""
+    if not (math.isfinite(r) and math.isfinite(p) and math.isfinite(t)):
+        out[0], out[1], out[2] = math.nan, math.nan, math.nan
+        return _ST_INPUT
+    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
+    fx = _OX + FOOT_X * math.cos(t)
+    fz = _OZ - FOOT_X * math.sin(t)
+    out[0] = _CX + (cp * fx + sp * fz)
+    out[1] = _CY + (sr * sp * fx - sr * cp * fz)
+    out[2] = _CZ + (-cr * sp * fx + cr * cp * fz)
+    return OK
+
+
+@batch_kernel
+def _foot_b(r, p, t, out):
+    for j in prange(r.shape[0]):
+        _foot_k(r[j], p[j], t[j], out[j])
+
+
+@kernel
+def _foot_s(r, p, t, out):
+    for j in range(r.shape[0]):
+        _foot_k(r[j], p[j], t[j], out[j])
+
+
+# --- forward kinematics of the closed sub-chain (the polynomial in tan(roll / 2), see the comment above
+# _n_matrix: T_C = cos(roll) (1 + t^2) = 1 - t^2, T_S = sin(roll) (1 + t^2) = 2 t, T_1 = 1 + t^2)
+@kernel
+def _tips_k(t1, t2, tip, dtip):
+    """Lever tips S_i (2, 3) and dS_i/dtheta_i (seed eqs 7, 14) for motor angles t1, t2."""
+    for i in range(2):
+        if i == 0:
+            phi, px, py, pz = t1 + BETA, _PX0, _PY0, _PZ0
+        else:
+            phi, px, py, pz = t2 - BETA, _PX1, _PY1, _PZ1
+        c, s = math.cos(phi), math.sin(phi)
+        tip[i, 0] = _LX * c + px
+        tip[i, 1] = _LX * s + py
+        tip[i, 2] = _LZ + pz
+        dtip[i, 0] = -_LX * s
+        dtip[i, 1] = _LX * c
+        dtip[i, 2] = 0.0
+
+
+@kernel
+def _pmul_k(a, b, out):
+    """out = a * b (ascending polynomial coefficients; len(out) = len(a) + len(b) - 1)."""
+    for j in range(out.shape[0]):
+        out[j] = 0.0
+    for i in range(a.shape[0]):
+        for j in range(b.shape[0]):
+            out[i + j] += a[i] * b[j]
+
+
+@kernel
+def _roll_poly_k(tip, poly, al, be, ga):
+    """The degree-8 polynomial poly (9,) in t = tan(roll / 2) and the per-rod quadratics al, be, ga (2, 3)."""
+    for i in range(2):
+        if i == 0:
+            ax, ay, az = _AX0, _AY0, _AZ0
+        else:
+            ax, ay, az = _AX1, _AY1, _AZ1
+        wx, wy, wz = _CX - tip[i, 0], _CY - tip[i, 1], _CZ - tip[i, 2]
+        kap = 0.5 * (_L * _L - (wx * wx + wy * wy + wz * wz) - (ax * ax + ay * ay + az * az))
+        qz0, qz1, qz2 = wz * 1.0, -wy * 2.0, wz * -1.0  # -wy T_S + wz T_C
+        qy0, qy1, qy2 = wy * 1.0, wz * 2.0, wy * -1.0  # wy T_C + wz T_S
+        al[i, 0] = wx * ax + az * qz0
+        al[i, 1] = az * qz1
+        al[i, 2] = wx * ax + az * qz2
+        be[i, 0] = wx * az - ax * qz0
+        be[i, 1] = -ax * qz1
+        be[i, 2] = wx * az - ax * qz2
+        ga[i, 0] = ay * qy0 - kap
+        ga[i, 1] = ay * qy1
+        ga[i, 2] = ay * qy2 - kap
+    t1 = np.empty(5)
+    t2 = np.empty(5)
+    det = np.empty(5)
+    cc = np.empty(5)
+    ss = np.empty(5)
+    _pmul_k(al[0], be[1], t1)
+    _pmul_k(al[1], be[0], t2)
+    det[:] = t1 - t2
+    _pmul_k(be[0], ga[1], t1)
+    _pmul_k(be[1], ga[0], t2)
+    cc[:] = t1 - t2
+    _pmul_k(al[1], ga[0], t1)
+    _pmul_k(al[0], ga[1], t2)
+    ss[:] = t1 - t2
+    p1 = np.empty(9)
+    p2 = np.empty(9)
+    p3 = np.empty(9)
+    _pmul_k(cc, cc, p1)
+    _pmul_k(ss, ss, p2)
+    _pmul_k(det, det, p3)
+    poly[:] = p1 + p2 - p3
+
+
+@kernel
+def _roots_k(c, z):
+    """Complex roots z (8,) of the polynomial c (9,) (ascending), NaN-padded: Aberth-Ehrlich iteration.
+
+    Zero leading coefficients lower the degree (a pose at roll = pi); a non-finite polynomial has no roots.
+    Returns the number of roots.
+    """
+    for j in range(8):
+        z[j] = complex(math.nan, math.nan)
+    for j in range(9):
+        if not math.isfinite(c[j]):
+            return 0
+    n = 8
+    while n > 0 and c[n] == 0.0:
+        n -= 1
+    if n == 0:
+        return 0
+    lead = c[n]
+    # starting points on a circle: the geometric mean of the roots' moduli, at most Fujiwara's bound
+    rad = 0.0
+    for k in range(n):
+        v = (abs(c[k] / lead) / (2.0 if k == 0 else 1.0)) ** (1.0 / (n - k))
+        if v > rad:
+            rad = v
+    rad = 2.0 * rad
+    if not (rad > 0.0 and math.isfinite(rad)):
+        rad = 1.0
+    g0 = abs(c[0] / lead) ** (1.0 / n)
+    if g0 > 0.0 and g0 < rad:
+        rad = g0
+    zr = np.empty(8)
+    zi = np.empty(8)
+    for j in range(n):
+        ang = _TWO_PI * j / n + 0.4
+        zr[j], zi[j] = rad * math.cos(ang), rad * math.sin(ang)
+    done = np.zeros(8, dtype=np.bool_)
+    prev = np.full(8, math.inf)
+    for _ in range(100):
+        ndone = 0
+        for j in range(n):
+            if done[j]:
+                ndone += 1
+                continue
+            xr, xi = zr[j], zi[j]
+            pr, pi_ = c[n], 0.0
+            dr, di = 0.0, 0.0
+            for k in range(n - 1, -1, -1):
+                dr, di = dr * xr - di * xi + pr, dr * xi + di * xr + pi_
+                pr, pi_ = pr * xr - pi_ * xi + c[k], pr * xi + pi_ * xr
+            if pr == 0.0 and pi_ == 0.0:
+                done[j] = True
+                continue
+            # ratio = p / p'
+            dd = dr * dr + di * di
+            rr, ri = (pr * dr + pi_ * di) / dd, (pi_ * dr - pr * di) / dd
+            sr, si = 0.0, 0.0
+            for k in range(n):
+                if k != j:
+                    er, ei = xr - zr[k], xi - zi[k]
+                    e2 = er * er + ei * ei
+                    sr += er / e2
+                    si -= ei / e2
+            # w = ratio / (1 - ratio s)
+            qr, qi = 1.0 - (rr * sr - ri * si), -(rr * si + ri * sr)
+            q2 = qr * qr + qi * qi
+            wr, wi = (rr * qr + ri * qi) / q2, (ri * qr - rr * qi) / q2
+            if not (math.isfinite(wr) and math.isfinite(wi)):
+                wr, wi = rr, ri
+            zr[j], zi[j] = xr - wr, xi - wi
+            # converged (cubically: the last correction leaves rounding only), or stalled at the rounding floor
+            # of a (near-)multiple root, where the convergence is linear
+            aw = math.hypot(wr, wi)
+            az = math.hypot(xr, xi)
+            if aw <= 1e-12 * az or (aw <= 1e-6 * az and aw >= 0.5 * prev[j]):
+                done[j] = True
+            prev[j] = aw
+        if ndone == n:
+            break
+    for j in range(n):
+        z[j] = complex(zr[j], zi[j])
+    return n
+
+
+@kernel
+def _rod_system_k(x0, x1, tip, g, nm):
+    """Rod equations g_i = (|A_i - S_i|^2 - L^2) / 2 (2,) and N (2, 2) (N_ik = d_i . dA_i/dx_k) at (x0, x1).
+
+    Returns max |g_i| (NaN if not finite)."""
+    cr, sr, cp, sp = math.cos(x0), math.sin(x0), math.cos(x1), math.sin(x1)
+    worst = 0.0
+    for i in range(2):
+        if i == 0:
+            ax, ay, az = _AX0, _AY0, _AZ0
+        else:
+            ax, ay, az = _AX1, _AY1, _AZ1
+        rx = cp * ax + sp * az
+        ry = sr * sp * ax + cr * ay - sr * cp * az
+        rz = -cr * sp * ax + sr * ay + cr * cp * az
+        d0, d1, d2 = _CX + rx - tip[i, 0], _CY + ry - tip[i, 1], _CZ + rz - tip[i, 2]
+        g[i] = 0.5 * ((d0 * d0 + d1 * d1 + d2 * d2) - _L * _L)
+        nm[i, 0] = -d1 * rz + d2 * ry
+        nm[i, 1] = d0 * (cr * rz - sr * ry) + (d1 * sr - d2 * cr) * rx
+        a = abs(g[i])
+        if not (a <= worst):
+            worst = a if math.isfinite(a) or math.isnan(worst) else math.nan
+    return worst if math.isfinite(worst) else math.nan
+
+
+@kernel
+def _sgn(v):
+    return 1.0 if v > 0.0 else (-1.0 if v < 0.0 else (0.0 if v == 0.0 else math.nan))
+
+
+@kernel
+def _rod_newton_k(x, tip, max_iter, keep_sign):
+    """Damped Newton on both rod equations from x (2,) (in place; as in the numpy version of issue 15): each
+    accepted step decreases max|g|; with keep_sign it also keeps the sign of det N of the start. Returns the
+    rod-length error (m), inf where not finite."""
+    g = np.empty(2)
+    nm = np.empty((2, 2))
+    gt = np.empty(2)
+    nt = np.empty((2, 2))
+    cur = _rod_system_k(x[0], x[1], tip, g, nm)
+    sign = _sgn(nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0])
+    act = math.isfinite(cur)
+    for it in range(max_iter):
+        if it == 8 and not (cur <= 1e-4 * _L):
+            act = False
+        if not act:
+            break
+        det = nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0]
+        s0 = -((nm[1, 1] * g[0] - nm[0, 1] * g[1]) / det)
+        s1 = -((nm[0, 0] * g[1] - nm[1, 0] * g[0]) / det)
+        fin = math.isfinite(s0) and math.isfinite(s1)
+        if fin:
+            s0 = min(max(s0, -0.3), 0.3)
+            s1 = min(max(s1, -0.3), 0.3)
+        else:
+            s0 = 0.0
+            s1 = 0.0
+        smax = max(abs(s0), abs(s1))
+        fin = fin and smax > 1e-16 * (1.0 + max(abs(x[0]), abs(x[1])))
+        lam = 1.0
+        acc = False
+        if fin:
+            for _ in range(16):
+                xt0 = x[0] + lam * s0
+                xt1 = x[1] + lam * s1
+                ct = _rod_system_k(xt0, xt1, tip, gt, nt)
+                ok = ct < cur
+                if keep_sign:
+                    ok = ok and _sgn(nt[0, 0] * nt[1, 1] - nt[0, 1] * nt[1, 0]) == sign
+                if ok:
+                    acc = True
+                    x[0], x[1], cur = xt0, xt1, ct
+                    g[0], g[1] = gt[0], gt[1]
+                    nm[:, :] = nt
+                    break
+                lam *= 0.5
+        if not acc or smax * lam <= 1e-16:
+            act = False
+    gm = max(abs(g[0]), abs(g[1]))
+    err = gm * 2.0 / (_L + math.sqrt(max(2.0 * gm + _L * _L, 0.0)))
+    return err if math.isfinite(err) else math.inf
+
+
+@kernel
+def _null_k(nm, v):
+    """Singular values (s_max, s_min) of N (2, 2) and the right singular vector v (2,) of s_min."""
+    a = nm[0, 0] * nm[0, 0] + nm[1, 0] * nm[1, 0]
+    b = nm[0, 0] * nm[0, 1] + nm[1, 0] * nm[1, 1]
+    c = nm[0, 1] * nm[0, 1] + nm[1, 1] * nm[1, 1]
+    h = math.sqrt(0.25 * (a - c) ** 2 + b * b)
+    lmax = 0.5 * (a + c) + h
+    smax = math.sqrt(lmax)
+    det = abs(nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0])
+    smin = det / smax if smax > 0.0 else 0.0
+    lmin = smin * smin
+    # eigenvector of N^T N for lmin: (b, lmin - a) or (lmin - c, b), the better conditioned
+    v0, v1 = b, lmin - a
+    u0, u1 = lmin - c, b
+    if u0 * u0 + u1 * u1 > v0 * v0 + v1 * v1:
+        v0, v1 = u0, u1
+    nv = math.hypot(v0, v1)
+    if nv > 0.0:
+        v[0], v[1] = v0 / nv, v1 / nv
+    elif a <= c:
+        v[0], v[1] = 1.0, 0.0
+    else:
+        v[0], v[1] = 0.0, 1.0
+    return smax, smin
+
+
+#: Most seeds per motor pair: 8 roots (x3 where the rod equations are parallel), and the fold seeds of each.
+_MAX_SEEDS = 24
+_MAX_SOL = _MAX_SEEDS * (1 + 2 * len(_FOLD_OFFSETS))
+_FOLD = np.array(_FOLD_OFFSETS)
+
+
+@kernel
+def _solutions_k(t1, t2, tol, max_iter, xs, bl, sdet):
+    """Every platform pose within the joint limits closing both rods for motors (t1, t2): xs (m, 2), motor
+    branch bl (m, 2) (0 on a chain's reach boundary), sign det N sdet (m,). Returns m (duplicates possible).
+
+    The roots of the degree-8 polynomial in tan(roll / 2) with |roll| <= ~pi/2 (and nearly real complex pairs),
+    their pitch from the two rod equations (linear in cos, sin pitch), each polished by Newton; near the forward
+    singularity, extra Newton runs from both sides of each near-singular solution with the det N barrier.
+    """
+    tip = np.empty((2, 3))
+    dtip = np.empty((2, 3))
+    _tips_k(t1, t2, tip, dtip)
+    poly = np.empty(9)
+    al = np.empty((2, 3))
+    be = np.empty((2, 3))
+    ga = np.empty((2, 3))
+    _roll_poly_k(tip, poly, al, be, ga)
+    z = np.empty(8, dtype=np.complex128)
+    nr = _roots_k(poly, z)
+    x0 = np.empty((_MAX_SOL, 2))
+    imag = np.empty(_MAX_SOL)
+    m = 0
+    nbad = 0
+    bad = np.empty((8, 4))  # roll, base, c, imag of the seeds whose rod equations are (nearly) parallel
+    for j in range(nr):
+        zr, zi = z[j].real, z[j].imag
+        if not (math.isfinite(zr) and math.isfinite(zi)):
+            continue
+        if not (abs(zi) <= 1e-2 * (1.0 + abs(z[j])) and abs(zr) <= 1.0 + 1e-3):
+            continue
+        t = zr
+        a0 = (al[0, 2] * t + al[0, 1]) * t + al[0, 0]
+        a1 = (al[1, 2] * t + al[1, 1]) * t + al[1, 0]
+        b0 = (be[0, 2] * t + be[0, 1]) * t + be[0, 0]
+        b1 = (be[1, 2] * t + be[1, 1]) * t + be[1, 0]
+        g0 = (ga[0, 2] * t + ga[0, 1]) * t + ga[0, 0]
+        g1 = (ga[1, 2] * t + ga[1, 1]) * t + ga[1, 0]
+        det = a0 * b1 - a1 * b0
+        cp = (b0 * g1 - b1 * g0) / det
+        sp = (a1 * g0 - a0 * g1) / det
+        roll = 2.0 * math.atan(t)
+        pitch = math.atan2(sp, cp)
+        x0[m, 0] = roll if math.isfinite(roll) else 0.0
+        x0[m, 1] = pitch if math.isfinite(pitch) else 0.0
+        imag[m] = abs(zi)
+        m += 1
+        if not (abs(det) > 1e-6 * (abs(a0 * b1) + abs(a1 * b0))):
+            if math.hypot(a1, b1) > math.hypot(a0, b0):
+                ak, bk, gk = a1, b1, g1
+            else:
+                ak, bk, gk = a0, b0, g0
+            bad[nbad, 0] = roll
+            bad[nbad, 1] = math.atan2(bk, ak)
+            kc = -gk / math.hypot(ak, bk)
+            bad[nbad, 2] = math.acos(min(max(kc, -1.0), 1.0)) if not math.isnan(kc) else math.nan
+            bad[nbad, 3] = abs(zi)
+            nbad += 1
+    for sgn in (1.0, -1.0):
+        for j in range(nbad):
+            r_, p_ = bad[j, 0], bad[j, 1] + sgn * bad[j, 2]
+            x0[m, 0] = r_ if math.isfinite(r_) else 0.0
+            x0[m, 1] = p_ if math.isfinite(p_) else 0.0
+            imag[m] = bad[j, 3]
+            m += 1
+    nseed = m
+    x = np.empty((_MAX_SOL, 2))
+    err = np.empty(_MAX_SOL)
+    g = np.empty(2)
+    nm = np.empty((2, 2))
+    v = np.empty(2)
+    for j in range(nseed):
+        x[j, 0], x[j, 1] = x0[j, 0], x0[j, 1]
+        err[j] = _rod_newton_k(x[j], tip, max_iter, False)
+    # near the forward singularity: seeds on both sides of each near-singular solution (or unconverged nearly
+    # real root), along the null vector of N, Newton with the det N barrier
+    near = np.empty((_MAX_SEEDS, 4))
+    nnear = 0
+    for j in range(nseed):
+        if err[j] <= 1e-6:
+            y0, y1 = x[j, 0], x[j, 1]
+        else:
+            y0, y1 = x0[j, 0], x0[j, 1]
+        _rod_system_k(y0, y1, tip, g, nm)
+        for q in range(2):
+            for r in range(2):
+                if not math.isfinite(nm[q, r]):
+                    nm[q, r] = 0.0
+        smax, smin = _null_k(nm, v)
+        if err[j] <= tol:
+            isnear = smin < 1e-3 * max(smax, 1e-300)
+        else:
+            isnear = imag[j] <= 1e-4
+        if isnear:
+            near[nnear, 0], near[nnear, 1], near[nnear, 2], near[nnear, 3] = y0, y1, v[0], v[1]
+            nnear += 1
+    for h in _FOLD:
+        for sgn in (1.0, -1.0):
+            for j in range(nnear):
+                x[m, 0] = near[j, 0] + sgn * h * near[j, 2]
+                x[m, 1] = near[j, 1] + sgn * h * near[j, 3]
+                err[m] = _rod_newton_k(x[m], tip, max_iter, True)
+                m += 1
+    kk = np.empty(2)
+    th = np.empty(2)
+    rot = np.empty((3, 3))
+    out = 0
+    for j in range(m):
+        r_, p_ = _wrap_k(x[j, 0]), _wrap_k(x[j, 1])
+        if not (err[j] <= tol and abs(r_) <= PLATFORM_LIMIT + _LIMIT_TOL and abs(p_) <= PLATFORM_LIMIT + _LIMIT_TOL):
+            continue
+        r_ = min(max(r_, -PLATFORM_LIMIT), PLATFORM_LIMIT)
+        p_ = min(max(p_, -PLATFORM_LIMIT), PLATFORM_LIMIT)
+        _rot_k(r_, p_, rot)
+        _chain_k(rot, 0, 1.0, K_TOL, th, kk)
+        _chain_k(rot, 1, 1.0, K_TOL, th, kk)
+        _rod_system_k(r_, p_, tip, g, nm)
+        xs[out, 0], xs[out, 1] = r_, p_
+        cr, sr, cp, sp = math.cos(r_), math.sin(r_), math.cos(p_), math.sin(p_)
+        for i in range(2):
+            if i == 0:
+                ax, ay, az, sg = _AX0, _AY0, _AZ0, 1.0
+            else:
+                ax, ay, az, sg = _AX1, _AY1, _AZ1, -1.0
+            rx = cp * ax + sp * az
+            ry = sr * sp * ax + cr * ay - sr * cp * az
+            rz = -cr * sp * ax + sr * ay + cr * cp * az
+            dd = ((_CX + rx - tip[i, 0]) * dtip[i, 0] + (_CY + ry - tip[i, 1]) * dtip[i, 1]
+                  + (_CZ + rz - tip[i, 2]) * dtip[i, 2])
+            bl[out, i] = 0.0 if abs(abs(kk[i]) - 1.0) <= BOUNDARY_TOL else -sg * _sgn(dd)
+        sdet[out] = _sgn(nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0])
+        out += 1
+    return out
+
+
+@kernel
+def _ref_sign_k(b1, b2):
+    """Sign of det N at the neutral pose R_P = I on motor branch (b1, b2) (the reference of assembly +1)."""
+    rot = np.eye(3)
+    th = np.empty(2)
+    kk = np.empty(2)
+    _chains_k(rot, b1, b2, K_TOL, th, kk)
+    tip = np.empty((2, 3))
+    dtip = np.empty((2, 3))
+    _tips_k(th[0], th[1], tip, dtip)
+    g = np.empty(2)
+    nm = np.empty((2, 2))
+    _rod_system_k(0.0, 0.0, tip, g, nm)
+    return _sgn(nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0])
+
+
+_REF = np.array([[_ref_sign_k(-1.0, -1.0), _ref_sign_k(-1.0, 1.0)], [_ref_sign_k(1.0, -1.0), _ref_sign_k(1.0, 1.0)]])
+
+
+@kernel
+def _ref_of(b1, b2):
+    return _REF[1 if b1 > 0 else 0, 1 if b2 > 0 else 0]
+
+
+@kernel
+def _fk_select_k(t1, t2, b1, b2, s, tol, max_iter, x):
+    """The pose x (2,) of motors (t1, t2) in mode (b1, b2), s within the limits nearest R_P = I (the numpy
+    ``_fk_select``). Returns _OK, _ST_INPUT (non-finite motors) or _ST_ASSEMBLE (x NaN)."""
+    x[0] = math.nan
+    x[1] = math.nan
+    if not (math.isfinite(t1) and math.isfinite(t2)):
+        return _ST_INPUT
+    xs = np.empty((_MAX_SOL, 2))
+    bl = np.empty((_MAX_SOL, 2))
+    sdet = np.empty(_MAX_SOL)
+    m = _solutions_k(t1, t2, tol, max_iter, xs, bl, sdet)
+    ref = _ref_of(b1, b2)
+    best = math.inf
+    for j in range(m):
+        if not ((bl[j, 0] == b1 or bl[j, 0] == 0.0) and (bl[j, 1] == b2 or bl[j, 1] == 0.0) and sdet[j] * ref == s):
+            continue
+        nrm = math.hypot(xs[j, 0], xs[j, 1])
+        if nrm < best:
+            best = nrm
+            x[0], x[1] = xs[j, 0], xs[j, 1]
+    return OK if best < math.inf else _ST_ASSEMBLE
+
+
+@batch_kernel
+def _fk_select_b(t1, t2, b1, b2, s, tol, max_iter, x, ok):
+    for j in prange(t1.shape[0]):
+        ok[j] = _fk_select_k(t1[j], t2[j], b1[j], b2[j], s[j], tol, max_iter, x[j]) == OK
+
+
+@kernel
+def _fk_select_s(t1, t2, b1, b2, s, tol, max_iter, x, ok):
+    for j in range(t1.shape[0]):
+        ok[j] = _fk_select_k(t1[j], t2[j], b1[j], b2[j], s[j], tol, max_iter, x[j]) == OK
+
+
+@kernel
+def _poses_k(t1, t2, tol, max_iter, x, br, asm):
+    """:func:`platform_poses` for one motor pair: every pose (nearest R_P = I first, duplicates - the same pose
+    with the same sign of det N - dropped), its motor branch and assembly mode, into x (8, 2), br (8, 2),
+    asm (8,) (NaN / 0 padded). Returns the number of poses."""
+    x[:, :] = math.nan
+    br[:, :] = 0
+    asm[:] = 0
+    if not (math.isfinite(t1) and math.isfinite(t2)):
+        return 0
+    xs = np.empty((_MAX_SOL, 2))
+    bl = np.empty((_MAX_SOL, 2))
+    sdet = np.empty(_MAX_SOL)
+    m = _solutions_k(t1, t2, tol, max_iter, xs, bl, sdet)
+    nrm = np.empty(m)
+    for j in range(m):
+        nrm[j] = math.hypot(xs[j, 0], xs[j, 1])
+    order = np.argsort(nrm, kind="mergesort")
+    sd = np.zeros(8)
+    cnt = 0
+    for c in order:
+        if cnt >= 8:
+            break
+        dup = False
+        for q in range(cnt):
+            if max(abs(x[q, 0] - xs[c, 0]), abs(x[q, 1] - xs[c, 1])) <= 1e-9 and sd[q] == sdet[c]:
+                dup = True
+                break
+        if dup:
+            continue
+        x[cnt, 0], x[cnt, 1] = xs[c, 0], xs[c, 1]
+        sd[cnt] = sdet[c]
+        br[cnt, 0], br[cnt, 1] = int(bl[c, 0]), int(bl[c, 1])
+        asm[cnt] = int(sdet[c] * _ref_of(1.0 if bl[c, 0] == 0.0 else bl[c, 0], 1.0 if bl[c, 1] == 0.0 else bl[c, 1]))
+        cnt += 1
+    return cnt
+
+
+@batch_kernel
+def _poses_b(t1, t2, tol, max_iter, x, br, asm):
+    for j in prange(t1.shape[0]):
+        _poses_k(t1[j], t2[j], tol, max_iter, x[j], br[j], asm[j])
+
+
+@kernel
+def _poses_s(t1, t2, tol, max_iter, x, br, asm):
+    for j in range(t1.shape[0]):
+        _poses_k(t1[j], t2[j], tol, max_iter, x[j], br[j], asm[j])
+
+
+@kernel
+def _fk_guess_k(t1, t2, g0, g1, b1, b2, tol, max_iter, x):
+    """:func:`platform_orientation` from a guess: plain Newton from (g0, g1), then the pose must close both rods
+    within tol and give back the motors (t1, t2) on branch (b1, b2). Returns _OK or _ST_ASSEMBLE (x NaN)."""
+    tip = np.empty((2, 3))
+    dtip = np.empty((2, 3))
+    _tips_k(t1, t2, tip, dtip)
+    x[0], x[1] = g0, g1
+    err = _rod_newton_k(x, tip, max_iter, False)
+    x[0], x[1] = _wrap_k(x[0]), _wrap_k(x[1])
+    ok = err <= tol
+    if ok:
+        rot = np.empty((3, 3))
+        _rot_k(x[0], x[1], rot)
+        th = np.empty(2)
+        kk = np.empty(2)
+        ok = _chains_k(rot, b1, b2, K_TOL, th, kk) == OK
+        ok = ok and max(abs(_wrap_k(th[0] - t1)), abs(_wrap_k(th[1] - t2))) <= 1e-6
+    if ok:
+        return OK
+    x[0], x[1] = math.nan, math.nan
+    return _ST_ASSEMBLE
+
+
+@batch_kernel
+def _fk_guess_b(t1, t2, g, b1, b2, tol, max_iter, x, ok):
+    for j in prange(t1.shape[0]):
+        ok[j] = _fk_guess_k(t1[j], t2[j], g[j, 0], g[j, 1], b1, b2, tol, max_iter, x[j]) == OK
+
+
+@kernel
+def _fk_guess_s(t1, t2, g, b1, b2, tol, max_iter, x, ok):
+    for j in range(t1.shape[0]):
+        ok[j] = _fk_guess_k(t1[j], t2[j], g[j, 0], g[j, 1], b1, b2, tol, max_iter, x[j]) == OK
+
+
+@kernel
+def _gain_k(r, p, tll, tip, dtip):
+    """Spectral norm of d(foot)/d(theta1, theta2) (m/rad) at the pose (r, p) closed by the lever tips tip:
+    ``dx/dtheta = N^-1 diag(D)``, ``dp/dx = [e_x x R f, (Rx(roll) e_y) x R f]``; inf on det N = 0."""
+    g = np.empty(2)
+    nm = np.empty((2, 2))
+    _rod_system_k(r, p, tip, g, nm)
+    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
+    dd = np.empty(2)
+    for i in range(2):
+        if i == 0:
+            ax, ay, az = _AX0, _AY0, _AZ0
+        else:
+            ax, ay, az = _AX1, _AY1, _AZ1
+        rx = cp * ax + sp * az
+        ry = sr * sp * ax + cr * ay - sr * cp * az
+        rz = -cr * sp * ax + sr * ay + cr * cp * az
+        dd[i] = ((_CX + rx - tip[i, 0]) * dtip[i, 0] + (_CY + ry - tip[i, 1]) * dtip[i, 1]
+                 + (_CZ + rz - tip[i, 2]) * dtip[i, 2])
+    det = nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0]
+    # adj(N) diag(D)
+    j00, j01 = nm[1, 1] * dd[0], -nm[0, 1] * dd[1]
+    j10, j11 = -nm[1, 0] * dd[0], nm[0, 0] * dd[1]
+    ffx = _OX + FOOT_X * math.cos(tll)
+    ffz = _OZ - FOOT_X * math.sin(tll)
+    fx = cp * ffx + sp * ffz
+    fy = sr * sp * ffx - sr * cp * ffz
+    fz = -cr * sp * ffx + cr * cp * ffz
+    # dp/dx rows: (0, cr fz - sr fy), (-fz, sr fx), (fy, -cr fx)
+    q0, q1 = cr * fz - sr * fy, sr * fx
+    m00, m01 = q0 * j10, q0 * j11
+    m10, m11 = -fz * j00 + q1 * j10, -fz * j01 + q1 * j11
+    m20, m21 = fy * j00 - cr * fx * j10, fy * j01 - cr * fx * j11
+    a = m00 * m00 + m10 * m10 + m20 * m20
+    b = m00 * m01 + m10 * m11 + m20 * m21
+    c = m01 * m01 + m11 * m11 + m21 * m21
+    gain = math.sqrt(0.5 * (a + c) + math.sqrt(0.25 * (a - c) ** 2 + b * b)) / abs(det)
+    return gain if math.isfinite(gain) else math.inf
+
+
+@kernel
+def _foot_position_k(t1, t2, t0, sv, b1, b2, s, out, aux):
+    """:func:`foot_position`: the FK pose in mode (b1, b2), s, the band check, the foot. aux = (roll, pitch,
+    gain). Returns _OK, _ST_INPUT, _ST_ASSEMBLE or _ST_BAND (out NaN then)."""
+    out[0] = math.nan
+    out[1] = math.nan
+    out[2] = math.nan
+    if not math.isfinite(t0):
+        return _ST_INPUT
+    x = aux[:2]
+    st = _fk_select_k(t1, t2, b1, b2, s, 1e-12, 50, x)
+    aux[2] = math.inf
+    if st != OK:
+        return st
+    tll = -RATIO * t0 + sv
+    tip = np.empty((2, 3))
+    dtip = np.empty((2, 3))
+    _tips_k(t1, t2, tip, dtip)
+    aux[2] = _gain_k(x[0], x[1], tll, tip, dtip)
+    if not (aux[2] < FK_GAIN_MAX):
+        return _ST_BAND
+    return _foot_k(x[0], x[1], tll, out)
+
+
+@batch_kernel
+def _foot_position_b(t1, t2, t0, sv, b1, b2, s, out, aux, st):
+    for j in prange(t1.shape[0]):
+        st[j] = _foot_position_k(t1[j], t2[j], t0[j], sv, b1, b2, s, out[j], aux[j])
+
+
+@kernel
+def _foot_position_s(t1, t2, t0, sv, b1, b2, s, out, aux, st):
+    for j in range(t1.shape[0]):
+        st[j] = _foot_position_k(t1[j], t2[j], t0[j], sv, b1, b2, s, out[j], aux[j])
+
+
+
+_REF_SIGN = {b: float(_ref_of(float(b[0]), float(b[1]))) for b in MOTOR_BRANCHES}
 
 
 def _assembly_ref(b: np.ndarray):
@@ -764,37 +1409,16 @@ def _assembly_ref(b: np.ndarray):
                     np.where(p1, _REF_SIGN[(-1, 1)], _REF_SIGN[(-1, -1)]))
 
 
-def _in_class(bl: np.ndarray, sdet: np.ndarray, b: np.ndarray, s) -> np.ndarray:
-    """Solutions on motor branch b (boundary chains match both) in assembly mode s (b, s per solution or one)."""
-    return np.all((bl == b) | (bl == 0.0), -1) & (sdet * _assembly_ref(b) == s)
-
-
-def _first_per_item(n: int, item: np.ndarray, key: np.ndarray, mask: np.ndarray):
-    """Index into the candidate arrays of the masked candidate with the smallest key per item (-1: none)."""
-    out = np.full(n, -1)
-    sel = np.flatnonzero(mask)
-    if len(sel):
-        order = sel[np.lexsort((key[sel], item[sel]))]
-        first = np.unique(item[order], return_index=True)
-        out[first[0]] = order[first[1]]
-    return out
-
-
 def _fk_select(theta: np.ndarray, b: np.ndarray, s, tol: float = 1e-12, max_iter: int = 50):
-    """The pose (n, 2) of motor angles theta (n, 2) in mode (b, s) within the limits nearest R_P = I, and ok.
-
-    b (2,) or (n, 2), s scalar or (n,).
-    """
+    """The pose (n, 2) of motor angles theta (n, 2) in mode (b, s) within the limits nearest R_P = I, and ok
+    (the batch kernel :func:`_fk_select_b`). b (2,) or (n, 2), s scalar or (n,)."""
     n = len(theta)
-    x = np.full((n, 2), np.nan)
-    if not n:
-        return x, np.zeros(0, dtype=bool)
-    item, xs, bl, sdet = _platform_solutions(theta, tol, max_iter)
-    b = np.broadcast_to(np.asarray(b, dtype=float), (n, 2))[item]
-    s = np.broadcast_to(np.asarray(s, dtype=float), (n,))[item]
-    pick = _first_per_item(n, item, np.linalg.norm(xs, axis=-1), _in_class(bl, sdet, b, s))
-    ok = pick >= 0
-    x[ok] = xs[pick[ok]]
+    bb = np.broadcast_to(np.asarray(b, dtype=np.float64), (n, 2))
+    ss = np.array(np.broadcast_to(np.asarray(s, dtype=np.float64), (n,)), dtype=np.float64)
+    x = np.empty((n, 2))
+    ok = np.empty(n, dtype=np.bool_)
+    _loop(_fk_select_b, _fk_select_s, n)(np.array(theta[:, 0], dtype=np.float64), np.array(theta[:, 1], dtype=np.float64),
+                                         np.array(bb[:, 0]), np.array(bb[:, 1]), ss, float(tol), int(max_iter), x, ok)
     return x, ok
 
 
@@ -847,24 +1471,12 @@ def platform_poses(theta1, theta2, *, tol: float = 1e-12, max_iter: int = 50) ->
     tol = _check_real(tol, "tol", 0.0, 1e-6, "rod-length residual, m")
     max_iter = _check_count(max_iter, "max_iter", 1, 10_000, "Newton iterations")
     shape = t1.shape
-    theta = np.stack([t1.ravel(), t2.ravel()], -1)
-    n = len(theta)
-    x = np.full((n, 8, 2), np.nan)
-    bran = np.zeros((n, 8, 2), dtype=int)
-    asm = np.zeros((n, 8), dtype=int)
-    if n:
-        item, xs, bl, sdet = _platform_solutions(theta, tol, max_iter)
-        order = np.lexsort((np.linalg.norm(xs, axis=-1), item))
-        slot = np.zeros(n, dtype=int)
-        sd = np.zeros((n, 8))
-        for c in order:  # drop duplicates: the same pose with the same sign of det N
-            i, j = item[c], slot[item[c]]
-            if j >= 8 or (j and np.any((np.abs(x[i, :j] - xs[c]).max(-1) <= 1e-9) & (sd[i, :j] == sdet[c]))):
-                continue
-            x[i, j], sd[i, j] = xs[c], sdet[c]
-            bran[i, j] = bl[c].astype(int)
-            asm[i, j] = int(sdet[c] * _assembly_ref(np.where(bl[c] == 0.0, 1.0, bl[c])))
-            slot[i] += 1
+    n = t1.size
+    x = np.empty((n, 8, 2))
+    bran = np.empty((n, 8, 2), dtype=np.int64)
+    asm = np.empty((n, 8), dtype=np.int64)
+    _loop(_poses_b, _poses_s, n)(_flat(t1), _flat(t2),
+             tol, max_iter, x, bran, asm)
     mask = np.isfinite(x[..., 0])
     return PlatformPoses(x.reshape(shape + (8, 2)), bran.reshape(shape + (8, 2)), asm.reshape(shape + (8,)),
                          mask.reshape(shape + (8,)))
@@ -912,6 +1524,14 @@ def platform_orientation(
         ConvergenceError: single input whose closed sub-chain does not assemble in that mode within the joint
             limits (the message lists the modes in which it does).
     """
+    if (return_mask is False and guess is None and type(theta1) in _SCALARS and type(theta2) in _SCALARS
+            and type(steps) is int and 1 <= steps <= 1000 and type(tol) is float and 0.0 < tol <= 1e-6
+            and type(max_iter) is int and 1 <= max_iter <= 10_000):
+        fb, fs = _fast_branch(branch), _fast_sign(assembly)
+        if fb is not None and fs is not None:
+            x = np.empty(2)
+            if _fk_select_k(theta1, theta2, fb[0], fb[1], fs, tol, max_iter, x) == OK:
+                return x
     t1, t2 = as_angles(theta1, theta2, names=("theta1", "theta2"))
     b = _check_branch(branch)
     s = _check_assembly(assembly)
@@ -927,14 +1547,11 @@ def platform_orientation(
             g = np.broadcast_to(g, shape + (2,)).reshape(-1, 2)
         except ValueError:
             raise InvalidInputError(f"guess must broadcast to shape {shape + (2,)}, got shape {g.shape}") from None
-        tip, _ = _lever_tips(target)
-        x, err = _rod_newton(g.astype(float).copy(), tip, max_iter)
-        x = _wrap(x)
-        ok = err <= tol
-        if ok.any():
-            th, _, ok2 = _chains(_rot(x[:, 0], x[:, 1]), b)
-            near = np.abs(_wrap(th - target)).max(-1) <= 1e-6
-            ok &= np.all(ok2, -1) & near
+        x = np.empty((len(target), 2))
+        ok = np.empty(len(target), dtype=np.bool_)
+        _loop(_fk_guess_b, _fk_guess_s, len(target))(
+            np.array(target[:, 0], dtype=np.float64), np.array(target[:, 1], dtype=np.float64),
+            np.array(g, dtype=np.float64), float(b[0]), float(b[1]), tol, max_iter, x, ok)
     else:
         x, ok = _fk_select(target, b, s, tol, max_iter)
     x = np.where(ok[:, None], x, np.nan).reshape(shape + (2,))
@@ -979,13 +1596,20 @@ def foot_position_from_platform(roll, pitch, theta_ll) -> np.ndarray:
     Seed eqs 1, 17, 18, 20 (eq 18 printed without its last row (0, 0, 0, 1)). At theta_LL = 0 the foot is at
     (0.140, 0, -0.037) in P.
     """
+    if type(roll) in _SCALARS and type(pitch) in _SCALARS and type(theta_ll) in _SCALARS:
+        out = np.empty(3)
+        if _foot_k(roll, pitch, theta_ll, out) == OK:
+            return out
     r, p, t = as_angles(roll, pitch, theta_ll, names=("roll", "pitch", "theta_ll"))
     return _foot_from_pose(r, p, t)
 
 
 def _foot_from_pose(r, p, t):
-    f, _ = _foot_in_p(t)
-    return CENTER + np.einsum("...ij,...j->...i", _rot(r, p), f)
+    """:func:`foot_position_from_platform` of checked arrays (the batch kernel :func:`_foot_b`)."""
+    out = np.empty((r.size, 3))
+    _loop(_foot_b, _foot_s, r.size)(_flat(r), _flat(p),
+            _flat(t), out)
+    return out.reshape(r.shape + (3,))
 
 
 def _foot_gain(x: np.ndarray, theta: np.ndarray, tll: np.ndarray) -> np.ndarray:
@@ -1042,19 +1666,26 @@ def foot_position(
         ConvergenceError: single input whose closed sub-chain does not assemble in that mode.
         SingularityError: single input in the forward-singularity band.
     """
+    if (return_mask is False and type(theta1) in _SCALARS and type(theta2) in _SCALARS
+            and type(theta0) in _SCALARS):
+        fb, fs, fv = _fast_branch(branch), _fast_sign(assembly), _fast_offset(starting_value)
+        if fb is not None and fs is not None and fv is not None:
+            out, aux = np.empty(3), np.empty(3)
+            if _foot_position_k(theta1, theta2, theta0, fv, fb[0], fb[1], fs, out, aux) == OK:
+                return out
     t1, t2, t0 = as_angles(theta1, theta2, theta0, names=("theta1", "theta2", "theta0"))
     sv = _check_offset(starting_value)
     b = _check_branch(branch)
     s = _check_assembly(assembly)
     _check_flag(return_mask, "return_mask")
-    theta = np.stack([t1.ravel(), t2.ravel()], -1)
-    x, assembled = _fk_select(theta, b, s)
-    tll = -RATIO * t0.ravel() + sv
-    gain = np.full(len(theta), np.inf)
-    gain[assembled] = _foot_gain(x[assembled], theta[assembled], tll[assembled])
-    ok = assembled & (gain < FK_GAIN_MAX)
-    p = _foot_from_pose(np.where(ok, x[:, 0], 0.0), np.where(ok, x[:, 1], 0.0), tll)
-    p = np.where(ok[:, None], p, np.nan).reshape(t1.shape + (3,))
+    n = t1.size
+    p, aux, st = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.int64)
+    _loop(_foot_position_b, _foot_position_s, n)(_flat(t1), _flat(t2),
+                     _flat(t0), sv, float(b[0]), float(b[1]), s, p, aux, st)
+    ok = st == OK
+    x, gain = aux[:, :2], aux[:, 2]
+    assembled = st != _ST_ASSEMBLE
+    p = p.reshape(t1.shape + (3,))
 
     def error():
         if not bool(assembled[0]):

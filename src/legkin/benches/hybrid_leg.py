@@ -17,6 +17,7 @@ from ..bench import Method, MethodResult, ModelBench, Score
 from ..checks.hybrid_leg import LL_RANGE, closed_configuration, sample_workspace
 from ..errors import LegkinError
 from . import SOLVE_TOL, levenberg_marquardt, pinocchio_positions, sizes
+from ._single import SingleCall
 
 TOL = 1e-12
 MAX_ITER = 100
@@ -25,6 +26,50 @@ MAX_ITER = 100
 def _sizes(n: int | None, quick: bool) -> tuple[int, int, int]:
     """(batch targets, scalar-loop targets, iterative-solver targets)."""
     return sizes(n, quick, full=(20_000, 2_000, 200), small=(1_000, 100, 10))
+
+
+#: The single-call inputs: a platform pose of the neutral assembly mode and an extension-motor angle.
+SINGLE_POSE = (0.1, 0.2)
+SINGLE_THETA0 = 1.0
+
+
+def single_calls() -> list[SingleCall]:
+    """One single call per public function of :mod:`legkin.analytic.hybrid_leg`, inputs bound.
+
+    Inputs: the motors of the platform pose :data:`SINGLE_POSE` (roll, pitch) on branch (1, 1), theta0 =
+    :data:`SINGLE_THETA0`, the foot they give as the IK target. Yardsticks: Pinocchio ``forwardKinematics`` +
+    ``updateFramePlacement`` on the quadruped (``quadruped_fk``) for the closed forms; ``Robot.solve_loops`` on
+    the hybrid leg (``solve_loops``, ``iterative=True``) for the functions that solve the closed sub-chain's
+    forward kinematics (the degree-8 polynomial and Newton): platform_orientation, platform_poses, foot_position,
+    foot_jacobian and foot_ik_solutions (which runs the forward kinematics of every branch).
+    """
+    roll, pitch = SINGLE_POSE
+    t0 = SINGLE_THETA0
+    rot = ah.platform_rotation(roll, pitch)
+    t1, t2 = (float(v) for v in ah.motor_angles(roll, pitch))
+    tll = float(ah.ll_angle(t0))
+    p = ah.foot_position(t1, t2, t0)
+    cf, it = "quadruped_fk", "solve_loops"
+    return [
+        SingleCall("ll_angle", lambda: ah.ll_angle(t0), cf),
+        SingleCall("extension_motor_angle", lambda: ah.extension_motor_angle(tll), cf),
+        SingleCall("platform_rotation", lambda: ah.platform_rotation(roll, pitch), cf),
+        SingleCall("rod_spans", lambda: ah.rod_spans(t1, t2, roll, pitch), cf),
+        SingleCall("motor_angles", lambda: ah.motor_angles(roll, pitch), cf),
+        SingleCall("motor_angles_from_rotation", lambda: ah.motor_angles_from_rotation(rot), cf),
+        SingleCall("motor_jacobian", lambda: ah.motor_jacobian(roll, pitch), cf),
+        SingleCall("sphere_joint_angles", lambda: ah.sphere_joint_angles(rot), cf),
+        SingleCall("spherical_free_axis", lambda: ah.spherical_free_axis(rot), cf),
+        SingleCall("assembly_mode", lambda: ah.assembly_mode(roll, pitch), cf),
+        SingleCall("foot_position_from_platform", lambda: ah.foot_position_from_platform(roll, pitch, tll), cf),
+        SingleCall("foot_platform_ik", lambda: ah.foot_platform_ik(p), cf),
+        SingleCall("foot_ik", lambda: ah.foot_ik(p), cf),
+        SingleCall("platform_orientation", lambda: ah.platform_orientation(t1, t2), it, iterative=True),
+        SingleCall("platform_poses", lambda: ah.platform_poses(t1, t2), it, iterative=True),
+        SingleCall("foot_position", lambda: ah.foot_position(t1, t2, t0), it, iterative=True),
+        SingleCall("foot_jacobian", lambda: ah.foot_jacobian(t1, t2, t0), it, iterative=True),
+        SingleCall("foot_ik_solutions", lambda: ah.foot_ik_solutions(p), it, iterative=True),
+    ]
 
 
 def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:

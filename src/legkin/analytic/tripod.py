@@ -34,7 +34,7 @@ from ..errors import (
     UnreachableError,
 )
 from ..models.tripod import SPEC as _SPEC
-from ._batch import as_angles, as_input, finish
+from ._batch import as_angles, as_input
 from ._kernels import OK, batch_kernel, kernel, prange
 
 __all__ = [
@@ -165,46 +165,9 @@ def _params(d: float, alpha: float, eta: Sequence[float] | None = None) -> tuple
     return out[0], out[1], eta_arr
 
 
-def _rx(t: np.ndarray) -> np.ndarray:
-    c, s = np.cos(t), np.sin(t)
-    o, z = np.ones_like(t), np.zeros_like(t)
-    return np.stack([o, z, z, z, c, -s, z, s, c], axis=-1).reshape(t.shape + (3, 3))
-
-
-def _ry(t: np.ndarray) -> np.ndarray:
-    c, s = np.cos(t), np.sin(t)
-    o, z = np.ones_like(t), np.zeros_like(t)
-    return np.stack([c, z, s, z, o, z, -s, z, c], axis=-1).reshape(t.shape + (3, 3))
-
-
-def _rz(t: np.ndarray) -> np.ndarray:
-    c, s = np.cos(t), np.sin(t)
-    o, z = np.ones_like(t), np.zeros_like(t)
-    return np.stack([c, -s, z, s, c, z, z, z, o], axis=-1).reshape(t.shape + (3, 3))
-
-
-def _homogeneous(rot: np.ndarray, pos: np.ndarray) -> np.ndarray:
-    out = np.zeros(rot.shape[:-2] + (4, 4))
-    out[..., :3, :3] = rot
-    out[..., :3, 3] = pos
-    out[..., 3, 3] = 1.0
-    return out
-
-
 def _wrap(a: np.ndarray) -> np.ndarray:
     """Angles wrapped to [-pi, pi)."""
     return (np.asarray(a) + np.pi) % (2.0 * np.pi) - np.pi
-
-
-def _leg_position(q1: np.ndarray, q2: np.ndarray, eta: np.ndarray, d: float, alpha: float) -> np.ndarray:
-    """Eqs (10) last column and (12): p = d (-h1, -(c_eta h2 + s_eta h3), c_eta h3 - s_eta h2)."""
-    c1, s1, c2, s2 = np.cos(q1), np.sin(q1), np.cos(q2), np.sin(q2)
-    ca, sa = math.cos(alpha), math.sin(alpha)
-    ce, se = np.cos(eta), np.sin(eta)
-    h1 = c1 * s2 * sa - s1 * (1 - ca)
-    h2 = c1 * (1 - ca) + s1 * s2 * sa
-    h3 = c2 * sa
-    return np.stack([-d * h1, -d * (ce * h2 + se * h3), d * (ce * h3 - se * h2)], axis=-1)
 
 
 # ------------------------------------------------------------------------------------------ legs
@@ -439,36 +402,6 @@ def _ik_eval(cy, sy, cz, sz, g: _Geometry, signs=None, with_sc: bool = False):
     return q1, q2, c2, s2, nb2
 
 
-def _jac_general(cy, sy, cz, sz, c2, s2, nb2, g: _Geometry, e: float) -> tuple[np.ndarray, np.ndarray]:
-    """A_u's two columns (..., 3) in any assembly mode, by the chain rule through :func:`_ik_eval`.
-
-    With ``E = e L b / sqrt(2 n)`` (n = 1 + c_y c_z): ``dE = e L (2 n)^(-1/2) (db - b dn / (2 n))``;
-    ``d cos q2 = (c_K dz - s_K dy) / (d s_alpha)``, ``d sin q2 = -cos q2 d cos q2 / sin q2`` (either sign of
-    sin q2); ``q1 = atan2(P, Q)`` with ``P = k x + sigma w``, ``Q = -sigma x + k w``, ``sigma = s_alpha sin q2``,
-    ``w = -(c_K y + s_K z)``, ``k = 1 - c_alpha``: ``dq1 = (Q dP - P dQ) / (P^2 + Q^2)``. In the home mode it
-    equals eqs (103)-(105) (:func:`_jac_eval`) to rounding.
-    """
-    n = nb2
-    lead = -e * g.minus_l / np.sqrt(2.0 * n)
-    bx, by, bz = n, sz * cy, -sy
-    x, y, z = lead * bx, lead * by, lead * bz
-    w = -(g.ce * y + g.se * z)
-    sig = g.sa * s2
-    p_, q_ = g.k * x + sig * w, -sig * x + g.k * w
-    pq = p_ * p_ + q_ * q_
-    cols = []
-    for dn, dbx, dby, dbz in ((-sy * cz, -sy * cz, -sz * sy, -cy), (-cy * sz, -cy * sz, cz * cy, 0.0 * cy)):
-        h = dn / (2.0 * n)
-        dx, dy, dz = lead * (dbx - bx * h), lead * (dby - by * h), lead * (dbz - bz * h)
-        dc2 = (g.ce * dz - g.se * dy) / g.dsa
-        dsig = g.sa * (-c2 * dc2 / s2)
-        dw = -(g.ce * dy + g.se * dz)
-        dp = g.k * dx + sig * dw + w * dsig
-        dq = -sig * dx - x * dsig + g.k * dw
-        cols.append((q_ * dp - p_ * dq) / pq)
-    return cols[0], cols[1]
-
-
 def _inside(c2: np.ndarray, nb2: np.ndarray) -> np.ndarray:
     """Success mask (..., 1) of :func:`_ik_eval`: not singular, every leg reached and 1 - |cos q_K2| > BOUNDARY_TOL.
 
@@ -517,14 +450,6 @@ def _ik_error(ay, az, c2, sing, unreachable, leg_sing) -> Exception:
                 f"(cos q_{leg}2 = {float(c2[k]):.17g}); joints 1 and 3 of the leg are aligned"
             )
     return SingularityError(f"{where}: inverse kinematics failed")  # pragma: no cover
-
-
-def _checked_u(alpha_y, alpha_z, d, alpha, eta):
-    """Validate once at a public entry point: (alpha_y, alpha_z) broadcast, their cos/sin (..., 1), geometry."""
-    d, alpha, eta_arr = _params(d, alpha, eta)
-    ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))
-    yc, zc = ay[..., None], az[..., None]
-    return ay, az, (np.cos(yc), np.sin(yc), np.cos(zc), np.sin(zc)), _geometry(d, alpha, eta_arr)
 
 
 def _modes_sel(mode: str):
@@ -660,28 +585,6 @@ def ik(
     return (q, np.asarray(True)) if return_mask else q
 
 
-def _jac_eval(cy, sy, cz, sz, s2, nb2, g: _Geometry) -> tuple[np.ndarray, np.ndarray]:
-    """Unchecked eqs (103)-(105): the two columns of A_u, (..., 3) each, from the trig of u (..., 1),
-    sin q_K2 (..., 3) and 1 + c_y c_z (..., 1) of :func:`_ik_eval` (call under ``np.errstate``).
-
-    The expressions of :func:`actuation_jacobian`'s docstring, evaluated in the same order (repeated
-    sub-expressions are computed once).
-    """
-    ck, sk, n = g.ce, g.se, nb2
-    cpc = cy + cz
-    ck_cpc, sk_cpc = ck * cpc, sk * cpc
-    ck_sy, sk_sy, ck_cy = ck * sy, sk * sy, ck * cy
-    ck_sy_sz, sk_sy_sz = ck_sy * sz, sk_sy * sz
-    f = g.tan_half * (ck_sy + sk * cy * sz)  # eq (105)
-    m = g.opc * s2**2 + 1 - g.ca
-    p = n**2 + (ck_cy * sz - sk_sy) ** 2
-    den = 2 * s2 * n**2 * m
-    mf = -f
-    a1 = mf * (ck_cpc - sk_sy_sz + (ck_cy - sk_sy_sz) * n) / den - (ck_sy_sz + sk_cpc) / p
-    a2 = mf * cy * (sk_cpc + ck_sy_sz + sk * cz * n) / den + cy * (ck_cpc - sk_sy_sz) / p
-    return a1, a2
-
-
 def actuation_jacobian(
     alpha_y,
     alpha_z,
@@ -705,11 +608,11 @@ def actuation_jacobian(
 
     transcribed as printed (no error found: it matches Pinocchio's closed-loop differential kinematics
     and central differences of :func:`ik`, on the branch q_K2 in (0, pi)). A_u does not depend on d.
-    In another assembly ``mode`` (:data:`MODES`) the chain rule through that mode's IK (:func:`_jac_general`).
+    In another assembly ``mode`` (:data:`MODES`) the chain rule through that mode's IK (:func:`_k_jac_general`).
     Undefined where the pose is outside the workspace or singular (NaN / the exceptions of :func:`ik`); the
     actuation-singularity guard of :func:`ik` (:data:`DET_GUARD`) does not apply: A_u is defined there.
     """
-    g, G = _geo(d, alpha, eta)
+    G = _geo(d, alpha, eta)[1]
     if type(mode) is not str or mode != HOME_MODE:
         mode = _checked_mode(mode)
     if return_mask is not False and return_mask is not True:
@@ -841,7 +744,7 @@ _ST_FAIL = 8  # closed forms: the pose is outside / singular (the wrapper diagno
 _TWO_PI = 2.0 * math.pi
 
 
-def _geometry_vector(g: "_Geometry") -> np.ndarray:
+def _geometry_vector(g: _Geometry) -> np.ndarray:
     """The kernels' geometry: (d, c_alpha, s_alpha, k, k^2, 1 + c_alpha, d s_alpha, -L, tan(alpha/2), c_eta (3),
     s_eta (3), sin(eta_{K+2} - eta_{K+1}) (3))."""
     head = [g.d, g.ca, g.sa, g.k, g.k2, g.opc, g.dsa, g.minus_l, g.tan_half]
@@ -906,7 +809,8 @@ def _k_inside(c2a, c2b, c2c, nb2):
 
 @kernel
 def _k_jac_home(K, cy, sy, cz, sz, s2, n, G):
-    """Seed eqs (103)-(105), row K of A_u (home mode): (A_K1, A_K2) (see :func:`actuation_jacobian`)."""
+    """Seed eqs (103)-(105), row K of A_u (home mode): (A_K1, A_K2), the expressions of :func:`actuation_jacobian`'s
+    docstring evaluated in the same order (repeated sub-expressions computed once)."""
     ck, sk = G[_G_CE + K], G[_G_SE + K]
     cpc = cy + cz
     ck_cpc, sk_cpc = ck * cpc, sk * cpc
@@ -925,7 +829,14 @@ def _k_jac_home(K, cy, sy, cz, sz, s2, n, G):
 
 @kernel
 def _k_jac_general(K, cy, sy, cz, sz, c2, s2, n, G, e):
-    """Row K of A_u in any assembly mode (:func:`_jac_general`, the chain rule through the mode's IK)."""
+    """Row K of A_u in any assembly mode, by the chain rule through the mode's IK (:func:`_k_leg`).
+
+    With ``E = e L b / sqrt(2 n)`` (n = 1 + c_y c_z): ``dE = e L (2 n)^(-1/2) (db - b dn / (2 n))``;
+    ``d cos q2 = (c_K dz - s_K dy) / (d s_alpha)``, ``d sin q2 = -cos q2 d cos q2 / sin q2`` (either sign of
+    sin q2); ``q1 = atan2(P, Q)`` with ``P = k x + sigma w``, ``Q = -sigma x + k w``, ``sigma = s_alpha sin q2``,
+    ``w = -(c_K y + s_K z)``, ``k = 1 - c_alpha``: ``dq1 = (Q dP - P dQ) / (P^2 + Q^2)``. In the home mode it
+    equals eqs (103)-(105) (:func:`_k_jac_home`) to rounding.
+    """
     ce, se, k, sa = G[_G_CE + K], G[_G_SE + K], G[_G_K], G[_G_SA]
     lead = -e * G[_G_ML] / np.sqrt(2.0 * n)
     bx, by, bz = n, sz * cy, -sy
@@ -1524,7 +1435,7 @@ def _k_workspace(G, eta, ch, ay, az, cos_q2, reachable, phi, theta_k, tilt_max, 
             ratio = ch / abs(np.sin(phi[i] - eta[K]))
             v = 2.0 * np.arcsin(min(ratio, 1.0)) if ratio <= 1.0 else np.nan
             theta_k[K, i] = v
-            if v < t:
+            if v < t:  # noqa: PLR1730 (NaN: keeps t, as np.nanmin)
                 t = v
         tilt_max[i] = t
     bound = np.empty(m)
@@ -1851,18 +1762,6 @@ class Workspace:
     platform_singular: np.ndarray
     tilt_max: np.ndarray
     phi: np.ndarray
-
-
-def _tilt_to_u(theta: np.ndarray, phi: np.ndarray) -> np.ndarray:
-    ay = -np.arcsin(np.clip(np.sin(theta) * np.sin(phi), -1.0, 1.0))
-    az = np.arctan2(np.sin(theta) * np.cos(phi), np.cos(theta))
-    pts = np.stack([ay, az], axis=-1)
-    # split pieces where alpha_z wraps around
-    jump = np.abs(np.diff(az)) > np.pi
-    if np.any(jump):
-        idx = np.nonzero(jump)[0] + 1
-        pts = np.insert(pts, idx, np.nan, axis=0)
-    return pts
 
 
 def workspace(

@@ -143,6 +143,16 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
     def batch_ik(p):
         return aq.foot_ik(p, LEG)
 
+    def batch_ik_one_thread(p):  # the same call on one numba thread (the thread count restored after)
+        import numba
+
+        before = numba.get_num_threads()
+        numba.set_num_threads(1)
+        try:
+            return aq.foot_ik(p, LEG)
+        finally:
+            numba.set_num_threads(before)
+
     def scalar_ik(p):
         out = np.full((len(p), 3), np.nan)
         for i, pi in enumerate(p):
@@ -181,6 +191,8 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
 
     methods = [
         Method(f"legkin batch closed form (foot_ik, {n_batch} at once)", targets, batch_ik, joints_score, repeats=7),
+        Method("legkin batch closed form, 1 thread (numba.set_num_threads(1))", targets, batch_ik_one_thread,
+               joints_score, repeats=7),
         Method("legkin batch FK (foot_position)", q_gen, lambda q: aq.foot_position(q, LEG), fk_score,
                repeats=7),
         Method("floor: foot_ik's transcendental calls alone (2 sqrt, acos, 2 atan2)", targets, floor_run,
@@ -271,13 +283,15 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         batch = next(r for r in results if "batch closed form" in r.name)
         fk = next(r for r in results if "batch FK" in r.name)
         floor = next(r for r in results if r.group == "floor")
+        one = next(r for r in results if "1 thread" in r.name)
         lines = [
             f"batch closed form: {1.0 / batch.time_per_target_s / 1e6:.2f} M targets/s on "
             f"{numba.get_num_threads()} thread(s); IK/floor = {batch.time_per_target_s / floor.time_per_target_s:.1f}"
-            f" (floor = its transcendental calls alone); IK/FK = {batch.time_per_target_s / fk.time_per_target_s:.1f}"
+            f" (floor = its transcendental calls alone); IK/FK = {batch.time_per_target_s / fk.time_per_target_s:.1f}; "
+            f"{numba.get_num_threads()} threads vs 1: {one.time_per_target_s / batch.time_per_target_s:.2f}x faster"
         ]
         for r in by.values():
-            if r is batch or r is fk or r is floor:
+            if r is batch or r is fk or r is floor or r is one:
                 continue
             speedup = r.time_per_target_s / batch.time_per_target_s
             lines.append(f"batch closed form is {speedup:,.0f}x faster than {r.name}")

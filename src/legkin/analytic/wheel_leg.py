@@ -387,6 +387,90 @@ def _xyw(z: np.ndarray, w) -> np.ndarray:
     return np.stack(np.broadcast_arrays(z.real, z.imag, np.asarray(w, dtype=float)), axis=-1)
 
 
+#: For each name of :data:`POINTS`: (index in :data:`_CF_NAMES` or -1 for O, conjugated: right half).
+_POINT_SOURCE = tuple(
+    (-1 if n == "O" else _CF_NAMES.index(n.rsplit("_", 1)[0] if n.endswith(("_L", "_R")) else n), n.endswith("_R"))
+    for n in POINTS
+)
+_PT_INDEX = np.array([i for i, _ in _POINT_SOURCE], dtype=np.int64)
+_PT_CONJ = np.array([c for _, c in _POINT_SOURCE], dtype=np.bool_)
+
+
+@kernel
+def _k_linkage(theta, beta, K, KC, idx, conj, out):
+    """:func:`linkage_points` for one (theta, beta) into ``out`` (22, 3): the closed form (:func:`_k_closed`),
+    right half = conjugates, rotated by ``exp(i (beta + pi/2))``, w = 0."""
+    pts, _der = _k_closed(theta, K, KC, False)
+    rot = complex(math.cos(beta + math.pi / 2), math.sin(beta + math.pi / 2))
+    for j in range(idx.shape[0]):
+        i = idx[j]
+        if i < 0:
+            v = 0j
+        else:
+            v = pts[0]
+            for k in range(12):  # (a tuple is indexed by constants only)
+                if k == i:
+                    v = pts[k]
+        if conj[j]:
+            v = v.conjugate()
+        v = rot * v
+        out[j, 0], out[j, 1], out[j, 2] = v.real, v.imag, 0.0
+
+
+@_loop(4096)
+def _k_linkage_batch(theta, beta, K, KC, idx, conj, out):
+    """:func:`_k_linkage` over theta, beta (n,) into out (n, 22, 3)."""
+    for i in prange(theta.shape[0]):
+        _k_linkage(theta[i], beta[i], K, KC, idx, conj, out[i])
+
+
+@kernel
+def _k_passive(theta, beta, K, KC, out):
+    """:func:`passive_angles` for one (theta, beta) into ``out`` (10,) in the order of :data:`PASSIVE_JOINTS`:
+    the link orientations of the closed form at theta and at theta0, ``d(link) = arg(u(theta) conj(u(theta0)))``
+    with the unit vectors u of the crank (A), bar AE (E - A), bar CD (C - D), upper rim (C - B), lower rim (G - F)."""
+    now, _d = _k_closed(theta, K, KC, False)
+    ref, _d = _k_closed(THETA0, K, KC, False)
+    d = np.empty(5)
+    for j in range(5):
+        if j == 0:
+            a, b = now[_IA], ref[_IA]
+        elif j == 1:
+            a, b = now[_IE] - now[_IA], ref[_IE] - ref[_IA]
+        elif j == 2:
+            a, b = now[_IC] - now[_ID], ref[_IC] - ref[_ID]
+        elif j == 3:
+            a, b = now[_IC] - now[_IB], ref[_IC] - ref[_IB]
+        else:
+            a, b = now[_IG] - now[_IF], ref[_IG] - ref[_IF]
+        z = (a / abs(a)) * (b / abs(b)).conjugate()
+        d[j] = math.atan2(z.imag, z.real)
+    out[0] = beta + (theta - THETA0)
+    out[1] = beta - (theta - THETA0)
+    hA, hB, hD, hF = d[1] - d[0], d[3] - d[0], d[2] - d[1], d[4] - d[3]
+    out[2], out[3], out[4], out[5] = hA, -hA, hB, -hB
+    out[6], out[7], out[8], out[9] = hD, -hD, hF, -hF
+
+
+@_loop(4096)
+def _k_passive_batch(theta, beta, K, KC, out):
+    """:func:`_k_passive` over theta, beta (n,) into out (n, 10)."""
+    for i in prange(theta.shape[0]):
+        _k_passive(theta[i], beta[i], K, KC, out[i])
+
+
+def _angle_pair(theta, beta):
+    """(theta, beta) checked, broadcast and flattened; the fast path for two numbers. Returns
+    (theta (n,), beta (n,), shape)."""
+    if type(theta) in _SCALARS and type(beta) in _SCALARS:
+        t = float(theta)
+        if THETA_MIN - 1e-12 <= t <= THETA_MAX + 1e-12 and math.isfinite(beta):
+            return np.array([t]), np.array([float(beta)]), ()
+    theta, beta = as_angles(theta, beta, names=("theta", "beta"))
+    _check_theta(theta)
+    return as_rows(theta, 1)[:, 0], as_rows(beta, 1)[:, 0], theta.shape
+
+
 def linkage_points(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict[str, np.ndarray]:
     """Every hinge point and rim centre of the leg in the leg frame {L}, by the closed form.
 
@@ -404,25 +488,12 @@ def linkage_points(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict
     Returns:
         dict name -> array (..., 3) of (x, y, w = 0) in {L}; names in :data:`POINTS`.
     """
-    geo = _geometry(geometry)
-    theta, beta = as_angles(theta, beta, names=("theta", "beta"))
-    _check_theta(theta)
-    pts, _ = _closed_form(theta, _constants(geo.R), geo.R + FOOT_OFFSET, want_der=False)
-    rot = _rot(beta)
-    return {k: _xyw(rot * v, 0.0) for k, v in _both_halves(pts).items()}
-
-
-def _link_angles(pts: dict) -> dict:
-    """Absolute orientation (as unit complex numbers) of the left-half links."""
-    def unit(v):
-        return v / np.abs(v)
-    return dict(
-        crank=unit(pts["A"]),
-        bar_AE=unit(pts["E"] - pts["A"]),
-        bar_CD=unit(pts["C"] - pts["D"]),
-        rim_upper=unit(pts["C"] - pts["B"]),
-        rim_lower=unit(pts["G"] - pts["F"]),
-    )
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    t, b, shape = _angle_pair(theta, beta)
+    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    out = np.empty((t.shape[0], len(POINTS), 3))
+    _k_linkage_batch(t, b, K, KC, _PT_INDEX, _PT_CONJ, out)
+    return {k: out[:, j].reshape(shape + (3,)) for j, k in enumerate(POINTS)}
 
 
 def passive_angles(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict[str, np.ndarray]:
@@ -443,20 +514,12 @@ def passive_angles(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict
     Returns:
         dict joint name (without the ``<leg>_`` prefix, see :data:`PASSIVE_JOINTS`) -> array.
     """
-    geo = _geometry(geometry)
-    theta, beta = as_angles(theta, beta, names=("theta", "beta"))
-    _check_theta(theta)
-    c = _constants(geo.R)
-    now = _link_angles(_closed_form(theta, c, geo.R, want_der=False, full=False)[0])
-    ref = _link_angles(_closed_form(np.array(THETA0), c, geo.R, want_der=False, full=False)[0])
-    d = {k: np.angle(now[k] * np.conj(ref[k])) for k in now}
-    out = {"phi_L": beta + (theta - THETA0), "phi_R": beta - (theta - THETA0)}
-    for hinge, child, parent in (
-        ("A", "bar_AE", "crank"), ("B", "rim_upper", "crank"), ("D", "bar_CD", "bar_AE"), ("F", "rim_lower", "rim_upper"),
-    ):  # fmt: skip
-        a = d[child] - d[parent]
-        out[f"hinge_{hinge}_L"], out[f"hinge_{hinge}_R"] = a, -a
-    return {k: out[k] for k in PASSIVE_JOINTS}
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    t, b, shape = _angle_pair(theta, beta)
+    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    out = np.empty((t.shape[0], len(PASSIVE_JOINTS)))
+    _k_passive_batch(t, b, K, KC, out)
+    return {k: out[:, j].reshape(shape) for j, k in enumerate(PASSIVE_JOINTS)}
 
 
 def motor_angles(theta, beta) -> tuple[np.ndarray, np.ndarray]:
@@ -694,6 +757,65 @@ def _rim_seed(theta, beta, alpha, geo: Geometry, radius: float, want_der: bool):
     return _rim(theta, beta, alpha, geo, radius, want_der, True)
 
 
+@kernel
+def _k_rim(theta, beta, alpha, w, seed, rho, K, KC, out):
+    """:func:`rim_point` (``seed=False``) / :func:`rim_point_seed` for one item into ``out`` (3,): the arc of
+    :func:`_k_select`, the point of :func:`_k_plane`, rotated by ``exp(i (beta + pi/2))``."""
+    upper, right, e = _k_select(alpha, seed, rho, K[0])
+    z, _dz = _k_plane(theta, upper, right, e, seed, K, KC, False, True)
+    z = complex(math.cos(beta + math.pi / 2), math.sin(beta + math.pi / 2)) * z
+    out[0], out[1], out[2] = z.real, z.imag, w
+
+
+@_loop(4096)
+def _k_rim_batch(theta, beta, alpha, w, seed, rho, K, KC, out):
+    """:func:`_k_rim` over theta, beta, alpha, w (n,) into out (n, 3)."""
+    for i in prange(theta.shape[0]):
+        _k_rim(theta[i], beta[i], alpha[i], w[i], seed, rho, K, KC, out[i])
+
+
+_PSI_NEXT = float(np.nextafter(PSI_FG, 4.0))
+
+
+@kernel
+def _k_jump(theta, rho, K, KC):
+    """:func:`rim_jump_seed` for one theta: ``|z(psi_FG+) - z(psi_FG)|`` on the seed rim (beta = 0)."""
+    rot = complex(math.cos(math.pi / 2), math.sin(math.pi / 2))
+    u1, r1, e1 = _k_select(PSI_FG, True, rho, K[0])
+    u2, r2, e2 = _k_select(_PSI_NEXT, True, rho, K[0])
+    z1, _d = _k_plane(theta, u1, r1, e1, True, K, KC, False, True)
+    z2, _d = _k_plane(theta, u2, r2, e2, True, K, KC, False, True)
+    return abs(rot * z2 - rot * z1)
+
+
+@_loop(4096)
+def _k_jump_batch(theta, rho, K, KC, out):
+    """:func:`_k_jump` over theta (n,) into out (n,)."""
+    for i in prange(theta.shape[0]):
+        out[i] = _k_jump(theta[i], rho, K, KC)
+
+
+def _rim_call(theta, beta, alpha, w, radius, geometry, seed):
+    """The wrapper of :func:`rim_point` / :func:`rim_point_seed`: checks (fast path for four numbers), then
+    the batch of :func:`_k_rim`."""
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    rho = (geo.R + FOOT_OFFSET if seed else geo.R) if radius is None else None
+    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    if (rho is not None and type(theta) in _SCALARS and type(beta) in _SCALARS and type(alpha) in _SCALARS and type(w) in _SCALARS
+            and THETA_MIN - 1e-12 <= theta <= THETA_MAX + 1e-12 and math.isfinite(beta)
+            and abs(alpha) <= math.pi + 1e-12 and abs(w) <= geo.T / 2 + 1e-15):
+        out = np.empty(3)
+        _k_rim(float(theta), float(beta), float(alpha), float(w), seed, rho, K, KC, out)
+        return out
+    theta, beta, alpha, w = _rim_inputs(theta, beta, alpha, w, geo)
+    if rho is None:
+        rho = float(radius)
+    shape = theta.shape
+    out = np.empty((int(np.prod(shape, dtype=int)), 3))
+    _k_rim_batch(*(as_rows(x, 1)[:, 0] for x in (theta, beta, alpha, w)), seed, rho, K, KC, out)
+    return out.reshape(shape + (3,))
+
+
 def _rim_inputs(theta, beta, alpha, w, geo):
     theta, beta, alpha, w = as_angles(theta, beta, alpha, w, names=("theta", "beta", "alpha", "w"))
     _check_theta(theta)
@@ -729,10 +851,7 @@ def rim_point(theta, beta, alpha, w=0.0, *, radius: float | None = None, geometr
     Returns:
         array (..., 3): (x, y, w) in {L}.
     """
-    geo = _geometry(geometry)
-    theta, beta, alpha, w = _rim_inputs(theta, beta, alpha, w, geo)
-    z, _ = _rim_continuous(theta, beta, alpha, geo, geo.R if radius is None else float(radius), False)
-    return _xyw(z, w)
+    return _rim_call(theta, beta, alpha, w, radius, geometry, False)
 
 
 def rim_point_seed(theta, beta, alpha, w=0.0, *, radius: float | None = None, geometry: Geometry | None = None):
@@ -750,11 +869,7 @@ def rim_point_seed(theta, beta, alpha, w=0.0, *, radius: float | None = None, ge
     leaves out the lower-rim arcs: it is discontinuous at alpha = +-psi_FG once theta > theta0
     (:func:`rim_jump_seed`), and the toe arc about O_r is not attached to any link.
     """
-    geo = _geometry(geometry)
-    theta, beta, alpha, w = _rim_inputs(theta, beta, alpha, w, geo)
-    rho = geo.R + FOOT_OFFSET if radius is None else float(radius)
-    z, _ = _rim_seed(theta, beta, alpha, geo, rho, False)
-    return _xyw(z, w)
+    return _rim_call(theta, beta, alpha, w, radius, geometry, True)
 
 
 def rim_jump_seed(theta, *, radius: float | None = None, geometry: Geometry | None = None) -> np.ndarray:
@@ -762,14 +877,14 @@ def rim_jump_seed(theta, *, radius: float | None = None, geometry: Geometry | No
 
     The distance between the toe-arc point at alpha = psi_FG and the upper-rim point at alpha -> psi_FG+.
     """
-    geo = _geometry(geometry)
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     theta = as_input(theta, "theta")
     _check_theta(theta)
     rho = geo.R + FOOT_OFFSET if radius is None else float(radius)
-    a = np.full(theta.shape, PSI_FG)
-    inside, _ = _rim_seed(theta, 0.0, a, geo, rho, False)
-    above, _ = _rim_seed(theta, 0.0, np.nextafter(a, 4.0), geo, rho, False)
-    return np.abs(above - inside)
+    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    out = np.empty(theta.size)
+    _k_jump_batch(as_rows(theta, 1)[:, 0], rho, K, KC, out)
+    return out.reshape(theta.shape)
 
 
 # ---------------------------------------------------------------- leg frame -> robot frame

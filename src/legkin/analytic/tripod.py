@@ -697,7 +697,8 @@ def _initial_guess(qm: np.ndarray, g: _Geometry, with_det: bool = False):
 
 
 def _gauss_newton_step(a1: np.ndarray, a2: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``-pinv(A) r`` for ``A = [a1 a2]`` (n, 3, 2) given as its columns (n, 3), without an SVD; (n, 1) each.
+    """``-pinv(A) r`` for ``A = [a1 a2]`` (n, 3, 2) given as its columns (n, 3), without an SVD; (n, 1) each (a loop over
+    the kernel :func:`_k_gn_step`, for tests).
 
     Least squares in closed form: with ``n = a1 x a2``, ``|n|^2 = det(A^T A)`` (Lagrange's identity) and the
     normal equations solved by Cramer's rule, ``x = ((r x a2) . n, (a1 x r) . n) / |n|^2``. Written with cross
@@ -706,17 +707,11 @@ def _gauss_newton_step(a1: np.ndarray, a2: np.ndarray, r: np.ndarray) -> tuple[n
     the second column vanish), the rank-1 pseudo-inverse ``A^T r / |A|_F^2`` is used, as ``np.linalg.pinv``
     with that rcond would (``0`` for ``A = 0``).
     """
-    a1i, a1j, a2i, a2j, ri, rj = a1[:, _NEXT], a1[:, _PREV], a2[:, _NEXT], a2[:, _PREV], r[:, _NEXT], r[:, _PREV]
-    n = a1i * a2j - a1j * a2i  # a1 x a2
-    nn = np.add.reduce(n * n, axis=-1, keepdims=True)
-    s0 = np.add.reduce((a2i * rj - a2j * ri) * n, axis=-1, keepdims=True) / nn  # -((r x a2) . n) / |n|^2
-    s1 = np.add.reduce((ri * a1j - rj * a1i) * n, axis=-1, keepdims=True) / nn  # -((a1 x r) . n) / |n|^2
-    f = np.add.reduce(a1 * a1 + a2 * a2, axis=-1, keepdims=True)
-    rank1 = nn <= (STEP_RCOND * STEP_RCOND) * f * f
-    if rank1.any():
-        fs = np.where(f > 0, f, 1.0)
-        s0 = np.where(rank1, -np.add.reduce(a1 * r, axis=-1, keepdims=True) / fs, s0)
-        s1 = np.where(rank1, -np.add.reduce(a2 * r, axis=-1, keepdims=True) / fs, s1)
+    rows = [np.ascontiguousarray(v, dtype=np.float64).reshape(-1, 3) for v in (a1, a2, r)]
+    n = rows[0].shape[0]
+    s0, s1 = np.empty((n, 1)), np.empty((n, 1))
+    for i in range(n):  # the kernel of fk's iteration (:func:`_k_gn_step`), item by item
+        s0[i, 0], s1[i, 0] = _k_gn_step(rows[0][i], rows[1][i], rows[2][i])
     return s0, s1
 
 

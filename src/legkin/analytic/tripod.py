@@ -195,10 +195,10 @@ def leg_transform(q, eta: float, d: float = D, alpha: float = ALPHA) -> np.ndarr
         d, alpha, _ = _params(d, alpha)
     eta = _angle(eta, "eta")
     G = _geo(d, alpha, None)[1] if type(d) is float and type(alpha) is float else _geo(float(d), float(alpha), None)[1]
-    if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (4,) and np.isfinite(q).all():
+    if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (4,):
         T = np.empty((4, 4))
-        _k_leg_transform(q[0], q[1], q[2], q[3], eta, alpha, G, T)
-        return T
+        if _k_leg_transform(q[0], q[1], q[2], q[3], eta, alpha, G, T) == OK:
+            return T
     q = as_input(q, "q", (4,))
     shape = q.shape[:-1]
     rows = np.ascontiguousarray(q.reshape(-1, 4))
@@ -1284,7 +1284,9 @@ def _k_leg_position(q1, q2, eta, G, T):
 
 @kernel
 def _k_leg_transform(q1, q2, q3, q4, eta, alpha, G, T):
-    """:func:`leg_transform` of one joint vector into T (4, 4)."""
+    """:func:`leg_transform` of one joint vector into T (4, 4); returns OK or _ST_NONFINITE (T not written)."""
+    if not (np.isfinite(q1) and np.isfinite(q2) and np.isfinite(q3) and np.isfinite(q4)):
+        return _ST_NONFINITE
     R = _k_matmul3(_k_rot(0, eta), _k_rot(2, math.pi))  # Rx(eta) Rz(pi) Rz(q1) Ry(q2) Rx(-alpha) Ry(q3) Rz(-q4) Rx(pi - eta)
     R = _k_matmul3(R, _k_rot(2, q1))
     R = _k_matmul3(R, _k_rot(1, q2))
@@ -1295,6 +1297,7 @@ def _k_leg_transform(q1, q2, q3, q4, eta, alpha, G, T):
     for i in range(3):
         T[i, 0], T[i, 1], T[i, 2] = R[3 * i], R[3 * i + 1], R[3 * i + 2]
     _k_leg_position(q1, q2, eta, G, T)
+    return OK
 
 
 @kernel
@@ -1360,6 +1363,15 @@ def _uv_closed(kind: int, alpha_y, alpha_z, core: tuple, G):
     for c in core:
         size *= c
     if isinstance(alpha_y, float) and isinstance(alpha_z, float) and math.isfinite(alpha_y) and math.isfinite(alpha_z):
+        if kind != 0:  # one item: the scalar kernel straight into the result
+            res = np.empty(core)
+            if kind == 1:
+                _k_platform_axis(float(alpha_y), float(alpha_z), res)
+            elif kind == 2:
+                _k_platform_position(float(alpha_y), float(alpha_z), G, res)
+            else:
+                _k_platform_rotation(float(alpha_y), float(alpha_z), res)
+            return res
         y, z, shape = np.array([float(alpha_y)]), np.array([float(alpha_z)]), ()
     else:
         ay, az = as_angles(alpha_y, alpha_z, names=("alpha_y", "alpha_z"))

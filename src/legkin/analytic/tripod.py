@@ -995,12 +995,17 @@ def _k_shrunk(ay, az, f):
 
 
 @kernel
-def _k_fk_report(ay, az, qm, G, home, e, s, a1, a2, q1, c2, s2, sn, cn, r):
-    """The reported pose (alpha_y in [-pi/2, pi/2]), its inconsistency, ik's success test and the rounding floor."""
+def _k_fk_report(ay, az, qm, G, home, e, s, a1, a2, q1, c2, s2, sn, cn, r, last):
+    """The reported pose (alpha_y in [-pi/2, pi/2]), its inconsistency, ik's success test and the rounding floor.
+    ``last`` = (alpha_y, alpha_z, 1 + c_y c_z) of the pose q1, c2, ... were last evaluated at: reused when the
+    reported pose is that one (the usual exit: converged without a further step)."""
     if np.cos(ay) < 0:
         ay, az = math.pi - ay, az + math.pi
     ay, az = _k_wrap(ay), _k_wrap(az)
-    nb2 = _k_pose(np.cos(ay), np.sin(ay), np.cos(az), np.sin(az), G, home, e, s, q1, c2, s2, sn, cn)
+    if ay == last[0] and az == last[1] and ay != 0.0 and az != 0.0:  # (not at a signed zero: same bits)
+        nb2 = last[2]
+    else:
+        nb2 = _k_pose(np.cos(ay), np.sin(ay), np.cos(az), np.sin(az), G, home, e, s, q1, c2, s2, sn, cn)
     for K in range(3):
         r[K] = _k_wrap(q1[K] - qm[K])
     inc, norm_a = _k_normal_residual(a1, a2, r)
@@ -1035,9 +1040,11 @@ def _k_fk(qa, qb, qc, G, home, e, s, tol, max_iter, max_inc, out):
     tries = 0
     a1[:] = np.nan
     a2[:] = np.nan
+    last = (np.nan, np.nan, np.nan)
     for _ in range(max_iter):
         cy, sy, cz, sz = np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
         nb2 = _k_pose(cy, sy, cz, sz, G, home, e, s, q1, c2, s2, sn, cn)
+        last = (ay, az, nb2)
         rr = 0.0
         for K in range(3):
             r[K] = _k_wrap(q1[K] - qm[K])
@@ -1081,9 +1088,10 @@ def _k_fk(qa, qb, qc, G, home, e, s, tol, max_iter, max_inc, out):
             break
     if not np.isfinite(py):
         active = False
-    ry, rz, inc, inside, floor = _k_fk_report(ay, az, qm, G, home, e, s, a1, a2, q1, c2, s2, sn, cn, r)
+    ry, rz, inc, inside, floor = _k_fk_report(ay, az, qm, G, home, e, s, a1, a2, q1, c2, s2, sn, cn, r, last)
     if converged and not inside:  # the last (tiny) step left the workspace: report the iterate before it
-        by, bz, binc, binside, bfloor = _k_fk_report(py, pz, qm, G, home, e, s, a1, a2, q1, c2, s2, sn, cn, r)
+        last = (np.nan, np.nan, np.nan)  # q1, c2, ... now hold the reported pose's, not py's
+        by, bz, binc, binside, bfloor = _k_fk_report(py, pz, qm, G, home, e, s, a1, a2, q1, c2, s2, sn, cn, r, last)
         if binside:
             ry, rz, inc, inside, floor = by, bz, binc, binside, bfloor
     out[0], out[1], out[2] = ry, rz, inc

@@ -309,7 +309,7 @@ def _k_closed(theta, K, KC, want_der):
     return pts, (dA, dB, dC, dD, complex(dE, 0.0), dF, dG, dU, dL, dH, dG, dJ)
 
 
-@_loop(4096)
+@_loop(32768)
 def _k_closed_batch(theta, K, KC, want_der, P, DP):
     """:func:`_k_closed` over theta (n,) into P, DP (n, 12)."""
     for i in prange(theta.shape[0]):
@@ -341,20 +341,6 @@ def _closed_form(theta: np.ndarray, c: _Const, foot_radius: float, want_der: boo
     return pts, {"O": zero, **{k: DP[:, j].reshape(theta.shape) for j, k in enumerate(names)}}
 
 
-_ON_AXIS = ("O", "E", "G", "O_r")
-
-
-def _both_halves(half: dict) -> dict:
-    """Left-half dict -> dict keyed by POINTS (right half = conjugates), still unrotated."""
-    out = {}
-    for k, v in half.items():
-        if k in _ON_AXIS:
-            out[k] = v
-        else:
-            out[k + "_L"], out[k + "_R"] = v, np.conj(v)
-    return out
-
-
 def _check_theta(theta: np.ndarray, name: str = "theta") -> None:
     bad = (theta < THETA_MIN - 1e-12) | (theta > THETA_MAX + 1e-12)
     if np.any(bad):
@@ -381,10 +367,6 @@ def _check_w(w: np.ndarray, geo: Geometry) -> None:
 
 def _rot(beta: np.ndarray) -> np.ndarray:
     return _cis(beta + math.pi / 2)
-
-
-def _xyw(z: np.ndarray, w) -> np.ndarray:
-    return np.stack(np.broadcast_arrays(z.real, z.imag, np.asarray(w, dtype=float)), axis=-1)
 
 
 #: For each name of :data:`POINTS`: (index in :data:`_CF_NAMES` or -1 for O, conjugated: right half).
@@ -417,7 +399,7 @@ def _k_linkage(theta, beta, K, KC, idx, conj, out):
         out[j, 0], out[j, 1], out[j, 2] = v.real, v.imag, 0.0
 
 
-@_loop(4096)
+@_loop(32768)
 def _k_linkage_batch(theta, beta, K, KC, idx, conj, out):
     """:func:`_k_linkage` over theta, beta (n,) into out (n, 22, 3)."""
     for i in prange(theta.shape[0]):
@@ -452,7 +434,7 @@ def _k_passive(theta, beta, K, KC, out):
     out[6], out[7], out[8], out[9] = hD, -hD, hF, -hF
 
 
-@_loop(4096)
+@_loop(32768)
 def _k_passive_batch(theta, beta, K, KC, out):
     """:func:`_k_passive` over theta, beta (n,) into out (n, 10)."""
     for i in prange(theta.shape[0]):
@@ -576,53 +558,6 @@ class _Sel(NamedTuple):
         return _Sel(self.seed, self.upper[idx], self.right[idx], self.e[idx])
 
 
-def _select(alpha: np.ndarray, seed: bool, radius: float, R: float) -> _Sel:
-    """The arc of every alpha (:data:`_SEGMENTS` for the continuous rim; seed 1.1's three arcs)."""
-    alpha = np.asarray(alpha, dtype=float)
-    if seed:
-        up_r, up_l = alpha > PSI_FG, alpha < -PSI_FG
-        a0 = np.where(up_r, PSI_FG, np.where(up_l, -PSI_FG, 0.0))
-        e = _cis(alpha - a0) * radius
-        upper, right = up_r | up_l, up_r
-    else:
-        seg = rim_segment(alpha)
-        a0 = np.asarray(_SEG_A0)[seg]
-        e = _cis(alpha - a0) * radius / R
-        upper, right = (seg == 0) | (seg == 3), seg >= 2
-    return _Sel(seed, upper, right, np.where(right, np.conj(e), e))
-
-
-def _plane(pts: dict, der: dict | None, sel: _Sel, want_der: bool, conj: bool = True):
-    """Contact point z (complex, leg plane, before the beta rotation) and dz/dtheta from the closed form.
-
-    With ``conj=False`` the right-half points are left unconjugated (same modulus: what the radial IK uses).
-    """
-    up = sel.upper
-    lo_c, lo_r = ("O_r", "G") if sel.seed else ("L", "G")
-    hi_r = "J" if sel.seed else "F"
-    ctr = np.where(up, pts["U"], pts[lo_c])
-    v = np.where(up, pts[hi_r], pts[lo_r]) - ctr
-    if sel.seed:
-        nv = np.abs(v)
-        y = ctr + sel.e * v / nv
-    else:
-        y = ctr + sel.e * v
-    dy = None
-    if want_der:
-        dc = np.where(up, der["U"], der[lo_c])
-        dv = np.where(up, der[hi_r], der[lo_r]) - dc
-        if sel.seed:
-            dnv = (np.conj(v) * dv).real / nv
-            dy = dc + sel.e * (dv - v * dnv / nv) / nv
-        else:
-            dy = dc + sel.e * dv
-    if conj:
-        y = np.where(sel.right, np.conj(y), y)
-        if want_der:
-            dy = np.where(sel.right, np.conj(dy), dy)
-    return y, dy
-
-
 @kernel
 def _k_select(alpha, seed, rho, R):
     """:func:`_select` for one alpha: (upper, right, e) (``e`` conjugated on the right half)."""
@@ -674,6 +609,31 @@ def _k_plane(theta, upper, right, e, seed, K, KC, want_der, conj):
     return y, dy
 
 
+@_loop(32768)
+def _k_select_batch(alpha, seed, rho, R, upper, right, e):
+    """:func:`_k_select` over alpha (n,) into upper, right, e (n,)."""
+    for i in prange(alpha.shape[0]):
+        upper[i], right[i], e[i] = _k_select(alpha[i], seed, rho, R)
+
+
+def _select(alpha: np.ndarray, seed: bool, radius: float, R: float) -> _Sel:
+    """The arc of every alpha (:data:`_SEGMENTS` for the continuous rim; seed 1.1's three arcs): the batch of
+    :func:`_k_select`."""
+    alpha = np.asarray(alpha, dtype=np.float64)
+    flat = as_rows(alpha, 1)[:, 0]
+    n = flat.shape[0]
+    upper, right, e = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.complex128)
+    _k_select_batch(flat, bool(seed), float(radius), float(R), upper, right, e)
+    return _Sel(seed, upper.reshape(alpha.shape), right.reshape(alpha.shape), e.reshape(alpha.shape))
+
+
+@_loop(32768)
+def _k_plane_batch(theta, upper, right, e, seed, K, KC, z):
+    """:func:`_k_plane` (no derivative, right halves conjugated) over theta and the arc choice (n,) into z."""
+    for i in prange(theta.shape[0]):
+        z[i], _dz = _k_plane(theta[i], upper[i], right[i], e[i], seed, K, KC, False, True)
+
+
 #: Kernel status codes (besides :data:`OK`): NaN/inf input or result, theta / alpha / w out of range.
 _NONFINITE, _THETA_RANGE, _ALPHA_RANGE, _W_RANGE = 1, 2, 3, 4
 
@@ -723,7 +683,7 @@ def _k_contact(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, wan
     return _k_fk(theta, q[1], q[2], upper, right, e, seed, K, KC, s, dwheel + s * w, o0, o1, o2, want_jac, p, J)
 
 
-@_loop(4096)
+@_loop(32768)
 def _k_contact_batch(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac, P, J, status):
     """:func:`_k_contact` over q (n, 3), alpha, w (n,) into P (n, 3), J (n, 9), status (n,)."""
     for i in prange(q.shape[0]):
@@ -731,30 +691,12 @@ def _k_contact_batch(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o
                                P[i], J[i])
 
 
-@_loop(4096)
+@_loop(32768)
 def _k_fk_batch(q, upper, right, e, a, seed, K, KC, s, o0, o1, o2, want_jac, P, J):
     """:func:`_k_fk` over q (n, 3) and the prepared arc choice (:class:`_Sel`) into P (n, 3), J (n, 9)."""
     for i in prange(q.shape[0]):
         _k_fk(q[i, 0], q[i, 1], q[i, 2], upper[i], right[i], e[i], seed, K, KC, s, a[i], o0, o1, o2, want_jac,
               P[i], J[i])
-
-
-def _rim(theta, beta, alpha, geo: Geometry, radius: float, want_der: bool, seed: bool):
-    sel = _select(alpha, seed, radius, geo.R)
-    pts, der = _closed_form(theta, _constants(geo.R), geo.R + FOOT_OFFSET, want_der, full=seed)
-    z, dz = _plane(pts, der, sel, want_der)
-    rot = _rot(beta)
-    return rot * z, (rot * dz if want_der else None)
-
-
-def _rim_continuous(theta, beta, alpha, geo: Geometry, radius: float, want_der: bool):
-    """:func:`rim_point`'s arcs in the leg plane (complex, rotated by beta) and their theta-derivatives."""
-    return _rim(theta, beta, alpha, geo, radius, want_der, False)
-
-
-def _rim_seed(theta, beta, alpha, geo: Geometry, radius: float, want_der: bool):
-    """:func:`rim_point_seed`'s arcs in the leg plane (complex, rotated by beta) and their theta-derivatives."""
-    return _rim(theta, beta, alpha, geo, radius, want_der, True)
 
 
 @kernel
@@ -767,7 +709,7 @@ def _k_rim(theta, beta, alpha, w, seed, rho, K, KC, out):
     out[0], out[1], out[2] = z.real, z.imag, w
 
 
-@_loop(4096)
+@_loop(32768)
 def _k_rim_batch(theta, beta, alpha, w, seed, rho, K, KC, out):
     """:func:`_k_rim` over theta, beta, alpha, w (n,) into out (n, 3)."""
     for i in prange(theta.shape[0]):
@@ -788,7 +730,7 @@ def _k_jump(theta, rho, K, KC):
     return abs(rot * z2 - rot * z1)
 
 
-@_loop(4096)
+@_loop(32768)
 def _k_jump_batch(theta, rho, K, KC, out):
     """:func:`_k_jump` over theta (n,) into out (n,)."""
     for i in prange(theta.shape[0]):
@@ -917,10 +859,24 @@ def module_origin(leg, geometry: Geometry | None = None) -> np.ndarray:
     return np.array([sx * geo.L_body / 2, sy * geo.W_body / 2, geo.d_abad])
 
 
-def _rz(gamma: np.ndarray) -> np.ndarray:
-    c, s = np.cos(gamma), np.sin(gamma)
-    o, z = np.ones_like(c), np.zeros_like(c)
-    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
+@kernel
+def _k_frame(p, gamma, RLM, R0, dwheel, o, out):
+    """:func:`leg_frame_to_robot` for one point: ``out = o + R0 Rz(gamma) (RLM p + (d_wheel, 0, 0))``."""
+    pm = np.empty(3)
+    for i in range(3):
+        pm[i] = RLM[i, 0] * p[0] + RLM[i, 1] * p[1] + RLM[i, 2] * p[2]
+    pm[0] += dwheel
+    c, s_ = math.cos(gamma), math.sin(gamma)
+    r0, r1, r2 = c * pm[0] - s_ * pm[1], s_ * pm[0] + c * pm[1], pm[2]
+    for i in range(3):
+        out[i] = o[i] + R0[i, 0] * r0 + R0[i, 1] * r1 + R0[i, 2] * r2
+
+
+@_loop(32768)
+def _k_frame_batch(p, gamma, RLM, R0, dwheel, o, out):
+    """:func:`_k_frame` over p (n, 3), gamma (n,) into out (n, 3)."""
+    for i in prange(p.shape[0]):
+        _k_frame(p[i], gamma[i], RLM, R0, dwheel, o, out[i])
 
 
 def leg_frame_to_robot(p_L, gamma, leg, *, geometry: Geometry | None = None) -> np.ndarray:
@@ -929,13 +885,25 @@ def leg_frame_to_robot(p_L, gamma, leg, *, geometry: Geometry | None = None) -> 
     ``p_M = T_L^M p_L`` (the seed's matrices, offset d_wheel), ``p_R = o_i + R0_i Rz(gamma) p_M``; the
     seed does not print ``T_M^R``: this is the module placement of "Coord definitions".
     """
-    geo = _geometry(geometry)
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     _, side, _ = _leg(leg)
+    o = module_origin(leg, geo)
+    if (type(p_L) is np.ndarray and p_L.shape == (3,) and p_L.dtype == np.float64 and type(gamma) in _SCALARS
+            and math.isfinite(gamma) and np.isfinite(p_L).all()):
+        out = np.empty(3)
+        _k_frame(p_L, float(gamma), _R_LM[side], _R_0[side], geo.d_wheel, o, out)
+        return out
     p_L = as_input(p_L, "p_L", (3,))
     gamma = as_input(gamma, "gamma")
-    p_M = p_L @ _R_LM[side].T + np.array([geo.d_wheel, 0.0, 0.0])
-    rot = _R_0[side] @ _rz(gamma)
-    return module_origin(leg, geo) + np.einsum("...ij,...j->...i", rot, p_M)
+    try:
+        shape = np.broadcast_shapes(p_L.shape[:-1], gamma.shape)
+    except ValueError:  # the error numpy gave before
+        shape = np.broadcast_shapes(p_L.shape, gamma.shape + (1,))[:-1]
+    n = int(np.prod(shape, dtype=int))
+    out = np.empty((n, 3))
+    _k_frame_batch(as_rows(np.broadcast_to(p_L, shape + (3,)), 3), as_rows(np.broadcast_to(gamma, shape), 1)[:, 0],
+                   _R_LM[side], _R_0[side], geo.d_wheel, o, out)
+    return out.reshape(shape + (3,))
 
 
 class _Ctx(NamedTuple):
@@ -991,14 +959,10 @@ def _fk(q: np.ndarray, ctx: _Ctx, want_jac: bool):
     P = np.empty((n, 3))
     J = np.empty((n, 9) if want_jac else (n, 0))
     o = ctx.origin
-    _k_fk_batch(flat, items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128), a,
+    _k_fk_batch.serial(flat, items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128), a,
                 ctx.seed, K, KC, ctx.s, float(o[0]), float(o[1]), float(o[2]), bool(want_jac), P, J)
     p = P.reshape(shape + (3,))
     return p, (J.reshape(shape + (3, 3)) if want_jac else None)
-
-
-def _contact(q, alpha, w, leg, rim, geo, want_jac, radius):
-    return _fk(q, _context(alpha, w, leg, rim, geo, radius), want_jac)
 
 
 def _q_inputs(q, alpha, w, geo):
@@ -1178,14 +1142,6 @@ _GUESS_NODES = 64
 _START_MARGIN = 0.5 * (THETA_MAX - THETA_MIN) / (_GUESS_NODES - 1)
 
 
-@lru_cache(maxsize=16)
-def _guess_grid(R: float, seed: bool) -> tuple[np.ndarray, dict]:
-    """The closed form on the start grid (theta only: computed once per geometry, not per call)."""
-    grid = np.linspace(THETA_MIN, THETA_MAX, _GUESS_NODES)
-    pts, _ = _closed_form(grid, _constants(R), R + FOOT_OFFSET, want_der=False, full=seed)
-    return grid, pts
-
-
 def _out_of_plane(target: np.ndarray, ctx: _Ctx):
     """The target's in-plane coordinates for the out-of-plane branch ``y_L <= 0``, and gamma.
 
@@ -1242,11 +1198,16 @@ def _guesses(target, ctx: _Ctx, count: int, branch: float = -1.0):
         k = np.argmin(key, axis=1)
         key[rows, k] = np.inf
         order.append(k)
-    pts = _guess_grid(ctx.geo.R, ctx.seed)[1]
+    K_, KC = _kconst(ctx.c.R, ctx.geo.R + FOOT_OFFSET)
+    n = int(np.prod(shape, dtype=int))
+    sel = [np.ascontiguousarray(np.broadcast_to(x, shape).reshape(n), dtype=dt)
+           for x, dt in ((ctx.sel.upper, np.bool_), (ctx.sel.right, np.bool_), (ctx.sel.e, np.complex128))]
     out = []
     for k in order:
         k = k.reshape(shape)
-        zk = _rot(0.0) * _plane({name: v[k] for name, v in pts.items()}, None, ctx.sel, False)[0]
+        zk = np.empty(n, dtype=np.complex128)
+        _k_plane_batch(np.ascontiguousarray(grid[k].reshape(n)), *sel, ctx.seed, K_, KC, zk)
+        zk = _rot(0.0) * zk.reshape(shape)
         # half a grid cell inside the domain: a start on a bound of theta can stall the projected iteration
         # there (seen: theta = 160 deg start, solution at 158.5 deg, error stuck at 2.8e-5 m)
         theta = np.clip(grid[k], THETA_MIN + _START_MARGIN, THETA_MAX - _START_MARGIN)

@@ -407,38 +407,57 @@ def _k_linkage_batch(theta, beta, K, KC, idx, conj, out):
 
 
 @kernel
-def _k_passive(theta, beta, K, KC, out):
+def _k_links(pts):
+    """Left-half link vectors: crank (A), bar AE (E - A), bar CD (C - D), upper rim (C - B), lower rim (G - F)."""
+    return (pts[_IA], pts[_IE] - pts[_IA], pts[_IC] - pts[_ID], pts[_IC] - pts[_IB], pts[_IG] - pts[_IF])
+
+
+@kernel
+def _k_turn(a, b):
+    """``arg(u(a) conj(u(b)))``, u the unit vector: the angle from link vector b to a."""
+    z = a * b.conjugate()  # (the positive scales of the unit vectors do not change the angle)
+    return math.atan2(z.imag, z.real)
+
+
+@kernel
+def _k_passive(theta, beta, K, KC, KR, out):
     """:func:`passive_angles` for one (theta, beta) into ``out`` (10,) in the order of :data:`PASSIVE_JOINTS`:
     the link orientations of the closed form at theta and at theta0, ``d(link) = arg(u(theta) conj(u(theta0)))``
     with the unit vectors u of the crank (A), bar AE (E - A), bar CD (C - D), upper rim (C - B), lower rim (G - F)."""
     now, _d = _k_closed(theta, K, KC, False)
-    ref, _d = _k_closed(THETA0, K, KC, False)
-    d = np.empty(5)
-    for j in range(5):
-        if j == 0:
-            a, b = now[_IA], ref[_IA]
-        elif j == 1:
-            a, b = now[_IE] - now[_IA], ref[_IE] - ref[_IA]
-        elif j == 2:
-            a, b = now[_IC] - now[_ID], ref[_IC] - ref[_ID]
-        elif j == 3:
-            a, b = now[_IC] - now[_IB], ref[_IC] - ref[_IB]
-        else:
-            a, b = now[_IG] - now[_IF], ref[_IG] - ref[_IF]
-        z = (a / abs(a)) * (b / abs(b)).conjugate()
-        d[j] = math.atan2(z.imag, z.real)
+    ln = _k_links(now)
+    lr = (KR[0], KR[1], KR[2], KR[3], KR[4])  # the link vectors at theta0 (:func:`_ref_links`)
+    d0, d1, d2 = _k_turn(ln[0], lr[0]), _k_turn(ln[1], lr[1]), _k_turn(ln[2], lr[2])
+    d3, d4 = _k_turn(ln[3], lr[3]), _k_turn(ln[4], lr[4])
     out[0] = beta + (theta - THETA0)
     out[1] = beta - (theta - THETA0)
-    hA, hB, hD, hF = d[1] - d[0], d[3] - d[0], d[2] - d[1], d[4] - d[3]
+    hA, hB, hD, hF = d1 - d0, d3 - d0, d2 - d1, d4 - d3
     out[2], out[3], out[4], out[5] = hA, -hA, hB, -hB
     out[6], out[7], out[8], out[9] = hD, -hD, hF, -hF
 
 
 @_loop(32768)
-def _k_passive_batch(theta, beta, K, KC, out):
+def _k_passive_batch(theta, beta, K, KC, KR, out):
     """:func:`_k_passive` over theta, beta (n,) into out (n, 10)."""
     for i in prange(theta.shape[0]):
-        _k_passive(theta[i], beta[i], K, KC, out[i])
+        _k_passive(theta[i], beta[i], K, KC, KR, out[i])
+
+
+@kernel
+def _k_ref_links(K, KC, out):
+    pts, _d = _k_closed(THETA0, K, KC, False)
+    links = _k_links(pts)
+    for j in range(5):
+        out[j] = links[j]
+
+
+@lru_cache(maxsize=16)
+def _ref_links(R: float) -> np.ndarray:
+    """The left-half link vectors of :func:`_k_links` at theta0 (wheel mode), once per geometry."""
+    out = np.empty(5, dtype=np.complex128)
+    _k_ref_links(*_kconst(R, R + FOOT_OFFSET), out)
+    out.setflags(write=False)
+    return out
 
 
 def _angle_pair(theta, beta):
@@ -500,7 +519,7 @@ def passive_angles(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict
     t, b, shape = _angle_pair(theta, beta)
     K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
     out = np.empty((t.shape[0], len(PASSIVE_JOINTS)))
-    _k_passive_batch(t, b, K, KC, out)
+    _k_passive_batch(t, b, K, KC, _ref_links(geo.R), out)
     return {k: out[:, j].reshape(shape) for j, k in enumerate(PASSIVE_JOINTS)}
 
 

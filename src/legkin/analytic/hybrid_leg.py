@@ -169,6 +169,7 @@ FK_GAIN_MAX = 1e4
 PITCH_SPLIT = 1.2
 #: Order in which the default foot_ik / foot_platform_ik try the two IK-only branches: (ll_branch, roll_branch).
 FOOT_IK_ORDER = ((-1, 1), (1, 1), (-1, -1), (1, -1))
+_FOOT_IK_COMBOS = np.array(FOOT_IK_ORDER, dtype=np.float64)
 
 
 def _wrap(a):
@@ -595,14 +596,6 @@ def _det2(m: np.ndarray) -> np.ndarray:
     return m[..., 0, 0] * m[..., 1, 1] - m[..., 0, 1] * m[..., 1, 0]
 
 
-def _solve2(m: np.ndarray, r: np.ndarray) -> np.ndarray:
-    """m^-1 r for (..., 2, 2) and (..., 2), by Cramer's rule (non-finite where m is singular)."""
-    det = _det2(m)
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        return np.stack([m[..., 1, 1] * r[..., 0] - m[..., 0, 1] * r[..., 1],
-                         m[..., 0, 0] * r[..., 1] - m[..., 1, 0] * r[..., 0]], -1) / det[..., None]
-
-
 #: Offsets (rad) of the extra starting poses on either side of a near-singular solution (along the null vector of
 #: N), from which Newton runs with the forward-singularity barrier: near det N = 0 two poses of opposite modes are
 #: close together, and the plain Newton iteration from the roots may find only one of them.
@@ -611,7 +604,8 @@ _FOLD_OFFSETS = (1e-9, 1e-7, 1e-5, 1e-3)
 
 # ----------------------------------------------------------------------------- compiled kernels (issue 16)
 # Each kinematic quantity below is written once, as a scalar numba kernel (the seed equations it implements are
-# cited); the batch functions are compiled prange loops over the same kernels. Status codes: _OK and the _ST_*.
+# cited); the batch functions are compiled prange loops over the same kernels (each with a serial twin, _s, run
+# below _PARALLEL_MIN items). Status codes: OK and the _ST_*.
 _ST_INPUT = 1  # a non-finite input: the wrapper's checks raise the InvalidInputError
 _ST_REACH = 2  # a chain out of the motors' reach (|k| > 1 + tol)
 _ST_ASSEMBLE = 3  # the closed sub-chain does not assemble in the mode asked for
@@ -1395,6 +1389,220 @@ def _foot_position_s(t1, t2, t0, sv, b1, b2, s, out, aux, st):
         st[j] = _foot_position_k(t1[j], t2[j], t0[j], sv, b1, b2, s, out[j], aux[j])
 
 
+# --- foot IK (closed form per branch; see foot_platform_ik and foot_ik)
+@kernel
+def _ik_candidate_k(ux, uy, uz, sv, llb, rb, b1, b2, pose, motors, info):
+    """One (ll_branch, roll_branch, motor branch) closed-form candidate for the target u = p - CENTER.
+
+    pose (3,) = (theta_LL, roll, pitch) (:func:`foot_platform_ik`: the LL arc, then roll and pitch), motors (3,)
+    = (theta1, theta2, theta0) (the chains of :func:`motor_angles` with IK_K_TOL, eq 19 inverted), NaN where the
+    candidate does not exist; info (7,) = (exists, inlim, mode, gain, kk, reach, axis) as floats (see
+    :func:`_ik_candidate`). Returns _OK if the candidate exists, else _ST_REACH.
+    """
+    # the LL arc: |u|^2 = LL0^2 + h^2 - 2 h LL0 cos(theta_LL - delta)
+    r2 = ux * ux + uy * uy + uz * uz
+    kk = (_LL0 * _LL0 + _H * _H - r2) / (2.0 * _H * _LL0)
+    reach = math.isfinite(kk) and abs(kk) <= 1.0 + LL_TOL
+    kc = min(max(kk if reach else 1.0, -1.0), 1.0)
+    tll = LL_DELTA + llb * math.acos(kc)
+    fx = _OX + FOOT_X * math.cos(tll)
+    fz = _OZ - FOOT_X * math.sin(tll)
+    # roll and pitch: u = Rx(roll) v, v = Ry(pitch) f, v_y = 0
+    rho = math.hypot(uy, uz)
+    sg = (1.0 if uz >= 0.0 else -1.0) * rb
+    vz = sg * rho
+    if rho <= RHO_TOL:
+        roll = 0.0 if rb > 0 else math.pi
+    else:
+        roll = math.atan2(-uy * sg, uz * sg)
+    pitch = math.atan2(fz, fx) - math.atan2(vz, ux)
+    x0, x1, x2 = _wrap_k(tll), _wrap_k(roll), _wrap_k(pitch)
+    near1 = abs(x1) <= PLATFORM_LIMIT + _LIMIT_TOL
+    near2 = abs(x2) <= PLATFORM_LIMIT + _LIMIT_TOL
+    inlim = near1 and near2
+    if near1:  # rounding at a limit
+        x1 = min(max(x1, -PLATFORM_LIMIT), PLATFORM_LIMIT)
+    if near2:
+        x2 = min(max(x2, -PLATFORM_LIMIT), PLATFORM_LIMIT)
+    pose[0], pose[1], pose[2] = x0, x1, x2
+    rot = np.empty((3, 3))
+    _rot_k(x1, x2, rot)
+    th = np.empty(2)
+    kx = np.empty(2)
+    ok1 = _chain_k(rot, 0, b1, IK_K_TOL, th, kx)
+    ok2 = _chain_k(rot, 1, b2, IK_K_TOL, th, kx)
+    exists = reach and ok1 and ok2
+    gain = math.inf
+    mode = 0.0
+    if exists:
+        tip = np.empty((2, 3))
+        dtip = np.empty((2, 3))
+        _tips_k(th[0], th[1], tip, dtip)
+        g = np.empty(2)
+        nm = np.empty((2, 2))
+        _rod_system_k(x1, x2, tip, g, nm)
+        # a chain clipped at its reach boundary (|k| up to 1 + IK_K_TOL) leaves its rod off by g: the FK pose of
+        # these motor angles moves by ~N^-1 g and the foot by at most |u| sqrt(2) times that
+        det = nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0]
+        s0 = (nm[1, 1] * g[0] - nm[0, 1] * g[1]) / det
+        s1 = (nm[0, 0] * g[1] - nm[1, 0] * g[0]) / det
+        shift = math.sqrt(s0 * s0 + s1 * s1) * math.sqrt(2.0) * math.sqrt(r2)
+        clipped = min(abs(abs(kx[0]) - 1.0), abs(abs(kx[1]) - 1.0)) <= IK_K_TOL
+        exists = (not clipped) or shift <= CLIP_FOOT_TOL
+        if exists:
+            mode = _sgn(det) * _ref_of(b1, b2)
+            gain = _gain_k(x1, x2, x0, tip, dtip)
+    if exists:
+        motors[0], motors[1], motors[2] = th[0], th[1], (sv - x0) / RATIO
+    else:
+        motors[0], motors[1], motors[2] = math.nan, math.nan, math.nan
+    info[0] = 1.0 if exists else 0.0
+    info[1] = 1.0 if inlim else 0.0
+    info[2], info[3], info[4] = mode, gain, kk
+    info[5] = 1.0 if reach else 0.0
+    info[6] = 0.0 if rho > 0.0 else 1.0
+    return OK if exists else _ST_REACH
+
+
+@batch_kernel
+def _ik_candidate_b(u, sv, llb, rb, b1, b2, pose, motors, info):
+    for j in prange(u.shape[0]):
+        _ik_candidate_k(u[j, 0], u[j, 1], u[j, 2], sv, llb[j], rb[j], b1[j], b2[j], pose[j], motors[j], info[j])
+
+
+@kernel
+def _ik_candidate_s(u, sv, llb, rb, b1, b2, pose, motors, info):
+    for j in range(u.shape[0]):
+        _ik_candidate_k(u[j, 0], u[j, 1], u[j, 2], sv, llb[j], rb[j], b1[j], b2[j], pose[j], motors[j], info[j])
+
+
+@kernel
+def _accepted_k(pose, motors, info, b1, b2, s):
+    """The mode-checked IK keeps the candidate: inside the limits, in mode (b1, b2), s, off the forward-singularity
+    band, and the pose the forward kinematics of its motor angles returns in that mode. The neutral aspect
+    (branch (1, 1), mode +1, pitch < PITCH_SPLIT) is one-to-one and nearer R_P = I than the other region of that
+    mode: there the forward kinematics returns exactly these poses; elsewhere it is asked."""
+    if not (info[0] == 1.0 and info[1] == 1.0 and info[2] == s and info[3] < FK_GAIN_MAX):
+        return False
+    if b1 == 1.0 and b2 == 1.0 and s == 1.0 and pose[2] < PITCH_SPLIT:
+        return True
+    xf = np.empty(2)
+    if _fk_select_k(motors[0], motors[1], b1, b2, s, 1e-12, 50, xf) != OK:
+        return False
+    return max(abs(xf[0] - pose[1]), abs(xf[1] - pose[2])) <= 1e-7
+
+
+@kernel
+def _foot_ik_k(ux, uy, uz, sv, combos, b1, b2, s, limits_only, axis_ok, motors, pose):
+    """The mode-checked foot IK of one target u = p - CENTER: the first candidate, in the order combos (k, 2) of (ll_branch,
+    roll_branch), that :func:`_accepted_k` keeps (limits_only: that reaches the LL arc inside the joint limits,
+    as the default :func:`foot_platform_ik`; not axis_ok: off the roll axis). motors (3,), pose (3,); returns _OK
+    or _ST_ASSEMBLE (NaN)."""
+    info = np.empty(7)
+    if not (math.isfinite(ux) and math.isfinite(uy) and math.isfinite(uz)):
+        motors[:] = math.nan
+        pose[:] = math.nan
+        return _ST_INPUT
+    for c in range(combos.shape[0]):
+        _ik_candidate_k(ux, uy, uz, sv, combos[c, 0], combos[c, 1], b1, b2, pose, motors, info)
+        if limits_only:
+            acc = info[5] == 1.0 and info[1] == 1.0
+        else:
+            acc = _accepted_k(pose, motors, info, b1, b2, s)
+        if acc and (axis_ok or info[6] == 0.0):
+            return OK
+    motors[:] = math.nan
+    pose[:] = math.nan
+    return _ST_ASSEMBLE
+
+
+@batch_kernel
+def _foot_ik_b(u, sv, combos, b1, b2, s, limits_only, axis_ok, motors, pose, ok):
+    for j in prange(u.shape[0]):
+        ok[j] = _foot_ik_k(u[j, 0], u[j, 1], u[j, 2], sv, combos, b1, b2, s, limits_only, axis_ok, motors[j],
+                           pose[j]) == OK
+
+
+@kernel
+def _foot_ik_s(u, sv, combos, b1, b2, s, limits_only, axis_ok, motors, pose, ok):
+    for j in range(u.shape[0]):
+        ok[j] = _foot_ik_k(u[j, 0], u[j, 1], u[j, 2], sv, combos, b1, b2, s, limits_only, axis_ok, motors[j],
+                           pose[j]) == OK
+
+
+@kernel
+def _foot_jacobian_k(t1, t2, t0, sv, b1, b2, s, jac):
+    """:func:`foot_jacobian`: d(foot)/d(theta1, theta2, theta0) (3, 3) at the FK pose in mode (b1, b2), s.
+
+    ``dx/dtheta = N^-1 diag(D)``, ``dp/droll = e_x x R f``, ``dp/dpitch = (Rx(roll) e_y) x R f``,
+    ``dp/dtheta0 = -RATIO R_P df/dtheta_LL`` (eq 19). Returns _OK, _ST_INPUT, _ST_ASSEMBLE or _ST_SINGULAR
+    (N singular; jac NaN then)."""
+    jac[:, :] = math.nan
+    if not math.isfinite(t0):
+        return _ST_INPUT
+    x = np.empty(2)
+    st = _fk_select_k(t1, t2, b1, b2, s, 1e-12, 50, x)
+    if st != OK:
+        return st
+    r, p = x[0], x[1]
+    tip = np.empty((2, 3))
+    dtip = np.empty((2, 3))
+    _tips_k(t1, t2, tip, dtip)
+    g = np.empty(2)
+    nm = np.empty((2, 2))
+    _rod_system_k(r, p, tip, g, nm)
+    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
+    dd = np.empty(2)
+    for i in range(2):
+        if i == 0:
+            ax, ay, az = _AX0, _AY0, _AZ0
+        else:
+            ax, ay, az = _AX1, _AY1, _AZ1
+        rx = cp * ax + sp * az
+        ry = sr * sp * ax + cr * ay - sr * cp * az
+        rz = -cr * sp * ax + sr * ay + cr * cp * az
+        dd[i] = ((_CX + rx - tip[i, 0]) * dtip[i, 0] + (_CY + ry - tip[i, 1]) * dtip[i, 1]
+                 + (_CZ + rz - tip[i, 2]) * dtip[i, 2])
+    det = nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0]
+    scale = max(max(abs(nm[0, 0]), abs(nm[0, 1])), max(abs(nm[1, 0]), abs(nm[1, 1]))) ** 2
+    if not abs(det) > 1e-12 * max(scale, 1e-300):
+        return _ST_SINGULAR
+    # dx/dtheta = N^-1 diag(D)
+    d00, d01 = nm[1, 1] / det * dd[0], -nm[0, 1] / det * dd[1]
+    d10, d11 = -nm[1, 0] / det * dd[0], nm[0, 0] / det * dd[1]
+    tll = -RATIO * t0 + sv
+    ct, st_ = math.cos(tll), math.sin(tll)
+    ffx, ffz = _OX + FOOT_X * ct, _OZ - FOOT_X * st_
+    dfx, dfz = -FOOT_X * st_, -FOOT_X * ct
+    fx = cp * ffx + sp * ffz
+    fy = sr * sp * ffx - sr * cp * ffz
+    fz = -cr * sp * ffx + cr * cp * ffz
+    # dp/dx (3, 2): columns e_x x R f = (0, -fz, fy) and (0, cr, sr) x R f = (cr fz - sr fy, sr fx, -cr fx)
+    a0, a1, a2 = 0.0, -fz, fy
+    c0, c1, c2 = cr * fz - sr * fy, sr * fx, -cr * fx
+    jac[0, 0], jac[0, 1] = a0 * d00 + c0 * d10, a0 * d01 + c0 * d11
+    jac[1, 0], jac[1, 1] = a1 * d00 + c1 * d10, a1 * d01 + c1 * d11
+    jac[2, 0], jac[2, 1] = a2 * d00 + c2 * d10, a2 * d01 + c2 * d11
+    jac[0, 2] = -RATIO * (cp * dfx + sp * dfz)
+    jac[1, 2] = -RATIO * (sr * sp * dfx - sr * cp * dfz)
+    jac[2, 2] = -RATIO * (-cr * sp * dfx + cr * cp * dfz)
+    return OK
+
+
+@batch_kernel
+def _foot_jacobian_b(t1, t2, t0, sv, b1, b2, s, jac, st):
+    for j in prange(t1.shape[0]):
+        st[j] = _foot_jacobian_k(t1[j], t2[j], t0[j], sv, b1, b2, s, jac[j])
+
+
+@kernel
+def _foot_jacobian_s(t1, t2, t0, sv, b1, b2, s, jac, st):
+    for j in range(t1.shape[0]):
+        st[j] = _foot_jacobian_k(t1[j], t2[j], t0[j], sv, b1, b2, s, jac[j])
+
+
+
+
 
 _REF_SIGN = {b: float(_ref_of(float(b[0]), float(b[1]))) for b in MOTOR_BRANCHES}
 
@@ -1612,38 +1820,6 @@ def _foot_from_pose(r, p, t):
     return out.reshape(r.shape + (3,))
 
 
-def _foot_gain(x: np.ndarray, theta: np.ndarray, tll: np.ndarray) -> np.ndarray:
-    """Spectral norm (m,) of d(foot)/d(theta1, theta2) (m/rad) at poses x (m, 2) closed by motors theta (m, 2).
-
-    ``dx/dtheta = N^-1 diag(D)`` (implicit differentiation of the rod lengths), ``dp/dx = [e_x x R f,
-    (Rx(roll) e_y) x R f]``. Infinite on the forward singularity (det N = 0).
-    """
-    rot = _rot(x[:, 0], x[:, 1])
-    ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
-    tip, dtip = _lever_tips(theta)
-    d = CENTER + ra - tip
-    return _gain(rot, _n_matrix(ra, d, x[:, 0]), np.sum(d * dtip, -1), x[:, 0], tll)
-
-
-def _gain(rot: np.ndarray, nm: np.ndarray, dd: np.ndarray, roll: np.ndarray, tll: np.ndarray) -> np.ndarray:
-    """:func:`_foot_gain` from the platform rotation, N, D = d_i . dS_i/dtheta_i, roll and theta_LL."""
-    det = _det2(nm)
-    adj = np.stack([np.stack([nm[:, 1, 1], -nm[:, 0, 1]], -1), np.stack([-nm[:, 1, 0], nm[:, 0, 0]], -1)], -2)
-    f, _ = _foot_in_p(tll)
-    rf = np.einsum("...ij,...j->...i", rot, f)
-    c, s = np.cos(roll), np.sin(roll)
-    fx, fy, fz = rf[:, 0], rf[:, 1], rf[:, 2]
-    # dp/droll = e_x x R f, dp/dpitch = (0, c, s) x R f
-    dpdx = np.stack([np.stack([np.zeros_like(fx), c * fz - s * fy], -1), np.stack([-fz, s * fx], -1),
-                     np.stack([fy, -c * fx], -1)], -2)
-    m = dpdx @ (adj * dd[:, None, :])  # det N x d(foot)/d(theta)
-    mtm = np.swapaxes(m, -1, -2) @ m
-    a, b, c = mtm[:, 0, 0], mtm[:, 0, 1], mtm[:, 1, 1]
-    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-        gain = np.sqrt(0.5 * (a + c) + np.sqrt(0.25 * (a - c) ** 2 + b * b)) / np.abs(det)
-    return np.where(np.isfinite(gain), gain, np.inf)
-
-
 def foot_position(
     theta1,
     theta2,
@@ -1733,30 +1909,16 @@ def _ik_candidate(u: np.ndarray, sv: float, llb, rb, b: np.ndarray) -> dict:
     reach), inlim (inside the URDF limits), mode (+1/-1/0, :func:`assembly_mode`), gain (m/rad), kk, reach (LL
     arc), axis (exactly on the roll axis).
     """
-    x, kk, rho, reach, nonsing = _platform_ik(u, llb, rb)
-    near = np.abs(x[:, 1:]) <= PLATFORM_LIMIT + _LIMIT_TOL
-    inlim = np.all(near, -1)
-    x[:, 1:] = np.where(near, np.clip(x[:, 1:], -PLATFORM_LIMIT, PLATFORM_LIMIT), x[:, 1:])  # rounding at a limit
-    rot = _rot(x[:, 1], x[:, 2])
-    th, k, ok2 = _chains(rot, b, IK_K_TOL)
-    exists = reach & np.all(ok2, -1)  # on the roll axis (rho = 0) roll is 0 or pi, see _platform_ik
-    th = np.where(exists[:, None], th, np.nan)
-    ths = np.where(exists[:, None], th, 0.0)
-    tip, dtip = _lever_tips(ths)
-    ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
-    d = CENTER + ra - tip
-    nm = _n_matrix(ra, d, x[:, 1])
-    # a chain clipped at its reach boundary (|k| up to 1 + IK_K_TOL) leaves its rod off by g: the FK pose of these
-    # motor angles moves by ~N^-1 g and the foot by at most |u| sqrt(2) times that
-    g = 0.5 * (np.sum(d * d, -1) - ROD_LENGTH**2)
-    with np.errstate(over="ignore", invalid="ignore"):
-        shift = np.linalg.norm(_solve2(nm, g), axis=-1) * math.sqrt(2.0) * np.linalg.norm(u, axis=-1)
-    exists &= ~(np.abs(np.abs(k) - 1.0).min(-1) <= IK_K_TOL) | (shift <= CLIP_FOOT_TOL)
-    mode = np.where(exists, np.sign(_det2(nm)) * _assembly_ref(b), 0.0)
-    gain = np.where(exists, _gain(rot, nm, np.sum(d * dtip, -1), x[:, 1], x[:, 0]), np.inf)
-    motors = np.concatenate([th, ((sv - x[:, 0]) / RATIO)[:, None]], -1)
-    return {"pose": x, "motors": np.where(exists[:, None], motors, np.nan), "exists": exists, "inlim": inlim,
-            "mode": mode, "gain": gain, "kk": kk, "reach": reach, "axis": ~nonsing}
+    n = len(u)
+    ll = np.array(np.broadcast_to(np.asarray(llb, dtype=np.float64), (n,)), dtype=np.float64)
+    rr = np.array(np.broadcast_to(np.asarray(rb, dtype=np.float64), (n,)), dtype=np.float64)
+    bb = np.broadcast_to(np.asarray(b, dtype=np.float64), (n, 2))
+    pose, motors, info = np.empty((n, 3)), np.empty((n, 3)), np.empty((n, 7))
+    _loop(_ik_candidate_b, _ik_candidate_s, n)(np.array(u, dtype=np.float64).reshape(n, 3), float(sv), ll, rr,
+                                               np.array(bb[:, 0]), np.array(bb[:, 1]), pose, motors, info)
+    return {"pose": pose, "motors": motors, "exists": info[:, 0] == 1.0, "inlim": info[:, 1] == 1.0,
+            "mode": info[:, 2], "gain": info[:, 3], "kk": info[:, 4], "reach": info[:, 5] == 1.0,
+            "axis": info[:, 6] == 1.0}
 
 
 def _accepted(c: dict, b: np.ndarray, s: float) -> np.ndarray:
@@ -1789,6 +1951,12 @@ def _search(u: np.ndarray, sv: float, combos: list, b: np.ndarray, s, limits_onl
     the roll axis (with roll 0 or pi).
     """
     n, k = len(u), len(combos)
+    if np.ndim(b) == 1 and np.ndim(s) == 0:
+        motors, pose, ok = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.bool_)
+        _loop(_foot_ik_b, _foot_ik_s, n)(np.array(u, dtype=np.float64).reshape(n, 3), float(sv),
+                                         np.array(combos, dtype=np.float64).reshape(-1, 2), float(b[0]), float(b[1]),
+                                         float(s), bool(limits_only), bool(axis_ok), motors, pose, ok)
+        return motors, pose, ok
     lls = np.repeat([float(c[0]) for c in combos], n)
     rbs = np.repeat([float(c[1]) for c in combos], n)
     uu = np.tile(u, (k, 1))
@@ -1961,6 +2129,12 @@ def foot_platform_ik(
             AssemblyModeError: only in another mode).
         SingularityError: single target exactly on the roll axis.
     """
+    if (ll_branch is None and roll_branch is None and branch is None and assembly is None and return_mask is False
+            and type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64):
+        motors, pose = np.empty(3), np.empty(3)
+        if _foot_ik_k(p[0] - _CX, p[1] - _CY, p[2] - _CZ, 0.0, _FOOT_IK_COMBOS, 1.0, 1.0, 1.0, True, False, motors,
+                      pose) == OK:
+            return pose
     p = as_input(p, "p", (3,))
     llb = _check_sign(ll_branch, "ll_branch", allow_none=True)
     rb = _check_sign(roll_branch, "roll_branch", allow_none=True)
@@ -2026,6 +2200,14 @@ def foot_ik(
         SingularityError: single target in the forward-singularity band, or exactly on the roll axis (where roll
             is undetermined and foot_ik tries roll = 0 and pi) with neither roll reaching it in the mode.
     """
+    if (ll_branch is None and roll_branch is None and all_branches is False and return_mask is False
+            and type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64):
+        fb, fs, fv = _fast_branch(branch), _fast_sign(assembly), _fast_offset(starting_value)
+        if fb is not None and fs is not None and fv is not None:
+            motors, pose = np.empty(3), np.empty(3)
+            if _foot_ik_k(p[0] - _CX, p[1] - _CY, p[2] - _CZ, fv, _FOOT_IK_COMBOS, fb[0], fb[1], fs, False, True,
+                          motors, pose) == OK:
+                return motors
     p = as_input(p, "p", (3,))
     sv = _check_offset(starting_value)
     llb = _check_sign(ll_branch, "ll_branch", allow_none=True)
@@ -2124,33 +2306,25 @@ def foot_jacobian(
         ConvergenceError: single input whose closed sub-chain did not assemble in that mode.
         SingularityError: single input where N is singular.
     """
+    if (return_mask is False and type(theta1) in _SCALARS and type(theta2) in _SCALARS
+            and type(theta0) in _SCALARS):
+        fb, fs, fv = _fast_branch(branch), _fast_sign(assembly), _fast_offset(starting_value)
+        if fb is not None and fs is not None and fv is not None:
+            jac = np.empty((3, 3))
+            if _foot_jacobian_k(theta1, theta2, theta0, fv, fb[0], fb[1], fs, jac) == OK:
+                return jac
     t1, t2, t0 = as_angles(theta1, theta2, theta0, names=("theta1", "theta2", "theta0"))
     sv = _check_offset(starting_value)
     b = _check_branch(branch)
     s = _check_assembly(assembly)
     _check_flag(return_mask, "return_mask")
-    theta = np.stack([t1.ravel(), t2.ravel()], -1)
-    x, assembled = _fk_select(theta, b, s)
-    r = np.where(assembled, x[:, 0], 0.0)
-    pch = np.where(assembled, x[:, 1], 0.0)
-    rot = _rot(r, pch)
-    nmat, dd = _jacobian_parts(rot, r, theta)
-    det = _det2(nmat)
-    scale = np.abs(nmat).max(axis=(-1, -2), initial=0.0) ** 2
-    nonsing = np.abs(det) > 1e-12 * np.maximum(scale, 1e-300)
-    ninv = np.linalg.inv(np.where(nonsing[:, None, None], nmat, np.eye(2)))
-    dx_dth = ninv * dd[:, None, :]
-    tll = -RATIO * t0.ravel() + sv
-    f, df = _foot_in_p(tll)
-    rf = np.einsum("...ij,...j->...i", rot, f)
-    ey_r = np.stack([np.zeros_like(r), np.cos(r), np.sin(r)], -1)
-    dp_dx = np.stack([np.cross(np.array([1.0, 0.0, 0.0]), rf), np.cross(ey_r, rf)], -1)  # (n, 3, 2)
-    cols12 = dp_dx @ dx_dth
-    col0 = -RATIO * np.einsum("...ij,...j->...i", rot, df)
-    jac = np.concatenate([cols12, col0[..., None]], -1)
-    ok = assembled & nonsing
-    jac = np.where(ok[:, None, None], jac, np.nan).reshape(t1.shape + (3, 3))
-    ok = ok.reshape(t1.shape)
+    n = t1.size
+    jac, st = np.empty((n, 3, 3)), np.empty(n, dtype=np.int64)
+    _loop(_foot_jacobian_b, _foot_jacobian_s, n)(_flat(t1), _flat(t2), _flat(t0), sv, float(b[0]), float(b[1]), s,
+                                                 jac, st)
+    assembled = st != _ST_ASSEMBLE
+    jac = jac.reshape(t1.shape + (3, 3))
+    ok = (st == OK).reshape(t1.shape)
 
     def error():
         if not bool(assembled[0]):

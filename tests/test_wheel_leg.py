@@ -608,3 +608,15 @@ def test_ik_contract_property(theta, beta, gamma, alpha, w, leg, rim, offset, ax
             continue
         assert abs(q[2]) <= wl.ABAD_LIMIT and wl.THETA_MIN <= q[0] <= wl.THETA_MAX
         assert np.linalg.norm(wl.contact_point(q, alpha, w, leg, rim=rim) - target) <= 1e-12
+
+
+def test_ik_info_counts_evaluations():
+    q = np.array([[1.0, 0.2, 0.1], [1.5, -0.3, -0.2]])
+    target = wl.contact_point(q, 0.3, 0.01, "FL")
+    for method in ("radial", "damped", "seed"):
+        _, info = wl.ik(target, 0.3, 0.01, "FL", method=method, return_info=True)
+        assert info.evaluations.shape == (2,) and (info.evaluations >= 1).all()
+        _, one = wl.ik(target[0], 0.3, 0.01, "FL", method=method, return_info=True)
+        assert int(one.evaluations) == int(info.evaluations[0])
+        if method == "radial":
+            np.testing.assert_array_equal(info.evaluations, info.iterations + 1)

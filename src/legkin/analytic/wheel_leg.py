@@ -1463,40 +1463,109 @@ def _fk_flat(q, ctx: _Ctx, jac: bool, ev: np.ndarray, rows=slice(None)):
     return _fk(q, ctx, jac)
 
 
+@kernel
+def _k_solve3(M, b, x):
+    """``x = M^-1 b`` for a 3x3 system by LU with partial pivoting (as LAPACK's getrf/getrs); returns the
+    determinant (0: singular, x untouched)."""
+    A = M.copy()
+    y = b.copy()
+    det = 1.0
+    for c in range(3):
+        piv = c
+        for r in range(c + 1, 3):
+            if abs(A[r, c]) > abs(A[piv, c]):
+                piv = r
+        if A[piv, c] == 0.0:
+            return 0.0
+        if piv != c:
+            det = -det
+            for k in range(3):
+                A[c, k], A[piv, k] = A[piv, k], A[c, k]
+            y[c], y[piv] = y[piv], y[c]
+        det *= A[c, c]
+        for r in range(c + 1, 3):
+            f = A[r, c] / A[c, c]
+            for k in range(c, 3):
+                A[r, k] -= f * A[c, k]
+            y[r] -= f * y[c]
+    for r in range(2, -1, -1):
+        acc = y[r]
+        for k in range(r + 1, 3):
+            acc -= A[r, k] * x[k]
+        x[r] = acc / A[r, r]
+    return det
+
+
+@kernel
+def _k_ik_seed(q, tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, tol, max_iter, delta):
+    """The seed's Gauss-Newton (seed 2.2-2.3) for one target from ``q`` (3,, updated in place): forward-difference
+    Jacobian ``(FK(q + delta e_k) - FK(q)) / delta``, full steps ``-(J^T J)^-1 J^T E``, no bounds; stops at
+    ``|E| <= tol``, a non-finite error, a singular ``J^T J`` (NaN step) or ``max_iter``. Returns (iterations,
+    error, converged, FK evaluations)."""
+    p = np.empty(3)
+    pk = np.empty(3)
+    J = np.empty((3, 3))
+    JtJ = np.empty((3, 3))
+    JtE = np.empty(3)
+    dq = np.empty(3)
+    qk = np.empty(3)
+    _k_fk(q[0], q[1], q[2], upper, right, e, seed, K, KC, s, a, o0, o1, o2, False, p, p)
+    ev = 1
+    err = math.sqrt((p[0] - tgt[0]) ** 2 + (p[1] - tgt[1]) ** 2 + (p[2] - tgt[2]) ** 2)
+    it = 0
+    while True:
+        if err <= tol:
+            return it, err, True, ev
+        if not math.isfinite(err) or it >= max_iter:
+            return it, err, False, ev
+        for k in range(3):
+            qk[0], qk[1], qk[2] = q[0], q[1], q[2]
+            qk[k] += delta
+            _k_fk(qk[0], qk[1], qk[2], upper, right, e, seed, K, KC, s, a, o0, o1, o2, False, pk, pk)
+            for r in range(3):
+                J[r, k] = (pk[r] - p[r]) / delta
+        ev += 3
+        for i in range(3):
+            JtE[i] = J[0, i] * (p[0] - tgt[0]) + J[1, i] * (p[1] - tgt[1]) + J[2, i] * (p[2] - tgt[2])
+            for k in range(3):
+                JtJ[i, k] = J[0, i] * J[0, k] + J[1, i] * J[1, k] + J[2, i] * J[2, k]
+        det = _k_solve3(JtJ, JtE, dq)
+        if not abs(det) > 1e-300:
+            dq[0], dq[1], dq[2] = math.nan, math.nan, math.nan
+        for k in range(3):
+            q[k] -= dq[k]
+        it += 1
+        _k_fk(q[0], q[1], q[2], upper, right, e, seed, K, KC, s, a, o0, o1, o2, False, p, p)
+        ev += 1
+        err = math.sqrt((p[0] - tgt[0]) ** 2 + (p[1] - tgt[1]) ** 2 + (p[2] - tgt[2]) ** 2)
+
+
+@_loop(256)
+def _k_ik_seed_batch(q, tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, tol, max_iter, delta, its, err, ok, ev):
+    """:func:`_k_ik_seed` over starts q (n, 3) (updated) and targets (n, 3)."""
+    for i in prange(q.shape[0]):
+        its[i], err[i], ok[i], ev[i] = _k_ik_seed(q[i], tgt[i], upper[i], right[i], e[i], a[i], seed, K, KC, s, o0,
+                                                  o1, o2, tol, max_iter, delta)
+
+
 def _ik_seed(q, target, ctx, tol, max_iter, delta):
+    """The seed method on a batch: :func:`_k_ik_seed` per target (compiled loop)."""
     max_iter = 100 if max_iter is None else max_iter
     n = q.shape[0]
-    it = np.zeros(n, dtype=int)
-    ev = np.zeros(n, dtype=int)
-    active = np.ones(n, dtype=bool)
-    ok = np.zeros(n, dtype=bool)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        p = _fk_flat(q, ctx, False, ev)[0]
-        err = np.linalg.norm(p - target, axis=1)
-        for _ in range(max_iter + 1):
-            ok |= active & (err <= tol)
-            active &= ~ok & np.isfinite(err)
-            if not np.any(active) or np.all(it[active] >= max_iter):
-                break
-            a = np.flatnonzero(active & (it < max_iter))
-            ctx_a = ctx if a.size == n else ctx.take(a)
-            qa, pa = q[a], p[a]
-            E = pa - target[a]
-            J = np.empty((a.size, 3, 3))
-            for k in range(3):
-                qk = qa.copy()
-                qk[:, k] += delta
-                J[:, :, k] = (_fk_flat(qk, ctx_a, False, ev, a)[0] - pa) / delta
-            JtJ = np.einsum("nji,njk->nik", J, J)
-            JtE = np.einsum("nji,nj->ni", J, E)
-            good = np.abs(np.linalg.det(JtJ)) > 1e-300
-            dq = np.full((a.size, 3), np.nan)
-            if np.any(good):
-                dq[good] = -np.linalg.solve(JtJ[good], JtE[good][..., None])[..., 0]
-            q[a] = qa + dq
-            it[a] += 1
-            p[a] = _fk_flat(q[a], ctx_a, False, ev, a)[0]
-            err[a] = np.linalg.norm(p[a] - target[a], axis=1)
+    q = as_rows(q, 3).copy()
+    sel = ctx.sel
+
+    def items(x, dtype):
+        return np.ascontiguousarray(np.broadcast_to(x, (n,)), dtype=dtype)
+
+    K, KC = _kconst(ctx.c.R, ctx.geo.R + FOOT_OFFSET)
+    o = ctx.origin
+    it, ev = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64)
+    err, ok = np.empty(n), np.empty(n, dtype=np.bool_)
+    _k_ik_seed_batch(q, as_rows(target, 3), items(sel.upper, np.bool_), items(sel.right, np.bool_),
+                     items(sel.e, np.complex128), items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64), ctx.seed, K, KC,
+                     ctx.s, float(o[0]), float(o[1]), float(o[2]), float(tol), int(max_iter), float(delta), it, err, ok,
+                     ev)
     return q, it, err, ok, ev
 
 

@@ -513,6 +513,16 @@ def _jacobian_parts(rot: np.ndarray, roll: np.ndarray, theta: np.ndarray):
     return n, dd
 
 
+def _jacobian_and_mode(r: np.ndarray, p: np.ndarray, b: np.ndarray):
+    """The kernel :func:`_motor_jacobian_k` over checked (roll, pitch) arrays: jac (..., 2, 2), k (..., 2),
+    status (...), mode (...)."""
+    n = r.size
+    jac, k, mode, st = np.empty((n, 2, 2)), np.empty((n, 2)), np.empty((n, 1)), np.empty(n, dtype=np.int64)
+    _loop(_motor_jacobian_b, _motor_jacobian_s, n)(_flat(r), _flat(p), float(b[0]), float(b[1]), jac, k, mode, st)
+    sh = r.shape
+    return jac.reshape(sh + (2, 2)), k.reshape(sh + (2,)), st.reshape(sh), mode.reshape(sh)
+
+
 def motor_jacobian(roll, pitch, branch: Sequence[int] = (1, 1), *, return_mask: bool = False):
     """d(theta1, theta2)/d(roll, pitch), shape (..., 2, 2), by implicit differentiation of the rod lengths.
 
@@ -524,17 +534,18 @@ def motor_jacobian(roll, pitch, branch: Sequence[int] = (1, 1), *, return_mask: 
         UnreachableError: single (roll, pitch) out of reach.
         SingularityError: single pose on the reach boundary (a motor cannot move its rod end).
     """
+    if return_mask is False and type(roll) in _SCALARS and type(pitch) in _SCALARS:
+        fb = _fast_branch(branch)
+        if fb is not None:
+            jac, k, mode = np.empty((2, 2)), np.empty(2), np.empty(1)
+            if _motor_jacobian_k(roll, pitch, fb[0], fb[1], jac, k, mode) == OK:
+                return jac
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
     b = _check_branch(branch)
     _check_flag(return_mask, "return_mask")
-    rot = _rot(r, p)
-    theta, k, ok2 = _chains(rot, b)
-    reach = np.all(ok2, axis=-1)
-    n, dd = _jacobian_parts(rot, r, np.where(reach[..., None], theta, 0.0))
-    with np.errstate(divide="ignore", invalid="ignore"):
-        jac = n / dd[..., None]
-    ok = reach & np.all(np.isfinite(jac), axis=(-1, -2)) & np.all(dd != 0.0, axis=-1)
-    jac = np.where(ok[..., None, None], jac, np.nan)
+    jac, k, st = _jacobian_and_mode(r, p, b)[:3]
+    reach = st != _ST_REACH
+    ok = st == OK
 
     def error():
         if not bool(reach):
@@ -1601,6 +1612,61 @@ def _foot_jacobian_s(t1, t2, t0, sv, b1, b2, s, jac, st):
         st[j] = _foot_jacobian_k(t1[j], t2[j], t0[j], sv, b1, b2, s, jac[j])
 
 
+@kernel
+def _motor_jacobian_k(r, p, b1, b2, jac, kout, mode):
+    """:func:`motor_jacobian` jac (2, 2) = d(theta1, theta2)/d(roll, pitch) = D^-1 N and :func:`assembly_mode`
+    mode (1,) = sign(det N) x its sign at R_P = I on (b1, b2), at the pose (r, p). Returns _OK, _ST_INPUT,
+    _ST_REACH (jac NaN, mode 0) or _ST_SINGULAR (on the reach boundary, D = 0: jac NaN)."""
+    jac[:, :] = math.nan
+    mode[0] = 0.0
+    th = np.empty(2)
+    st = _motor_angles_k(r, p, b1, b2, th, kout)
+    if st != OK:
+        return st
+    tip = np.empty((2, 3))
+    dtip = np.empty((2, 3))
+    _tips_k(th[0], th[1], tip, dtip)
+    g = np.empty(2)
+    nm = np.empty((2, 2))
+    _rod_system_k(r, p, tip, g, nm)
+    mode[0] = _sgn(nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0]) * _ref_of(b1, b2)
+    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
+    for i in range(2):
+        if i == 0:
+            ax, ay, az = _AX0, _AY0, _AZ0
+        else:
+            ax, ay, az = _AX1, _AY1, _AZ1
+        rx = cp * ax + sp * az
+        ry = sr * sp * ax + cr * ay - sr * cp * az
+        rz = -cr * sp * ax + sr * ay + cr * cp * az
+        dd = ((_CX + rx - tip[i, 0]) * dtip[i, 0] + (_CY + ry - tip[i, 1]) * dtip[i, 1]
+              + (_CZ + rz - tip[i, 2]) * dtip[i, 2])
+        if dd == 0.0:
+            jac[:, :] = math.nan
+            return _ST_SINGULAR
+        jac[i, 0] = nm[i, 0] / dd
+        jac[i, 1] = nm[i, 1] / dd
+    for i in range(2):
+        for j in range(2):
+            if not math.isfinite(jac[i, j]):
+                jac[:, :] = math.nan
+                return _ST_SINGULAR
+    return OK
+
+
+@batch_kernel
+def _motor_jacobian_b(r, p, b1, b2, jac, kout, mode, st):
+    for j in prange(r.shape[0]):
+        st[j] = _motor_jacobian_k(r[j], p[j], b1, b2, jac[j], kout[j], mode[j])
+
+
+@kernel
+def _motor_jacobian_s(r, p, b1, b2, jac, kout, mode, st):
+    for j in range(r.shape[0]):
+        st[j] = _motor_jacobian_k(r[j], p[j], b1, b2, jac[j], kout[j], mode[j])
+
+
+
 
 
 
@@ -1643,13 +1709,9 @@ def assembly_mode(roll, pitch, branch: Sequence[int] = (1, 1), *, return_mask: b
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
     b = _check_branch(branch)
     _check_flag(return_mask, "return_mask")
-    rot = _rot(r, p)
-    theta, k, ok2 = _chains(rot, b)
-    ok = np.all(ok2, axis=-1)
-    tip, _ = _lever_tips(np.where(ok[..., None], theta, 0.0))
-    ra = np.einsum("...jk,ik->...ij", rot, ATTACH)
-    mode = np.sign(_det2(_n_matrix(ra, CENTER + ra - tip, r))) * _assembly_ref(b)
-    mode = np.where(ok, mode, 0.0).astype(int)
+    _, k, st, mode = _jacobian_and_mode(r, p, b)
+    ok = st != _ST_REACH
+    mode = mode.astype(int)
     what = f"(roll, pitch) = ({float(r):.6g}, {float(p):.6g})" if r.ndim == 0 else ""
     return finish(mode, ok, r.ndim == 0, return_mask, lambda: _unreachable(what, k))
 

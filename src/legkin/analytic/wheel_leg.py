@@ -1457,12 +1457,6 @@ def _ik_iterative(flat, ctx, q0, method, tol, max_iter, delta, limits):
 _METHODS = ("damped", "seed", "radial")
 
 
-def _fk_flat(q, ctx: _Ctx, jac: bool, ev: np.ndarray, rows=slice(None)):
-    """The IK solvers' forward kinematics; counts one evaluation in ``ev[rows]`` (``IKInfo.evaluations``)."""
-    ev[rows] += 1
-    return _fk(q, ctx, jac)
-
-
 @kernel
 def _k_solve3(M, b, x):
     """``x = M^-1 b`` for a 3x3 system by LU with partial pivoting (as LAPACK's getrf/getrs); returns the
@@ -1569,76 +1563,99 @@ def _ik_seed(q, target, ctx, tol, max_iter, delta):
     return q, it, err, ok, ev
 
 
-def _solve3(M: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``M^-1 b`` for a batch of 3x3 systems; NaN rows where ``M`` is singular or not finite (the damped
-    iteration then damps harder), instead of numpy's LinAlgError for the whole batch (issue 10)."""
-    with np.errstate(all="ignore"):
-        det = np.linalg.det(M)
-        good = np.isfinite(det) & (det != 0.0)
-        out = np.full(b.shape, np.nan)
-        if good.all():
-            try:
-                return np.linalg.solve(M, b[..., None])[..., 0]
-            except np.linalg.LinAlgError:  # a zero pivot that the determinant's rounding hid
-                good = np.zeros(good.shape, dtype=bool)
-        for i in np.flatnonzero(good) if not good.all() else ():
-            try:
-                out[i] = np.linalg.solve(M[i], b[i])
-            except np.linalg.LinAlgError:
-                pass
-    return out
+@kernel
+def _k_ik_damped(q, tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, tol, max_iter):
+    """The damped method for one target from ``q`` (3,, updated in place): Gauss-Newton with the analytic
+    Jacobian (:func:`_k_fk`), Levenberg-Marquardt damping ``(J^T J + lam tr(J^T J) I)`` raised 100x while a
+    step does not lower ``|E|`` (10 trials) and lowered 10x when it does, theta projected onto [17, 160] deg;
+    once ``|E| <= tol`` one more step is taken if it lowers ``|E|``. Returns (iterations, error, FK evaluations)."""
+    p = np.empty(3)
+    pn = np.empty(3)
+    J = np.empty(9)
+    Jn = np.empty(9)
+    M = np.empty((3, 3))
+    JtE = np.empty(3)
+    dq = np.empty(3)
+    qn = np.empty(3)
+    best = np.empty(3)
+    JtJ = np.empty((3, 3))
+    q[0] = _k_clip(q[0], THETA_MIN, THETA_MAX)
+    _k_fk(q[0], q[1], q[2], upper, right, e, seed, K, KC, s, a, o0, o1, o2, True, p, J)
+    ev = 1
+    err = math.sqrt((p[0] - tgt[0]) ** 2 + (p[1] - tgt[1]) ** 2 + (p[2] - tgt[2]) ** 2)
+    active = err > tol
+    polish = not active
+    mu = 1e-16
+    it = 0
+    for _ in range(max_iter):
+        if not active:
+            break
+        for i in range(3):
+            JtE[i] = J[i] * (p[0] - tgt[0]) + J[3 + i] * (p[1] - tgt[1]) + J[6 + i] * (p[2] - tgt[2])
+            for k in range(3):
+                JtJ[i, k] = J[i] * J[k] + J[3 + i] * J[3 + k] + J[6 + i] * J[6 + k]
+        scale = max(JtJ[0, 0] + JtJ[1, 1] + JtJ[2, 2], 1e-300)
+        best[0], best[1], best[2] = q[0], q[1], q[2]
+        best_err = err
+        improved = False
+        lam = mu
+        for _trial in range(10):
+            if improved:
+                break
+            for i in range(3):
+                for k in range(3):
+                    M[i, k] = JtJ[i, k] + (lam * scale if i == k else 0.0)
+            det = _k_solve3(M, JtE, dq)
+            if not (math.isfinite(det) and det != 0.0):
+                dq[0], dq[1], dq[2] = math.nan, math.nan, math.nan
+            qn[0] = _k_clip(q[0] - dq[0], THETA_MIN, THETA_MAX)
+            qn[1], qn[2] = q[1] - dq[1], q[2] - dq[2]
+            _k_fk(qn[0], qn[1], qn[2], upper, right, e, seed, K, KC, s, a, o0, o1, o2, False, pn, Jn)
+            ev += 1
+            en = math.sqrt((pn[0] - tgt[0]) ** 2 + (pn[1] - tgt[1]) ** 2 + (pn[2] - tgt[2]) ** 2)
+            if en < err:
+                improved = True
+                best[0], best[1], best[2] = qn[0], qn[1], qn[2]
+                best_err = en
+                lam = max(lam / 10.0, 1e-16)
+            else:
+                lam *= 100.0
+        q[0], q[1], q[2] = best[0], best[1], best[2]
+        err = best_err
+        mu = lam
+        it += 1
+        _k_fk(q[0], q[1], q[2], upper, right, e, seed, K, KC, s, a, o0, o1, o2, True, p, J)
+        ev += 1
+        done = err <= tol
+        active = ((not done) or (not polish)) and improved
+        polish = polish or done
+    return it, err, ev
+
+
+@_loop(256)
+def _k_ik_damped_batch(q, tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, tol, max_iter, its, err, ev):
+    """:func:`_k_ik_damped` over starts q (n, 3) (updated) and targets (n, 3)."""
+    for i in prange(q.shape[0]):
+        its[i], err[i], ev[i] = _k_ik_damped(q[i], tgt[i], upper[i], right[i], e[i], a[i], seed, K, KC, s, o0, o1,
+                                             o2, tol, max_iter)
 
 
 def _ik_damped(q, target, ctx, tol, max_iter, delta):
+    """The damped method on a batch: :func:`_k_ik_damped` per target (compiled loop)."""
     max_iter = 60 if max_iter is None else max_iter
     n = q.shape[0]
-    q = q.copy()
-    q[:, 0] = np.clip(q[:, 0], THETA_MIN, THETA_MAX)
-    it = np.zeros(n, dtype=int)
-    ev = np.zeros(n, dtype=int)
-    mu = np.full(n, 1e-16)
-    p, J = _fk_flat(q, ctx, True, ev)
-    err = np.linalg.norm(p - target, axis=1)
-    active = err > tol
-    polish = ~active  # one more (kept only if it helps) Gauss-Newton step after reaching tol
-    eye = np.eye(3)
-    for _ in range(max_iter):
-        a = np.flatnonzero(active)
-        if a.size == 0:
-            break
-        ctx_a = ctx if a.size == n else ctx.take(a)
-        E = p[a] - target[a]
-        Ja = J[a]
-        JtJ = np.einsum("nji,njk->nik", Ja, Ja)
-        JtE = np.einsum("nji,nj->ni", Ja, E)
-        scale = np.maximum(np.trace(JtJ, axis1=1, axis2=2), 1e-300)
-        best_q, best_err = q[a].copy(), err[a].copy()
-        improved = np.zeros(a.size, dtype=bool)
-        # Try Gauss-Newton first (mu tiny), then damp harder where the error does not drop.
-        lam = mu[a].copy()
-        for _trial in range(10):
-            todo = ~improved
-            if not np.any(todo):
-                break
-            t = np.flatnonzero(todo)
-            M = JtJ[t] + (lam[t] * scale[t])[:, None, None] * eye
-            dq = -_solve3(M, JtE[t])
-            qn = q[a[t]] + dq
-            qn[:, 0] = np.clip(qn[:, 0], THETA_MIN, THETA_MAX)
-            with np.errstate(invalid="ignore"):  # NaN steps (singular systems) give NaN errors: not better
-                pn = _fk_flat(qn, ctx_a if t.size == a.size else ctx_a.take(t), False, ev, a[t])[0]
-                en = np.linalg.norm(pn - target[a[t]], axis=1)
-            better = en < err[a[t]]
-            improved[t[better]] = True
-            best_q[t[better]], best_err[t[better]] = qn[better], en[better]
-            lam[t[~better]] *= 100.0
-            lam[t[better]] = np.maximum(lam[t[better]] / 10.0, 1e-16)
-        q[a], err[a], mu[a] = best_q, best_err, lam
-        it[a] += 1
-        p[a], J[a] = _fk_flat(q[a], ctx_a, True, ev, a)
-        done = err[a] <= tol
-        active[a] = (~done | ~polish[a]) & improved
-        polish[a] |= done
+    q = as_rows(q, 3).copy()
+    sel = ctx.sel
+
+    def items(x, dtype):
+        return np.ascontiguousarray(np.broadcast_to(x, (n,)), dtype=dtype)
+
+    K, KC = _kconst(ctx.c.R, ctx.geo.R + FOOT_OFFSET)
+    o = ctx.origin
+    it, ev, err = np.empty(n, dtype=np.int64), np.empty(n, dtype=np.int64), np.empty(n)
+    _k_ik_damped_batch(q, as_rows(target, 3), items(sel.upper, np.bool_), items(sel.right, np.bool_),
+                       items(sel.e, np.complex128), items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64), ctx.seed, K,
+                       KC, ctx.s, float(o[0]), float(o[1]), float(o[2]), float(tol), int(max_iter), it, err, ev)
     return q, it, err, err <= tol, ev
 
 

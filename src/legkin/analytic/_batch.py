@@ -8,13 +8,14 @@ leading dimensions) returns arrays with NaN where an item fails, and with
 
 from __future__ import annotations
 
+import numbers
 from typing import Callable
 
 import numpy as np
 
 from ..errors import InvalidInputError, InvalidParameterError
 
-__all__ = ["as_input", "as_angles", "finish", "check_number", "check_integer", "check_flag", "check_choice"]
+__all__ = ["as_input", "as_angles", "finish", "real_number", "check_number", "check_integer", "check_flag", "check_choice"]
 
 
 def as_input(x, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = False) -> np.ndarray:
@@ -77,6 +78,23 @@ def finish(
             return (*value, ok)
         return value, ok
     return value
+
+
+def real_number(value, name: str, valid) -> float:
+    """A real scalar parameter (int, float, numpy real, 0-d real array; not bool, str, complex) as float.
+
+    ``valid``: the range text for the message (or a callable making it, called only on failure). The range
+    itself is the caller's to check.
+    """
+    if type(value) is float:  # the common case, fast
+        return value
+    ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
+    if not ok and isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
+        ok, value = True, value.item()
+    if not ok:
+        text = valid() if callable(valid) else valid
+        raise InvalidParameterError(f"{name} must be a real number, got {value!r}; valid range {text}")
+    return float(value)
 
 
 def _range_text(low, high, low_open: bool, high_open: bool) -> str:

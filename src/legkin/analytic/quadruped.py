@@ -30,13 +30,12 @@ and a legkin error in a single call.
 from __future__ import annotations
 
 import math
-import numbers
 
 import numpy as np
 
 from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
 from ..models.quadruped import SPEC as _SPEC
-from ._batch import as_input, finish
+from ._batch import real_number as _number, as_input
 from ._kernels import OK, SERIAL_BELOW, as_rows, batch_kernel, kernel, prange
 
 __all__ = [
@@ -119,20 +118,6 @@ _NAN3 = np.full(3, np.nan)
 
 
 # ----------------------------------------------------------------------------- parameter checks (Python)
-def _number(value, name: str, valid) -> float:
-    """A real scalar parameter (int, float, numpy real, 0-d real array; not bool, str, complex) as float.
-    ``valid``: the range text for the message (or a callable making it)."""
-    if type(value) is float:  # the common case, fast
-        return value
-    ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
-    if not ok and isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
-        ok, value = True, value.item()
-    if not ok:
-        text = valid() if callable(valid) else valid
-        raise InvalidParameterError(f"{name} must be a real number, got {value!r}; valid range {text}")
-    return float(value)
-
-
 _FOOT_Z = _SPEC.params["foot_z"]
 # the fast path of the foot_z check: a float inside the registry's closed range is returned as it is
 _FZ_LO = -math.inf if _FOOT_Z.low is None or _FOOT_Z.low_open else _FOOT_Z.low

@@ -34,7 +34,7 @@ from ..errors import (
     UnreachableError,
 )
 from ..models.tripod import SPEC as _SPEC
-from ._batch import as_angles, as_input
+from ._batch import real_number as _number, as_angles, as_input
 from ._kernels import OK, batch_kernel, kernel, prange
 
 __all__ = [
@@ -96,20 +96,6 @@ def _mode_signs(mode: str):
     if mode == HOME_MODE:
         return None
     return (-1.0 if mode[0] == "-" else 1.0), np.array([-1.0 if c == "-" else 1.0 for c in mode[1:]])
-
-
-def _number(value, name: str, valid) -> float:
-    """A real scalar parameter (int, float, numpy real, 0-d real array; not bool, str, complex) as float.
-    ``valid``: the range text for the message (or a callable making it)."""
-    if type(value) is float:  # the common case, fast
-        return value
-    ok = isinstance(value, numbers.Real) and not isinstance(value, (bool, np.bool_))
-    if not ok and isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf":
-        ok, value = True, value.item()
-    if not ok:
-        text = valid() if callable(valid) else valid
-        raise InvalidParameterError(f"{name} must be a real number, got {value!r}; valid range {text}")
-    return float(value)
 
 
 def _in_range(value, name: str, lo: float, hi: float, valid: str, *, lo_open=False, hi_open=False) -> float:

@@ -1325,14 +1325,12 @@ def _fk_guess_s(t1, t2, g, b1, b2, tol, max_iter, x, ok):
 
 
 @kernel
-def _gain_k(r, p, tll, tip, dtip):
-    """Spectral norm of d(foot)/d(theta1, theta2) (m/rad) at the pose (r, p) closed by the lever tips tip:
-    ``dx/dtheta = N^-1 diag(D)``, ``dp/dx = [e_x x R f, (Rx(roll) e_y) x R f]``; inf on det N = 0."""
+def _rod_rates_k(r, p, tip, dtip, nm, dd):
+    """The rod system's Jacobian ``N = dg/d(roll, pitch)`` (into nm) and ``D_i = (c_i - tip_i) . dtip_i``, the
+    rate of rod i's residual per motor radian (into dd), at the pose (r, p) closed by the lever tips tip."""
     g = np.empty(2)
-    nm = np.empty((2, 2))
     _rod_system_k(r, p, tip, g, nm)
     cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
-    dd = np.empty(2)
     for i in range(2):
         if i == 0:
             ax, ay, az = _AX0, _AY0, _AZ0
@@ -1343,6 +1341,16 @@ def _gain_k(r, p, tll, tip, dtip):
         rz = -cr * sp * ax + sr * ay + cr * cp * az
         dd[i] = ((_CX + rx - tip[i, 0]) * dtip[i, 0] + (_CY + ry - tip[i, 1]) * dtip[i, 1]
                  + (_CZ + rz - tip[i, 2]) * dtip[i, 2])
+
+
+@kernel
+def _gain_k(r, p, tll, tip, dtip):
+    """Spectral norm of d(foot)/d(theta1, theta2) (m/rad) at the pose (r, p) closed by the lever tips tip:
+    ``dx/dtheta = N^-1 diag(D)``, ``dp/dx = [e_x x R f, (Rx(roll) e_y) x R f]``; inf on det N = 0."""
+    nm = np.empty((2, 2))
+    dd = np.empty(2)
+    _rod_rates_k(r, p, tip, dtip, nm, dd)
+    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
     det = nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0]
     # adj(N) diag(D)
     j00, j01 = nm[1, 1] * dd[0], -nm[0, 1] * dd[1]
@@ -1559,21 +1567,10 @@ def _foot_jacobian_k(t1, t2, t0, sv, b1, b2, s, jac):
     tip = np.empty((2, 3))
     dtip = np.empty((2, 3))
     _tips_k(t1, t2, tip, dtip)
-    g = np.empty(2)
     nm = np.empty((2, 2))
-    _rod_system_k(r, p, tip, g, nm)
-    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
     dd = np.empty(2)
-    for i in range(2):
-        if i == 0:
-            ax, ay, az = _AX0, _AY0, _AZ0
-        else:
-            ax, ay, az = _AX1, _AY1, _AZ1
-        rx = cp * ax + sp * az
-        ry = sr * sp * ax + cr * ay - sr * cp * az
-        rz = -cr * sp * ax + sr * ay + cr * cp * az
-        dd[i] = ((_CX + rx - tip[i, 0]) * dtip[i, 0] + (_CY + ry - tip[i, 1]) * dtip[i, 1]
-                 + (_CZ + rz - tip[i, 2]) * dtip[i, 2])
+    _rod_rates_k(r, p, tip, dtip, nm, dd)
+    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
     det = nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0]
     scale = max(max(abs(nm[0, 0]), abs(nm[0, 1])), max(abs(nm[1, 0]), abs(nm[1, 1]))) ** 2
     if not abs(det) > 1e-12 * max(scale, 1e-300):

@@ -1623,26 +1623,16 @@ def _motor_jacobian_k(r, p, b1, b2, jac, kout, mode):
     tip = np.empty((2, 3))
     dtip = np.empty((2, 3))
     _tips_k(th[0], th[1], tip, dtip)
-    g = np.empty(2)
     nm = np.empty((2, 2))
-    _rod_system_k(r, p, tip, g, nm)
+    dd = np.empty(2)
+    _rod_rates_k(r, p, tip, dtip, nm, dd)
     mode[0] = _sgn(nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0]) * _ref_of(b1, b2)
-    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
     for i in range(2):
-        if i == 0:
-            ax, ay, az = _AX0, _AY0, _AZ0
-        else:
-            ax, ay, az = _AX1, _AY1, _AZ1
-        rx = cp * ax + sp * az
-        ry = sr * sp * ax + cr * ay - sr * cp * az
-        rz = -cr * sp * ax + sr * ay + cr * cp * az
-        dd = ((_CX + rx - tip[i, 0]) * dtip[i, 0] + (_CY + ry - tip[i, 1]) * dtip[i, 1]
-              + (_CZ + rz - tip[i, 2]) * dtip[i, 2])
-        if dd == 0.0:
+        if dd[i] == 0.0:
             jac[:, :] = math.nan
             return _ST_SINGULAR
-        jac[i, 0] = nm[i, 0] / dd
-        jac[i, 1] = nm[i, 1] / dd
+        jac[i, 0] = nm[i, 0] / dd[i]
+        jac[i, 1] = nm[i, 1] / dd[i]
     for i in range(2):
         for j in range(2):
             if not math.isfinite(jac[i, j]):

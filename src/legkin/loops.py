@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from .analytic._batch import as_input
+from ._batch import as_input
 from .errors import InvalidInputError, LegkinError, LoopClosureError
 
 __all__ = [

@@ -10,7 +10,7 @@ import pinocchio as pin
 
 from ._generate import model_files
 from ._registry import MODELS, get_spec
-from .analytic._batch import as_input
+from ._batch import as_input
 from .errors import InvalidInputError, InvalidParameterError, LegkinError
 from .loops import DEFAULT_DAMPING, LoopSet, LoopSolveInfo, check_count, check_real, parse_loops
 

@@ -41,8 +41,8 @@ from ..errors import (
     SingularityError,
     UnreachableError,
 )
-from ._batch import as_angles, as_input, finish
-from ._kernels import OK, batch_kernel, kernel, prange
+from .._batch import as_angles, as_input, finish
+from .._kernels import OK, batch_kernel, kernel, prange
 
 __all__ = [
     "CENTER",

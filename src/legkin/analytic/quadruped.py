@@ -14,12 +14,12 @@ returns plain arrays and raises on failure; a batch returns NaN rows where an it
 and ``q_ref``) their leading shapes broadcast, and the call is a single one only if the broadcast shape is ``()``
 (a single target with a batch of ``q_ref`` is a batch).
 
-Implementation (issue 16, see :mod:`legkin.analytic._kernels`): every function is a compiled numba kernel,
+Implementation (issue 16, see :mod:`legkin._kernels`): every function is a compiled numba kernel,
 written once beside its seed equations; a batch is a compiled loop over the same kernel (``prange``, threads:
-``numba.set_num_threads`` or ``NUMBA_NUM_THREADS``; batches below :data:`legkin.analytic._kernels.SERIAL_BELOW`
+``numba.set_num_threads`` or ``NUMBA_NUM_THREADS``; batches below :data:`legkin._kernels.SERIAL_BELOW`
 items run on the calling thread). The Python wrappers only check the inputs and apply the single/batch rule.
 
-Inputs are checked at every public function: arrays as by :func:`legkin.analytic._batch.as_input` (wrong shape,
+Inputs are checked at every public function: arrays as by :func:`legkin._batch.as_input` (wrong shape,
 NaN/inf, complex, strings, ragged: ``InvalidInputError``; a float64 array of the right shape goes straight to
 the kernel, which tests finiteness and reports it by its status code), keyword parameters for kind and range
 (``InvalidParameterError`` naming the value and the valid range; ``foot_z``'s range is the registry's,
@@ -35,8 +35,8 @@ import numpy as np
 
 from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
 from ..models.quadruped import SPEC as _SPEC
-from ._batch import real_number as _number, as_input
-from ._kernels import OK, SERIAL_BELOW, as_rows, batch_kernel, kernel, prange
+from .._batch import real_number as _number, as_input
+from .._kernels import OK, SERIAL_BELOW, as_rows, batch_kernel, kernel, prange
 
 __all__ = [
     "LEGS",

@@ -34,8 +34,8 @@ from ..errors import (
     UnreachableError,
 )
 from ..models.tripod import SPEC as _SPEC
-from ._batch import real_number as _number, as_angles, as_input
-from ._kernels import OK, batch_kernel, kernel, prange
+from .._batch import real_number as _number, as_angles, as_input
+from .._kernels import OK, batch_kernel, kernel, prange
 
 __all__ = [
     "LEGS",
@@ -719,7 +719,7 @@ def _det_planes(s: np.ndarray, c: np.ndarray, g: _Geometry) -> np.ndarray:
 
 
 # ------------------------------------------------------------------------------------------ compiled kernels
-# The one implementation (issue 16, see :mod:`legkin.analytic._kernels`): scalar kernels beside the equations
+# The one implementation (issue 16, see :mod:`legkin._kernels`): scalar kernels beside the equations
 # they implement (the docstrings of the numpy-era helpers above and below give the derivations), batch loops
 # over them, and status codes. Geometry: a float64 vector (see :func:`_geometry_vector`):
 _G_D, _G_CA, _G_SA, _G_K, _G_K2, _G_OPC, _G_DSA, _G_ML, _G_TH, _G_CE, _G_SE, _G_W = 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 12, 15

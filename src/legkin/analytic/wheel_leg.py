@@ -32,8 +32,8 @@ from typing import Mapping, NamedTuple
 import numpy as np
 
 from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
-from ._kernels import OK, as_rows, batch_kernel, kernel, prange
-from ._batch import as_angles, as_input, check_choice, check_flag, check_integer, check_number, finish
+from .._kernels import OK, as_rows, batch_kernel, kernel, prange
+from .._batch import as_angles, as_input, check_choice, check_flag, check_integer, check_number, finish
 
 __all__ = [
     "LEGS",

@@ -13,7 +13,7 @@ from typing import Callable
 
 import numpy as np
 
-from ..errors import InvalidInputError, InvalidParameterError
+from .errors import InvalidInputError, InvalidParameterError
 
 __all__ = ["as_input", "as_angles", "finish", "real_number", "check_number", "check_integer", "check_flag", "check_choice"]
 

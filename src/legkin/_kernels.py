@@ -13,7 +13,7 @@ The rule (issue 16), for every analytic module:
   same compiled function): starting the worker threads costs a few microseconds.
 * The Python wrapper only checks the inputs (lean: a float64 array of the core shape goes straight to the
   kernel), calls the kernel (single input) or the batch loop (leading dimensions), and applies the
-  single/batch rule of :mod:`legkin.analytic._batch` (a single call raises a legkin error on failure, a batch
+  single/batch rule of :mod:`legkin._batch` (a single call raises a legkin error on failure, a batch
   gives NaN plus the mask).
 * Iterative solvers are per-target compiled loops with early exit.
 

@@ -1,0 +1,32 @@
+"""Closed-form IK of any HAA-HFE-KFE quadruped leg, measured from its URDF (issue 13).
+
+>>> from legkin import legs
+>>> model, urdf, dirs = legs.load_erd("go2")
+>>> go2 = legs.from_model(model)            # {"FL": Leg, "FR": Leg, "RL": Leg, "RR": Leg}
+>>> q = go2["FL"].ik([0.19, 0.14, -0.3])    # the branch inside the URDF limits
+
+Modules: :mod:`.kinematics` (the :class:`Leg` and its compiled kernels), :mod:`.extract` (finding and measuring
+legs in a Pinocchio model), :mod:`.erd` (the nine quadrupeds of example-robot-data), :mod:`.registry`,
+:mod:`.checks` (rows of ``legkin check``), :mod:`.bench`.
+"""
+
+from .erd import ERD_ROBOTS, ErdRobot, erd_files, external_models, load_erd, reference_configuration
+from .extract import find_chains, from_model, from_urdf
+from .kinematics import BRANCHES, Leg, LegStructureError
+from .registry import erd_spec
+
+__all__ = [
+    "Leg",
+    "LegStructureError",
+    "BRANCHES",
+    "from_model",
+    "from_urdf",
+    "find_chains",
+    "ERD_ROBOTS",
+    "ErdRobot",
+    "erd_files",
+    "load_erd",
+    "reference_configuration",
+    "external_models",
+    "erd_spec",
+]

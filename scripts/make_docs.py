@@ -62,7 +62,7 @@ def pictures() -> str:
 
 
 def check_tables(samples: int) -> str:
-    from legkin.plots import write_check_plots
+    from legkin.figures import write_check_plots
 
     results = run_checks(samples=samples)
     write_json(results, DOCS / "check.json")

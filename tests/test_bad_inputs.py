@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 import legkin
-from legkin.analytic import hybrid_leg as hl
-from legkin.analytic import quadruped as aq
-from legkin.analytic import tripod as at
-from legkin.analytic import wheel_leg as wl
+from legkin.hybrid_leg import kinematics as hl
+from legkin.quadruped import kinematics as aq
+from legkin.tripod import kinematics as at
+from legkin.wheel_leg import kinematics as wl
 
 P_LF = aq.foot_position([0.1, 1.0, 1.0], "LF")
 T_FL = wl.contact_point([1.0, 0.1, 0.0], 0.0, 0.0, "FL")

@@ -69,7 +69,7 @@ def test_quick_all_models_covers_the_registry(tmp_path):
 
 
 def test_missing_peer_is_skipped_with_a_note(tmp_path, monkeypatch, capsys):
-    import legkin.benches.quadruped as bq
+    import legkin.quadruped.bench as bq
 
     monkeypatch.setattr(bq, "missing", lambda dist, module=None: f"{dist} is not installed (test)")
     code, doc = _run(tmp_path, "quadruped")
@@ -140,7 +140,7 @@ def _bench_modules():
 
 
 def test_single_call_entries_run_and_name_known_yardsticks():
-    from legkin.benches._single import YARDSTICKS, SingleCall
+    from legkin._single_call import YARDSTICKS, SingleCall
 
     for name, module in _bench_modules().items():
         if module is None or not hasattr(module, "single_calls"):
@@ -154,7 +154,7 @@ def test_single_call_entries_run_and_name_known_yardsticks():
 
 
 def test_yardstick_calls_every_key_every_model():
-    from legkin.benches._single import YARDSTICKS
+    from legkin._single_call import YARDSTICKS
 
     for name in legkin.list_models():
         calls = bench.yardstick_calls(name, list(YARDSTICKS))
@@ -189,7 +189,7 @@ def test_single_call_table_built_for_every_model_with_single_calls(monkeypatch):
 def test_single_call_table_with_a_toy_module_and_json(tmp_path, monkeypatch):
     import types
 
-    from legkin.benches._single import SingleCall
+    from legkin._single_call import SingleCall
 
     def boom():
         raise RuntimeError("broken entry")
@@ -234,7 +234,7 @@ def test_quick_cli_has_single_call_section_and_peer_rows(tmp_path, capsys):
     assert "single calls" in text
     single = doc["models"]["quadruped"]["single_calls"]
     assert "rows" in single and "yardsticks" in single
-    from legkin.benches import peers
+    from legkin import peers
 
     names = [m["name"] for m in doc["models"]["quadruped"]["methods"]]
     skipped = doc["models"]["quadruped"]["skipped_methods"]

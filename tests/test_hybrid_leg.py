@@ -18,8 +18,8 @@ from legkin import (
     SingularityError,
     UnreachableError,
 )
-from legkin.analytic import hybrid_leg as ah
-from legkin.checks import hybrid_leg as ch
+from legkin.hybrid_leg import kinematics as ah
+from legkin.hybrid_leg import checks as ch
 
 DEG = math.pi / 180
 ACTUATED = ("MCS1", "MCS2", "LL")

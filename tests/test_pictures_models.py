@@ -12,10 +12,10 @@ import pytest
 from conftest import shot
 
 import legkin
-from legkin import animations
-from legkin.analytic import hybrid_leg as ah
-from legkin.analytic import tripod as at
-from legkin.analytic import wheel_leg as wl
+from legkin import clips as animations
+from legkin.hybrid_leg import kinematics as ah
+from legkin.tripod import kinematics as at
+from legkin.wheel_leg import kinematics as wl
 from legkin.viewer import chromium_path
 
 FIGURES = {
@@ -48,7 +48,7 @@ def test_figures_are_nonblank_pngs(model, tmp_path):
     pytest.importorskip("matplotlib")
     from PIL import Image
 
-    paths = importlib.import_module(f"legkin.plots.{model}").figures(tmp_path)
+    paths = importlib.import_module(f"legkin.{model}.figures").figures(tmp_path)
     assert sorted(p.name for p in paths) == FIGURES[model]
     for p in paths:
         assert p.parent == tmp_path and p.exists()
@@ -64,7 +64,7 @@ def test_figures_are_nonblank_pngs(model, tmp_path):
 
 def test_check_plots_pick_up_model_figures(tmp_path):
     pytest.importorskip("matplotlib")
-    from legkin.plots import write_check_plots
+    from legkin.figures import write_check_plots
     from legkin.validation import compare
 
     row = compare("a check row", [1e-16, 1e-15], 1e-12)
@@ -105,7 +105,7 @@ def test_wheel_leg_transform_goes_from_wheel_to_leg_mode_and_back(robots, clips)
 
 
 def test_tripod_clip_sweeps_just_inside_the_boundary(robots, clips):
-    from legkin.animations.tripod import MARGIN, TILT_CAP
+    from legkin.tripod.clips import MARGIN, TILT_CAP
 
     robot, qs = robots["tripod"], clips["tripod"]
     axis = np.array([robot.frame_placement(q, "platform").rotation[:, 0] for q in qs])  # Pinocchio's platform

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import legkin
-from legkin import animations
+from legkin import clips as animations
 from legkin.__main__ import main
 from legkin._registry import MODELS
 

@@ -10,8 +10,8 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import legkin
-from legkin.analytic import quadruped as aq
-from legkin.checks import quadruped as checks
+from legkin.quadruped import kinematics as aq
+from legkin.quadruped import checks as checks
 
 LEGS = aq.LEGS
 L1 = math.hypot(aq.X23, aq.Z23)
@@ -272,7 +272,7 @@ def test_keyword_parameters_are_validated(kw, match):
 
 
 def test_foot_z_range_is_the_registry_one():
-    from legkin.models.quadruped import SPEC
+    from legkin.quadruped.spec import SPEC
 
     param = SPEC.params["foot_z"]
     q = np.array([0.0, 0.75, 1.5])
@@ -465,7 +465,7 @@ def test_ik_robustness_row_passes():
 def test_batch_is_the_single_call_kernel_item_by_item(rng):
     """The batch is a compiled loop over the single-call kernel: identical answers, bit for bit, on both
     the serial (small) and the parallel (large) path, with and without q_ref, and on non-contiguous input."""
-    from legkin.analytic._kernels import SERIAL_BELOW
+    from legkin._kernels import SERIAL_BELOW
 
     lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
     n = SERIAL_BELOW + 44

@@ -13,8 +13,8 @@ from hypothesis import strategies as st
 
 import legkin
 from legkin import InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
-from legkin.analytic import tripod as at
-from legkin.checks import tripod as ct
+from legkin.tripod import kinematics as at
+from legkin.tripod import checks as ct
 
 ALPHAS = (math.pi / 4, math.pi / 3, math.pi / 2)
 

@@ -11,9 +11,9 @@ from hypothesis import strategies as st
 
 import legkin
 from legkin import _generate
-from legkin.analytic import wheel_leg as wl
-from legkin.checks import wheel_leg as checks
-from legkin.models.wheel_leg import SPEC, annular_sector, rim_meshes
+from legkin.wheel_leg import kinematics as wl
+from legkin.wheel_leg import checks as checks
+from legkin.wheel_leg.spec import SPEC, annular_sector, rim_meshes
 
 DEG = math.pi / 180
 GEO = wl.Geometry()

@@ -148,7 +148,7 @@ def _cmd_check(args) -> int:
     if args.json:
         write_json(results, args.json)
     if args.plots:
-        from .plots import write_check_plots
+        from .figures import write_check_plots
 
         for path in write_check_plots(results, args.plots):
             print(f"wrote {path}")
@@ -182,7 +182,7 @@ def _cmd_view(args) -> int:
     else:
         q = robot.q0
     if args.animate:
-        from .animations import frames
+        from .clips import frames
         from .viewer import write_animation_html
 
         qs = frames(robot, args.animate)
@@ -241,7 +241,7 @@ def build_parser() -> argparse.ArgumentParser:
     g = p.add_mutually_exclusive_group()
     g.add_argument("--pose", help="a named pose from the SRDF")
     g.add_argument("--q", type=finite_float, nargs="+", help="a configuration vector")
-    p.add_argument("--animate", metavar="NAME", help="play an animation clip (see legkin.animations)")
+    p.add_argument("--animate", metavar="NAME", help="play an animation clip (the clips of legkin.<model>.clips)")
     p.add_argument("--html", metavar="PATH", type=output_file, help="write a static page and exit")
     p.set_defaults(func=_cmd_view)
 

@@ -70,9 +70,9 @@ def render(spec: ModelSpec, args: Mapping[str, object]) -> GeneratedFiles:
     srdf = xdir / f"{spec.name}.srdf.xacro"
     if srdf.exists():
         files[f"{spec.name}.srdf"] = _run_xacro(srdf, args)
-    if spec.assets:
-        mod, _, func = spec.assets.rpartition(".")
-        files.update(getattr(importlib.import_module(mod), func)(dict(args)))
+    assets = getattr(importlib.import_module(f"{spec.package}.spec"), "assets", None)
+    if assets is not None:
+        files.update(assets(dict(args)))
     return files
 
 

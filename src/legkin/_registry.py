@@ -6,6 +6,7 @@ import importlib
 import math
 import pkgutil
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Mapping
 
 from .errors import InvalidParameterError, UnknownModelError
@@ -71,11 +72,13 @@ class ModelSpec:
         params: xacro arguments (name -> :class:`Param`).
         actuated_joints: names of the actuated joints.
         floating: whether ``load(..., floating=True)`` makes sense (a walking robot).
-        analytic: dotted path of the analytic module.
-        checks: dotted path of the module whose ``run(samples, rng)`` validates it.
-        assets: dotted path of a function ``(args) -> {relative path: bytes}`` making
-            generated files other than URDF/SRDF (meshes), written beside the URDF.
         reference_pose: the SRDF pose used as ``Robot.q0``.
+
+    The mechanism itself is the package ``legkin.<name>`` (:attr:`package`), found by one rule: every
+    sub-package of :mod:`legkin` with a ``spec`` module defining ``SPEC``. Its modules are found by name:
+    ``spec`` (this entry; an optional ``assets(args) -> {relative path: bytes}`` making generated files
+    other than URDF/SRDF, e.g. meshes), ``kinematics`` (re-exported by the package, with ``Geometry``),
+    ``checks`` (``run(samples, rng)``), ``bench`` (``build``, ``single_calls``), ``figures`` and ``clips``.
     """
 
     name: str
@@ -84,10 +87,12 @@ class ModelSpec:
     params: Mapping[str, Param] = field(default_factory=dict)
     actuated_joints: tuple[str, ...] = ()
     floating: bool = False
-    analytic: str = ""
-    checks: str = ""
-    assets: str = ""
     reference_pose: str = "standing"
+
+    @property
+    def package(self) -> str:
+        """Dotted name of the mechanism's package."""
+        return f"legkin.{self.name}"
 
     @property
     def xacro_file(self) -> str:
@@ -108,14 +113,19 @@ class ModelSpec:
 
 
 def _discover() -> dict[str, ModelSpec]:
-    """Collect ``SPEC`` from every module of :mod:`legkin.models` (one module per mechanism)."""
-    from . import models
+    """Collect ``SPEC`` from every mechanism package: each sub-package ``legkin.<name>`` with a ``spec``
+    module (the one rule by which the framework finds a mechanism)."""
+    import legkin
 
     found: dict[str, ModelSpec] = {}
-    for info in sorted(pkgutil.iter_modules(models.__path__), key=lambda m: m.name):
-        if info.name.startswith("_"):
+    for info in sorted(pkgutil.iter_modules(legkin.__path__), key=lambda m: m.name):
+        if not info.ispkg or info.name.startswith("_"):
             continue
-        spec = importlib.import_module(f"{models.__name__}.{info.name}").SPEC
+        if not (Path(info.module_finder.path) / info.name / "spec.py").is_file():  # type: ignore[union-attr]
+            continue  # a package that is not a mechanism (read from disk: nothing else is imported)
+        spec = importlib.import_module(f"legkin.{info.name}.spec").SPEC
+        if spec.name != info.name:
+            raise RuntimeError(f"legkin.{info.name}.spec.SPEC is named {spec.name!r}: it must be {info.name!r}")
         found[spec.name] = spec
     return found
 

@@ -1,6 +1,6 @@
 """``legkin bench``: analytic kinematics timed side by side with iterative solvers, on the same targets.
 
-How a model is benchmarked: its module ``legkin.benches.<model>`` defines
+How a model is benchmarked: its module ``legkin.<model>.bench`` defines
 ``build(n, rng, quick) -> ModelBench``, a list of :class:`Method` records, each with its inputs (the
 same random reachable targets for every method of a group), a ``run`` callable (the timed part) and a
 ``score`` callable (untimed: turns the output into per-target errors measured the same way for every
@@ -8,10 +8,10 @@ method, by Pinocchio). This module times each method (median of ``repeats`` runs
 in one process), scores it, and prints one table per model; ``--json`` writes the same numbers.
 
 The single-call table (issue 16): a bench module may also define ``single_calls() -> list[SingleCall]``
-(:mod:`legkin.benches._single`), one entry per public analytic function with its inputs bound. Each is timed
+(:mod:`legkin._single_call`), one entry per public analytic function with its inputs bound. Each is timed
 ``timeit``-style (loops of ``number`` calls, median over repeats) next to its yardstick, the Pinocchio call
-for the same quantity (:data:`legkin.benches._single.YARDSTICKS`) timed the same way in the same run on the
-same model. For the quadruped the bench also runs the peer IK libraries of :mod:`legkin.benches.peers`.
+for the same quantity (:data:`legkin._single_call.YARDSTICKS`) timed the same way in the same run on the
+same model. For the quadruped the bench also runs the peer IK libraries of :mod:`legkin.peers`.
 """
 
 from __future__ import annotations
@@ -300,11 +300,11 @@ def _run_methods(bench: ModelBench, runnable: list[Method], progress: _Progress)
 
 def _load_bench_module(name: str):
     """The bench module of ``name``, or None if there is none."""
-    modname = f"legkin.benches.{name}"
+    modname = f"legkin.{name}.bench"
     try:
         return importlib.import_module(modname)
     except ModuleNotFoundError as exc:
-        if exc.name == modname:
+        if exc.name in (modname, f"legkin.{name}"):
             return None
         raise
 
@@ -325,12 +325,12 @@ def run_bench(
     for name in names:
         module = _load_bench_module(name)
         if module is None:
-            out["skipped"][name] = f"no bench module legkin.benches.{name}"
+            out["skipped"][name] = f"no bench module legkin.{name}.bench"
             continue
         rng = np.random.default_rng(seed)
         bench = module.build(n, rng, quick)
         if name == "quadruped":
-            from .benches import peers
+            from . import peers
 
             peers.add_quadruped_peers(bench)
         out["models"][name] = (bench, run_model(bench, label=name, quiet=quiet))
@@ -424,7 +424,7 @@ def yardstick_calls(name: str, keys, seed: int = 0) -> dict[str, tuple[Callable[
     import pinocchio as pin
 
     from . import load
-    from .benches._single import YARDSTICKS
+    from ._single_call import YARDSTICKS
 
     out: dict[str, tuple[Callable[[], object], str]] = {}
     robots: dict[str, Any] = {}

@@ -123,7 +123,7 @@ def run_checks(
     """
     names = list(models or list_models())
     specs = [get_spec(name) for name in names]  # every unknown name raises before any work
-    modules = [importlib.import_module(spec.checks) for spec in specs]
+    modules = [importlib.import_module(f"{spec.package}.checks") for spec in specs]
     steps = sum(2 if hasattr(m, "ik_robustness") else 1 for m in modules)
     out = {}
     with progress_bar(steps, "legkin check", enabled=progress) as bar:

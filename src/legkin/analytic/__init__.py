@@ -1,1 +1,4 @@
-"""Hand-derived analytic kinematics, one module per mechanism (numpy only, vectorised)."""
+"""Deprecated: the kinematics moved to one package per mechanism (``from legkin import quadruped``).
+
+``legkin.analytic.<name>`` keeps working, with a DeprecationWarning, for one release.
+"""

@@ -1,1 +1,0 @@
-"""Per-mechanism validation: each module's ``run(samples, rng)`` returns ``CheckResult`` rows."""

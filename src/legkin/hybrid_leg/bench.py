@@ -1,0 +1,176 @@
+"""Hybrid leg: closed-form ``foot_ik`` (batch and scalar) vs a Pinocchio closed-loop iterative IK, same targets.
+
+Targets: Pinocchio's ``FCS`` frame at closed configurations (``checks.hybrid_leg.closed_configuration``) of
+random platform poses of the neutral assembly mode (``checks.hybrid_leg.sample_workspace``, motor Jacobian
+sigma_min >= 1e-2) and theta_LL uniform on the extension side [-0.3, delta] (the ``ll_branch`` foot_ik tries first).
+Every answer (three motor angles) is scored the same way: the foot that those motors give in the neutral
+assembly mode (:func:`legkin.hybrid_leg.foot_position`, validated against Pinocchio) vs the target.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import load
+from . import kinematics as ah
+from ..bench import Method, MethodResult, ModelBench, Score
+from .checks import LL_RANGE, closed_configuration, sample_workspace
+from ..errors import LegkinError
+from .._benchkit import SOLVE_TOL, levenberg_marquardt, pinocchio_positions, sizes
+from .._single_call import SingleCall
+
+TOL = 1e-12
+MAX_ITER = 100
+
+
+def _sizes(n: int | None, quick: bool) -> tuple[int, int, int]:
+    """(batch targets, scalar-loop targets, iterative-solver targets)."""
+    return sizes(n, quick, full=(20_000, 2_000, 200), small=(1_000, 100, 10))
+
+
+#: The single-call inputs: a platform pose of the neutral assembly mode and an extension-motor angle.
+SINGLE_POSE = (0.1, 0.2)
+SINGLE_THETA0 = 1.0
+
+
+def single_calls() -> list[SingleCall]:
+    """One single call per public function of :mod:`legkin.hybrid_leg`, inputs bound.
+
+    Inputs: the motors of the platform pose :data:`SINGLE_POSE` (roll, pitch) on branch (1, 1), theta0 =
+    :data:`SINGLE_THETA0`, the foot they give as the IK target. Yardsticks: Pinocchio ``forwardKinematics`` +
+    ``updateFramePlacement`` on the quadruped (``quadruped_fk``) for the closed forms; ``Robot.solve_loops`` on
+    the hybrid leg (``solve_loops``, ``iterative=True``) for the functions that solve the closed sub-chain's
+    forward kinematics (the degree-8 polynomial and Newton): platform_orientation, platform_poses, foot_position,
+    foot_jacobian and foot_ik_solutions (which runs the forward kinematics of every branch).
+    """
+    roll, pitch = SINGLE_POSE
+    t0 = SINGLE_THETA0
+    rot = ah.platform_rotation(roll, pitch)
+    t1, t2 = (float(v) for v in ah.motor_angles(roll, pitch))
+    tll = float(ah.ll_angle(t0))
+    p = ah.foot_position(t1, t2, t0)
+    cf, it = "quadruped_fk", "solve_loops"
+    return [
+        SingleCall("ll_angle", lambda: ah.ll_angle(t0), cf),
+        SingleCall("extension_motor_angle", lambda: ah.extension_motor_angle(tll), cf),
+        SingleCall("platform_rotation", lambda: ah.platform_rotation(roll, pitch), cf),
+        SingleCall("rod_spans", lambda: ah.rod_spans(t1, t2, roll, pitch), cf),
+        SingleCall("motor_angles", lambda: ah.motor_angles(roll, pitch), cf),
+        SingleCall("motor_angles_from_rotation", lambda: ah.motor_angles_from_rotation(rot), cf),
+        SingleCall("motor_jacobian", lambda: ah.motor_jacobian(roll, pitch), cf),
+        SingleCall("sphere_joint_angles", lambda: ah.sphere_joint_angles(rot), cf),
+        SingleCall("spherical_free_axis", lambda: ah.spherical_free_axis(rot), cf),
+        SingleCall("assembly_mode", lambda: ah.assembly_mode(roll, pitch), cf),
+        SingleCall("foot_position_from_platform", lambda: ah.foot_position_from_platform(roll, pitch, tll), cf),
+        SingleCall("foot_platform_ik", lambda: ah.foot_platform_ik(p), cf),
+        SingleCall("foot_ik", lambda: ah.foot_ik(p), cf),
+        SingleCall("platform_orientation", lambda: ah.platform_orientation(t1, t2), it, iterative=True),
+        SingleCall("platform_poses", lambda: ah.platform_poses(t1, t2), it, iterative=True),
+        SingleCall("foot_position", lambda: ah.foot_position(t1, t2, t0), it, iterative=True),
+        SingleCall("foot_jacobian", lambda: ah.foot_jacobian(t1, t2, t0), it, iterative=True),
+        SingleCall("foot_ik_solutions", lambda: ah.foot_ik_solutions(p), it, iterative=True),
+    ]
+
+
+def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
+    n_batch, n_scalar, n_iter = _sizes(n, quick)
+    import pinocchio as pin
+
+    robot = load("hybrid_leg")
+    model, data = robot.model, robot.data
+    fid = robot.frame_id("FCS")
+    roll, pitch = sample_workspace(n_batch, rng)
+    theta_ll = rng.uniform(LL_RANGE[0], ah.LL_DELTA, n_batch)
+    qs_true = closed_configuration(robot, np.stack([roll, pitch], -1), theta_ll)
+    targets, _ = pinocchio_positions(model, data, fid, qs_true)
+    i_m = [robot.idx_q(j) for j in ("MCS1", "MCS2", "LL")]
+
+    def score_motors(p, motors, residual=None, iters=None, evals=None) -> Score:
+        motors = np.asarray(motors, dtype=float)
+        ok_in = np.all(np.isfinite(motors), axis=-1)
+        foot = np.full((len(p), 3), np.nan)
+        if ok_in.any():
+            foot[ok_in] = ah.foot_position(motors[ok_in, 0], motors[ok_in, 1], motors[ok_in, 2])
+        err = np.linalg.norm(foot - p, axis=-1)
+        solved = err <= SOLVE_TOL
+        if residual is not None:
+            solved &= residual <= SOLVE_TOL
+        return Score(error=err, solved=solved, orientation=residual, iterations=iters, fk_evals=evals)
+
+    def batch_ik(p):
+        return ah.foot_ik(p)
+
+    def scalar_ik(p):
+        out = np.full((len(p), 3), np.nan)
+        for i, pi in enumerate(p):
+            try:
+                out[i] = ah.foot_ik(pi)
+            except LegkinError:
+                pass
+        return out
+
+    loopset = robot._loopset
+    ldata = loopset.data
+    free = np.ones(model.nv, dtype=bool)
+
+    def pin_ik(p):
+        k = len(p)
+        qs = np.full((k, model.nq), np.nan)
+        iters, evals = np.full(k, np.nan), np.full(k, np.nan)
+        for i, target in enumerate(p):
+
+            def residual_and_jacobian(q):
+                r, jc = loopset.residual_and_jacobian(q)  # forwardKinematics + computeJointJacobians in ldata
+                pin.updateFramePlacement(model, ldata, fid)
+                jf = pin.getFrameJacobian(model, ldata, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
+                return np.concatenate([r, ldata.oMf[fid].translation - target]), np.vstack([jc, jf])
+
+            q, it, ev, ok = levenberg_marquardt(model, residual_and_jacobian, robot.q0.copy(), free, TOL, MAX_ITER)
+            iters[i], evals[i] = it, ev
+            if ok:
+                qs[i] = q
+        return qs, iters, evals
+
+    def pin_score(p, out) -> Score:
+        qs, iters, evals = out
+        motors = np.column_stack([qs[:, i_m[0]], qs[:, i_m[1]], ah.extension_motor_angle(qs[:, i_m[2]])])
+        res = np.array([np.linalg.norm(robot.constraint_residual(q)) if np.all(np.isfinite(q)) else np.nan for q in qs])
+        return score_motors(p, motors, res, iters, evals)
+
+    methods = [
+        Method(f"legkin batch closed form (foot_ik; {n_batch} at once)", targets, batch_ik,
+               lambda p, m: score_motors(p, m), repeats=5),
+        Method("legkin scalar closed form, Python loop", targets, scalar_ik, lambda p, m: score_motors(p, m),
+               max_targets=n_scalar, repeats=3),
+        Method("pinocchio closed-loop IK (LM on loops + foot, start q0)", targets, pin_ik, pin_score,
+               max_targets=n_iter, repeats=3),
+    ]
+    notes = [
+        f"targets: Pinocchio FCS of {n_batch} closed configurations, platform poses of the neutral assembly mode "
+        "(sigma_min(dtheta/dx) >= 1e-2), theta_LL uniform in [-0.3, delta] (the ll_branch foot_ik tries first); the "
+        f"scalar loop solves the first {n_scalar}, Pinocchio the first {n_iter}",
+        "err = foot of the answer's motors (theta1, theta2, theta0) in the neutral assembly mode (foot_position) vs "
+        "target (m); loop |r| = Pinocchio loop residual of the Pinocchio answer; a Pinocchio answer closing the "
+        "loops in another assembly mode lands elsewhere and counts as not solved",
+        f"pinocchio closed-loop IK: the Levenberg-Marquardt of Robot.solve_loops on [2 rod closures; FCS - target] "
+        f"(getFrameJacobian LOCAL_WORLD_ALIGNED), every joint free, tolerance {TOL:g}, at most {MAX_ITER} iterations; "
+        "theta0 from theta_LL by eq 19",
+    ]
+
+    def summary(results: list[MethodResult]) -> list[str]:
+        b = next(r for r in results if "batch" in r.name)
+        s = next(r for r in results if "scalar" in r.name)
+        p = next(r for r in results if "pinocchio" in r.name)
+        return [
+            f"batch foot_ik is {p.time_per_target_s / b.time_per_target_s:,.0f}x and the scalar call "
+            f"{p.time_per_target_s / s.time_per_target_s:,.1f}x faster than the Pinocchio closed-loop IK"
+        ]
+
+    return ModelBench(
+        methods=methods,
+        units={"ik": "m"},
+        tolerance=f"foot error <= {SOLVE_TOL:g} m (and loop |r| <= {SOLVE_TOL:g} for Pinocchio's configuration)",
+        notes=notes,
+        summary=summary,
+        secondary="loop |r|",
+    )

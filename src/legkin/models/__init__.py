@@ -1,1 +1,0 @@
-"""Registry entries: one module per mechanism, each defining ``SPEC``."""

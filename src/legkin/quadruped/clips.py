@@ -1,0 +1,24 @@
+"""Quadruped clips: every foot traces a circle, solved by the closed-form IK at each frame."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import kinematics as aq
+
+
+def foot_circles(robot, frames: int = 90, radius: float = 0.06) -> list[np.ndarray]:
+    """Feet trace vertical circles (radius 6 cm) around their standing positions, legs half a turn apart."""
+    t = np.linspace(0.0, 2.0 * np.pi, frames, endpoint=False)
+    qs = np.tile(robot.q0, (frames, 1))
+    for k, leg in enumerate(aq.LEGS):
+        iq = robot.idx_q(f"{leg}_HAA")
+        q_stand = robot.q0[iq : iq + 3]
+        centre = aq.foot_position(q_stand, leg)
+        phase = t + (np.pi if k in (1, 2) else 0.0)  # trot-like: LF/RH together, LH/RF together
+        p = centre + radius * np.stack([np.cos(phase), np.zeros_like(t), np.sin(phase)], axis=-1)
+        qs[:, iq : iq + 3] = aq.foot_ik(p, leg, q_ref=q_stand)
+    return list(qs)
+
+
+ANIMATIONS = {"foot_circles": foot_circles}

@@ -1,0 +1,433 @@
+"""Validation of :mod:`legkin.tripod` against Pinocchio, for alpha in {pi/3 (default), pi/4, pi/2}."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pinocchio as pin
+
+from .. import load
+from ..errors import LoopClosureError
+from . import kinematics as at
+from ..validation import CheckResult, classify_failures, compare, per_sample, pinocchio_frames, robustness_row
+
+TOL = 1e-12
+#: The parameter sets checked: the default (alpha = pi/3) and alpha = pi/4, pi/2 (generated into the cache).
+ALPHAS = (("pi/3", math.pi / 3), ("pi/4", math.pi / 4), ("pi/2", math.pi / 2))
+#: A_u from Pinocchio inverts the 2x2 map from the closed-loop null space to (alpha_y, alpha_z): its error grows
+#: like 1e-16 |A_u| / (sigma_10 / sigma_1 * |cos alpha_y|). Samples below this conditioning go to their own row.
+COND_MIN = 1e-3
+#: Tolerance of that ill-conditioned row (measured: 4.5e-11 at sigma_10 / sigma_1 = 5e-7, alpha = pi/4).
+TOL_ILL = 1e-9
+#: Central differences of ik (4th order at H and H/2, Richardson-combined to 6th order): truncation
+#: ~ H^6 |q^(7)|, roundoff ~ 1e-16 / H;
+#: used on samples with min |sin q_K2| > 0.1, |cos alpha_y| > 0.1 and 1 + c_y c_z > 0.1, where the derivatives of
+#: ik stay moderate (relative error measured <= 3e-10 at 10,000 samples).
+H = 1e-4
+TOL_FD = 1e-9
+#: fk vs solve_loops: the configuration solve_loops closes (residual ~1e-15, A_q1 and B_q1 held) is only as
+#: accurate as 1e-15 x gain, gain = 1 / sigma_min(constraint Jacobian on the free joints), which is large near
+#: bifurcations of the legs' branches (measured: 1.75e-12 rad at gain 3.9e4, alpha = pi/4, seed 2; error / gain <= 1.4e-16 over seeds 0, 2, 5, 7). Samples with
+#: gain > GAIN_MAX report error / gain against TOL_GAIN.
+GAIN_MAX = 1e3
+TOL_GAIN = 1e-15
+#: fk vs solve_loops: samples (loop solving is slower) and the solver tolerance (tighter than the default
+#: 1e-12, which would limit the comparison to ~1e-12 x conditioning).
+SOLVE_SAMPLES = 200
+#: Near the platform singularity 1 + c_y c_z = 0 (tilt -> pi) fk and ik are ill-conditioned: the orientation
+#: error of fk(ik(u)) grows like 1e-16 / (1 + c_y c_z) (measured 3.8e-10 at 1 + c_y c_z = 7e-7, alpha = pi/4); samples with
+#: 1 + c_y c_z <= NEAR_FLIP get rows of their own with TOL_FLIP, valid down to 1 + c_y c_z ~ 1e-7.
+NEAR_FLIP = 1e-2
+TOL_FLIP = 1e-8
+SOLVE_TOL = 1e-14
+
+
+def sample_workspace(n: int, rng: np.random.Generator, alpha: float, margin: float = 0.0):
+    """(alpha_y, alpha_z) uniform in [-pi/2, pi/2] x [-pi, pi], kept where :func:`ik` succeeds and
+    every leg has 1 - |cos q_K2| > margin."""
+    ays, azs = [], []
+    while sum(len(a) for a in ays) < n:
+        ay = rng.uniform(-np.pi / 2, np.pi / 2, 2 * n)
+        az = rng.uniform(-np.pi, np.pi, 2 * n)
+        q, ok = at.ik(ay, az, alpha=alpha, return_mask=True)
+        ok &= np.all(1.0 - np.abs(np.cos(q[..., [1, 5, 9]])) > margin, axis=-1) if margin > 0 else ok
+        ays.append(ay[ok])
+        azs.append(az[ok])
+    return np.concatenate(ays)[:n], np.concatenate(azs)[:n]
+
+
+def sample_near_boundary(n: int, rng: np.random.Generator, alpha: float):
+    """Orientations with some leg at 1 - |cos q_K2| in [1e-10, 1e-3] (close to the workspace boundary)."""
+    ch = math.cos(alpha / 2)
+    ays, azs = [], []
+    while sum(len(a) for a in ays) < n:
+        phi = rng.uniform(-np.pi, np.pi, 2 * n)
+        k = rng.integers(0, 3, 2 * n)
+        s = np.abs(np.sin(phi - np.asarray(at.ETA)[k]))
+        gap = 10 ** rng.uniform(-10, -3, 2 * n)  # target 1 - |cos q_K2|
+        arg = (1.0 - gap) * ch / s
+        good = arg < 1.0
+        theta = 2 * np.arcsin(np.minimum(arg, 1.0))
+        r = np.stack([np.cos(theta), np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi)], axis=-1)
+        ay, az = at.orientation_from_axis(r)
+        _, ok = at.ik(ay, az, alpha=alpha, return_mask=True)
+        ok &= good
+        ays.append(ay[ok])
+        azs.append(az[ok])
+    return np.concatenate(ays)[:n], np.concatenate(azs)[:n]
+
+
+def sample_near_flip(n: int, rng: np.random.Generator, alpha: float):
+    """Reachable orientations with tilt pi - delta, delta in [1e-3, 3e-2] (1 + c_y c_z ~ delta^2 / 2 >= 5e-7)."""
+    phi = rng.uniform(-np.pi, np.pi, 20 * n)
+    theta = np.pi - 10 ** rng.uniform(-3, -1.5, 20 * n)
+    r = np.stack([np.cos(theta), np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi)], axis=-1)
+    ay, az = at.orientation_from_axis(r)
+    _, ok = at.ik(ay, az, alpha=alpha, return_mask=True)
+    return ay[ok][:n], az[ok][:n]
+
+
+def _rot_err(ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
+    """Rotation angle of ra^T rb (rad), robust for tiny angles."""
+    m = np.swapaxes(ra, -1, -2) @ rb
+    skew = np.stack([m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]], -1)
+    return np.arctan2(np.linalg.norm(skew, axis=-1) / 2, (np.trace(m, axis1=-2, axis2=-1) - 1) / 2)
+
+
+def _pin_actuation_jacobian(robot, q: np.ndarray) -> tuple[np.ndarray, float]:
+    """d(q_A1, q_B1, q_C1)/d(alpha_y, alpha_z) from Pinocchio alone, and its conditioning.
+
+    The closed-loop velocities span the null space N (12 x 2) of the stacked constraint Jacobian; the
+    platform's angular velocity is w = J_platform[3:] N; the platform axis r = R e_x moves as dr = w x r, and
+    (alpha_y, alpha_z) = (-asin r3, atan2(r2, r1)) (definition, eq 5) moves as G = d(alpha)/dr . dr.
+    Then A_u = N[actuated] G^-1.
+    """
+    jac = robot.constraint_jacobian(q)
+    _, s, vt = np.linalg.svd(jac)
+    null = vt[-2:].T
+    jf = robot.frame_jacobian(q, "platform")
+    r = robot.data.oMf[robot.frame_id("platform")].rotation[:, 0]
+    dr = np.cross(jf[3:].T, r).T @ null  # (w x r) for each null vector
+    rho2 = r[0] ** 2 + r[1] ** 2
+    g = np.stack([-dr[2] / math.sqrt(rho2), (r[0] * dr[1] - r[1] * dr[0]) / rho2])
+    act = [robot.idx_v(j) for j in robot.actuated_joints]
+    cond = s[-3] / s[0] * math.sqrt(rho2)
+    return null[act] @ np.linalg.inv(g), cond
+
+
+def _fd_actuation_jacobian(ay, az, alpha):
+    def motors(y, z):
+        return at.ik(y, z, alpha=alpha)[..., [0, 4, 8]]
+
+    def d4(h, dy, dz):
+        f = lambda k: motors(ay + k * h * dy, az + k * h * dz)  # noqa: E731
+        return (8 * (f(1) - f(-1)) - (f(2) - f(-2))) / (12 * h)
+
+    cols = []
+    for dy, dz in ((1.0, 0.0), (0.0, 1.0)):
+        cols.append((16 * d4(H / 2, dy, dz) - d4(H, dy, dz)) / 15)  # Richardson: 6th order
+    return np.stack(cols, axis=-1)
+
+
+def _is_cv_branch(q: np.ndarray) -> bool:
+    q2 = q[[1, 5, 9]]
+    return bool(
+        np.all(np.abs(at._wrap(q[[2, 6, 10]] - q2)) < 1e-9)
+        and np.all(np.abs(at._wrap(q[[3, 7, 11]] - q[[0, 4, 8]])) < 1e-9)
+        and np.all(np.sin(q2) > 0)
+    )
+
+
+def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -> list[CheckResult]:
+    robot = load("tripod") if tag == "pi/3" else load("tripod", alpha=alpha)
+    pre = f"[alpha={tag}] "
+    rows: list[CheckResult] = []
+    # --- open chains: every joint random
+    qs = rng.uniform(-np.pi, np.pi, (samples, 12))
+    pos, rot = pinocchio_frames(robot, qs, [f"{k}_ee" for k in at.LEGS])
+    perr, rerr, cverr = [], [], []
+    for k, leg in enumerate(at.LEGS):
+        t = at.leg_transform(qs[:, 4 * k : 4 * k + 4], at.ETA[k], alpha=alpha)
+        perr.append(per_sample(t[:, :3, 3] - pos[:, k]))
+        rerr.append(_rot_err(t[:, :3, :3], rot[:, k]))
+    rows.append(compare(pre + "leg_transform vs oMf K_ee, open chains, position (m)", perr, TOL))
+    rows.append(compare(pre + "leg_transform vs oMf K_ee, open chains, rotation (rad)", rerr, TOL))
+    # --- eq (10) on the CV branch (q3 = q2, q4 = q1)
+    qcv = qs.copy()
+    for k in range(3):
+        qcv[:, 4 * k + 2] = qcv[:, 4 * k + 1]
+        qcv[:, 4 * k + 3] = qcv[:, 4 * k]
+    pos, rot = pinocchio_frames(robot, qcv, [f"{k}_ee" for k in at.LEGS])
+    for k in range(3):
+        t = at.leg_transform_cv(qcv[:, 4 * k], qcv[:, 4 * k + 1], at.ETA[k], alpha=alpha)
+        cverr.append(np.maximum(per_sample(t[:, :3, 3] - pos[:, k]), _rot_err(t[:, :3, :3], rot[:, k])))
+    rows.append(compare(pre + "eq (10) leg_transform_cv vs oMf K_ee, q3=q2, q4=q1 (m | rad)", cverr, TOL))
+
+    # --- ik -> Pinocchio
+    ay, az = sample_workspace(samples, rng, alpha)
+    fy, fz = sample_near_flip(max(samples // 10, 50), rng, alpha)
+    if len(fy):  # the workspace reaches the platform singularity only for alpha <= pi/3 (default eta)
+        ay, az = np.concatenate([ay, fy]), np.concatenate([az, fz])
+    far = 1 + np.cos(ay) * np.cos(az) > NEAR_FLIP
+    q = at.ik(ay, az, alpha=alpha)
+    res = np.array([np.linalg.norm(robot.constraint_residual(qi)) for qi in q])
+    pos, rot = pinocchio_frames(robot, q, ["platform"])
+    rot_e = _rot_err(at.platform_rotation(ay, az), rot[:, 0])
+    pos_e = per_sample(at.platform_position(ay, az, alpha=alpha) - pos[:, 0])
+    for sel, tag_, tol in ((far, f"1 + c_y c_z > {NEAR_FLIP:g}", TOL), (~far, f"1 + c_y c_z <= {NEAR_FLIP:g}", TOL_FLIP)):
+        if not sel.any():
+            continue
+        rows.append(compare(pre + f"ik -> loop residual |r| (Pinocchio) ({tag_})", res[sel], tol))
+        rows.append(compare(pre + f"ik -> platform rotation vs platform_rotation (rad) ({tag_})", rot_e[sel], tol))
+        rows.append(compare(pre + f"ik -> platform position vs platform_position (m) ({tag_})", pos_e[sel], tol))
+    by, bz = sample_near_boundary(max(samples // 10, 50), rng, alpha)
+    qb = at.ik(by, bz, alpha=alpha)
+    resb = np.array([np.linalg.norm(robot.constraint_residual(qi)) for qi in qb])
+    farb = 1 + np.cos(by) * np.cos(bz) > NEAR_FLIP  # boundary samples can be near the flip too
+    for sel, tag_, tol in ((farb, f"1 + c_y c_z > {NEAR_FLIP:g}", TOL), (~farb, f"1 + c_y c_z <= {NEAR_FLIP:g}", TOL_FLIP)):
+        if sel.any():
+            rows.append(compare(pre + f"ik -> loop residual, near boundary (1-|cos q2| in [1e-10, 1e-3]) ({tag_})",
+                                resb[sel], tol))
+
+    # --- actuation Jacobian
+    a_an = at.actuation_jacobian(ay, az, alpha=alpha)
+    err, cond = np.empty(len(q)), np.empty(len(q))
+    for i, qi in enumerate(q):
+        a_pin, cond[i] = _pin_actuation_jacobian(robot, qi)
+        err[i] = np.abs(a_pin - a_an[i]).max() / max(1.0, np.abs(a_an[i]).max())
+    well = (cond > COND_MIN) & far
+    rows.append(compare(pre + f"A_u vs Pinocchio closed-loop null space, rel. (cond > {COND_MIN:g}, far from flip)", err[well], TOL))
+    rows.append(compare(pre + f"A_u vs Pinocchio closed-loop null space, rel. (cond <= {COND_MIN:g} or near flip)", err[~well], TOL_ILL))
+    s2 = np.abs(np.sin(q[:, [1, 5, 9]])).min(axis=-1)
+    fd_ok = (s2 > 0.1) & (np.abs(np.cos(ay)) > 0.1) & (1 + np.cos(ay) * np.cos(az) > 0.1)
+    a_fd = _fd_actuation_jacobian(ay[fd_ok], az[fd_ok], alpha)
+    scale = np.maximum(1.0, np.abs(a_an[fd_ok]).max(axis=(-1, -2)))
+    rows.append(compare(pre + f"A_u vs Richardson central differences of ik, rel. (h={H:g})",
+                        np.abs(a_fd - a_an[fd_ok]).max(axis=(-1, -2)) / scale, TOL_FD))
+
+    # --- fk
+    # near the flip the motors' rounding noise is amplified (|A_u| ~ 1 / (1 + c_y c_z)): measured
+    # inconsistency up to 5e-9 rad there, so those samples accept up to 1e-6 (the default is 1e-9)
+    u = at.fk(q[:, 0], q[:, 4], q[:, 8], alpha=alpha, return_mask=True, max_inconsistency=1e-6)
+    u[3][far & (u[2] > 1e-9)] = False
+    fk_rot = _rot_err(at.platform_rotation(np.nan_to_num(u[0]), np.nan_to_num(u[1])), at.platform_rotation(ay, az))
+    fk_rot[~u[3]] = np.nan  # a failure counts against the row
+    far = 1 + np.cos(ay) * np.cos(az) > NEAR_FLIP
+    rows.append(compare(pre + f"fk(ik(u)) round trip, platform rotation (rad) (1 + c_y c_z > {NEAR_FLIP:g})",
+                        fk_rot[far], TOL))
+    if (~far).any():
+        rows.append(compare(pre + f"fk(ik(u)) round trip, platform rotation (rad) (1 + c_y c_z <= {NEAR_FLIP:g})",
+                            fk_rot[~far], TOL_FLIP))
+    rows.append(compare(pre + f"fk(ik(u)) inconsistency of consistent motors (rad) (1 + c_y c_z > {NEAR_FLIP:g})",
+                        u[2][far], TOL))
+    q, ay, az = q[far], ay[far], az[far]
+    m = min(samples, SOLVE_SAMPLES)
+    delta = rng.normal(0.0, 0.15, (m, 2))
+    q_start, ok = at.ik(ay[:m] + delta[:, 0], az[:m] + delta[:, 1], alpha=alpha, return_mask=True)
+    errs, gain, other, failed = [], [], 0, 0
+    held_free = np.ones(robot.model.nv, dtype=bool)
+    held_free[[robot.idx_v("A_q1"), robot.idx_v("B_q1")]] = False
+    for i in np.nonzero(ok)[0]:
+        try:
+            qs_i = robot.solve_loops(q_start[i], {"A_q1": q[i, 0], "B_q1": q[i, 4]}, tol=SOLVE_TOL)
+        except LoopClosureError:
+            failed += 1  # a local minimum of |r| that does not close (reported, see docs/tripod.md)
+            continue
+        if not _is_cv_branch(qs_i):
+            other += 1  # another assembly mode of the legs: outside fk's model (q3=q2, q4=q1, q2 in (0, pi))
+            continue
+        uf = at.fk(qs_i[0], qs_i[4], qs_i[8], alpha=alpha)
+        errs.append(_rot_err(at.platform_rotation(uf[0], uf[1]), robot.frame_placement(qs_i, "platform").rotation))
+        # The closed configuration's own error (its residual <= SOLVE_TOL) is amplified by 1 / sigma_min of the
+        # constraint Jacobian on the free joints: near a bifurcation of the legs' branches it is large
+        jac_free = robot.constraint_jacobian(qs_i)[:, held_free]
+        gain.append(1.0 / np.linalg.svd(jac_free, compute_uv=False)[-1])
+    errs, gain = np.asarray(errs), np.asarray(gain)
+    well = gain <= GAIN_MAX
+    head = pre + f"fk vs solve_loops (A_q1, B_q1 held, start 0.15 rad away; {other} of {int(ok.sum())} " \
+        f"landed on another assembly mode, {failed} did not close; both skipped)"
+    if well.any():
+        rows.append(compare(head + f", loop gain <= {GAIN_MAX:g}", errs[well], TOL))
+    if (~well).any():
+        rows.append(compare(head + f", loop gain > {GAIN_MAX:g}: error / gain", errs[~well] / gain[~well], TOL_GAIN))
+    # --- mobility
+    mob = [robot.mobility(qi) for qi in q[: min(samples, 1000)]]
+    rows.append(compare(pre + "Robot.mobility - 2 at random workspace poses", np.asarray(mob) - 2, 0.0))
+    # --- named poses
+    rows.append(compare(pre + "SRDF poses: loop residual |r|",
+                        [np.linalg.norm(robot.constraint_residual(p)) for p in robot.poses.values()], TOL))
+    return rows
+
+
+def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
+    rows: list[CheckResult] = []
+    for tag, alpha in ALPHAS:
+        rows += _run_alpha(tag, alpha, samples, rng)
+    return rows
+
+
+# ---------------------------------------------------------------- the IK contract row
+#: Contract tolerance (rad): every solved orientation is reproduced by the default fk to this.
+CONTRACT_TOL = 1e-9
+
+
+def pose_error(ay, az, y, z) -> np.ndarray:
+    """How far the pose (y, z) is from (ay, az) (rad): the smaller of the parameter distance (modulo 2 pi and
+    the equivalence (pi - alpha_y, alpha_z + pi)) and the rotation angle between the platform rotations.
+
+    Each measure is ill-conditioned at one singular set of the parametrisation, the other is not: alpha_z is
+    undefined at c_y = 0 (same rotation for every alpha_z), and R(u) folds a circle of rotations onto the flip
+    point 1 + c_y c_z = 0 (the parameters are well determined there)."""
+    d1 = np.hypot(at._wrap(y - ay), at._wrap(z - az))
+    d2 = np.hypot(at._wrap(np.pi - y - ay), at._wrap(z + np.pi - az))
+    with np.errstate(invalid="ignore"):
+        rot = _rot_err(at.platform_rotation(ay, az), at.platform_rotation(np.nan_to_num(y), np.nan_to_num(z)))
+    return np.minimum(np.minimum(d1, d2), np.where(np.isfinite(y) & np.isfinite(z), rot, np.inf))
+
+
+def made_targets(n: int, rng: np.random.Generator, alpha: float = at.ALPHA) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` orientations made by the default :func:`fk` from in-limit joints of a closed configuration.
+
+    Motors q_A1, q_B1 uniform in the joint limits [-pi, pi]; E on both motor planes and the sphere |E| = L (a
+    line cut by a sphere: zero or two points, see :func:`legkin.tripod._initial_guess`); for the points
+    in the home mode's half (E_x < 0, sin q_A2, sin q_B2 > 0) that leg C reaches, q_C1 from leg C on its home
+    branch (eqs 98, 102 at E); the target is ``fk(q_A1, q_B1, q_C1)`` with default options, kept where fk
+    solves it.
+    """
+    g = at._geometry(at.D, alpha, np.asarray(at.ETA))
+    ce, se, dk, big_l = g.ce, g.se, g.d * g.k, -g.minus_l
+    ys, zs, total = [], [], 0
+    while total < n:
+        m = max(2 * n, 1000) * 4
+        q = rng.uniform(-np.pi, np.pi, (m, 2))
+        s, c = np.sin(q), np.cos(q)
+        na = np.stack([s[:, 0], -c[:, 0] * ce[0], -c[:, 0] * se[0]], axis=-1)
+        nb = np.stack([s[:, 1], -c[:, 1] * ce[1], -c[:, 1] * se[1]], axis=-1)
+        cab = np.sum(na * nb, axis=-1)
+        v = np.cross(na, nb)
+        vv = np.sum(v * v, axis=-1)
+        p0 = dk * (na + nb) / (1.0 + cab)[:, None]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            t = np.sqrt(big_l**2 - np.sum(p0 * p0, axis=-1)) / np.sqrt(vv)
+        keep = np.isfinite(t) & (vv > 1e-12)
+        for sign in (-1.0, 1.0):
+            e = p0 + (sign * t)[:, None] * v
+            h1, h2 = -e[:, 0] / g.d, -(ce[:2, None] * e[:, 1] + se[:2, None] * e[:, 2]).T / g.d
+            s2sa = c * h1[:, None] + s * h2  # sin q_K2 sin(alpha) of legs A and B at E
+            # q_C1 from E on leg C's home branch (eqs 98, 102; straight from E, not through the orientation)
+            c2 = (ce[2] * e[:, 2] - se[2] * e[:, 1]) / g.dsa
+            home = keep & (e[:, 0] < 0) & np.all(s2sa > 0, axis=-1) & (np.abs(c2) < 1.0)
+            e, c2 = e[home], c2[home]
+            sc = np.sqrt(1.0 - c2 * c2) * g.sa
+            w = -(ce[2] * e[:, 1] + se[2] * e[:, 2])
+            qc = np.arctan2(g.k * e[:, 0] + sc * w, -sc * e[:, 0] + g.k * w)
+            qa = q[home]
+            y, z, _, solved = at.fk(qa[:, 0], qa[:, 1], qc, alpha=alpha, return_mask=True)
+            ys.append(y[solved])
+            zs.append(z[solved])
+            total += int(solved.sum())
+    return np.concatenate(ys)[:n], np.concatenate(zs)[:n]
+
+
+def _det_curve_points(rng: np.random.Generator, alpha: float, grid: int = 121) -> np.ndarray:
+    """Points (alpha_y, alpha_z) on the actuation-singular curves det M = 0 of the home mode's motors: bisection
+    between grid neighbours where det M changes sign, along alpha_y (random alpha_z) and along alpha_z (random
+    alpha_y; at alpha = pi/2 det M vanishes on the lines alpha_z = +-pi/2)."""
+    geo = at._geometry(at.D, alpha, np.asarray(at.ETA))
+
+    def det_of(y, z):
+        trig = tuple(f(v)[..., None] for v in (y, z) for f in (np.cos, np.sin))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            _, _, c2, _, nb2, sn, cn = at._ik_eval(*trig, geo, with_sc=True)
+            return np.where(at._inside(c2, nb2)[..., 0], at._det_planes(sn, cn, geo), np.nan)
+
+    out = []
+    for along_y in (True, False):
+        line = np.linspace(-np.pi / 2, np.pi / 2, grid) if along_y else np.linspace(-np.pi, np.pi, 2 * grid)
+        other = rng.uniform(-np.pi, np.pi, grid) if along_y else rng.uniform(-np.pi / 2, np.pi / 2, grid)
+        g1, g2 = np.meshgrid(line, other, indexing="ij")
+
+        def det_on(v, w, along_y=along_y):
+            return det_of(v, w) if along_y else det_of(w, v)
+
+        dm = det_on(g1, g2)
+        i, j = np.nonzero(np.sign(dm[1:]) * np.sign(dm[:-1]) < 0)
+        lo, hi, w = line[i], line[i + 1], other[j]
+        flo = det_on(lo, w)
+        for _ in range(60):
+            mid = 0.5 * (lo + hi)
+            fm = det_on(mid, w)
+            left = np.sign(fm) == np.sign(flo)
+            lo, flo, hi = np.where(left, mid, lo), np.where(left, fm, flo), np.where(left, hi, mid)
+        v = 0.5 * (lo + hi)
+        out.append(np.stack([v, w] if along_y else [w, v], axis=-1))
+    return np.concatenate(out)
+
+
+def random_orientations(n: int, rng: np.random.Generator, alpha: float = at.ALPHA) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` orientations in and around the workspace: uniform over a box a little larger than the principal
+    range (40 %), any representation (|alpha_y|, |alpha_z| up to 20 rad, 10 %), near the flip
+    (1 + c_y c_z log-uniform in [1e-14, 1e-2], 15 %), a hair inside or outside a leg's boundary
+    (|1 - |cos q_K2|| log-uniform in [1e-15, 1e-3], 25 %), and near the actuation-singular curves det M = 0
+    (offsets log-uniform in [1e-12, 1e-2] rad, 10 %)."""
+    ay = rng.uniform(-np.pi / 2 - 0.3, np.pi / 2 + 0.3, n)
+    az = rng.uniform(-np.pi - 0.3, np.pi + 0.3, n)
+    kind = rng.uniform(size=n)
+    far = (kind >= 0.4) & (kind < 0.5)
+    ay[far], az[far] = rng.uniform(-20, 20, far.sum()), rng.uniform(-20, 20, far.sum())
+    phi = rng.uniform(-np.pi, np.pi, n)
+    flip = (kind >= 0.5) & (kind < 0.65)
+    theta = np.arccos(np.clip(10 ** rng.uniform(-14, -2, n) - 1.0, -1.0, 1.0))
+    bnd = (kind >= 0.65) & (kind < 0.9)
+    k = rng.integers(0, 3, n)
+    sk = np.abs(np.sin(phi - np.asarray(at.ETA)[k]))
+    gap = 10 ** rng.uniform(-15, -3, n) * rng.choice([-1.0, 1.0], n)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        arg = (1.0 - gap) * math.cos(alpha / 2) / sk
+    theta = np.where(bnd, 2.0 * np.arcsin(np.clip(arg, -1.0, 1.0)), theta)
+    sel = flip | bnd
+    r = np.stack([np.cos(theta), np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi)], axis=-1)[sel]
+    ay[sel], az[sel] = at.orientation_from_axis(r)
+    det = np.nonzero(kind >= 0.9)[0]
+    pts = _det_curve_points(rng, alpha)
+    if len(det) and len(pts):
+        base = pts[rng.integers(0, len(pts), len(det))]
+        off = 10 ** rng.uniform(-12, -2, (len(det), 1)) * rng.normal(size=(len(det), 2))
+        ay[det], az[det] = (base + off).T
+    return ay, az
+
+
+def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 2000) -> CheckResult:
+    """The IK contract row of the tripod (default geometry; see :func:`legkin.validation.robustness_row`).
+
+    Half the targets are :func:`made_targets` (fk of in-limit motors, each must be solved), the rest
+    :func:`random_orientations`. The default batch ``ik`` solves them; for the solved ones the error is
+    :func:`pose_error` between the target and the default ``fk`` of the answer's motors (an answer whose
+    joints leave the URDF limits [-pi, pi], or that fk does not solve, counts as not reproduced). Up to
+    ``classify`` unsolved targets (None: all) are classified by single calls.
+    """
+    n_made = n // 2
+    my, mz = made_targets(n_made, rng)
+    ry, rz = random_orientations(n - n_made, rng)
+    ay, az = np.concatenate([my, ry]), np.concatenate([mz, rz])
+    made = np.arange(n) < n_made
+    exceptions = 0
+    y, z, ok = np.full(n, np.nan), np.full(n, np.nan), np.zeros(n, dtype=bool)
+    try:
+        q, solved = at.ik(ay, az, return_mask=True)
+        qs = q[solved]
+        y[solved], z[solved], _, ok[solved] = at.fk(qs[:, 0], qs[:, 4], qs[:, 8], return_mask=True)
+    except Exception:  # noqa: BLE001 - a foreign (or any) exception from a batch call is a defect
+        exceptions += 1
+        q, solved = np.full((n, 12), np.nan), np.zeros(n, dtype=bool)
+    inside = np.all((q >= -np.pi) & (q <= np.pi), axis=-1)
+    error = np.where(solved & ok & inside, pose_error(ay, az, y, z), np.inf)
+    unsolved = np.nonzero(~solved)[0]
+    if classify is not None and len(unsolved) > classify:
+        unsolved = np.sort(rng.choice(unsolved, classify, replace=False))
+    reasons, foreign = classify_failures(lambda i: at.ik(float(ay[i]), float(az[i])), unsolved)
+    return robustness_row(
+        "tripod", made=made, solved=solved, error=error, reasons=reasons, classified=len(unsolved),
+        exceptions=exceptions + foreign, tolerance=CONTRACT_TOL,
+    )

@@ -1,0 +1,258 @@
+"""Wheel-leg rim-contact IK: legkin's ``ik`` (analytic Jacobian; radial) vs the seed's finite differences vs Pinocchio.
+
+Targets: Pinocchio's contact point (the rim link's placement times the contact point's fixed local
+coordinates, as in ``checks.wheel_leg``) for random (theta, beta, gamma) of leg FL, rim parameter alpha and
+lateral coordinate w. Every answer is scored the same way: the Pinocchio configuration closing all loops for
+the returned (theta, beta, gamma) (or Pinocchio's own configuration), its contact point against the target,
+its loop residual, and theta inside [17, 160] deg.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import load
+from . import kinematics as wl
+from ..bench import Method, MethodResult, ModelBench, Score
+from .checks import SEGMENT_LINKS, configuration, leg_joint_names, local_contact_point, sample_leg_q
+from ..errors import UnreachableError
+from .._benchkit import SOLVE_TOL, levenberg_marquardt, sizes
+from .._single_call import SingleCall
+
+LEG = "FL"
+#: Every iterative method is asked for the same position tolerance (m) (wl.ik's default).
+TOL = 1e-12
+MAX_ITER = 100
+
+
+def _sizes(n: int | None, quick: bool) -> tuple[int, int, int]:
+    """(batch targets, scalar-loop targets, iterative-solver targets)."""
+    return sizes(n, quick, full=(5_000, 300, 100), small=(300, 20, 5))
+
+
+#: The single-call inputs: q = (theta, beta, gamma) of leg FL, rim parameter alpha, lateral coordinate w.
+SINGLE_Q = np.array([1.2, 0.3, 0.2])
+SINGLE_ALPHA, SINGLE_W = 0.5, 0.01
+
+
+def single_calls() -> list[SingleCall]:
+    """One single call per public function of :mod:`legkin.wheel_leg`, inputs bound (leg FL,
+    :data:`SINGLE_Q`, :data:`SINGLE_ALPHA`, :data:`SINGLE_W`; the IK target is that configuration's contact point).
+
+    Yardsticks: Pinocchio ``forwardKinematics`` + ``updateFramePlacement`` on the quadruped (``quadruped_fk``)
+    for the closed forms; ``Robot.solve_loops`` on the wheel-leg (``solve_loops``, ``iterative=True``) for
+    ``ik`` (every method).
+    """
+    q = SINGLE_Q.copy()
+    theta, beta, gamma = (float(v) for v in q)
+    alpha, w = SINGLE_ALPHA, SINGLE_W
+    phi_L, phi_R = (float(v) for v in wl.motor_angles(theta, beta))
+    target = wl.contact_point(q, alpha, w, LEG)
+    p_L = wl.rim_point(theta, beta, alpha, w)
+    cf, it = "quadruped_fk", "solve_loops"
+    return [
+        SingleCall("linkage_constants", lambda: wl.linkage_constants(), cf),
+        SingleCall("linkage_points", lambda: wl.linkage_points(theta, beta), cf),
+        SingleCall("passive_angles", lambda: wl.passive_angles(theta, beta), cf),
+        SingleCall("motor_angles", lambda: wl.motor_angles(theta, beta), cf),
+        SingleCall("theta_beta", lambda: wl.theta_beta(phi_L, phi_R), cf),
+        SingleCall("rim_point", lambda: wl.rim_point(theta, beta, alpha, w), cf),
+        SingleCall("rim_point_seed", lambda: wl.rim_point_seed(theta, beta, alpha, w), cf),
+        SingleCall("rim_jump_seed", lambda: wl.rim_jump_seed(theta), cf),
+        SingleCall("rim_segment", lambda: wl.rim_segment(alpha), cf),
+        SingleCall("contact_point", lambda: wl.contact_point(q, alpha, w, LEG), cf),
+        SingleCall("contact_jacobian", lambda: wl.contact_jacobian(q, alpha, w, LEG), cf),
+        SingleCall("leg_frame_to_robot", lambda: wl.leg_frame_to_robot(p_L, gamma, LEG), cf),
+        SingleCall("module_origin", lambda: wl.module_origin(LEG), cf),
+        SingleCall("ik", lambda: wl.ik(target, alpha, w, LEG), it, iterative=True),
+        SingleCall("ik (method='damped')", lambda: wl.ik(target, alpha, w, LEG, method="damped"), it, iterative=True),
+        SingleCall("ik (method='seed')", lambda: wl.ik(target, alpha, w, LEG, method="seed"), it, iterative=True),
+    ]
+
+
+def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
+    n_batch, n_scalar, n_iter = _sizes(n, quick)
+    import pinocchio as pin
+
+    robot = load("wheel_leg")
+    model, data = robot.model, robot.data
+    geo = wl.Geometry.from_params(robot.params)
+    k_leg = wl.LEGS.index(LEG)
+
+    q_leg = sample_leg_q(n_batch, rng)
+    alpha = rng.uniform(-np.pi, np.pi, n_batch)
+    w = rng.uniform(-geo.T / 2, geo.T / 2, n_batch)
+    local, seg = local_contact_point(alpha, w, geo)
+    frame_ids = np.array([robot.frame_id(f"{LEG}_{SEGMENT_LINKS[s][0]}") for s in range(4)])[seg]
+
+    def full_config(leg_q: np.ndarray) -> np.ndarray:
+        """Configurations closing every loop: leg FL at ``leg_q``, the other legs in wheel mode."""
+        all_q = np.tile(np.array([wl.THETA0, 0.0, 0.0]), (len(leg_q), 4, 1))
+        all_q[:, k_leg] = leg_q
+        return configuration(robot, all_q)
+
+    def contact_and_residual(qs: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        pos = np.full((len(qs), 3), np.nan)
+        res = np.full(len(qs), np.nan)
+        for i, q in zip(rows, qs):
+            if np.all(np.isfinite(q)):
+                pin.framesForwardKinematics(model, data, q)
+                M = data.oMf[int(frame_ids[i])]
+                pos[i] = M.translation + M.rotation @ local[i]
+                res[i] = np.linalg.norm(robot.constraint_residual(q))
+        return pos, res
+
+    targets, _ = contact_and_residual(full_config(q_leg), np.arange(n_batch))
+    inputs = (targets, alpha, w)
+    i_theta = (robot.idx_q(f"{LEG}_phi_L"), robot.idx_q(f"{LEG}_phi_R"))
+
+    def theta_ok(theta):
+        with np.errstate(invalid="ignore"):
+            return (theta >= wl.THETA_MIN - 1e-12) & (theta <= wl.THETA_MAX + 1e-12)
+
+    def score_configs(inp, qs, theta, iters, evals) -> Score:
+        k = len(inp[0])
+        pos, res = contact_and_residual(qs, np.arange(k))
+        err = np.linalg.norm(pos - inp[0], axis=-1)
+        ok = (err <= SOLVE_TOL) & (res <= SOLVE_TOL) & theta_ok(theta)
+        return Score(error=err, solved=ok, orientation=res, iterations=iters, fk_evals=evals, reached=err <= SOLVE_TOL)
+
+    # ---------------------------------------------------------------- legkin
+    def analytic(method: str, scalar: bool = False):
+        def run(inp):
+            t, a, ww = inp
+            if not scalar:
+                return wl.ik(t, a, ww, LEG, method=method, tol=TOL, geometry=geo, return_info=True)
+            q, its = np.full((len(t), 3), np.nan), np.zeros(len(t), dtype=int)
+            evals = np.full(len(t), np.nan)
+            for i in range(len(t)):
+                try:
+                    q[i], info = wl.ik(t[i], a[i], ww[i], LEG, method=method, tol=TOL, geometry=geo, return_info=True)
+                    its[i], evals[i] = info.iterations, info.evaluations
+                except UnreachableError:
+                    pass
+            return q, wl.IKInfo(its, np.full(len(t), np.nan), None, evals)
+
+        def score(inp, out) -> Score:
+            q, info = out
+            k = len(q)
+            evals = np.full(k, np.nanmean(info.evaluations))  # IKInfo.evaluations: linkage evaluations per target
+            finite = np.all(np.isfinite(q), axis=-1)
+            qs = np.full((k, model.nq), np.nan)
+            if finite.any():
+                qs[finite] = full_config(q[finite])
+            return score_configs(inp, qs, q[:, 0], info.iterations.astype(float), evals)
+
+        return run, score
+
+    # ---------------------------------------------------------------- Pinocchio closed-loop IK
+    free = np.zeros(model.nv, dtype=bool)
+    for j in leg_joint_names(LEG):
+        free[robot.idx_v(j)] = True
+    loopset = robot._loopset
+    ldata = loopset.data
+
+    def pin_ik(inp):
+        t, a, ww = inp
+        k = len(t)
+        starts = wl._initial_guesses(t, a, ww, LEG, "continuous", geo, None, 1)[0]  # the analytic IK's start
+        qs = np.full((k, model.nq), np.nan)
+        iters, evals = np.full(k, np.nan), np.full(k, np.nan)
+        q_start = full_config(np.column_stack([np.clip(starts[:, 0], wl.THETA_MIN, wl.THETA_MAX), starts[:, 1:]]))
+        for i in range(k):
+            fid, loc, target = int(frame_ids[i]), local[i], t[i]
+
+            def residual_and_jacobian(q):
+                r, jc = loopset.residual_and_jacobian(q)  # forwardKinematics + computeJointJacobians in ldata
+                pin.updateFramePlacement(model, ldata, fid)
+                M = ldata.oMf[fid]
+                rr = M.rotation @ loc
+                j6 = pin.getFrameJacobian(model, ldata, fid, pin.LOCAL_WORLD_ALIGNED)
+                jp = j6[:3] - np.cross(rr, j6[3:].T).T  # velocity of the contact point: v + w x r
+                return np.concatenate([r, M.translation + rr - target]), np.vstack([jc, jp])
+
+            q, it, ev, ok = levenberg_marquardt(model, residual_and_jacobian, q_start[i], free, TOL, MAX_ITER)
+            iters[i], evals[i] = it, ev
+            if ok:
+                qs[i] = q
+        return qs, iters, evals
+
+    def pin_score(inp, out) -> Score:
+        qs, iters, evals = out
+        theta = (qs[:, i_theta[0]] - qs[:, i_theta[1]]) / 2 + wl.THETA0
+        return score_configs(inp, qs, theta, iters, evals)
+
+    run_d, score_d = analytic("damped")
+    run_s, score_s = analytic("seed")
+    run_r, score_r = analytic("radial")
+    run_d1, score_d1 = analytic("damped", scalar=True)
+    run_s1, score_s1 = analytic("seed", scalar=True)
+    run_r1, score_r1 = analytic("radial", scalar=True)
+    methods = [
+        Method(f"legkin batch ik, analytic Jacobian (method='damped'; {n_batch} at once)", inputs, run_d, score_d,
+               repeats=5),
+        Method(f"legkin batch ik, radial (method='radial'; {n_batch} at once)", inputs, run_r, score_r, repeats=5),
+        Method(f"seed Gauss-Newton, forward differences (method='seed'; batch)", inputs, run_s, score_s, repeats=5),
+        Method("legkin scalar ik (damped), Python loop", inputs, run_d1, score_d1, max_targets=n_scalar, repeats=3),
+        Method("legkin scalar ik (radial), Python loop", inputs, run_r1, score_r1, max_targets=n_scalar, repeats=3),
+        Method("seed forward-difference Gauss-Newton, scalar calls in a loop", inputs, run_s1, score_s1,
+               max_targets=n_scalar, repeats=3),
+        Method("pinocchio closed-loop IK (LM on loops + contact point)", inputs, pin_ik, pin_score,
+               max_targets=n_iter, repeats=3),
+    ]
+    notes = [
+        f"targets: Pinocchio contact point of leg {LEG} for {n_batch} random (theta in [17, 160] deg, "
+        "beta in [-pi, pi], "
+        f"|gamma| <= 0.6), alpha in [-pi, pi], |w| <= T/2; scalar loops solve the first {n_scalar}, Pinocchio the "
+        f"first {n_iter}",
+        "err = Pinocchio contact point of the answer vs target (m); loop |r| = Pinocchio loop residual; "
+        "solved also needs theta in [17, 160] deg; iters = median; FK/solve = mean forward-kinematics "
+        "evaluations per target (legkin: IKInfo.evaluations, rows passed to the contact FK; the damped "
+        "method's FK also returns the Jacobian; radial: rows of its leg-plane closed form with theta-derivative "
+        "(Newton steps) plus the final contact FK that checks the answer, its 17-node grid and start table "
+        "look-ups are not counted; Pinocchio: residual + Jacobian evaluations)",
+        f"every method is given tolerance {TOL:g} m; the legkin methods are vectorised over the batch; damped "
+        "and seed start from the same geometric guess, the damped method restarts failures from two more "
+        "guesses and takes one polishing step; radial solves gamma and beta in closed form and theta by a "
+        "bracketed 1-D Newton (no start needed, every root found, the first returned); the Pinocchio IK starts "
+        "from the configuration of the damped/seed first guess",
+        "pinocchio closed-loop IK: the Levenberg-Marquardt of Robot.solve_loops on [16 loop residuals; contact "
+        "point - target] with the 11 joints of the leg free, contact Jacobian from getFrameJacobian",
+    ]
+
+    def summary(results: list[MethodResult]) -> list[str]:
+        d = next(r for r in results if "batch ik, analytic" in r.name)
+        r = next(r for r in results if "batch ik, radial" in r.name)
+        s = next(r for r in results if "forward differences" in r.name)
+        d1 = next(r for r in results if "scalar ik (damped)" in r.name)
+        r1 = next(r for r in results if "scalar ik (radial)" in r.name)
+        s1 = next(r for r in results if "scalar calls" in r.name)
+        p = next(r for r in results if "pinocchio" in r.name)
+
+        def acc(x):
+            if not np.isfinite(x.max_error):
+                return f"{x.solved:.1f}% solved, some targets unsolved"
+            worst = f"max error {x.max_error:.1e} m"
+            return f"{x.solved:.1f}% solved, {worst}"
+
+        return [
+            "speed-up over the seed's finite-difference iteration (target >= 10x at equal or better accuracy): "
+            f"damped (analytic Jacobian) {s.time_per_target_s / d.time_per_target_s:.2f}x batch, "
+            f"{s1.time_per_target_s / d1.time_per_target_s:.2f}x scalar calls; radial "
+            f"{s.time_per_target_s / r.time_per_target_s:.2f}x batch, "
+            f"{s1.time_per_target_s / r1.time_per_target_s:.2f}x scalar calls",
+            f"accuracy (batch): damped {acc(d)}; radial {acc(r)}; seed {acc(s)}",
+            f"batch ik is {p.time_per_target_s / d.time_per_target_s:,.0f}x (damped) / "
+            f"{p.time_per_target_s / r.time_per_target_s:,.0f}x (radial) and the scalar call "
+            f"{p.time_per_target_s / d1.time_per_target_s:,.1f}x / {p.time_per_target_s / r1.time_per_target_s:,.1f}x "
+            "faster than the Pinocchio closed-loop IK",
+        ]
+
+    return ModelBench(
+        methods=methods,
+        units={"ik": "m"},
+        tolerance=f"contact error <= {SOLVE_TOL:g} m, loop |r| <= {SOLVE_TOL:g}, theta in [17, 160] deg",
+        notes=notes,
+        summary=summary,
+        secondary="loop |r|",
+    )

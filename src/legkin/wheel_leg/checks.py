@@ -1,0 +1,310 @@
+"""Validation of :mod:`legkin.wheel_leg` against Pinocchio (closed loops, frames, contact Jacobian)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import load
+from . import kinematics as wl
+from ..validation import CheckResult, compare, per_sample, pinocchio_frames
+
+TOL = 1e-12
+#: Loop solver: passive angles after solve_loops (its own stopping tolerance is 1e-12 on the residual).
+TOL_SOLVE = 1e-10
+#: Residual tolerance asked of solve_loops (its default, 1e-12, leaves hinge points ~2e-12 off).
+SOLVE_TOL = 1e-14
+#: Central differences with h = 1e-6: truncation ~h^2 |p'''| plus rounding ~eps |p| / h (measured ~1.3e-10).
+TOL_FD = 1e-8
+FD_STEP = 1e-6
+#: Row sizes of the costlier comparisons (loop solving, constrained Jacobians, mobility).
+SOLVE_SAMPLES = 200
+JACOBIAN_SAMPLES = 2000
+MOBILITY_SAMPLES = 50
+GAMMA_RANGE = 0.6
+
+#: Hinge frames of one leg compared with :func:`linkage_points` (frame suffix -> point name).
+FRAME_POINTS = {
+    "A_L": "A_L", "A_R": "A_R", "B_L": "B_L", "B_R": "B_R", "C_L": "C_L", "C_R": "C_R",
+    "C_L_cut": "C_L", "C_R_cut": "C_R", "D_L": "D_L", "D_R": "D_R", "E": "E", "E_cut": "E",
+    "F_L": "F_L", "F_R": "F_R", "G": "G", "G_cut": "G", "H_L": "H_L", "H_R": "H_R",
+    "U_L": "U_L", "U_R": "U_R", "L_L": "L_L", "L_R": "L_R", "leg": "O",
+}  # fmt: skip
+
+#: Rim link of each segment of :func:`wl.rim_point` and the point where that link's frame sits.
+SEGMENT_LINKS = (("rim_upper_L", "B_L"), ("rim_lower_L", "F_L"), ("rim_lower_R", "F_R"), ("rim_upper_R", "B_R"))
+
+
+def sample_leg_q(n: int, rng: np.random.Generator) -> np.ndarray:
+    """(n, 3) random (theta, beta, gamma): theta over [17, 160] deg, beta in [-pi, pi], |gamma| <= 0.6."""
+    return np.stack(
+        [rng.uniform(wl.THETA_MIN, wl.THETA_MAX, n), rng.uniform(-np.pi, np.pi, n),
+         rng.uniform(-GAMMA_RANGE, GAMMA_RANGE, n)], -1,
+    )  # fmt: skip
+
+
+def configuration(robot, leg_q: np.ndarray) -> np.ndarray:
+    """Configurations (..., nq) closing every loop, from per-leg (theta, beta, gamma) of shape (..., 4, 3).
+
+    Every tree joint from :func:`wl.passive_angles`; the ABAD joint is gamma.
+    """
+    leg_q = np.asarray(leg_q, dtype=float)
+    geo = wl.Geometry.from_params(robot.params)
+    q = np.broadcast_to(robot.q0, leg_q.shape[:-2] + (robot.model.nq,)).copy()
+    for k, leg in enumerate(wl.LEGS):
+        ang = wl.passive_angles(leg_q[..., k, 0], leg_q[..., k, 1], geometry=geo)
+        for j, v in ang.items():
+            q[..., robot.idx_q(f"{leg}_{j}")] = v
+        q[..., robot.idx_q(f"{leg}_abad")] = leg_q[..., k, 2]
+    return q
+
+
+def leg_joint_names(leg: str) -> list[str]:
+    return [f"{leg}_abad"] + [f"{leg}_{j}" for j in wl.PASSIVE_JOINTS]
+
+
+def local_contact_point(alpha: np.ndarray, w: np.ndarray, geo: wl.Geometry, rim: str = "continuous"):
+    """The contact point in its rim link's frame: fixed, from the closed form at the wheel-mode reference
+    (where every link frame is parallel to {L} and sits at its parent hinge)."""
+    th0 = np.full(np.shape(alpha), wl.THETA0)
+    fn = wl.rim_point if rim == "continuous" else wl.rim_point_seed
+    p = fn(th0, 0.0, alpha, w, geometry=geo)
+    pts = wl.linkage_points(th0, geometry=geo)
+    seg = wl.rim_segment(alpha) if rim == "continuous" else np.where(alpha > 0, 3, 0)
+    origin = np.zeros_like(p)
+    for k, (_, pt) in enumerate(SEGMENT_LINKS):
+        origin[seg == k] = pts[pt][seg == k]
+    return p - origin, seg
+
+
+def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
+    robot = load("wheel_leg")
+    geo = wl.Geometry.from_params(robot.params)
+    rows: list[CheckResult] = []
+    n = samples
+
+    # ---------------------------------------------------------------- closed-form assembly
+    leg_q = sample_leg_q(4 * n, rng).reshape(n, 4, 3)
+    qs = configuration(robot, leg_q)
+    res = np.array([np.abs(robot.constraint_residual(q)).max() for q in qs])
+    rows.append(compare("closed-form configuration: loop residual (16 loops, theta 17-160 deg)", res, TOL))
+
+    frames = [f"{leg}_{f}" for leg in wl.LEGS for f in FRAME_POINTS]
+    pos = pinocchio_frames(robot, qs, frames)[0].reshape(n, 4, len(FRAME_POINTS), 3)
+    err = np.zeros((n, 4, len(FRAME_POINTS)))
+    for k, leg in enumerate(wl.LEGS):
+        pts = wl.linkage_points(leg_q[:, k, 0], leg_q[:, k, 1], geometry=geo)
+        for m, pt in enumerate(FRAME_POINTS.values()):
+            ana = wl.leg_frame_to_robot(pts[pt], leg_q[:, k, 2], leg, geometry=geo)
+            err[:, k, m] = per_sample(ana - pos[:, k, m])
+    rows.append(compare("linkage_points vs hinge frames oMf (23 frames x 4 legs)", err.max(axis=(1, 2)), TOL))
+
+    # ---------------------------------------------------------------- loop solver from the motors alone
+    ns = min(n, SOLVE_SAMPLES)
+    fixed = [f"{leg}_{j}" for leg in wl.LEGS for j in ("abad", "phi_L", "phi_R")]
+    passive = [f"{leg}_hinge_{h}_{s}" for leg in wl.LEGS for h in "ABDF" for s in "LR"]
+    ip = np.array([robot.idx_q(j) for j in passive])
+    ang_err, frame_err, iters = np.zeros(ns), np.zeros(ns), np.zeros(ns, dtype=int)
+    for i in range(ns):
+        q_init = qs[i].copy()
+        q_init[ip] += rng.uniform(-0.05, 0.05, ip.size)
+        q_sol, info = robot.solve_loops(q_init, fixed, tol=SOLVE_TOL, return_info=True)
+        iters[i] = info.iterations
+        ang_err[i] = np.abs(np.angle(np.exp(1j * (q_sol[ip] - qs[i][ip])))).max()
+        p_sol = pinocchio_frames(robot, q_sol[None], frames)[0].reshape(4, len(FRAME_POINTS), 3)
+        frame_err[i] = per_sample(p_sol - pos[i]).max()
+    rows.append(compare(f"solve_loops from motors (passive +-0.05 rad off) vs passive_angles, "
+                        f"{ns} samples, tol {SOLVE_TOL:g}, <= {iters.max()} iterations", ang_err, TOL_SOLVE))
+    rows.append(compare(f"solve_loops: hinge frames vs linkage_points, {ns} samples", frame_err, TOL))
+
+    # ---------------------------------------------------------------- mobility
+    nm = min(n, MOBILITY_SAMPLES)
+    mob_err = np.zeros(nm)
+    for i in range(nm):
+        k = i % 4
+        others = [j for leg in wl.LEGS if leg != wl.LEGS[k] for j in leg_joint_names(leg)]
+        m_leg = robot.mobility(qs[i], locked=others + [f"{wl.LEGS[k]}_abad"])
+        m_all = robot.mobility(qs[i])
+        mob_err[i] = abs(m_leg - 2) + abs(m_all - 12)
+    rows.append(compare(f"mobility: 2 per leg linkage (ABAD locked), 12 for the robot, {nm} samples", mob_err, 0.0))
+
+    # ---------------------------------------------------------------- contact point vs rim link placement
+    legs = rng.integers(0, 4, n)
+    alpha = rng.uniform(-np.pi, np.pi, n)
+    w = rng.uniform(-geo.T / 2, geo.T / 2, n)
+    q3 = leg_q[np.arange(n), legs]
+    local, seg = local_contact_point(alpha, w, geo)
+    seg_frames = [f"{leg}_{lk}" for leg in wl.LEGS for lk, _ in SEGMENT_LINKS]
+    fpos, frot = pinocchio_frames(robot, qs, seg_frames)
+    idx = legs * 4 + seg
+    pin_p = fpos[np.arange(n), idx] + np.einsum("nij,nj->ni", frot[np.arange(n), idx], local)
+    ana = np.empty((n, 3))
+    for k, leg in enumerate(wl.LEGS):
+        m = legs == k
+        ana[m] = wl.contact_point(q3[m], alpha[m], w[m], leg, geometry=geo)
+    rows.append(compare("contact_point vs rim link oMf * local point (alpha over the whole rim)",
+                        per_sample(ana - pin_p), TOL))
+
+    # seed rim: its upper-rim arcs are fixed in the upper rims (the toe arc about O_r is in no link)
+    up = np.abs(alpha) > wl.PSI_FG
+    local_s, seg_s = local_contact_point(alpha[up], w[up], geo, rim="seed")
+    idx_s = legs[up] * 4 + seg_s
+    pin_s = fpos[up][np.arange(up.sum()), idx_s] + np.einsum("nij,nj->ni", frot[up][np.arange(up.sum()), idx_s], local_s)
+    ana_s = np.empty((up.sum(), 3))
+    for k, leg in enumerate(wl.LEGS):
+        m = legs[up] == k
+        ana_s[m] = wl.contact_point(q3[up][m], alpha[up][m], w[up][m], leg, rim="seed", geometry=geo)
+    rows.append(compare("contact_point(rim='seed'), upper-rim arcs |alpha| > psi_FG vs upper rim oMf",
+                        per_sample(ana_s - pin_s), TOL))
+
+    # ---------------------------------------------------------------- contact Jacobian
+    jac = np.empty((n, 3, 3))
+    for k, leg in enumerate(wl.LEGS):
+        m = legs == k
+        jac[m] = wl.contact_jacobian(q3[m], alpha[m], w[m], leg, geometry=geo)
+    fd = np.empty_like(jac)
+    for c in range(3):
+        dq = np.zeros(3)
+        dq[c] = FD_STEP
+        for k, leg in enumerate(wl.LEGS):
+            m = legs == k
+            qm = q3[m]
+            plus = wl.contact_point(np.clip(qm + dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9]), alpha[m], w[m], leg, geometry=geo)
+            minus = wl.contact_point(np.clip(qm - dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9]), alpha[m], w[m], leg, geometry=geo)
+            step = np.clip(qm + dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9])[:, c] - np.clip(
+                qm - dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9])[:, c]
+            fd[m, :, c] = (plus - minus) / step[:, None]
+    rows.append(compare(f"contact_jacobian vs central differences (h = {FD_STEP:g})",
+                        np.abs(jac - fd).max(axis=(1, 2)), TOL_FD))
+
+    nj = min(n, JACOBIAN_SAMPLES)
+    jerr = np.zeros(nj)
+    import pinocchio as pin
+
+    model, data = robot.model, robot.data
+    for i in range(nj):
+        leg = wl.LEGS[legs[i]]
+        q = qs[i]
+        lk = f"{leg}_{SEGMENT_LINKS[seg[i]][0]}"
+        fid = robot.frame_id(lk)
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        J6 = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+        M = data.oMf[fid]
+        r = M.rotation @ local[i]
+        Jp = J6[:3] - np.cross(r, J6[3:].T).T  # velocity of the point: v + w x r
+        Jc = robot.constraint_jacobian(q)
+        iv = [robot.idx_v(f"{leg}_{j}") for j in ("phi_L", "phi_R", "abad")]
+        pv = [robot.idx_v(f"{leg}_hinge_{h}_{s}") for h in "ABDF" for s in "LR"]
+        # independent velocities (phi_L, phi_R, abad) per unit (theta, beta, gamma) rates
+        S_ind = np.array([[1.0, 1.0, 0.0], [-1.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+        S_pas = -np.linalg.pinv(Jc[:, pv], rcond=1e-10) @ (Jc[:, iv] @ S_ind)
+        J_pin = Jp[:, iv] @ S_ind + Jp[:, pv] @ S_pas
+        jerr[i] = np.abs(J_pin - jac[i]).max()
+    rows.append(compare(f"contact_jacobian vs Pinocchio closed-loop Jacobian (constraint null space), {nj} samples",
+                        jerr, TOL))
+
+    # ---------------------------------------------------------------- IK round trips
+    for method in ("damped", "seed", "radial"):
+        for rim in ("continuous", "seed"):
+            errs = np.full(n, np.nan)
+            its = np.zeros(n, dtype=int)
+            ok_all = np.zeros(n, dtype=bool)
+            found = np.full(n, np.nan)
+            for k, leg in enumerate(wl.LEGS):
+                m = legs == k
+                if rim == "seed":
+                    target = wl.contact_point(q3[m], alpha[m], w[m], leg, rim="seed", geometry=geo)
+                else:
+                    target = ana[m]
+                qk, ok, info = wl.ik(target, alpha[m], w[m], leg, method=method, rim=rim, geometry=geo,
+                                     return_mask=True, return_info=True)
+                reached = wl.contact_point(np.where(ok[:, None], qk, q3[m]), alpha[m], w[m], leg, rim=rim, geometry=geo)
+                errs[m] = np.where(ok, per_sample(reached - target), np.nan)
+                its[m], ok_all[m] = info.iterations, ok
+                if method == "radial":
+                    found[m] = solution_distance(info.solutions, q3[m]) * np.linalg.svd(
+                        wl.contact_jacobian(q3[m], alpha[m], w[m], leg, rim=rim, geometry=geo), compute_uv=False)[:, -1]
+            name = (f"ik(method='{method}', rim='{rim}') round trip: {ok_all.sum()}/{n} converged in [17, 160] deg, "
+                    f"iterations mean {its.mean():.2f} max {its.max()}")
+            if method == "seed":
+                # The baseline is measured, not required to succeed: the row covers the converged targets.
+                rows.append(compare(name + " (converged targets)", errs[ok_all], TOL))
+            else:
+                rows.append(compare(name, errs, TOL))
+            if method == "radial":
+                # Every root found: the sampled q is one of info.solutions. Its distance in q is scaled by the
+                # smallest singular value of the contact Jacobian at the sample (near folds theta is
+                # ill-conditioned: a position error e moves the root by ~e / sigma_min), giving metres.
+                rows.append(compare(f"ik(method='radial', rim='{rim}'): sampled q among info.solutions "
+                                    "(q distance x sigma_min(J), m)", found, TOL))
+
+    # radial IK against Pinocchio: targets are the rim link placements oMf times the local contact point,
+    # the answers are scored by Pinocchio on the configuration closing every loop
+    q_rad = leg_q.copy()
+    ok_rad = np.zeros(n, dtype=bool)
+    for k, leg in enumerate(wl.LEGS):
+        m = np.flatnonzero(legs == k)
+        qk, ok_rad[m] = wl.ik(pin_p[m], alpha[m], w[m], leg, method="radial", geometry=geo, return_mask=True)
+        q_rad[m[ok_rad[m]], k] = qk[ok_rad[m]]
+    fpos_r, frot_r = pinocchio_frames(robot, configuration(robot, q_rad), seg_frames)
+    pin_r = fpos_r[np.arange(n), idx] + np.einsum("nij,nj->ni", frot_r[np.arange(n), idx], local)
+    rows.append(compare(f"ik(method='radial') vs Pinocchio: target = rim link oMf * local point, answer's contact "
+                        f"point by Pinocchio (closed configuration), {ok_rad.sum()}/{n} solved",
+                        np.where(ok_rad, per_sample(pin_r - pin_p), np.nan), TOL))
+    return rows
+
+
+def solution_distance(solutions: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """Distance (max-norm, angles wrapped) from each q (n, 3) to the nearest of its solutions (n, S, 3)."""
+    d = solutions - q[:, None, :]
+    d[..., 1:] = np.angle(np.exp(1j * d[..., 1:]))
+    d = np.abs(d).max(axis=-1)
+    return np.min(np.where(np.isnan(d), np.inf, d), axis=1)
+
+
+def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 2000) -> CheckResult:
+    """The IK contract row: the default :func:`wl.ik` on ``n`` random targets in and around the workspace.
+
+    Half the targets (``made``) are :func:`wl.contact_point` of random joints inside the URDF limits (theta over
+    [17, 160] deg, beta over the circle, gamma over [-pi/2, pi/2], 10 % of them on a limit) at random rim
+    points (alpha, w); a quarter are such targets pushed off by up to 5 cm in a random direction; a quarter are
+    uniform in a 0.8 m box around the module origin. Legs in turn. Each solved answer is scored by the
+    default :func:`wl.contact_point`; up to ``classify`` unsolved targets are classified by single calls.
+    """
+    from ..validation import classify_failures, robustness_row
+
+    legs = np.arange(n) % 4
+    m_made, m_push = n // 2, n // 4
+    kind = np.zeros(n, dtype=int)
+    kind[m_made:m_made + m_push], kind[m_made + m_push:] = 1, 2
+    q = np.stack([rng.uniform(wl.THETA_MIN, wl.THETA_MAX, n), rng.uniform(-np.pi, np.pi, n),
+                  rng.uniform(-wl.ABAD_LIMIT, wl.ABAD_LIMIT, n)], -1)
+    on_limit = rng.random(n) < 0.1
+    q[on_limit, 2] = rng.choice([-wl.ABAD_LIMIT, wl.ABAD_LIMIT], on_limit.sum())
+    alpha, w = rng.uniform(-np.pi, np.pi, n), rng.uniform(-0.02, 0.02, n)
+    target = np.empty((n, 3))
+    solved = np.zeros(n, dtype=bool)
+    error = np.full(n, np.nan)
+    exceptions = 0
+    for k, leg in enumerate(wl.LEGS):
+        m = np.flatnonzero(legs == k)
+        t = wl.contact_point(q[m], alpha[m], w[m], leg)
+        push = kind[m] == 1
+        d = rng.normal(size=(push.sum(), 3))
+        t[push] += d / np.linalg.norm(d, axis=1, keepdims=True) * rng.uniform(0.0, 0.05, (push.sum(), 1))
+        box = kind[m] == 2
+        t[box] = wl.module_origin(leg) + rng.uniform(-0.4, 0.4, (box.sum(), 3))
+        target[m] = t
+        try:
+            qs, ok = wl.ik(t, alpha[m], w[m], leg, return_mask=True)
+        except Exception:  # noqa: BLE001 - a foreign exception from the batch is a defect, counted
+            exceptions += 1
+            continue
+        solved[m] = ok
+        error[m[ok]] = per_sample(wl.contact_point(qs[ok], alpha[m[ok]], w[m[ok]], leg) - t[ok])
+    unsolved = np.flatnonzero(~solved)
+    pick = unsolved if classify is None else unsolved[: max(int(classify), 0)]
+    reasons, single_exc = classify_failures(
+        lambda i: wl.ik(target[i], alpha[i], w[i], wl.LEGS[legs[i]]), pick)
+    return robustness_row("wheel_leg", made=kind == 0, solved=solved, error=error, reasons=reasons,
+                          classified=len(pick), exceptions=exceptions + single_exc)

@@ -74,6 +74,10 @@ REACH_TOL = 1e-12
 #: A joint angle up to this far (rad) outside the URDF limits is clipped onto the limit (the foot then moves by
 #: at most LIMIT_TOL x the leg's reach, < 1e-10 m).
 LIMIT_TOL = 1e-10
+#: Damped Newton steps (at most) polishing each closed-form branch on the exact forward map (see _polish_k).
+POLISH_STEPS = 3
+#: Damping (m) of the polishing steps: bounds a step to ~|e| / (2 lambda) rad near a singularity.
+POLISH_DAMPING = 1e-7
 #: Branch order of :meth:`Leg.ik_all`: ``(s_a, s_k)``, the abduction sign (sign of ``u3``, the foot's
 #: coordinate along ``e3 = a1 x a2`` in the abduction frame) and the knee sign (sign of ``beta``).
 BRANCHES = ((-1, -1), (-1, 1), (1, -1), (1, 1))
@@ -85,7 +89,9 @@ _H, _K, _L = 13, 15, 17  # h, k, l in pitch-plane coordinates (X, Y)
 _S3 = 19  # knee axis sign
 _KN, _LN, _PK, _PL = 20, 21, 22, 23  # |k|, |l|, phi_k, phi_l
 _LO, _HI = 24, 27  # lower, upper limits (3 each)
-_NPARAMS = 30
+_A1, _A2, _A3 = 30, 33, 36  # the measured unit axes a1, a2, a3 (exact forward map)
+_V21, _V32, _V3F = 39, 42, 45  # o2 - o1, o3 - o2, f - o3
+_NPARAMS = 48
 
 _TWO_PI = 2.0 * math.pi
 _NAN = math.nan
@@ -109,54 +115,118 @@ def _finite3(x) -> bool:
 
 
 @kernel
-def _pitch_k(q2, q3, g):
-    """Pitch plane: ``(u3, u1) = h + Rot(q2) [k + Rot(s3 q3) l]``; also returns ``Rot(q2) v`` and
-    ``Rot(q2) m'`` with ``m' = d/dq3 Rot(s3 q3) l = s3 perp(Rot(s3 q3) l)`` (for the Jacobian)."""
-    a = g[_S3] * q3
-    ca, sa = math.cos(a), math.sin(a)
-    mx = ca * g[_L] - sa * g[_L + 1]  # m = Rot(s3 q3) l
-    my = sa * g[_L] + ca * g[_L + 1]
-    vx, vy = g[_K] + mx, g[_K + 1] + my
-    c2, s2 = math.cos(q2), math.sin(q2)
-    wx, wy = c2 * vx - s2 * vy, s2 * vx + c2 * vy  # Rot(q2) v
-    dmx, dmy = -g[_S3] * my, g[_S3] * mx  # s3 perp(m)
-    gx, gy = c2 * dmx - s2 * dmy, s2 * dmx + c2 * dmy
-    return g[_H] + wx, g[_H + 1] + wy, wx, wy, gx, gy
+def _rot_k(g, ia, c, s, vx, vy, vz):
+    """Rodrigues: ``R(a, t) v = cos t v + sin t (a x v) + (1 - cos t) (a . v) a`` with ``a = g[ia:ia + 3]``."""
+    ax, ay, az = g[ia], g[ia + 1], g[ia + 2]
+    k = (1.0 - c) * (ax * vx + ay * vy + az * vz)
+    return (
+        c * vx + s * (ay * vz - az * vy) + k * ax,
+        c * vy + s * (az * vx - ax * vz) + k * ay,
+        c * vz + s * (ax * vy - ay * vx) + k * az,
+    )
+
+
+@kernel
+def _cross_k(g, ia, vx, vy, vz):
+    """``a x v`` with ``a = g[ia:ia + 3]``."""
+    ax, ay, az = g[ia], g[ia + 1], g[ia + 2]
+    return ay * vz - az * vy, az * vx - ax * vz, ax * vy - ay * vx
+
+
+@kernel
+def _fk3_k(q0, q1, q2, g):
+    """The product of exponentials with the measured axes and origins (what Pinocchio computes)::
+
+        t3 = R(a3, q3) (f - o3),  t2 = R(a2, q2) [(o3 - o2) + t3],  p = o1 + R(a1, q1) [(o2 - o1) + t2]
+    """
+    c, s = math.cos(q2), math.sin(q2)
+    t3x, t3y, t3z = _rot_k(g, _A3, c, s, g[_V3F], g[_V3F + 1], g[_V3F + 2])
+    c, s = math.cos(q1), math.sin(q1)
+    t2x, t2y, t2z = _rot_k(g, _A2, c, s, g[_V32] + t3x, g[_V32 + 1] + t3y, g[_V32 + 2] + t3z)
+    c, s = math.cos(q0), math.sin(q0)
+    px, py, pz = _rot_k(g, _A1, c, s, g[_V21] + t2x, g[_V21 + 1] + t2y, g[_V21 + 2] + t2z)
+    return g[_O] + px, g[_O + 1] + py, g[_O + 2] + pz
 
 
 @kernel
 def _fk_k(q, g, out) -> int:
-    """``p = o1 + u1 e1 + (c1 d - s1 u3) e2 + (s1 d + c1 u3) e3`` with ``(u3, u1)`` from :func:`_pitch_k`."""
+    """Foot position: :func:`_fk3_k`, ``p = o1 + R(a1, q1) [(o2 - o1) + R(a2, q2) ((o3 - o2) + R(a3, q3) (f - o3))]``."""
     if not _finite3(q):
         return _BAD_INPUT
-    u3, u1, _, _, _, _ = _pitch_k(q[1], q[2], g)
-    c1, s1 = math.cos(q[0]), math.sin(q[0])
-    d = g[_D]
-    b2 = c1 * d - s1 * u3
-    b3 = s1 * d + c1 * u3
-    for i in range(3):
-        out[i] = g[_O + i] + u1 * g[_E1 + i] + b2 * g[_E2 + i] + b3 * g[_E3 + i]
+    out[0], out[1], out[2] = _fk3_k(q[0], q[1], q[2], g)
     return OK
 
 
 @kernel
+def _jac3_k(q0, q1, q2, g, out) -> None:
+    """Columns ``a1 x R1 v1``, ``R1 (a2 x t2)``, ``R1 R2 (a3 x t3)`` (each joint: its spatial axis crossed with
+    the lever from its origin to the foot), with ``R_j = R(a_j, q_j)`` and ``t3, t2, v1`` of :func:`_fk3_k`."""
+    c3, s3 = math.cos(q2), math.sin(q2)
+    c2, s2 = math.cos(q1), math.sin(q1)
+    c1, s1 = math.cos(q0), math.sin(q0)
+    t3x, t3y, t3z = _rot_k(g, _A3, c3, s3, g[_V3F], g[_V3F + 1], g[_V3F + 2])
+    t2x, t2y, t2z = _rot_k(g, _A2, c2, s2, g[_V32] + t3x, g[_V32 + 1] + t3y, g[_V32 + 2] + t3z)
+    # column 1: a1 x R1 v1 = R1 (a1 x v1)
+    x, y, z = _cross_k(g, _A1, g[_V21] + t2x, g[_V21 + 1] + t2y, g[_V21 + 2] + t2z)
+    out[0, 0], out[1, 0], out[2, 0] = _rot_k(g, _A1, c1, s1, x, y, z)
+    x, y, z = _cross_k(g, _A2, t2x, t2y, t2z)
+    out[0, 1], out[1, 1], out[2, 1] = _rot_k(g, _A1, c1, s1, x, y, z)
+    x, y, z = _cross_k(g, _A3, t3x, t3y, t3z)
+    x, y, z = _rot_k(g, _A2, c2, s2, x, y, z)
+    out[0, 2], out[1, 2], out[2, 2] = _rot_k(g, _A1, c1, s1, x, y, z)
+
+
+@kernel
 def _jacobian_k(q, g, out) -> int:
-    """Columns ``dp/dq1 = e1 x (p - o1) = -(s1 d + c1 u3) e2 + (c1 d - s1 u3) e3``; for a pitch-plane vector
-    ``(X, Y)`` = d(u3, u1)/dq_j (``perp(Rot(q2) v)`` for q2, ``Rot(q2) s3 perp(Rot(s3 q3) l)`` for q3):
-    ``dp/dq_j = Y e1 - s1 X e2 + c1 X e3``."""
+    """Foot Jacobian ``dp/dq`` (3, 3): :func:`_jac3_k`."""
     if not _finite3(q):
         return _BAD_INPUT
-    u3, u1, wx, wy, gx, gy = _pitch_k(q[1], q[2], g)
-    c1, s1 = math.cos(q[0]), math.sin(q[0])
-    d = g[_D]
-    b2 = c1 * d - s1 * u3
-    b3 = s1 * d + c1 * u3
-    x2, y2 = -(wy), wx  # perp(Rot(q2) v) = d/dq2 (u3, u1) - the h term is constant
-    for i in range(3):
-        out[i, 0] = -b3 * g[_E2 + i] + b2 * g[_E3 + i]
-        out[i, 1] = y2 * g[_E1 + i] - s1 * x2 * g[_E2 + i] + c1 * x2 * g[_E3 + i]
-        out[i, 2] = gy * g[_E1 + i] - s1 * gx * g[_E2 + i] + c1 * gx * g[_E3 + i]
+    _jac3_k(q[0], q[1], q[2], g, out)
     return OK
+
+
+@kernel
+def _polish_k(p, g, q, jac) -> None:
+    """At most :data:`POLISH_STEPS` damped Newton steps on the exact forward map, each kept only if it reduces
+    the foot error: ``e = p - fk(q)``, ``dq = J^T (J J^T + lambda^2 I)^-1 e`` (``lambda`` = :data:`POLISH_DAMPING`).
+
+    The closed form is exact for the ideal structure (a1 perpendicular to a2 = +-a3); URDF angles written
+    with 11 digits (``rpy="0 1.57079632679 0"``) leave axes ~5e-12 off, i.e. ~1e-12 m at the foot, and near the
+    fold of the knee (|w| -> 0 when |k| = |l|) the law of cosines loses digits: the steps remove both.
+    """
+    fx, fy, fz = _fk3_k(q[0], q[1], q[2], g)
+    ex, ey, ez = p[0] - fx, p[1] - fy, p[2] - fz
+    err = ex * ex + ey * ey + ez * ez
+    lam2 = POLISH_DAMPING * POLISH_DAMPING
+    for _ in range(POLISH_STEPS):
+        if err == 0.0:
+            return
+        _jac3_k(q[0], q[1], q[2], g, jac)
+        # A = J J^T + lam^2 I (symmetric positive definite), solve A y = e by the adjugate, dq = J^T y
+        a00 = jac[0, 0] ** 2 + jac[0, 1] ** 2 + jac[0, 2] ** 2 + lam2
+        a11 = jac[1, 0] ** 2 + jac[1, 1] ** 2 + jac[1, 2] ** 2 + lam2
+        a22 = jac[2, 0] ** 2 + jac[2, 1] ** 2 + jac[2, 2] ** 2 + lam2
+        a01 = jac[0, 0] * jac[1, 0] + jac[0, 1] * jac[1, 1] + jac[0, 2] * jac[1, 2]
+        a02 = jac[0, 0] * jac[2, 0] + jac[0, 1] * jac[2, 1] + jac[0, 2] * jac[2, 2]
+        a12 = jac[1, 0] * jac[2, 0] + jac[1, 1] * jac[2, 1] + jac[1, 2] * jac[2, 2]
+        c00, c11, c22 = a11 * a22 - a12 * a12, a00 * a22 - a02 * a02, a00 * a11 - a01 * a01
+        c01, c02, c12 = a02 * a12 - a01 * a22, a01 * a12 - a02 * a11, a01 * a02 - a00 * a12
+        det = a00 * c00 + a01 * c01 + a02 * c02
+        if not det > 0.0:
+            return
+        yx = (c00 * ex + c01 * ey + c02 * ez) / det
+        yy = (c01 * ex + c11 * ey + c12 * ez) / det
+        yz = (c02 * ex + c12 * ey + c22 * ez) / det
+        n0 = q[0] + jac[0, 0] * yx + jac[1, 0] * yy + jac[2, 0] * yz
+        n1 = q[1] + jac[0, 1] * yx + jac[1, 1] * yy + jac[2, 1] * yz
+        n2 = q[2] + jac[0, 2] * yx + jac[1, 2] * yy + jac[2, 2] * yz
+        fx, fy, fz = _fk3_k(n0, n1, n2, g)
+        nx, ny, nz = p[0] - fx, p[1] - fy, p[2] - fz
+        new = nx * nx + ny * ny + nz * nz
+        if not new < err:
+            return
+        q[0], q[1], q[2] = n0, n1, n2
+        ex, ey, ez, err = nx, ny, nz, new
 
 
 @kernel
@@ -172,7 +242,8 @@ def _ik_all_k(p, g, ref, out, info) -> int:
     ``r^2 = y^2 + z^2``, ``u3 = s_a sqrt(r^2 - d^2)``, ``q1 = atan2(z, y) - atan2(u3, d)``;
     ``w = (u3, x1) - h``, ``cos beta = (|w|^2 - |k|^2 - |l|^2) / (2 |k||l|)``, ``beta = s_k acos(.)``,
     ``q3 = s3 (beta - phi_l + phi_k)``, ``q2 = atan2(w) - atan2(k + Rot(s3 q3) l)``. Each angle is moved to
-    its 2 pi representative nearest ``ref``. ``info`` (2,): on failure the miss (m) and its reason.
+    Each branch is then polished on the exact forward map (:func:`_polish_k`) and each angle moved to its
+    2 pi representative nearest ``ref``. ``info`` (2,): on failure the miss (m) and its reason.
     """
     for b in range(4):
         for j in range(3):
@@ -196,6 +267,8 @@ def _ik_all_k(p, g, ref, out, info) -> int:
     s3 = g[_S3]
     best, why = math.inf, 0.0
     found = 0
+    qb = np.empty(3)
+    jac = np.empty((3, 3))
     for ia in range(2):
         u3 = t if ia == 1 else -t
         q1 = phi - math.atan2(u3, d)
@@ -219,9 +292,11 @@ def _ik_all_k(p, g, ref, out, info) -> int:
             vy = g[_K + 1] + sa * g[_L] + ca * g[_L + 1]
             q2 = math.atan2(wy, wx) - math.atan2(vy, vx)
             b = 2 * ia + ik
-            out[b, 0] = _near_k(q1, ref[0])
-            out[b, 1] = _near_k(q2, ref[1])
-            out[b, 2] = _near_k(s3 * a, ref[2])
+            qb[0], qb[1], qb[2] = q1, q2, s3 * a
+            _polish_k(p, g, qb, jac)
+            out[b, 0] = _near_k(qb[0], ref[0])
+            out[b, 1] = _near_k(qb[1], ref[1])
+            out[b, 2] = _near_k(qb[2], ref[2])
             found += 1
     if found == 0:
         info[0], info[1] = best, why
@@ -481,6 +556,8 @@ class Leg:
         g[_KN], g[_LN] = kn, ln
         g[_PK], g[_PL] = math.atan2(k[1], k[0]), math.atan2(l[1], l[0])
         g[_LO:_LO + 3], g[_HI:_HI + 3] = lo, hi
+        g[_A1:_A1 + 3], g[_A2:_A2 + 3], g[_A3:_A3 + 3] = a1, a2, a3
+        g[_V21:_V21 + 3], g[_V32:_V32 + 3], g[_V3F:_V3F + 3] = o[1] - o[0], o[2] - o[1], f - o[2]
         return cls(
             name=str(name), joint_names=(str(j1), str(j2), str(j3)), foot_frame=str(foot_frame),
             lower=_frozen(lo), upper=_frozen(hi), origin=_frozen(o[0]), axes=_frozen(np.stack([a1, a2, a3])),

@@ -4,6 +4,7 @@ from ._registry import list_models
 from .errors import (
     AssemblyModeError,
     ConvergenceError,
+    InvalidArgumentError,
     InvalidInputError,
     InvalidParameterError,
     JointLimitError,
@@ -32,6 +33,7 @@ __all__ = [
     "UnknownModelError",
     "InvalidParameterError",
     "InvalidInputError",
+    "InvalidArgumentError",
     "UnreachableError",
     "JointLimitError",
     "AssemblyModeError",

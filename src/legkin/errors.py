@@ -7,6 +7,7 @@ __all__ = [
     "UnknownModelError",
     "InvalidParameterError",
     "InvalidInputError",
+    "InvalidArgumentError",
     "UnreachableError",
     "JointLimitError",
     "AssemblyModeError",
@@ -33,6 +34,14 @@ class InvalidParameterError(LegkinError, ValueError):
 
 class InvalidInputError(LegkinError, ValueError):
     """An input array with the wrong shape, or with NaN or infinite entries."""
+
+
+class InvalidArgumentError(InvalidParameterError, InvalidInputError):
+    """A keyword argument (an option such as a branch or a tolerance) of the wrong kind or out of range.
+
+    Both an :class:`InvalidParameterError` and an :class:`InvalidInputError` (hence a ``ValueError``): an
+    option is a parameter of the call and an input of the function alike.
+    """
 
 
 class UnreachableError(LegkinError):

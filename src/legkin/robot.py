@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import difflib
-from typing import Iterable, Mapping
+import importlib
+from types import ModuleType
+from typing import Any, Iterable, Literal, Mapping, overload
 
 import numpy as np
 import pinocchio as pin
@@ -54,6 +56,9 @@ class Robot:
         q0: the reference configuration (``poses[spec.reference_pose]``, else neutral).
         urdf_path, srdf_path: the files the model was built from.
         floating: whether a free-flyer root joint was added.
+        geometry: the mechanism's ``Geometry`` for these parameters (what its kinematic functions take as
+            ``geometry=``), e.g. ``legkin.load("tripod", alpha=0.8).geometry.alpha == 0.8``.
+        kinematics: the mechanism's package (``legkin.<name>``: ``fk``, ``ik``, ``jacobian``, ...).
     """
 
     def __init__(self, name: str, params: Mapping[str, object], floating: bool = False):
@@ -84,6 +89,16 @@ class Robot:
             pin.loadReferenceConfigurations(self.model, str(self.srdf_path), False)
         self.poses = {e.key(): np.array(e.data()) for e in self.model.referenceConfigurations}
         self.q0 = self.poses.get(spec.reference_pose, pin.neutral(self.model)).copy()
+
+    @property
+    def kinematics(self) -> ModuleType:
+        """The mechanism's package, ``legkin.<name>`` (its analytic kinematics)."""
+        return importlib.import_module(self.spec.package)
+
+    @property
+    def geometry(self) -> Any:
+        """``legkin.<name>.Geometry.from_params(self.params)``: the geometry this model was generated with."""
+        return self.kinematics.Geometry.from_params(self.params)
 
     def __repr__(self) -> str:
         return (
@@ -235,6 +250,30 @@ class Robot:
         free = self._free_mask(locked, "locked")
         return self._loopset.mobility(q, free, check_real("tol", tol, 0.0, 1.0, high_open=True))
 
+    @overload
+    def solve_loops(
+        self,
+        q_init: Any = ...,
+        fixed: Mapping[str, float] | Iterable[str] | None = ...,
+        *,
+        tol: float = ...,
+        max_iter: int = ...,
+        damping: float = ...,
+        return_info: Literal[False] = ...,
+    ) -> np.ndarray: ...
+
+    @overload
+    def solve_loops(
+        self,
+        q_init: Any = ...,
+        fixed: Mapping[str, float] | Iterable[str] | None = ...,
+        *,
+        tol: float = ...,
+        max_iter: int = ...,
+        damping: float = ...,
+        return_info: Literal[True],
+    ) -> tuple[np.ndarray, LoopSolveInfo]: ...
+
     def solve_loops(
         self,
         q_init=None,
@@ -276,7 +315,6 @@ class Robot:
                 q[sl] = x
         free = self._free_mask(fixed)
         q, info = self._loopset.solve(q, free, tol, max_iter, damping)
-        self.last_solve = info
         return (q, info) if return_info else q
 
 

@@ -78,6 +78,9 @@ LIMIT_TOL = 1e-10
 POLISH_STEPS = 3
 #: Damping (m) of the polishing steps: bounds a step to ~|e| / (2 lambda) rad near a singularity.
 POLISH_DAMPING = 1e-7
+#: Foot error (m) below which a branch is not polished (a few ulps of a 1 m reach).
+POLISH_BELOW = 1e-15
+_POLISH_DONE = POLISH_BELOW**2
 #: Branch order of :meth:`Leg.ik_all`: ``(s_a, s_k)``, the abduction sign (sign of ``u3``, the foot's
 #: coordinate along ``e3 = a1 x a2`` in the abduction frame) and the knee sign (sign of ``beta``).
 BRANCHES = ((-1, -1), (-1, 1), (1, -1), (1, 1))
@@ -106,6 +109,7 @@ _TOO_FAR = 2.0
 _TOO_NEAR = 3.0
 
 _S3SHAPE = (3,)
+_F64 = np.dtype(np.float64)
 
 
 # ---------------------------------------------------------------- kernels
@@ -187,8 +191,8 @@ def _jacobian_k(q, g, out) -> int:
 
 @kernel
 def _polish_k(p, g, q, jac) -> None:
-    """At most :data:`POLISH_STEPS` damped Newton steps on the exact forward map, each kept only if it reduces
-    the foot error: ``e = p - fk(q)``, ``dq = J^T (J J^T + lambda^2 I)^-1 e`` (``lambda`` = :data:`POLISH_DAMPING`).
+    """At most :data:`POLISH_STEPS` damped Newton steps on the exact forward map while the foot error exceeds
+    :data:`POLISH_BELOW`, each kept only if it reduces the error: ``e = p - fk(q)``, ``dq = J^T (J J^T + lambda^2 I)^-1 e`` (``lambda`` = :data:`POLISH_DAMPING`).
 
     The closed form is exact for the ideal structure (a1 perpendicular to a2 = +-a3); URDF angles written
     with 11 digits (``rpy="0 1.57079632679 0"``) leave axes ~5e-12 off, i.e. ~1e-12 m at the foot, and near the
@@ -199,7 +203,7 @@ def _polish_k(p, g, q, jac) -> None:
     err = ex * ex + ey * ey + ez * ez
     lam2 = POLISH_DAMPING * POLISH_DAMPING
     for _ in range(POLISH_STEPS):
-        if err == 0.0:
+        if err <= _POLISH_DONE:
             return
         _jac3_k(q[0], q[1], q[2], g, jac)
         # A = J J^T + lam^2 I (symmetric positive definite), solve A y = e by the adjugate, dq = J^T y
@@ -630,6 +634,10 @@ class Leg:
         Raises:
             InvalidInputError: ``q`` not a finite real array (..., 3).
         """
+        if q.__class__ is np.ndarray and q.shape == _S3SHAPE and q.dtype is _F64:  # a single call, fast
+            out = np.empty(3)
+            if _fk_k(q, self.params, out) == OK:
+                return out
         arr = as_input(q, "q", _S3SHAPE)
         if arr.ndim == 1:
             out = np.empty(3)
@@ -651,6 +659,10 @@ class Leg:
         Raises:
             InvalidInputError: ``q`` not a finite real array (..., 3).
         """
+        if q.__class__ is np.ndarray and q.shape == _S3SHAPE and q.dtype is _F64:  # a single call, fast
+            out = np.empty((3, 3))
+            if _jacobian_k(q, self.params, out) == OK:
+                return out
         arr = as_input(q, "q", _S3SHAPE)
         if arr.ndim == 1:
             out = np.empty((3, 3))
@@ -759,7 +771,16 @@ class Leg:
             InvalidInputError: ``p`` / ``q_near`` not finite real arrays (..., 3), or not broadcastable.
             InvalidParameterError: ``return_mask`` not a bool.
         """
-        return_mask = check_flag(return_mask, "return_mask")
+        if return_mask is not False and return_mask is not True:
+            return_mask = check_flag(return_mask, "return_mask")
+        if q_near is None and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast
+            out = np.empty(3)
+            info = np.zeros(2)
+            status = _ik_k(p, self.params, self.q_ref, out, info)
+            if status == OK:
+                return (out, np.array(True)) if return_mask else out
+            if status != _BAD_INPUT:
+                raise self._error(status, info, p.copy())
         rows, ref, batch, single = self._prepare(p, q_near)
         n = rows.shape[0]
         out = np.empty((n, 3))

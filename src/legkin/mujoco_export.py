@@ -153,7 +153,8 @@ def _robot(robot_or_name, params: Mapping[str, Any]) -> "Robot":
     if isinstance(robot_or_name, Robot):
         if params:
             raise InvalidParameterError(
-                f"model parameters ({', '.join(params)}) are for a model name; {robot_or_name.name!r} is already loaded"
+                f"unknown MJCF option(s) {', '.join(params)}; options: {', '.join(DEFAULTS)} (xacro arguments "
+                f"go with a model name: {robot_or_name.name!r} is already loaded)"
             )
         return robot_or_name
     if not isinstance(robot_or_name, str):
@@ -162,6 +163,13 @@ def _robot(robot_or_name, params: Mapping[str, Any]) -> "Robot":
 
 
 def _options(options: Mapping[str, Any]) -> dict[str, Any]:
+    try:
+        return _checked_options(options)
+    except InvalidInputError as exc:
+        raise InvalidParameterError(str(exc)) from None
+
+
+def _checked_options(options: Mapping[str, Any]) -> dict[str, Any]:
     unknown = sorted(set(options) - set(DEFAULTS))
     if unknown:
         raise InvalidParameterError(
@@ -379,6 +387,7 @@ def _build_xml(robot: "Robot", o: Mapping[str, Any]) -> str:
     )
     visual = ET.SubElement(root, "visual")
     ET.SubElement(visual, "global", offwidth="1600", offheight="1200")
+    ET.SubElement(visual, "quality", shadowsize="8192")
     ET.SubElement(visual, "headlight", ambient="0.35 0.35 0.35", diffuse="0.6 0.6 0.6", specular="0.1 0.1 0.1")
     default = ET.SubElement(root, "default")
     vis = ET.SubElement(default, "default", {"class": "visual"})
@@ -918,3 +927,88 @@ def check_rows(
                 res["passive"], TOL_CLIP,
             ))
     return rows
+
+
+# ------------------------------------------------------------------------------------------ pictures
+def render_png(
+    mech: MujocoMechanism,
+    path: str | Path,
+    q: np.ndarray | None = None,
+    *,
+    width: int = 800,
+    height: int = 600,
+    azimuth: float = 135.0,
+    elevation: float = -20.0,
+    zoom: float = 1.0,
+    lookat: Sequence[float] | None = None,
+) -> Path:
+    """Render configuration ``q`` (default: the current ``data``) with MuJoCo's own renderer to a PNG.
+
+    Headless machines need ``MUJOCO_GL=egl`` (or ``osmesa``) in the environment before ``import mujoco``.
+    The camera looks at ``lookat`` (default: the centre of the model's visuals) from ``azimuth``/``elevation``
+    (degrees), at a distance 1.6 times the visuals' extent divided by ``zoom``.
+
+    Raises:
+        LegkinError: no OpenGL context (the message says which ``MUJOCO_GL`` to try), or Pillow missing.
+    """
+    mujoco = _mujoco()
+    try:
+        from PIL import Image
+    except ImportError:
+        raise LegkinError("render_png needs Pillow: pip install pillow") from None
+    width, height = check_count("width", width, 1), check_count("height", height, 1)
+    if q is not None:
+        mech.set_configuration(q, forward=False)
+    mujoco.mj_forward(mech.model, mech.data)
+    geoms = [g for g in range(mech.model.ngeom) if mech.model.geom_type[g] != mujoco.mjtGeom.mjGEOM_PLANE]
+    pts = mech.data.geom_xpos[geoms] if geoms else mech.data.xpos
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    cam = mujoco.MjvCamera()
+    cam.lookat[:] = 0.5 * (lo + hi) if lookat is None else np.asarray(lookat, dtype=float)
+    cam.distance = 1.6 * max(float(np.linalg.norm(hi - lo)), 0.05) / zoom
+    cam.azimuth, cam.elevation = azimuth, elevation
+    try:
+        renderer = mujoco.Renderer(mech.model, height, width)
+    except Exception as exc:  # noqa: BLE001 - MuJoCo raises several kinds when there is no GL context
+        raise LegkinError(f"no OpenGL context for MuJoCo's renderer ({exc}); try MUJOCO_GL=egl or osmesa") from None
+    try:
+        renderer.update_scene(mech.data, camera=cam)
+        pixels = renderer.render()
+    finally:
+        renderer.close()
+    path = Path(path)
+    Image.fromarray(pixels).save(path)
+    return path
+
+
+# ------------------------------------------------------------------------------------------ command line
+def add_export_command(subparsers: "argparse._SubParsersAction") -> "argparse.ArgumentParser":
+    """Add ``legkin mjcf MODEL [-o FILE] [--floating] [--timestep S] [--png FILE]`` to ``legkin``'s parser."""
+    p = subparsers.add_parser("mjcf", help="write a MuJoCo MJCF of a model, loops as equality constraints")
+    p.add_argument("model")
+    p.add_argument("-o", "--output", metavar="PATH", help="write the MJCF to PATH (default: stdout)")
+    p.add_argument("--floating", action="store_true", help="a free base (models that walk only)")
+    p.add_argument("--timestep", type=float, default=DEFAULTS["timestep"], help="simulation step, s (default %(default)g)")
+    p.add_argument("--png", metavar="PATH", help="also render q0 with MuJoCo to PATH (needs MUJOCO_GL=egl headless)")
+    p.set_defaults(func=run_export)
+    return p
+
+
+def run_export(args: "argparse.Namespace") -> int:
+    """Run ``legkin mjcf``: write the MJCF (compiled once by MuJoCo first, when it is installed)."""
+    from .robot import load
+
+    robot = load(args.model, floating=bool(args.floating))
+    xml = to_mjcf(robot, timestep=args.timestep)
+    if unavailable_reason() is None:
+        mech = load_mujoco(robot, xml=xml)  # MuJoCo accepts it, or a LegkinError says why
+        if args.png:
+            print(f"wrote {render_png(mech, args.png, robot.q0)}")
+    elif args.png:
+        raise LegkinError(unavailable_reason())
+    if args.output:
+        Path(args.output).write_text(xml)
+        print(f"wrote {args.output}")
+    else:
+        print(xml, end="")
+    return 0

@@ -148,7 +148,8 @@ def test_check_passes_ik_options(monkeypatch, capsys):
 
 def test_check_ik_targets_sets_the_robustness_row(tmp_path):
     out = tmp_path / "c.json"
-    assert main(["check", "wheel_leg", "--samples", "20", "--ik-targets", "24", "--classify-all", "--json", str(out)]) == 0
+    args = ["check", "wheel_leg", "--samples", "20", "--ik-targets", "24", "--classify-all", "--json", str(out)]
+    assert main(args) == 0
     rows = [r for r in json.loads(out.read_text())["models"]["wheel_leg"]["checks"] if r.get("counts")]
     assert len(rows) == 1 and rows[0]["counts"]["targets"] == 24
 

@@ -16,8 +16,9 @@ from .errors import (
 )
 from .robot import Robot, load
 
-# The mechanisms, one package each (found by the registry; listed here so that `from legkin import tripod` works).
-from . import hybrid_leg, quadruped, tripod, wheel_leg  # noqa: E402
+# isort: split
+# The mechanisms, one package each, after the registry (which finds them); their kinematics load on first use.
+from . import hybrid_leg, quadruped, tripod, wheel_leg
 
 __version__ = "0.1.0"
 

@@ -15,7 +15,16 @@ import numpy as np
 
 from .errors import InvalidInputError, InvalidParameterError
 
-__all__ = ["as_input", "as_angles", "finish", "real_number", "check_number", "check_integer", "check_flag", "check_choice"]
+__all__ = [
+    "as_input",
+    "as_angles",
+    "finish",
+    "real_number",
+    "check_number",
+    "check_integer",
+    "check_flag",
+    "check_choice",
+]
 
 
 def as_input(x, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = False) -> np.ndarray:
@@ -131,10 +140,12 @@ def check_number(
 def check_integer(value, name: str, low: int | None = None, high: int | None = None) -> int:
     """A keyword parameter that must be an integer in ``[low, high]``."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        raise InvalidParameterError(f"{name} must be an integer in {_range_text(low, high, False, False)}, got {value!r}")
+        span = _range_text(low, high, False, False)
+        raise InvalidParameterError(f"{name} must be an integer in {span}, got {value!r}")
     v = int(value)
     if (low is not None and v < low) or (high is not None and v > high):
-        raise InvalidParameterError(f"{name}={v} is out of range: must be an integer in {_range_text(low, high, False, False)}")
+        span = _range_text(low, high, False, False)
+        raise InvalidParameterError(f"{name}={v} is out of range: must be an integer in {span}")
     return v
 
 

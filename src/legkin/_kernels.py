@@ -46,12 +46,12 @@ prange = numba.prange
 def kernel(fn: F) -> F:
     """Compile a scalar kernel: ``numba.njit(cache=True, error_model="numpy")`` (no ZeroDivisionError: IEEE
     semantics, NaN/inf propagate and the kernel's status reports them)."""
-    return numba.njit(cache=True, error_model="numpy")(fn)  # type: ignore[no-any-return]
+    return numba.njit(cache=True, error_model="numpy")(fn)  # type: ignore[return-value]
 
 
 def batch_kernel(fn: F) -> F:
     """Compile a batch loop over a kernel: like :func:`kernel`, with ``parallel=True`` (use ``prange``)."""
-    return numba.njit(cache=True, error_model="numpy", parallel=True)(fn)  # type: ignore[no-any-return]
+    return numba.njit(cache=True, error_model="numpy", parallel=True)(fn)  # type: ignore[return-value]
 
 
 def as_rows(x: np.ndarray, core: int) -> np.ndarray:

@@ -39,7 +39,9 @@ class Param:
             return "one of " + ", ".join(repr(c) for c in self.choices)
         lo = "-inf" if self.low is None else f"{self.low:g}"
         hi = "inf" if self.high is None else f"{self.high:g}"
-        return f"{'(' if self.low_open or self.low is None else '['}{lo}, {hi}{')' if self.high_open or self.high is None else ']'}"
+        left = "(" if self.low_open or self.low is None else "["
+        right = ")" if self.high_open or self.high is None else "]"
+        return f"{left}{lo}, {hi}{right}"
 
     def check(self, name: str, value) -> float | str:
         """Return the value converted to the argument's type, or raise."""

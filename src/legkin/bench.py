@@ -220,6 +220,7 @@ def _time_method(m: Method, inputs, progress: _Progress) -> tuple[float, Any]:
     for r in range(m.repeats):
         progress.show(f"{m.name} (run {r + 1}/{m.repeats})")
         t0 = time.perf_counter()
+        assert m.run is not None  # a method without run is skipped before timing
         out = m.run(inputs)
         times.append(time.perf_counter() - t0)
     progress.step(m.name)
@@ -261,6 +262,7 @@ def _run_methods(bench: ModelBench, runnable: list[Method], progress: _Progress)
         inputs = _subset(m.inputs, m.max_targets)
         k = _count(inputs)
         seconds, out = _time_method(m, inputs, progress)
+        assert m.score is not None
         s = m.score(inputs, out)
         solved = np.asarray(s.solved, dtype=bool)
         med, worst = _stats(s.error)
@@ -475,7 +477,7 @@ def yardstick_calls(name: str, keys, seed: int = 0) -> dict[str, tuple[Callable[
             q_start[free] += np.random.default_rng(seed).normal(0.0, SOLVE_LOOPS_PERTURBATION, len(free))
             solve = robot.solve_loops
 
-            def call(solve=solve, q_start=q_start, act=act):
+            def call(solve=solve, q_start=q_start, act=act):  # type: ignore[misc]  # one name per branch
                 return solve(q_start, fixed=act)
 
             label = (f"{name}: solve_loops(q0 closed + N(0, {SOLVE_LOOPS_PERTURBATION:g}) on the "
@@ -495,7 +497,8 @@ def single_call_table(name: str, module, quick: bool = False, seed: int = 0) -> 
         return {"rows": [], "yardsticks": {}, "skipped": "no single-call entries yet"}
     entries = list(make())
     repeats, min_time = (3, 0.01) if quick else (7, 0.1)
-    stick_times, stick_errors = {}, {}
+    stick_times: dict[str, dict[str, Any]] = {}
+    stick_errors: dict[str, str] = {}
     for key in dict.fromkeys(e.yardstick for e in entries):
         try:
             ((call, label),) = yardstick_calls(name, [key], seed=seed).values()

@@ -117,7 +117,8 @@ def parse_loops(urdf_path: str | Path) -> list[LoopSpec]:
             raise LegkinError(
                 f"{urdf_path}: loop {el.get('name')!r} has type {el.get('type')!r}; valid: {', '.join(_TYPES)}"
             )
-        loops.append(LoopSpec(el.get("name"), el.get("type"), el.get("frame1"), el.get("frame2")))
+        a = el.attrib
+        loops.append(LoopSpec(a["name"], a["type"], a["frame1"], a["frame2"]))
     return loops
 
 

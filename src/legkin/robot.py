@@ -10,10 +10,10 @@ from typing import Any, Iterable, Literal, Mapping, overload
 import numpy as np
 import pinocchio as pin
 
+from ._batch import as_input
 from ._generate import model_files
 from ._registry import MODELS, get_spec
-from ._batch import as_input
-from .errors import InvalidInputError, InvalidParameterError, LegkinError
+from .errors import InvalidInputError, InvalidParameterError
 from .loops import DEFAULT_DAMPING, LoopSet, LoopSolveInfo, check_count, check_real, parse_loops
 
 __all__ = ["Robot", "load"]
@@ -33,7 +33,9 @@ def _names(name: str, value) -> list[str]:
     if value is None:
         return []
     if isinstance(value, (str, bytes)):
-        raise InvalidInputError(f"{name} must be a collection of joint names, got the string {value!r} (write [{value!r}])")
+        raise InvalidInputError(
+            f"{name} must be a collection of joint names, got the string {value!r} (write [{value!r}])"
+        )
     try:
         names = list(value)
     except TypeError:
@@ -119,7 +121,8 @@ class Robot:
             InvalidInputError: ``name`` is not a string or not a joint of the model (the message lists them).
         """
         if not isinstance(name, str):
-            raise InvalidInputError(f"a joint name must be a string, got {name!r}; joints: {', '.join(self.joint_names)}")
+            joints = ", ".join(self.joint_names)
+            raise InvalidInputError(f"a joint name must be a string, got {name!r}; joints: {joints}")
         if not self.model.existJointName(name):
             raise InvalidInputError(f"model {self.name!r} has no joint {name!r}; joints: {', '.join(self.joint_names)}")
         return self.model.getJointId(name)
@@ -215,7 +218,8 @@ class Robot:
             reference = _REFERENCE_FRAMES[reference]
         if not isinstance(reference, pin.ReferenceFrame):
             raise InvalidInputError(
-                f"reference must be a pinocchio.ReferenceFrame or one of {', '.join(_REFERENCE_FRAMES)}, got {reference!r}"
+                f"reference must be a pinocchio.ReferenceFrame or one of {', '.join(_REFERENCE_FRAMES)}, "
+                f"got {reference!r}"
             )
         return pin.computeFrameJacobian(self.model, self.data, q, fid, reference)
 

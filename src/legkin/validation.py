@@ -44,7 +44,7 @@ class CheckResult:
     p99_error: float
     tolerance: float
     passed: bool
-    errors: np.ndarray = field(default=None, repr=False, compare=False)
+    errors: np.ndarray | None = field(default=None, repr=False, compare=False)
     #: the counts of an IK robustness row (:class:`IKRobustness`), else None.
     counts: object = field(default=None, repr=False, compare=False)
 
@@ -147,7 +147,8 @@ def format_table(results) -> str:
     for name, (rows, seconds) in results.items():
         lines.append(f"{name}  ({seconds:.1f} s)")
         width = max([len(r.name) for r in rows] + [5])
-        lines.append(f"  {'check':<{width}}  {'samples':>8}  {'max error':>10}  {'p99 error':>10}  {'tolerance':>9}  result")
+        head = f"{'samples':>8}  {'max error':>10}  {'p99 error':>10}  {'tolerance':>9}  result"
+        lines.append(f"  {'check':<{width}}  {head}")
         for r in rows:
             lines.append(
                 f"  {r.name:<{width}}  {r.samples:>8d}  {r.max_error:>10.2e}  {r.p99_error:>10.2e}  "
@@ -185,7 +186,7 @@ def pinocchio_frames(robot, qs, frames: list[str], jacobians: bool = False):
     n = len(qs)
     pos = np.empty((n, len(ids), 3))
     rot = np.empty((n, len(ids), 3, 3))
-    jac = np.empty((n, len(ids), 6, model.nv)) if jacobians else None
+    jac = np.empty((n, len(ids), 6, model.nv if jacobians else 0))
     for i, q in enumerate(qs):
         if jacobians:
             pin.computeJointJacobians(model, data, q)

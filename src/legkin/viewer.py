@@ -8,7 +8,7 @@ import signal
 import subprocess
 import threading
 from pathlib import Path
-from typing import Iterator, Sequence
+from typing import Any, Iterator, Sequence
 
 import numpy as np
 
@@ -41,7 +41,7 @@ def _sigterm_interrupts() -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def open_viewer(robot: Robot, camera: Sequence[float] | None = None) -> Iterator[object]:
+def open_viewer(robot: Robot, camera: Sequence[float] | None = None) -> Iterator[Any]:
     """A ``pinocchio.visualize.MeshcatVisualizer`` with ``robot`` loaded; its zmq server is always stopped.
 
     meshcat 0.3.2 starts the server as a child process and has no working ``close``: the context

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pinocchio as pin
@@ -10,7 +11,6 @@ import pytest
 
 from legkin import LoopClosureError
 from legkin.loops import LoopSet, parse_loops
-from pathlib import Path
 
 FOURBAR = Path(__file__).parent / "data" / "fourbar.urdf"
 

@@ -5,7 +5,6 @@ from __future__ import annotations
 import importlib
 import math
 import os
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -15,8 +14,8 @@ import legkin
 from legkin import clips as animations
 from legkin.hybrid_leg import kinematics as ah
 from legkin.tripod import kinematics as at
-from legkin.wheel_leg import kinematics as wl
 from legkin.viewer import chromium_path
+from legkin.wheel_leg import kinematics as wl
 
 FIGURES = {
     "tripod": ["tripod_workspace.png"],

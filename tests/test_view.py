@@ -7,11 +7,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from conftest import shot
 
 import legkin
 from legkin._registry import MODELS
 from legkin.viewer import chromium_path, write_html
-from conftest import shot
 
 CHROMIUM = chromium_path()
 

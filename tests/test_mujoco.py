@@ -1,4 +1,4 @@
-"""MuJoCo models of the four mechanisms (legkin.mujoco_export): loops as equality constraints."""
+"""MuJoCo models of the four mechanisms (legkin.mjcf): loops as equality constraints."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import pytest
 mujoco = pytest.importorskip("mujoco")
 
 import legkin  # noqa: E402
-from legkin import mujoco_export as mx  # noqa: E402
+from legkin import mjcf as mx  # noqa: E402
 from legkin.errors import InvalidParameterError, LegkinError, UnknownModelError  # noqa: E402
 
 MODELS = ["hybrid_leg", "quadruped", "tripod", "wheel_leg"]

@@ -205,9 +205,9 @@ def drive_clip(mech: MujocoMechanism, qs: Sequence[np.ndarray], frame_time: floa
 def _clip_frames(robot: "Robot") -> tuple[str | None, list[np.ndarray]]:
     """The first clip of the model (name, configurations), or ``(None, [])``."""
     try:
-        from legkin.clips import available, frames
+        from ..clips import available, frames
     except ImportError:
-        from legkin.animations import available, frames
+        from ..animations import available, frames
     clips = available(robot.name)
     if not clips:
         return None, []

@@ -1,0 +1,473 @@
+"""legkin.legs: closed-form HAA-HFE-KFE leg IK measured from any URDF (issue 13)."""
+
+from __future__ import annotations
+
+import importlib.metadata
+import math
+from pathlib import Path
+
+import numpy as np
+import pinocchio as pin
+import pytest
+from hypothesis import assume, example, given
+from hypothesis import strategies as st
+
+from legkin import legs
+from legkin.errors import InvalidInputError, InvalidParameterError, JointLimitError, LegkinError, UnknownModelError, UnreachableError
+from legkin.legs import LegStructureError
+
+ROBOTS = tuple(legs.ERD_ROBOTS)
+TOL = 1e-12
+
+
+@pytest.fixture(scope="module")
+def erd():
+    """``{robot: (model, {leg: Leg})}`` for the nine example-robot-data quadrupeds."""
+    out = {}
+    for name in ROBOTS:
+        model = legs.load_erd(name)[0]
+        out[name] = (model, legs.from_model(model))
+    return out
+
+
+def pin_feet(model, found: dict, qleg: np.ndarray) -> np.ndarray:
+    """Pinocchio's feet (N, L, 3) (world = root frame: the base at its neutral pose) for leg joints (N, L, 3)."""
+    data = model.createData()
+    fids = [model.getFrameId(leg.foot_frame) for leg in found.values()]
+    idx = [list(leg.idx_q) for leg in found.values()]
+    q = pin.neutral(model)
+    out = np.empty(qleg.shape)
+    for i in range(len(qleg)):
+        for k, ix in enumerate(idx):
+            q[ix] = qleg[i, k]
+        pin.forwardKinematics(model, data, q)
+        for k, fid in enumerate(fids):
+            out[i, k] = pin.updateFramePlacement(model, data, fid).translation
+    return out
+
+
+def random_in_limits(found: dict, n: int, rng) -> np.ndarray:
+    return np.stack([rng.uniform(leg.lower, leg.upper, (n, 3)) for leg in found.values()], axis=1)
+
+
+# ------------------------------------------------------------------------------------------- the nine robots
+def test_erd_files_come_from_the_installed_distribution():
+    dist = importlib.metadata.distribution("example-robot-data")
+    base = Path(dist.locate_file("")).resolve()
+    assert len(ROBOTS) == 9
+    assert set(ROBOTS) == {"solo12", "anymal", "anymal_c", "hyq", "go1", "go2", "a1", "b1", "laikago"}
+    specs = legs.external_models()
+    assert set(specs) == set(ROBOTS)
+    for name in ROBOTS:
+        spec = legs.erd_spec(name)
+        assert spec == specs[name]
+        urdf = Path(spec["urdf"])
+        assert urdf.is_file() and base in urdf.parents
+        assert (spec["srdf"] is None) == (name == "laikago")
+        if spec["srdf"]:
+            assert Path(spec["srdf"]).is_file()
+            assert spec["reference_pose"] == "standing"
+        # package://example-robot-data/... resolves in the first package dir
+        assert (Path(spec["package_dirs"][0]) / "example-robot-data" / "robots").is_dir()
+        model, path, dirs = legs.load_erd(name)
+        assert isinstance(model, pin.Model) and Path(path) == urdf and dirs == spec["package_dirs"]
+        q = legs.reference_configuration(model, name)
+        assert q.shape == (model.nq,)
+    with pytest.raises(UnknownModelError, match="known: solo12"):
+        legs.load_erd("spot")
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_four_legs_and_fk_jacobian_match_pinocchio(erd, name):
+    model, found = erd[name]
+    assert len(found) == 4
+    assert len({leg.foot_frame for leg in found.values()}) == 4
+    for leg in found.values():
+        assert all(model.existJointName(j) for j in leg.joint_names)
+        assert model.existFrame(leg.foot_frame)
+        assert leg.idx_q == tuple(model.joints[model.getJointId(j)].idx_q for j in leg.joint_names)
+    rng = np.random.default_rng(1)
+    qleg = random_in_limits(found, 300, rng)
+    feet = pin_feet(model, found, qleg)
+    data = model.createData()
+    q = pin.neutral(model)
+    for k, leg in enumerate(found.values()):
+        assert np.abs(leg.fk(qleg[:, k]) - feet[:, k]).max() <= TOL
+        jac = leg.jacobian(qleg[:, k])
+        fid = model.getFrameId(leg.foot_frame)
+        for i in range(0, 300, 10):
+            q[list(leg.idx_q)] = qleg[i, k]
+            pin.computeJointJacobians(model, data, q)
+            pin.updateFramePlacements(model, data)
+            ref = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)[:3, list(leg.idx_v)]
+            assert np.abs(jac[i] - ref).max() <= TOL
+
+
+@pytest.mark.parametrize("name", ROBOTS)
+def test_ik_round_trip_10k_per_robot(erd, name):
+    """Every foot of 10^4 random in-limit configurations is solved inside the URDF limits, and Pinocchio's FK of
+    the answer reproduces it to 1e-12 m; every branch of ik_all reproduces it too."""
+    model, found = erd[name]
+    rng = np.random.default_rng(2024)
+    qleg = random_in_limits(found, 10_000, rng)
+    feet = pin_feet(model, found, qleg)
+    answers = np.empty_like(qleg)
+    for k, leg in enumerate(found.values()):
+        q, ok = leg.ik(feet[:, k], return_mask=True)
+        assert ok.all(), f"{name} {leg.name}: {int((~ok).sum())} targets unsolved"
+        assert np.all((q >= leg.lower) & (q <= leg.upper))
+        answers[:, k] = q
+        q_all, mask = leg.ik_all(feet[:300, k])
+        assert mask.any(axis=-1).all()
+        for b in range(4):
+            rows = mask[:, b]
+            assert np.abs(leg.fk(q_all[rows, b]) - feet[:300][rows, k]).max(initial=0.0) <= TOL
+    back = pin_feet(model, found, answers)
+    err = np.linalg.norm(back - feet, axis=-1)
+    assert err.max() <= TOL, f"{name}: max IK round-trip error {err.max():.3g} m"
+
+
+def test_extracted_geometry_of_known_robots(erd):
+    _, go2 = erd["go2"]
+    fl = go2["FL"]
+    assert fl.joint_names == ("FL_hip_joint", "FL_thigh_joint", "FL_calf_joint") and fl.foot_frame == "FL_foot"
+    assert fl.axis_labels == ("+x", "+y", "+y") and fl.knee_sign == 1.0
+    assert fl.lateral_offset == pytest.approx(0.0955, abs=1e-12)
+    assert fl.thigh_length == pytest.approx(0.213) and fl.shank_length == pytest.approx(0.213)
+    assert go2["FR"].lateral_offset == pytest.approx(-0.0955, abs=1e-12)
+    hyq = erd["hyq"][1]
+    assert hyq["lf"].axis_labels == ("-x", "+y", "+y")  # a rotated joint frame: the HAA axis points backwards
+    assert hyq["lf"].joint_names[0] == "lf_haa_joint"
+    anymal_c = erd["anymal_c"][1]
+    assert anymal_c["LF"].axis_labels[1] == "+y"  # its HFE is an RX joint in a rotated frame
+    assert erd["anymal"][1]["LF"].foot_frame == "LF_FOOT"  # BODY frame preferred over LF_ADAPTER_TO_FOOT
+    for name in ROBOTS:
+        for leg in erd[name][1].values():
+            s = leg.summary()
+            assert s["thigh_length"] > 0.1 and s["shank_length"] > 0.1
+            assert abs(leg.frame @ leg.frame.T - np.eye(3)).max() < 1e-15
+
+
+def test_named_leg_and_from_urdf(erd):
+    model, found = erd["go1"]
+    leg = legs.from_model(model, "RR")
+    assert isinstance(leg, legs.Leg) and leg.joint_names == found["RR"].joint_names
+    assert legs.from_model(model, "RR_hip_joint").name == "RR"
+    assert legs.from_model(model, "RR_foot").name == "RR"
+    with pytest.raises(InvalidParameterError, match="no leg 'XX'.*FL"):
+        legs.from_model(model, "XX")
+    urdf = legs.erd_files("go1")[0]
+    fixed = legs.from_urdf(urdf)
+    assert list(fixed) == list(found)
+    p = found["FL"].fk(np.array([0.1, 0.7, -1.5]))
+    np.testing.assert_allclose(fixed["FL"].fk(np.array([0.1, 0.7, -1.5])), p, atol=1e-15)
+    assert fixed["FL"].idx_q == (0, 1, 2)
+    by_frame = legs.from_model(model, foot_frames=["FL_foot_fixed"])
+    assert list(by_frame) == ["FL"] and by_frame["FL"].foot_frame == "FL_foot_fixed"
+    with pytest.raises(InvalidParameterError, match="nope"):
+        legs.from_model(model, foot_frames=["nope"])
+    with pytest.raises(LegStructureError, match="three revolute joints"):
+        legs.from_model(model, foot_frames=["FL_thigh"])  # hangs from only two joints
+    with pytest.raises(InvalidParameterError, match="does not exist"):
+        legs.from_urdf("/nonexistent/robot.urdf")
+    with pytest.raises(InvalidParameterError, match="pinocchio.Model"):
+        legs.from_model("go1")
+
+
+# ------------------------------------------------------------------------------------------- synthetic legs
+def _rot(rpy) -> np.ndarray:
+    return pin.rpy.rpyToMatrix(*map(float, rpy))
+
+
+def build_leg(
+    rpy=((0.0, 0.0, 0.0),) * 3,
+    t=((0.2, 0.1, 0.0), (0.05, 0.08, -0.02), (0.01, 0.02, -0.25)),
+    foot=(0.02, -0.01, -0.24),
+    a1=(1.0, 0.0, 0.0),
+    perp=0.3,
+    s3=1.0,
+    tilt_hfe_deg=0.0,
+    tilt_kfe_deg=0.0,
+    limits=(-math.pi, math.pi),
+    floating=False,
+):
+    """A one-leg Pinocchio model: three RevoluteUnaligned joints in rotated frames (rpy, t relative to the parent),
+    root-frame axes a1, a2 (perpendicular to a1, at angle ``perp`` about it), a3 = s3 a2; ``tilt_*`` tilts the
+    HFE axis off perpendicular / the KFE axis off parallel by that many degrees."""
+    model = pin.Model()
+    parent = 0
+    if floating:
+        parent = model.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "root_joint")
+    a1 = np.asarray(a1, float) / np.linalg.norm(a1)
+    helper = np.array([0.0, 0.0, 1.0]) if abs(a1[2]) < 0.9 else np.array([1.0, 0.0, 0.0])
+    b = np.cross(a1, helper)
+    b /= np.linalg.norm(b)
+    c = np.cross(a1, b)
+    a2 = math.cos(perp) * b + math.sin(perp) * c
+    a2t = math.cos(math.radians(tilt_hfe_deg)) * a2 + math.sin(math.radians(tilt_hfe_deg)) * a1
+    other = np.cross(a1, a2)
+    a3 = s3 * (math.cos(math.radians(tilt_kfe_deg)) * a2t + math.sin(math.radians(tilt_kfe_deg)) * other)
+    rots = [_rot(r) for r in rpy]
+    world = np.eye(3)
+    ids = []
+    for k, (axis, name) in enumerate(zip((a1, a2t, a3), ("X_HAA", "X_HFE", "X_KFE"))):
+        world = world @ rots[k]
+        local = world.T @ axis
+        jm = pin.JointModelRevoluteUnaligned(local / np.linalg.norm(local))
+        parent = model.addJoint(parent, jm, pin.SE3(rots[k], np.asarray(t[k], float)), name)
+        model.addJointFrame(parent, -1)
+        ids.append(parent)
+    model.addFrame(pin.Frame("X_FOOT", parent, pin.SE3(np.eye(3), np.asarray(foot, float)), pin.FrameType.OP_FRAME))
+    lo = model.lowerPositionLimit.copy()
+    hi = model.upperPositionLimit.copy()
+    for j in ids:
+        lo[model.joints[j].idx_q], hi[model.joints[j].idx_q] = limits
+    model.lowerPositionLimit, model.upperPositionLimit = lo, hi
+    return model
+
+
+def test_tilted_pitch_axis_raises_clear_error():
+    with pytest.raises(LegStructureError, match=r"HFE axis \(X_HFE.*is 0\.3 deg off parallel to the KFE axis"):
+        legs.from_model(build_leg(tilt_kfe_deg=0.3))
+    with pytest.raises(LegStructureError, match=r"HAA axis \(X_HAA.*is 2 deg off perpendicular to the HFE axis"):
+        legs.from_model(build_leg(tilt_hfe_deg=2.0))
+    with pytest.raises(LegStructureError, match="off parallel"):
+        legs.from_model(build_leg(tilt_kfe_deg=1e-6))  # 1.7e-8 rad > 1e-9
+    assert issubclass(LegStructureError, InvalidParameterError) and issubclass(LegStructureError, LegkinError)
+    legs.from_model(build_leg(tilt_kfe_deg=1e-9))  # 1.7e-11 rad: within the 1e-9 tolerance
+    with pytest.raises(LegStructureError, match="foot.*lies on the KFE axis"):
+        legs.from_model(build_leg(foot=(0.0, 0.0, 0.0), t=((0.2, 0.1, 0.0), (0.05, 0.08, -0.02), (0.0, 0.0, -0.25))))
+
+
+def test_no_leg_found():
+    model = pin.Model()
+    j = model.addJoint(0, pin.JointModelRY(), pin.SE3.Identity(), "only")
+    model.addJointFrame(j, -1)
+    with pytest.raises(InvalidParameterError, match="no HAA-HFE-KFE leg found"):
+        legs.from_model(model)
+
+
+angles = st.floats(-math.pi, math.pi, allow_nan=False)
+offsets = st.floats(-0.25, 0.25, allow_nan=False)
+
+
+@given(
+    rpy=st.tuples(*[st.tuples(angles, angles, angles)] * 3),
+    t=st.tuples(st.tuples(offsets, offsets, offsets), st.tuples(offsets, offsets, offsets),
+                st.tuples(offsets, offsets, offsets)),
+    foot=st.tuples(offsets, offsets, offsets),
+    a1=st.tuples(offsets, offsets, offsets),
+    perp=angles,
+    s3=st.sampled_from([-1.0, 1.0]),
+    floating=st.booleans(),
+    seed=st.integers(0, 2**32 - 1),
+)
+@example(rpy=((0.0, 0.0, 0.0),) * 3, t=((0.2, 0.1, 0.0), (0.05, 0.08, -0.02), (0.01, 0.02, -0.25)),
+         foot=(0.02, -0.01, -0.24), a1=(1.0, 0.0, 0.0), perp=0.3, s3=-1.0, floating=True, seed=0)
+def test_general_leg_matches_pinocchio(rpy, t, foot, a1, perp, s3, floating, seed):
+    """Any geometry: rotated joint frames, HAA axis off the HFE origin, pitch-plane offsets, any axis signs."""
+    assume(np.linalg.norm(a1) > 0.05)
+    model = build_leg(rpy, t, foot, a1, perp, s3, floating=floating)
+    try:
+        leg = legs.from_model(model, "X")
+    except LegStructureError as exc:  # only a degenerate thigh/shank may be refused
+        assert "length" in str(exc) or "lies on" in str(exc)
+        return
+    assume(min(leg.thigh_length, leg.shank_length) > 0.02)
+    rng = np.random.default_rng(seed)
+    q = rng.uniform(-math.pi, math.pi, (40, 3))
+    found = {"X": leg}
+    feet = pin_feet(model, found, q[:, None])[:, 0]
+    np.testing.assert_allclose(leg.fk(q), feet, atol=TOL, rtol=0)
+    sol, ok = leg.ik(feet, return_mask=True)
+    assert ok.all()
+    back = pin_feet(model, found, sol[:, None])[:, 0]
+    assert np.linalg.norm(back - feet, axis=-1).max() <= 1e-11
+    q_all, mask = leg.ik_all(feet)
+    # the sampled q is one of the branches (mod 2 pi), unless a singularity merges them
+    d = np.abs(np.angle(np.exp(1j * (q_all - q[:, None, :])))).max(axis=-1)
+    assert (np.nanmin(d, axis=-1) < 1e-6).mean() > 0.9
+
+
+# ------------------------------------------------------------------------------------------- the contract
+@pytest.fixture(scope="module")
+def fl(erd):
+    return erd["go2"][1]["FL"]
+
+
+BAD = [
+    ([np.nan, 0.0, 0.0], "finite"),
+    ([0.0, np.inf, 0.0], "finite"),
+    (np.array([1 + 1j, 0, 0]), "complex"),
+    ([0.1, 0.2], r"shape \(\.\.\., 3\)"),
+    (np.zeros((4, 2)), r"shape \(\.\.\., 3\)"),
+    (0.3, r"shape \(\.\.\., 3\)"),
+    ("abc", "numeric"),
+    ([[0.1, 0.2, 0.3], [0.1, 0.2]], "numeric"),
+    (None, "numeric"),
+    ([[0.1, 0.2, 0.3], [0.1, np.nan, 0.3]], "finite"),
+]
+
+
+@pytest.mark.parametrize("bad, match", BAD)
+@pytest.mark.parametrize("method", ["fk", "jacobian", "ik", "ik_all"])
+def test_bad_inputs_raise_legkin_errors(fl, bad, match, method):
+    with pytest.raises(InvalidInputError, match=match):
+        getattr(fl, method)(bad)
+
+
+def test_bad_options_raise_legkin_errors(fl):
+    p = fl.fk(np.array([0.0, 0.8, -1.5]))
+    with pytest.raises(InvalidParameterError, match="return_mask"):
+        fl.ik(p, return_mask="yes")
+    with pytest.raises(InvalidInputError, match="q_near"):
+        fl.ik(p, q_near=[0.0, 1.0])
+    with pytest.raises(InvalidInputError, match="q_near.*finite"):
+        fl.ik(p, q_near=[0.0, np.nan, 1.0])
+    with pytest.raises(InvalidInputError, match="broadcast"):
+        fl.ik(np.tile(p, (3, 1)), q_near=np.zeros((2, 3)))
+    assert issubclass(InvalidInputError, ValueError)
+
+
+@given(st.lists(st.tuples(st.floats(0, 1), st.floats(0, 1), st.floats(0, 1)), min_size=1, max_size=300),
+       st.integers(0, 299), st.sampled_from(["go2", "solo12", "anymal_c", "hyq"]))
+def test_single_call_equals_batch_row(erd, rows, i, name):
+    leg = next(iter(erd[name][1].values()))
+    u = np.array(rows)
+    q = leg.lower + u * (leg.upper - leg.lower)
+    p = leg.fk(q) + np.where(u > 0.9, 0.3, 0.0)  # some targets out of reach
+    i = i % len(q)
+    np.testing.assert_array_equal(leg.fk(q[i]), leg.fk(q)[i])
+    np.testing.assert_array_equal(leg.jacobian(q[i]), leg.jacobian(q)[i])
+    sol, ok = leg.ik(p, return_mask=True)
+    all_b, mask = leg.ik_all(p)
+    if ok[i]:
+        np.testing.assert_array_equal(leg.ik(p[i]), sol[i])
+        np.testing.assert_array_equal(leg.ik(p[i], q_near=q[i]), leg.ik(p, q_near=q)[i])
+    else:
+        assert np.isnan(sol[i]).all()
+        with pytest.raises(UnreachableError):
+            leg.ik(p[i])
+    if mask[i].any():
+        one, one_mask = leg.ik_all(p[i])
+        np.testing.assert_array_equal(one, all_b[i])
+        np.testing.assert_array_equal(one_mask, mask[i])
+
+
+def test_big_batch_equals_single_calls_and_shapes(fl):
+    rng = np.random.default_rng(3)
+    q = rng.uniform(fl.lower, fl.upper, (1000, 3))  # above SERIAL_BELOW: the parallel loop
+    p = fl.fk(q)
+    sol = fl.ik(p)
+    for i in range(0, 1000, 97):
+        np.testing.assert_array_equal(fl.ik(p[i]), sol[i])
+    assert fl.fk(q.reshape(10, 100, 3)).shape == (10, 100, 3)
+    assert fl.jacobian(q.reshape(10, 100, 3)).shape == (10, 100, 3, 3)
+    s, ok = fl.ik(p.reshape(10, 100, 3), return_mask=True)
+    assert s.shape == (10, 100, 3) and ok.shape == (10, 100)
+    a, m = fl.ik_all(p.reshape(10, 100, 3))
+    assert a.shape == (10, 100, 4, 3) and m.shape == (10, 100, 4)
+    assert fl.ik(np.empty((0, 3))).shape == (0, 3)
+    one, ok1 = fl.ik(p[0], return_mask=True)
+    assert one.shape == (3,) and ok1.shape == () and bool(ok1)
+    # a single target with a batch of q_near is a batch
+    assert fl.ik(p[0], q_near=q[:5]).shape == (5, 3)
+
+
+def test_unreachable_nan_mask_and_error(fl):
+    far = fl.origin + np.array([0.0, 0.0, -1.0])  # 1 m below the hip: beyond full stretch 0.426 m
+    inside = fl.origin.copy()  # on the HAA axis: inside the abduction cylinder (|d| = 0.0955 m)
+    good = fl.fk(np.array([0.1, 0.9, -1.6]))
+    p = np.stack([good, far, inside])
+    q, ok = fl.ik(p, return_mask=True)
+    assert ok.tolist() == [True, False, False]
+    assert np.isfinite(q[0]).all() and np.isnan(q[1:]).all()
+    q_all, mask = fl.ik_all(p)
+    assert mask[0].any() and not mask[1:].any() and np.isnan(q_all[1:]).all()
+    with pytest.raises(UnreachableError, match=r"out of reach of leg FL by 0\.5.* m: .*beyond the leg's full stretch"):
+        fl.ik(far)
+    with pytest.raises(UnreachableError, match=r"by 0\.0955 m: .*inside the abduction cylinder"):
+        fl.ik(inside)
+    with pytest.raises(UnreachableError):
+        fl.ik_all(far)
+    try:
+        fl.ik(far)
+    except UnreachableError as exc:
+        assert not isinstance(exc, JointLimitError)
+        np.testing.assert_array_equal(exc.target, far)
+
+
+def test_joint_limit_error(fl):
+    rng = np.random.default_rng(5)
+    q = rng.uniform(-math.pi, math.pi, (2000, 3))
+    p = fl.fk(q)
+    _, ok = fl.ik(p, return_mask=True)
+    q_all, mask = fl.ik_all(p)
+    only_outside = ~ok & mask.any(axis=-1)
+    assert only_outside.sum() > 10
+    for i in np.flatnonzero(only_outside)[:5]:
+        with pytest.raises(JointLimitError, match="reachable only outside the joint limits"):
+            fl.ik(p[i])
+        # every branch really is outside the limits (mod 2 pi)
+        for b in np.flatnonzero(mask[i]):
+            for n in (-1, 0, 1):
+                assert not fl.within_limits(q_all[i, b] + 2 * math.pi * n)
+
+
+def test_q_near_picks_the_branch(erd):
+    leg = erd["solo12"][1]["FL"]  # limits +-10 rad: every branch is inside
+    p = leg.fk(np.array([0.2, 0.7, -1.4]))
+    q_all, mask = leg.ik_all(p)
+    assert mask.all()
+    for b in range(4):
+        near = q_all[b] + 0.01
+        np.testing.assert_allclose(leg.ik(p, q_near=near), q_all[b], atol=1e-12)
+    # far from the limits' middle: the 2 pi representative nearest q_near inside +-10
+    np.testing.assert_allclose(leg.ik(p, q_near=q_all[1] + 2 * math.pi), q_all[1] + 2 * math.pi, atol=1e-12)
+
+
+# ------------------------------------------------------------------------------------------- legkin's POPI quadruped
+def _aq():
+    try:
+        from legkin.quadruped import kinematics as aq
+    except ImportError:
+        from legkin.analytic import quadruped as aq
+    fk = getattr(aq, "foot_position", None) or getattr(aq, "fk")
+    ik = getattr(aq, "foot_ik", None) or getattr(aq, "ik")
+    return fk, ik
+
+
+def test_popi_quadruped_legs_agree_with_its_closed_form(quadruped):
+    fk, ik = _aq()
+    found = legs.from_model(quadruped.model)
+    assert sorted(found) == ["LF", "LH", "RF", "RH"]
+    rng = np.random.default_rng(7)
+    for name, leg in found.items():
+        assert leg.joint_names == (f"{name}_HAA", f"{name}_HFE", f"{name}_KFE") and leg.foot_frame == f"{name}_FOOT"
+        q = rng.uniform(leg.lower, leg.upper, (2000, 3))
+        p = fk(q, name)
+        np.testing.assert_allclose(leg.fk(q), p, atol=TOL, rtol=0)
+        mine = leg.ik(p, q_near=q)
+        theirs = ik(p, name, q_ref=q)
+        assert np.abs(mine - theirs).max() < 1e-8
+        assert np.linalg.norm(fk(mine, name) - p, axis=-1).max() <= TOL
+
+
+# ------------------------------------------------------------------------------------------- check rows and bench
+def test_checks_run_rows_pass():
+    from legkin.legs import checks
+
+    rows = checks.run("go2", 300, np.random.default_rng(0))
+    assert len(rows) == 4 and all(r.passed for r in rows), [(r.name, r.max_error) for r in rows]
+    assert "1200/1200 solved" in rows[2].name
+
+
+def test_bench_go2_rows():
+    from legkin.legs.bench import bench_go2
+
+    rows = bench_go2(40)
+    names = [r["method"] for r in rows]
+    assert names[:3] == ["legkin Leg.ik (batch)", "legkin Leg.ik (single calls)",
+                         "Pinocchio CLIK (damped Newton, 3 leg joints)"]
+    assert rows[0]["success_rate"] == 1.0 and rows[1]["success_rate"] == 1.0
+    assert all({"method", "targets", "solved", "success_rate", "us_per_target", "max_error", "note"} <= set(r) for r in rows)

@@ -1,8 +1,10 @@
 """The 2-DOF constant-velocity parallel wrist (tripod, seed 000).
 
-The package is the mechanism: its registry entry (``spec``), its kinematics (re-exported here, imported on first use so that
-``import legkin`` stays light), its
-checks against Pinocchio (``checks``), bench (``bench``), figures (``figures``) and clips (``clips``).
+The package is the mechanism: its registry entry (``spec``), its ``Geometry`` (``geometry``), its kinematics (re-exported
+here from ``kinematics``, imported on first use so that ``import legkin`` stays light; split by concept into ``legs``,
+``platform``, ``closure``, ``inverse``, ``forward_kernels``, ``forward``, ``reachable``), the helpers of
+``configuration``, its contract (``contract``), checks against Pinocchio (``checks``), bench (``bench``), figures
+(``figures``) and clips (``clips``).
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they l
     from . import kinematics
     from .kinematics import *  # noqa: F403
 
-_SUBMODULES = ("kinematics", "checks", "bench", "figures", "clips")
+_SUBMODULES = ("kinematics", "geometry", "configuration", "contract", "checks", "bench", "figures", "clips")
 
 
 def __getattr__(name: str) -> Any:

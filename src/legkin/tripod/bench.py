@@ -1,6 +1,6 @@
 """Tripod: analytic ``fk`` / ``ik`` vs Pinocchio-only iterations on the closed-loop model, same targets.
 
-Targets: platform orientations (alpha_y, alpha_z) uniform over the workspace (``checks.tripod.sample_workspace``);
+Targets: platform orientations (alpha_y, alpha_z) uniform over the workspace (``configuration.sample_workspace``);
 their motor angles come from :func:`legkin.tripod.ik`. Scored the same way for every method:
 the platform rotation reached (from the answer's orientation, or Pinocchio's ``platform`` frame for a
 joint configuration) against the target, and Pinocchio's loop residual at the joint configuration.
@@ -11,11 +11,11 @@ from __future__ import annotations
 import numpy as np
 
 from .. import load
-from . import kinematics as at
-from ..bench import Method, MethodResult, ModelBench, Score
-from .checks import sample_workspace
-from ..errors import LegkinError, LoopClosureError
 from .._benchkit import SOLVE_TOL, levenberg_marquardt, rotation_error, sizes
+from ..bench import Method, MethodResult, ModelBench, Score
+from ..errors import LegkinError, LoopClosureError
+from . import kinematics as at
+from .configuration import MOTOR_COLUMNS, sample_workspace
 
 #: The tolerance every iterative method is given (fk's step tolerance, solve_loops' residual tolerance).
 TOL = 1e-12
@@ -32,11 +32,10 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
     robot = load("tripod")
     model = robot.model
     fid = robot.frame_id("platform")
-    ay, az = sample_workspace(n_batch, rng, at.ALPHA)
+    ay, az = sample_workspace(n_batch, rng)
     r_true = at.platform_rotation(ay, az)
-    q_true = at.ik(ay, az)
-    motors = q_true[:, [0, 4, 8]]
     orient = np.stack([ay, az], axis=-1)
+    motors = at.ik(orient)
 
     def pin_rot_and_residual(qs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         rot = np.full((len(qs), 3, 3), np.nan)
@@ -49,19 +48,18 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
 
     # ---------------------------------------------------------------- fk: motors -> orientation
     def fk_batch(m):
-        return at.fk(m[:, 0], m[:, 1], m[:, 2], tol=TOL)
+        return at.fk(m, tol=TOL)
 
     def fk_scalar(m):
         out = np.full((len(m), 2), np.nan)
-        for i, (a, b, c) in enumerate(m):
+        for i, row in enumerate(m):
             try:
-                out[i] = at.fk(a, b, c, tol=TOL)[:2]
+                out[i] = at.fk(row, tol=TOL)
             except LegkinError:
                 pass
         return out
 
-    def fk_score(m, out) -> Score:
-        u = np.stack(out[:2], axis=-1) if isinstance(out, tuple) else out
+    def fk_score(m, u) -> Score:
         k = len(m)
         err = rotation_error(at.platform_rotation(np.nan_to_num(u[:, 0]), np.nan_to_num(u[:, 1])), r_true[:k])
         err = np.where(np.all(np.isfinite(u), axis=-1), err, np.nan)
@@ -91,13 +89,13 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
 
     # ---------------------------------------------------------------- ik: orientation -> joints
     def ik_batch(u):
-        return at.ik(u[:, 0], u[:, 1])
+        return at.ik_joints(u)
 
     def ik_scalar(u):
         out = np.full((len(u), 12), np.nan)
-        for i, (a, b) in enumerate(u):
+        for i, row in enumerate(u):
             try:
-                out[i] = at.ik(a, b)
+                out[i] = at.ik_joints(row)
             except LegkinError:
                 pass
         return out
@@ -197,22 +195,26 @@ def single_calls() -> list:
     from .._single_call import SingleCall
 
     ay, az = 0.3, -0.4
-    q = at.ik(ay, az)
-    qa, qb, qc = (float(q[i]) for i in (0, 4, 8))
+    target = np.array([ay, az])
+    q = at.ik_joints(target)
+    motors = q[list(MOTOR_COLUMNS)]
     leg = np.array([float(q[0]), float(q[1]), float(q[2]) + 0.1, float(q[3]) - 0.2])
+    leg_cv = np.array([float(q[4]), float(q[5])])
     axis = at.platform_axis(ay, az)
     closed = [
-        ("leg_transform", lambda: at.leg_transform(leg, at.ETA[1])),
-        ("leg_transform_cv", lambda: at.leg_transform_cv(float(q[4]), float(q[5]), at.ETA[1])),
+        ("leg_transform", lambda: at.leg_transform(leg, "A")),
+        ("leg_transform_cv", lambda: at.leg_transform_cv(leg_cv, "B")),
         ("alpha_x", lambda: at.alpha_x(ay, az)),
         ("platform_rotation", lambda: at.platform_rotation(ay, az)),
         ("platform_position", lambda: at.platform_position(ay, az)),
         ("platform_axis", lambda: at.platform_axis(ay, az)),
         ("orientation_from_axis", lambda: at.orientation_from_axis(axis)),
-        ("ik", lambda: at.ik(ay, az)),
-        ("actuation_jacobian", lambda: at.actuation_jacobian(ay, az)),
+        ("ik", lambda: at.ik(target)),
+        ("ik_all", lambda: at.ik_all(target)),
+        ("ik_joints", lambda: at.ik_joints(target)),
+        ("jacobian", lambda: at.jacobian(target)),
         ("workspace", lambda: at.workspace(n=2, m=2)),
     ]
     calls = [SingleCall(name, call, "quadruped_fk") for name, call in closed]
-    calls.insert(9, SingleCall("fk", lambda: at.fk(qa, qb, qc), "solve_loops", iterative=True))
+    calls.insert(11, SingleCall("fk", lambda: at.fk(motors), "solve_loops", iterative=True))
     return calls

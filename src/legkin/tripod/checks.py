@@ -8,9 +8,14 @@ import numpy as np
 import pinocchio as pin
 
 from .. import load
+from .._rotations import rotation_angle as _rot_err
+from .._rotations import wrap
 from ..errors import LoopClosureError
-from . import kinematics as at
 from ..validation import CheckResult, classify_failures, compare, per_sample, pinocchio_frames, robustness_row
+from . import kinematics as at
+from ._common import BOUNDARY_TOL, HOME_MODE, SINGULAR_TOL
+from .configuration import MOTOR_COLUMNS, sample_workspace
+from .inverse import _run
 
 TOL = 1e-12
 #: The parameter sets checked: the default (alpha = pi/3) and alpha = pi/4, pi/2 (generated into the cache).
@@ -43,20 +48,6 @@ TOL_FLIP = 1e-8
 SOLVE_TOL = 1e-14
 
 
-def sample_workspace(n: int, rng: np.random.Generator, alpha: float, margin: float = 0.0):
-    """(alpha_y, alpha_z) uniform in [-pi/2, pi/2] x [-pi, pi], kept where :func:`ik` succeeds and
-    every leg has 1 - |cos q_K2| > margin."""
-    ays, azs = [], []
-    while sum(len(a) for a in ays) < n:
-        ay = rng.uniform(-np.pi / 2, np.pi / 2, 2 * n)
-        az = rng.uniform(-np.pi, np.pi, 2 * n)
-        q, ok = at.ik(ay, az, alpha=alpha, return_mask=True)
-        ok &= np.all(1.0 - np.abs(np.cos(q[..., [1, 5, 9]])) > margin, axis=-1) if margin > 0 else ok
-        ays.append(ay[ok])
-        azs.append(az[ok])
-    return np.concatenate(ays)[:n], np.concatenate(azs)[:n]
-
-
 def sample_near_boundary(n: int, rng: np.random.Generator, alpha: float):
     """Orientations with some leg at 1 - |cos q_K2| in [1e-10, 1e-3] (close to the workspace boundary)."""
     ch = math.cos(alpha / 2)
@@ -71,7 +62,7 @@ def sample_near_boundary(n: int, rng: np.random.Generator, alpha: float):
         theta = 2 * np.arcsin(np.minimum(arg, 1.0))
         r = np.stack([np.cos(theta), np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi)], axis=-1)
         ay, az = at.orientation_from_axis(r)
-        _, ok = at.ik(ay, az, alpha=alpha, return_mask=True)
+        _, ok = at.ik(np.stack([ay, az], axis=-1), geometry=at.Geometry(alpha=alpha), return_mask=True)
         ok &= good
         ays.append(ay[ok])
         azs.append(az[ok])
@@ -84,15 +75,8 @@ def sample_near_flip(n: int, rng: np.random.Generator, alpha: float):
     theta = np.pi - 10 ** rng.uniform(-3, -1.5, 20 * n)
     r = np.stack([np.cos(theta), np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi)], axis=-1)
     ay, az = at.orientation_from_axis(r)
-    _, ok = at.ik(ay, az, alpha=alpha, return_mask=True)
+    _, ok = at.ik(np.stack([ay, az], axis=-1), geometry=at.Geometry(alpha=alpha), return_mask=True)
     return ay[ok][:n], az[ok][:n]
-
-
-def _rot_err(ra: np.ndarray, rb: np.ndarray) -> np.ndarray:
-    """Rotation angle of ra^T rb (rad), robust for tiny angles."""
-    m = np.swapaxes(ra, -1, -2) @ rb
-    skew = np.stack([m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]], -1)
-    return np.arctan2(np.linalg.norm(skew, axis=-1) / 2, (np.trace(m, axis1=-2, axis2=-1) - 1) / 2)
 
 
 def _pin_actuation_jacobian(robot, q: np.ndarray) -> tuple[np.ndarray, float]:
@@ -117,8 +101,10 @@ def _pin_actuation_jacobian(robot, q: np.ndarray) -> tuple[np.ndarray, float]:
 
 
 def _fd_actuation_jacobian(ay, az, alpha):
+    geo = at.Geometry(alpha=alpha)
+
     def motors(y, z):
-        return at.ik(y, z, alpha=alpha)[..., [0, 4, 8]]
+        return at.ik(np.stack(np.broadcast_arrays(y, z), axis=-1), geometry=geo)
 
     def d4(h, dy, dz):
         f = lambda k: motors(ay + k * h * dy, az + k * h * dz)  # noqa: E731
@@ -133,14 +119,15 @@ def _fd_actuation_jacobian(ay, az, alpha):
 def _is_cv_branch(q: np.ndarray) -> bool:
     q2 = q[[1, 5, 9]]
     return bool(
-        np.all(np.abs(at._wrap(q[[2, 6, 10]] - q2)) < 1e-9)
-        and np.all(np.abs(at._wrap(q[[3, 7, 11]] - q[[0, 4, 8]])) < 1e-9)
+        np.all(np.abs(wrap(q[[2, 6, 10]] - q2)) < 1e-9)
+        and np.all(np.abs(wrap(q[[3, 7, 11]] - q[[0, 4, 8]])) < 1e-9)
         and np.all(np.sin(q2) > 0)
     )
 
 
 def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -> list[CheckResult]:
     robot = load("tripod") if tag == "pi/3" else load("tripod", alpha=alpha)
+    geo = at.Geometry(alpha=alpha)
     pre = f"[alpha={tag}] "
     rows: list[CheckResult] = []
     # --- open chains: every joint random
@@ -148,7 +135,7 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
     pos, rot = pinocchio_frames(robot, qs, [f"{k}_ee" for k in at.LEGS])
     perr, rerr, cverr = [], [], []
     for k, leg in enumerate(at.LEGS):
-        t = at.leg_transform(qs[:, 4 * k : 4 * k + 4], at.ETA[k], alpha=alpha)
+        t = at.leg_transform(qs[:, 4 * k : 4 * k + 4], leg, geometry=geo)
         perr.append(per_sample(t[:, :3, 3] - pos[:, k]))
         rerr.append(_rot_err(t[:, :3, :3], rot[:, k]))
     rows.append(compare(pre + "leg_transform vs oMf K_ee, open chains, position (m)", perr, TOL))
@@ -159,22 +146,22 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
         qcv[:, 4 * k + 2] = qcv[:, 4 * k + 1]
         qcv[:, 4 * k + 3] = qcv[:, 4 * k]
     pos, rot = pinocchio_frames(robot, qcv, [f"{k}_ee" for k in at.LEGS])
-    for k in range(3):
-        t = at.leg_transform_cv(qcv[:, 4 * k], qcv[:, 4 * k + 1], at.ETA[k], alpha=alpha)
+    for k, leg in enumerate(at.LEGS):
+        t = at.leg_transform_cv(qcv[:, 4 * k : 4 * k + 2], leg, geometry=geo)
         cverr.append(np.maximum(per_sample(t[:, :3, 3] - pos[:, k]), _rot_err(t[:, :3, :3], rot[:, k])))
     rows.append(compare(pre + "eq (10) leg_transform_cv vs oMf K_ee, q3=q2, q4=q1 (m | rad)", cverr, TOL))
 
     # --- ik -> Pinocchio
-    ay, az = sample_workspace(samples, rng, alpha)
+    ay, az = sample_workspace(samples, rng, geo)
     fy, fz = sample_near_flip(max(samples // 10, 50), rng, alpha)
     if len(fy):  # the workspace reaches the platform singularity only for alpha <= pi/3 (default eta)
         ay, az = np.concatenate([ay, fy]), np.concatenate([az, fz])
     far = 1 + np.cos(ay) * np.cos(az) > NEAR_FLIP
-    q = at.ik(ay, az, alpha=alpha)
+    q = at.ik_joints(np.stack([ay, az], axis=-1), geometry=geo)
     res = np.array([np.linalg.norm(robot.constraint_residual(qi)) for qi in q])
     pos, rot = pinocchio_frames(robot, q, ["platform"])
     rot_e = _rot_err(at.platform_rotation(ay, az), rot[:, 0])
-    pos_e = per_sample(at.platform_position(ay, az, alpha=alpha) - pos[:, 0])
+    pos_e = per_sample(at.platform_position(ay, az, geometry=geo) - pos[:, 0])
     for sel, tag_, tol in ((far, f"1 + c_y c_z > {NEAR_FLIP:g}", TOL), (~far, f"1 + c_y c_z <= {NEAR_FLIP:g}", TOL_FLIP)):
         if not sel.any():
             continue
@@ -182,7 +169,7 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
         rows.append(compare(pre + f"ik -> platform rotation vs platform_rotation (rad) ({tag_})", rot_e[sel], tol))
         rows.append(compare(pre + f"ik -> platform position vs platform_position (m) ({tag_})", pos_e[sel], tol))
     by, bz = sample_near_boundary(max(samples // 10, 50), rng, alpha)
-    qb = at.ik(by, bz, alpha=alpha)
+    qb = at.ik_joints(np.stack([by, bz], axis=-1), geometry=geo)
     resb = np.array([np.linalg.norm(robot.constraint_residual(qi)) for qi in qb])
     farb = 1 + np.cos(by) * np.cos(bz) > NEAR_FLIP  # boundary samples can be near the flip too
     for sel, tag_, tol in ((farb, f"1 + c_y c_z > {NEAR_FLIP:g}", TOL), (~farb, f"1 + c_y c_z <= {NEAR_FLIP:g}", TOL_FLIP)):
@@ -191,7 +178,7 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
                                 resb[sel], tol))
 
     # --- actuation Jacobian
-    a_an = at.actuation_jacobian(ay, az, alpha=alpha)
+    a_an = at.jacobian(np.stack([ay, az], axis=-1), geometry=geo)
     err, cond = np.empty(len(q)), np.empty(len(q))
     for i, qi in enumerate(q):
         a_pin, cond[i] = _pin_actuation_jacobian(robot, qi)
@@ -209,10 +196,12 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
     # --- fk
     # near the flip the motors' rounding noise is amplified (|A_u| ~ 1 / (1 + c_y c_z)): measured
     # inconsistency up to 5e-9 rad there, so those samples accept up to 1e-6 (the default is 1e-9)
-    u = at.fk(q[:, 0], q[:, 4], q[:, 8], alpha=alpha, return_mask=True, max_inconsistency=1e-6)
-    u[3][far & (u[2] > 1e-9)] = False
-    fk_rot = _rot_err(at.platform_rotation(np.nan_to_num(u[0]), np.nan_to_num(u[1])), at.platform_rotation(ay, az))
-    fk_rot[~u[3]] = np.nan  # a failure counts against the row
+    u, u_ok, u_info = at.fk(q[:, list(MOTOR_COLUMNS)], geometry=geo, return_mask=True, return_info=True,
+                            max_inconsistency=1e-6)
+    inconsistency = u_info.inconsistency
+    u_ok[far & (inconsistency > 1e-9)] = False
+    fk_rot = _rot_err(at.platform_rotation(np.nan_to_num(u[:, 0]), np.nan_to_num(u[:, 1])), at.platform_rotation(ay, az))
+    fk_rot[~u_ok] = np.nan  # a failure counts against the row
     far = 1 + np.cos(ay) * np.cos(az) > NEAR_FLIP
     rows.append(compare(pre + f"fk(ik(u)) round trip, platform rotation (rad) (1 + c_y c_z > {NEAR_FLIP:g})",
                         fk_rot[far], TOL))
@@ -220,11 +209,12 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
         rows.append(compare(pre + f"fk(ik(u)) round trip, platform rotation (rad) (1 + c_y c_z <= {NEAR_FLIP:g})",
                             fk_rot[~far], TOL_FLIP))
     rows.append(compare(pre + f"fk(ik(u)) inconsistency of consistent motors (rad) (1 + c_y c_z > {NEAR_FLIP:g})",
-                        u[2][far], TOL))
+                        inconsistency[far], TOL))
     q, ay, az = q[far], ay[far], az[far]
     m = min(samples, SOLVE_SAMPLES)
     delta = rng.normal(0.0, 0.15, (m, 2))
-    q_start, ok = at.ik(ay[:m] + delta[:, 0], az[:m] + delta[:, 1], alpha=alpha, return_mask=True)
+    q_start, ok = at.ik_joints(np.stack([ay[:m] + delta[:, 0], az[:m] + delta[:, 1]], axis=-1), geometry=geo,
+                               return_mask=True)
     errs, gain, other, failed = [], [], 0, 0
     held_free = np.ones(robot.model.nv, dtype=bool)
     held_free[[robot.idx_v("A_q1"), robot.idx_v("B_q1")]] = False
@@ -237,7 +227,7 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
         if not _is_cv_branch(qs_i):
             other += 1  # another assembly mode of the legs: outside fk's model (q3=q2, q4=q1, q2 in (0, pi))
             continue
-        uf = at.fk(qs_i[0], qs_i[4], qs_i[8], alpha=alpha)
+        uf = at.fk(qs_i[list(MOTOR_COLUMNS)], geometry=geo)
         errs.append(_rot_err(at.platform_rotation(uf[0], uf[1]), robot.frame_placement(qs_i, "platform").rotation))
         # The closed configuration's own error (its residual <= SOLVE_TOL) is amplified by 1 / sigma_min of the
         # constraint Jacobian on the free joints: near a bifurcation of the legs' branches it is large
@@ -279,8 +269,8 @@ def pose_error(ay, az, y, z) -> np.ndarray:
     Each measure is ill-conditioned at one singular set of the parametrisation, the other is not: alpha_z is
     undefined at c_y = 0 (same rotation for every alpha_z), and R(u) folds a circle of rotations onto the flip
     point 1 + c_y c_z = 0 (the parameters are well determined there)."""
-    d1 = np.hypot(at._wrap(y - ay), at._wrap(z - az))
-    d2 = np.hypot(at._wrap(np.pi - y - ay), at._wrap(z + np.pi - az))
+    d1 = np.hypot(wrap(y - ay), wrap(z - az))
+    d2 = np.hypot(wrap(np.pi - y - ay), wrap(z + np.pi - az))
     with np.errstate(invalid="ignore"):
         rot = _rot_err(at.platform_rotation(ay, az), at.platform_rotation(np.nan_to_num(y), np.nan_to_num(z)))
     return np.minimum(np.minimum(d1, d2), np.where(np.isfinite(y) & np.isfinite(z), rot, np.inf))
@@ -290,13 +280,15 @@ def made_targets(n: int, rng: np.random.Generator, alpha: float = at.ALPHA) -> t
     """``n`` orientations made by the default :func:`fk` from in-limit joints of a closed configuration.
 
     Motors q_A1, q_B1 uniform in the joint limits [-pi, pi]; E on both motor planes and the sphere |E| = L (a
-    line cut by a sphere: zero or two points, see :func:`legkin.tripod._initial_guess`); for the points
+    line cut by a sphere: zero or two points, see :mod:`legkin.tripod.forward_kernels`); for the points
     in the home mode's half (E_x < 0, sin q_A2, sin q_B2 > 0) that leg C reaches, q_C1 from leg C on its home
     branch (eqs 98, 102 at E); the target is ``fk(q_A1, q_B1, q_C1)`` with default options, kept where fk
     solves it.
     """
-    g = at._geometry(at.D, alpha, np.asarray(at.ETA))
-    ce, se, dk, big_l = g.ce, g.se, g.d * g.k, -g.minus_l
+    geo = at.Geometry(alpha=alpha)
+    ce, se = np.cos(np.asarray(geo.eta)), np.sin(np.asarray(geo.eta))
+    d, k, sa = geo.d, 1.0 - math.cos(alpha), math.sin(alpha)
+    dk, big_l, dsa = d * k, geo.length, d * sa
     ys, zs, total = [], [], 0
     while total < n:
         m = max(2 * n, 1000) * 4
@@ -313,19 +305,19 @@ def made_targets(n: int, rng: np.random.Generator, alpha: float = at.ALPHA) -> t
         keep = np.isfinite(t) & (vv > 1e-12)
         for sign in (-1.0, 1.0):
             e = p0 + (sign * t)[:, None] * v
-            h1, h2 = -e[:, 0] / g.d, -(ce[:2, None] * e[:, 1] + se[:2, None] * e[:, 2]).T / g.d
+            h1, h2 = -e[:, 0] / d, -(ce[:2, None] * e[:, 1] + se[:2, None] * e[:, 2]).T / d
             s2sa = c * h1[:, None] + s * h2  # sin q_K2 sin(alpha) of legs A and B at E
             # q_C1 from E on leg C's home branch (eqs 98, 102; straight from E, not through the orientation)
-            c2 = (ce[2] * e[:, 2] - se[2] * e[:, 1]) / g.dsa
+            c2 = (ce[2] * e[:, 2] - se[2] * e[:, 1]) / dsa
             home = keep & (e[:, 0] < 0) & np.all(s2sa > 0, axis=-1) & (np.abs(c2) < 1.0)
             e, c2 = e[home], c2[home]
-            sc = np.sqrt(1.0 - c2 * c2) * g.sa
+            sc = np.sqrt(1.0 - c2 * c2) * sa
             w = -(ce[2] * e[:, 1] + se[2] * e[:, 2])
-            qc = np.arctan2(g.k * e[:, 0] + sc * w, -sc * e[:, 0] + g.k * w)
+            qc = np.arctan2(k * e[:, 0] + sc * w, -sc * e[:, 0] + k * w)
             qa = q[home]
-            y, z, _, solved = at.fk(qa[:, 0], qa[:, 1], qc, alpha=alpha, return_mask=True)
-            ys.append(y[solved])
-            zs.append(z[solved])
+            u, solved = at.fk(np.stack([qa[:, 0], qa[:, 1], qc], axis=-1), geometry=geo, return_mask=True)
+            ys.append(u[solved, 0])
+            zs.append(u[solved, 1])
             total += int(solved.sum())
     return np.concatenate(ys)[:n], np.concatenate(zs)[:n]
 
@@ -334,13 +326,12 @@ def _det_curve_points(rng: np.random.Generator, alpha: float, grid: int = 121) -
     """Points (alpha_y, alpha_z) on the actuation-singular curves det M = 0 of the home mode's motors: bisection
     between grid neighbours where det M changes sign, along alpha_y (random alpha_z) and along alpha_z (random
     alpha_y; at alpha = pi/2 det M vanishes on the lines alpha_z = +-pi/2)."""
-    geo = at._geometry(at.D, alpha, np.asarray(at.ETA))
+    G = at.Geometry(alpha=alpha)._vector
 
-    def det_of(y, z):
-        trig = tuple(f(v)[..., None] for v in (y, z) for f in (np.cos, np.sin))
-        with np.errstate(invalid="ignore", divide="ignore"):
-            _, _, c2, _, nb2, sn, cn = at._ik_eval(*trig, geo, with_sc=True)
-            return np.where(at._inside(c2, nb2)[..., 0], at._det_planes(sn, cn, geo), np.nan)
+    def det_of(y, z):  # det M of the home mode's motor planes (ik's kernel, also where its guards refuse the pose)
+        aux = _run(*np.broadcast_arrays(np.asarray(y, dtype=float), np.asarray(z, dtype=float)), G, HOME_MODE)[1][..., 0, :]
+        inside = (aux[..., 3] > SINGULAR_TOL) & np.all(1.0 - np.abs(aux[..., :3]) > BOUNDARY_TOL, axis=-1)
+        return np.where(inside, aux[..., 4], np.nan)
 
     out = []
     for along_y in (True, False):
@@ -415,9 +406,9 @@ def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 20
     exceptions = 0
     y, z, ok = np.full(n, np.nan), np.full(n, np.nan), np.zeros(n, dtype=bool)
     try:
-        q, solved = at.ik(ay, az, return_mask=True)
-        qs = q[solved]
-        y[solved], z[solved], _, ok[solved] = at.fk(qs[:, 0], qs[:, 4], qs[:, 8], return_mask=True)
+        q, solved = at.ik_joints(np.stack([ay, az], axis=-1), return_mask=True)
+        u, ok[solved] = at.fk(q[solved][:, list(MOTOR_COLUMNS)], return_mask=True)
+        y[solved], z[solved] = u[:, 0], u[:, 1]
     except Exception:  # noqa: BLE001 - a foreign (or any) exception from a batch call is a defect
         exceptions += 1
         q, solved = np.full((n, 12), np.nan), np.zeros(n, dtype=bool)
@@ -426,7 +417,7 @@ def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 20
     unsolved = np.nonzero(~solved)[0]
     if classify is not None and len(unsolved) > classify:
         unsolved = np.sort(rng.choice(unsolved, classify, replace=False))
-    reasons, foreign = classify_failures(lambda i: at.ik(float(ay[i]), float(az[i])), unsolved)
+    reasons, foreign = classify_failures(lambda i: at.ik(np.array([ay[i], az[i]])), unsolved)
     return robustness_row(
         "tripod", made=made, solved=solved, error=error, reasons=reasons, classified=len(unsolved),
         exceptions=exceptions + foreign, tolerance=CONTRACT_TOL,

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import kinematics as at
+from .configuration import closed_configuration, robot_configuration
 
 #: How far inside the legs' singular curves sin q_K2 = 0 the sweep stays (rad of tilt).
 MARGIN = 0.05
@@ -14,9 +15,8 @@ MARGIN = 0.05
 TILT_CAP = np.pi - 0.3
 
 
-def _geometry(robot) -> dict:
-    p = robot.params
-    return dict(d=float(p["d"]), alpha=float(p["alpha"]), eta=(float(p["eta_A"]), float(p["eta_B"]), float(p["eta_C"])))
+def _geometry(robot) -> at.Geometry:
+    return at.Geometry.from_params(robot.params)
 
 
 def boundary_path(robot, dense: int = 2001) -> tuple[np.ndarray, np.ndarray]:
@@ -27,7 +27,7 @@ def boundary_path(robot, dense: int = 2001) -> tuple[np.ndarray, np.ndarray]:
     ``theta = min(tilt_max - MARGIN, TILT_CAP)``, mapped to (alpha_y, alpha_z) by ``orientation_from_axis``.
     """
     geo = _geometry(robot)
-    ws = at.workspace(**geo, n=3, m=dense)
+    ws = at.workspace(geometry=geo, n=3, m=dense)
     theta = np.minimum(ws.tilt_max - MARGIN, TILT_CAP)
     phi = ws.phi
     axis = np.stack([np.cos(theta), np.sin(theta) * np.cos(phi), np.sin(theta) * np.sin(phi)], axis=-1)
@@ -43,18 +43,14 @@ def workspace_boundary(robot, frames: int = 150) -> list[np.ndarray]:
     """
     geo = _geometry(robot)
     ay, az = boundary_path(robot)
-    q = at.ik(ay, az, **geo)  # (dense, 12); raises nothing for a batch: NaN if a point failed
+    q = closed_configuration(ay, az, geometry=geo)  # (dense, 12); raises nothing for a batch: NaN if a point failed
     if not np.all(np.isfinite(q)):
         raise RuntimeError("tripod workspace_boundary: the boundary path left the workspace")  # pragma: no cover
     step = np.linalg.norm(np.angle(np.exp(1j * np.diff(q, axis=0))), axis=-1)  # wrapped joint steps
     s = np.concatenate([[0.0], np.cumsum(step)])
     pick = np.searchsorted(s, np.linspace(0.0, s[-1], frames, endpoint=False))
-    q_frames = at.ik(ay[pick], az[pick], **geo)
-    qs = np.tile(robot.q0, (frames, 1))
-    for k, leg in enumerate(at.LEGS):
-        for j in range(4):
-            qs[:, robot.idx_q(f"{leg}_q{j + 1}")] = q_frames[:, 4 * k + j]
-    return list(qs)
+    q_frames = closed_configuration(ay[pick], az[pick], geometry=geo)
+    return list(robot_configuration(robot, q_frames))
 
 
 ANIMATIONS = {"workspace_boundary": workspace_boundary}

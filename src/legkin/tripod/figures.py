@@ -61,7 +61,7 @@ def figures(outdir: Path) -> list[Path]:
     theta = np.radians(np.linspace(0.0, 180.0, 181))
     P, T = np.meshgrid(phi, theta, indexing="ij")
     ay, az = at.orientation_from_axis(_tilt_axis(T, P))
-    q, ok = at.ik(ay, az, return_mask=True)
+    q, ok = at.ik_joints(np.stack([ay, az], axis=-1), return_mask=True)
     s2p = np.where(ok, np.abs(np.sin(q[..., [1, 5, 9]])).min(axis=-1), np.nan)
     pol.set_facecolor("0.85")
     pol.pcolormesh(P, deg(T), s2p, cmap="viridis", vmin=0.0, vmax=1.0, shading="nearest", rasterized=True)

@@ -1,0 +1,143 @@
+"""Constants, assembly modes, kernel status codes and argument checks shared by the tripod's kinematics files."""
+
+from __future__ import annotations
+
+import types
+import warnings
+from typing import Any, Callable
+
+import numpy as np
+
+from .._batch import check_choice, check_flag
+from .._kernels import kernel
+from ..errors import InvalidInputError, InvalidParameterError
+from .geometry import DEFAULT, Geometry
+
+LEGS = ("A", "B", "C")
+#: Below this, ``1 + c_y c_z`` counts as zero: the platform axis is turned back onto -x (E undefined).
+SINGULAR_TOL = 1e-12
+#: Below this, ``1 - |cos q_K2|`` counts as zero: leg K is on the workspace boundary, sin q_K2 = 0.
+BOUNDARY_TOL = 1e-12
+#: Assembly modes on the constant-velocity branch (q_K3 = q_K2, q_K4 = q_K1): a string of four signs, the side of
+#: the platform centre E along x (``-``: E_x < 0) then the signs of sin q_A2, sin q_B2, sin q_C2. Every
+#: orientation has one configuration per mode (E = -+L b/|b|, q_K2 = +-acos(cos q_K2)), all realising the
+#: same platform rotation; the motors differ. See docs/tripod.md, "IK contract".
+MODES = tuple(c + a + b + k for c in "-+" for a in "+-" for b in "+-" for k in "+-")
+#: The mode the mechanism is built in: that of its SRDF reference pose ``home`` (E = (-L, 0, 0), q_K2 = pi/2).
+HOME_MODE = "-+++"
+#: Actuation-singularity guard: :func:`ik` and :func:`fk` refuse motor angles whose planes (see
+#: :func:`legkin.tripod.fk_solver._k_initial_guess`) have ``|det M| < DET_GUARD`` (unit normals). There the motors
+#: fix the pose only to ~2e-16 / |det M| rad, and on det M = 0 they fit two poses (the planes share a line that
+#: cuts the sphere |E| = L twice; at tangency the two merge and A_u loses rank): fk could not reproduce ik's
+#: answers to 1e-9.
+DET_GUARD = 1e-6
+#: Motor-gain guard: :func:`ik` and :func:`fk` refuse poses where ``|A_u|_F > GAIN_GUARD``. The motors are then so
+#: sensitive to the orientation that its float representation fixes them only to ~ulp |A_u| > 1e-8 rad and the
+#: Gauss-Newton of fk stalls on that noise. |A_u|_F <= sqrt(3/2) / (min_K |sin q_K2| sqrt(1 + c_y c_z)) (measured),
+#: so this happens only where a leg is within ~1e-5 of its boundary next to the flip: near the points where the
+#: workspace boundary meets the flip (alpha <= pi/3, e.g. six directions at the default alpha). Away from them
+#: |A_u|_F stays below ~1e8 down to the singular tolerances (measured max 8e7 at alpha = pi/4).
+GAIN_GUARD = 1e8
+
+#: Kernel status codes (0 = :data:`legkin._kernels.OK`): fk's failures, a NaN / inf input, a closed form's failure.
+ST_SINGULAR_PLANES, ST_LEFT, ST_NOT_CONVERGED, ST_INCONSISTENT, ST_OUTSIDE, ST_GAIN = 1, 2, 3, 4, 5, 6
+ST_NONFINITE = 7  # an input is NaN or inf (the wrapper raises InvalidInputError with as_input's message)
+ST_FAIL = 8  # closed forms: the pose is outside / singular (the wrapper diagnoses it)
+
+#: Per assembly mode (:data:`MODES` order): home flag, side of E, signs of sin q_K2 (the kernels' mode arguments).
+MODE_HOME = np.array([m == HOME_MODE for m in MODES])
+MODE_E = np.array([-1.0 if m[0] == "-" else 1.0 for m in MODES])
+MODE_S = np.array([[-1.0 if c == "-" else 1.0 for c in m[1:]] for m in MODES])
+MODE_INDEX = {m: i for i, m in enumerate(MODES)}
+MODE_ARGS = {m: (bool(MODE_HOME[i]), float(MODE_E[i]), MODE_S[i]) for i, m in enumerate(MODES)}
+
+
+def modes_sel(mode: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The kernels' mode arrays (homes, es, ss) for one mode or ``"all"``."""
+    if mode == "all":
+        return MODE_HOME, MODE_E, MODE_S
+    j = MODE_INDEX[mode]
+    return MODE_HOME[j:j + 1], MODE_E[j:j + 1], MODE_S[j:j + 1]
+
+
+# ------------------------------------------------------------------------------------------ serial / parallel
+def serial(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """The serial twin of a batch loop (the same loop compiled without threads, ``prange`` as ``range``): the wrappers
+    use it below :data:`PARALLEL_MIN` items, where waking numba's thread pool costs more than the loop."""
+    twin = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + "_serial", fn.__defaults__, fn.__closure__)
+    twin.__qualname__ = fn.__qualname__ + "_serial"
+    twin.__doc__ = fn.__doc__
+    return kernel(twin)
+
+
+#: Batches smaller than this (items x modes, per function) run the serial twin of the batch loop. Chosen on a busy
+#: 2-core machine, where waking the pool costs up to ~10 ms: fk (~3 us an item) from 4096 items, the closed forms
+#: (~0.1-1 us an item) from 50000.
+PARALLEL_MIN = {"fk": 4096, "ik": 50000, "jac": 50000, "closed": 50000}
+
+
+def pick(pair: tuple[Callable[..., Any], Callable[..., Any]], n: int, kind: str) -> Callable[..., Any]:
+    """The parallel loop of ``pair = (parallel, serial)`` for n >= PARALLEL_MIN[kind] items, else its serial twin."""
+    return pair[0] if n >= PARALLEL_MIN[kind] else pair[1]
+
+
+# ------------------------------------------------------------------------------------------ arguments
+def geometry_of(geometry: object, legacy: dict[str, Any] | None = None, where: str = "") -> Geometry:
+    """The call's :class:`Geometry`: ``geometry`` (None: the default), or the deprecated ``d``, ``alpha``, ``eta``
+    (a DeprecationWarning, mapped onto a Geometry)."""
+    if legacy:
+        if geometry is not None:
+            raise InvalidParameterError(f"{where}: pass either geometry= or the deprecated {', '.join(legacy)}, not both")
+        warnings.warn(
+            f"{where}: the geometry arguments {', '.join(legacy)} are deprecated; pass geometry=tripod.Geometry(...)",
+            DeprecationWarning, stacklevel=4,
+        )
+        kw = dict(legacy)
+        if kw.get("eta") is None:
+            kw.pop("eta", None)
+        else:
+            try:
+                eta = np.asarray(kw["eta"])
+            except (TypeError, ValueError):
+                eta = None
+            if eta is None or eta.dtype.kind not in "biuf" or eta.shape != (3,):
+                raise InvalidParameterError(f"eta must be three finite real angles (eta_A, eta_B, eta_C), got {kw['eta']!r}")
+            kw["eta"] = tuple(float(v) for v in eta)
+        return Geometry(**kw)
+    if geometry is None:
+        return DEFAULT
+    if type(geometry) is not Geometry:
+        raise InvalidParameterError(f"geometry must be a legkin.tripod.Geometry or None, got {geometry!r}")
+    return geometry
+
+
+def checked_mode(mode: object, allow_all: bool = False) -> str:
+    """``mode`` if it is one of :data:`MODES` (or ``"all"`` where allowed), else InvalidParameterError."""
+    if type(mode) is str and mode == HOME_MODE:
+        return mode
+    return str(check_choice(mode, "mode", MODES + (("all",) if allow_all else ())))
+
+
+def flag(value: object, name: str) -> bool:
+    """A bool keyword (fast path for True / False)."""
+    if value is False or value is True:
+        return value  # type: ignore[return-value]
+    return check_flag(value, name)
+
+
+def deprecated(old: str, new: str) -> None:
+    """Warn that the call form / name ``old`` is deprecated in favour of ``new`` (stacklevel: the user's call)."""
+    warnings.warn(f"{old} is deprecated (legkin 0.2); use {new}", DeprecationWarning, stacklevel=4)
+
+
+def split_legacy(kwargs: dict[str, Any], where: str, allowed: tuple[str, ...]) -> dict[str, Any]:
+    """Pop the deprecated keyword arguments ``allowed`` out of ``kwargs``; refuse any other unknown keyword."""
+    legacy = {k: kwargs.pop(k) for k in allowed if k in kwargs}
+    if kwargs:
+        raise TypeError(f"{where}() got unexpected keyword argument(s) {', '.join(map(repr, kwargs))}")
+    return legacy
+
+
+def raise_nonfinite(name: str) -> None:
+    raise InvalidInputError(f"{name} must be finite, got a NaN or infinite entry")
+

@@ -1,0 +1,308 @@
+"""Forward kinematics of the tripod: the platform orientation from the motor angles (the public wrapper over
+:mod:`legkin.tripod.forward_kernels`, and the diagnosis of a failed single call)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any, Literal, Sequence, overload
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._batch import as_angles, as_input, check_integer, check_number
+from .._kernels import OK
+from ..errors import AssemblyModeError, ConvergenceError, SingularityError, UnreachableError
+from ._common import (
+    DET_GUARD, GAIN_GUARD, HOME_MODE, MODE_ARGS, MODES, ST_LEFT, ST_NONFINITE, ST_NOT_CONVERGED, ST_OUTSIDE,
+    ST_GAIN, ST_SINGULAR_PLANES, checked_mode, deprecated, flag, geometry_of, modes_sel, pick, split_legacy,
+)
+from .forward_kernels import FK_LOOP, _k_fk, _k_initial_guess
+from .geometry import Geometry
+from .inverse import ik_one, ik_single_error
+
+__all__ = ["fk", "FKInfo"]
+
+_GEOMETRY_KW = ("d", "alpha", "eta")
+
+
+@dataclass(frozen=True)
+class FKInfo:
+    """What :func:`fk` measured besides the pose (``return_info=True``).
+
+    Attributes:
+        inconsistency: (batch shape, or () for a single call; mode="all": (..., 16)) the distance (rad) of the
+            motors from the consistent set at the reported pose, to first order (NaN where an item failed).
+    """
+
+    inconsistency: np.ndarray
+
+
+def _fk_one(qa: float, qb: float, qc: float, G: np.ndarray, mode: str, tol: float, max_iter: int,
+            max_inc: float) -> tuple[np.ndarray, int]:
+    """The fk kernel on one motor triple in one mode: (alpha_y, alpha_z, inconsistency) (raw, also on failure),
+    status."""
+    home, e, s = MODE_ARGS[mode]
+    out = np.empty(3)
+    return out, _k_fk(qa, qb, qc, G, home, e, s, tol, max_iter, max_inc, out)
+
+
+def _motor_mode(qm: np.ndarray, g: Geometry) -> str | None:
+    """The assembly mode of motors (3,) read off their planes: E = d (1 - c_alpha) M^-1 (1, 1, 1) (None if M is
+    singular): the side of E_x, and per leg the sign of sin q_K2 sin(alpha) = c_K1 h1 + s_K1 h2 with
+    (h1, h2) = (-x, -(c_K y + s_K z)) / d (the leg's position equations, eq 101)."""
+    s, c = np.sin(qm), np.cos(qm)
+    ce, se = np.cos(np.asarray(g.eta)), np.sin(np.asarray(g.eta))
+    m = np.stack([s, -c * ce, -c * se], axis=-1)
+    try:
+        e = np.linalg.solve(m, np.full(3, g.d * (1.0 - math.cos(g.alpha))))
+    except np.linalg.LinAlgError:
+        return None
+    s2 = c * (-e[0] / g.d) + s * (-(ce * e[1] + se * e[2]) / g.d)
+    return ("-" if e[0] < 0 else "+") + "".join("-" if v < 0 else "+" for v in s2)
+
+
+def _motors_text(qs: Sequence[float]) -> str:
+    return f"(q_A1, q_B1, q_C1) = ({qs[0]:.17g}, {qs[1]:.17g}, {qs[2]:.17g})"
+
+
+def _fk_error(qs: Sequence[float], out: np.ndarray, status: int, mode: str, others: list[str], max_iter: int,
+              max_inconsistency: float, g: Geometry) -> Exception:
+    """The exception of a failed single :func:`fk` call (``out``, ``status``: the kernel's)."""
+    motors = _motors_text(qs)
+    ay, az, inconsistency = (float(v) for v in out)
+    target = np.array(qs, dtype=float)
+    if others:
+        return AssemblyModeError(
+            f"{motors} are consistent only in assembly mode(s) {', '.join(others)}, not in mode {mode}",
+            target=target, modes=[{"mode": m} for m in others],
+        )
+    if status == ST_SINGULAR_PLANES:
+        return SingularityError(
+            f"{motors} are an actuation singularity: their planes have |det M| < DET_GUARD = {DET_GUARD:g} "
+            "(nearly sharing a line): the motor angles do not determine the pose"
+        )
+    if status == ST_LEFT:  # diagnose at the planes' intersection (the start), as ik would there
+        G = g._vector
+        y0, z0, _ = _k_initial_guess(*(float(v) for v in qs), G)
+        _, aux, st = ik_one(y0, z0, G, mode)
+        if st != OK:
+            exc = ik_single_error(np.float64(y0), np.float64(z0), G, mode, aux)
+            return type(exc)(f"{motors}: no pose found; their planes meet at {exc}", *exc.args[1:])
+        return UnreachableError(f"{motors}: the solver left the workspace; no pose was found", target=target)
+    if status == ST_NOT_CONVERGED:
+        return ConvergenceError(f"{motors}: Gauss-Newton did not converge in {max_iter} iterations (singular A_u?)")
+    if status == ST_GAIN:
+        return SingularityError(
+            f"{motors}: at the pose (alpha_y, alpha_z) = ({ay:.17g}, {az:.17g}) the motors are too sensitive to the "
+            f"orientation (|A_u| > GAIN_GUARD = {GAIN_GUARD:g}: a leg next to its boundary near the flip)"
+        )
+    if status == ST_OUTSIDE:
+        return SingularityError(
+            f"{motors}: the pose (alpha_y, alpha_z) = ({ay:.17g}, {az:.17g}) is on the workspace boundary or the "
+            "platform singularity, where ik is undefined"
+        )
+    return UnreachableError(
+        f"{motors} are inconsistent: no pose produces all three; the least-squares pose "
+        f"(alpha_y, alpha_z) = ({ay:.17g}, {az:.17g}) misses them by {inconsistency:.3e} rad "
+        f"(max_inconsistency = {max_inconsistency:.1e})",
+        target=target,
+        closest=(ay, az),
+    )
+
+
+def _single(qs: tuple[float, float, float], g: Geometry, mode: str, tol: float, max_iter: int, max_inc: float,
+            bad: Any) -> tuple[np.ndarray, np.ndarray]:
+    """A single fk call: (out (3,) or (16, 3) for mode "all", ok); a legkin error on failure."""
+    G = g._vector
+    if mode == "all":
+        outs, ok = np.full((len(MODES), 3), np.nan), np.zeros(len(MODES), dtype=bool)
+        first: tuple[np.ndarray, int] | None = None
+        for j, m in enumerate(MODES):
+            out, st = _fk_one(*qs, G, m, tol, max_iter, max_inc)
+            if st == ST_NONFINITE:
+                bad()
+            first = first or (out, st)
+            if st == OK:
+                outs[j], ok[j] = out, True
+        if not ok.any():
+            assert first is not None
+            raise _fk_error(qs, first[0], first[1], HOME_MODE, [], max_iter, max_inc, g)
+        return outs, ok
+    out, st = _fk_one(*qs, G, mode, tol, max_iter, max_inc)
+    if st != OK:
+        if st == ST_NONFINITE:
+            bad()
+        others = []
+        if st != ST_SINGULAR_PLANES:  # consistent motors fit the mode their planes' intersection E points to
+            likely = _motor_mode(np.array(qs), g)
+            for m in [likely] if likely else MODES:
+                if m != mode and _fk_one(*qs, G, m, tol, max_iter, max_inc)[1] == OK:
+                    others.append(m)
+                    break
+        raise _fk_error(qs, out, st, mode, others, max_iter, max_inc, g)
+    return out, np.asarray(True)
+
+
+def _batch(qm: np.ndarray, g: Geometry, mode: str, tol: float, max_iter: int, max_inc: float) -> tuple[np.ndarray, np.ndarray]:
+    """A batch fk call on motors (..., 3): out (..., [16,] 3) NaN where an item fails, ok (..., [16])."""
+    shape = qm.shape[:-1]
+    rows = np.ascontiguousarray(qm.reshape(-1, 3), dtype=np.float64)
+    homes, es, ss = modes_sel(mode)
+    n, m = rows.shape[0], homes.shape[0]
+    out, status = np.empty((n, m, 3)), np.empty((n, m), dtype=np.int64)
+    pick(FK_LOOP, n * m, "fk")(rows, g._vector, homes, es, ss, tol, max_iter, max_inc, out, status)
+    ok = status == OK
+    if mode == "all":
+        return out.reshape(shape + (m, 3)), ok.reshape(shape + (m,))
+    return out[:, 0].reshape(shape + (3,)), ok[:, 0].reshape(shape)
+
+
+def _options(mode: Any, tol: Any, max_iter: Any, max_inc: Any) -> tuple[str, float, int, float]:
+    mode = checked_mode(mode, allow_all=True)
+    if type(tol) is not float or not 0.0 <= tol <= 0.1:
+        tol = check_number(tol, "tol", 0.0, 0.1)
+    if type(max_iter) is not int or not 1 <= max_iter <= 10000:
+        max_iter = check_integer(max_iter, "max_iter", 1, 10000)
+    if type(max_inc) is not float or not 0.0 <= max_inc <= math.inf:
+        if isinstance(max_inc, (float, np.floating)) and max_inc == math.inf:
+            max_inc = math.inf
+        else:
+            max_inc = check_number(max_inc, "max_inconsistency", 0.0, None)
+    return mode, tol, max_iter, max_inc
+
+
+def _finish(out: np.ndarray, ok: np.ndarray, return_mask: bool, return_info: bool) -> Any:
+    u = np.ascontiguousarray(out[..., :2])
+    res: tuple[Any, ...] = (u,)
+    if return_mask:
+        res += (ok,)
+    if return_info:
+        inc = out[..., 2]
+        res += (FKInfo(inconsistency=inc if inc.ndim else np.float64(inc)),)
+    return res if len(res) > 1 else u
+
+
+@overload
+def fk(q: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ..., tol: float = ..., max_iter: int = ...,
+       max_inconsistency: float = ..., return_mask: Literal[False] = ..., return_info: Literal[False] = ...) -> np.ndarray: ...
+@overload
+def fk(q: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ..., tol: float = ..., max_iter: int = ...,
+       max_inconsistency: float = ..., return_mask: Literal[True],
+       return_info: Literal[False] = ...) -> tuple[np.ndarray, np.ndarray]: ...
+@overload
+def fk(q: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ..., tol: float = ..., max_iter: int = ...,
+       max_inconsistency: float = ..., return_mask: Literal[False] = ...,
+       return_info: Literal[True]) -> tuple[np.ndarray, FKInfo]: ...
+@overload
+def fk(q: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ..., tol: float = ..., max_iter: int = ...,
+       max_inconsistency: float = ..., return_mask: Literal[True],
+       return_info: Literal[True]) -> tuple[np.ndarray, np.ndarray, FKInfo]: ...
+@overload
+def fk(q_A1: ArrayLike, q_B1: ArrayLike, q_C1: ArrayLike, d: float = ..., alpha: float = ...,
+       eta: Sequence[float] | None = ..., *, mode: str = ..., tol: float = ..., max_iter: int = ...,
+       max_inconsistency: float = ..., return_mask: bool = ...) -> Any: ...
+def fk(q: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | None = None, tol: float = 1e-13,
+       max_iter: int = 30, max_inconsistency: float = 1e-9, return_mask: bool = False, return_info: bool = False,
+       **legacy: Any) -> Any:
+    """Platform orientation (alpha_y, alpha_z) from the motor angles ``q = (q_A1, q_B1, q_C1)``: Gauss-Newton on
+    :func:`ik` with :func:`jacobian`.
+
+    Solves ``min_u |wrap(ik(u) - q)|`` over u = (alpha_y, alpha_z) (three equations, two unknowns):
+    ``u <- u - pinv(A_u) r`` (the 3 x 2 least-squares step in closed form, see
+    :mod:`legkin.tripod.forward_kernels`), from the closed-form start at the motor planes' intersection (not
+    in the seed), until the step (or its image ``A_u du`` in the motors) is below ``tol``; from consistent motors
+    the start is already exact to rounding and one iteration confirms it. The iterates are kept inside the
+    workspace (a step that leaves it is halved). The result is reported with ``alpha_y`` in [-pi/2, pi/2]
+    (``(pi - alpha_y, alpha_z + pi)`` is the same orientation) and ``alpha_z`` in (-pi, pi]. There is no
+    ``q_start``: the closed-form start is exact for consistent motors, so no user start could do better.
+
+    Assembly mode: the motors are those of :func:`ik` in ``mode`` (default :data:`HOME_MODE`, the mode the
+    mechanism is built in). Motors from another mode are not consistent with any pose of this one: unsolved
+    (batch: NaN, mask False; single call: ``AssemblyModeError`` naming the mode(s) in which they are consistent,
+    in ``.modes`` as ``[{"mode": ...}]``). ``mode="all"`` solves in every mode: (..., 16, 2) in :data:`MODES`
+    order, NaN where the motors do not fit that mode.
+
+    Redundant actuation: three motor angles produced by no pose are not averaged silently. The inconsistency
+    (rad, ``return_info=True``: :class:`FKInfo`) is the distance of the motors from the consistent set, to first
+    order: the residual ``r`` at the reported pose less its projection on the range of A_u. Above
+    ``max_inconsistency`` the call fails (single: ``UnreachableError`` carrying the least-squares pose in
+    ``closest``; batch: NaN). Pass ``max_inconsistency=np.inf`` to get least-squares poses for noisy readings.
+
+    Actuation singularity: motors whose planes have ``|det M| < DET_GUARD`` are refused (they fit two poses,
+    or fix the pose only to ~2e-16 / |det M| rad); :func:`ik` refuses the same poses, so every pose ik returns
+    is reproduced by fk and every pose fk returns is solved by ik.
+
+    Args:
+        q: motor angles (..., 3) = (q_A1, q_B1, q_C1) (rad).
+        mode: assembly mode, one of :data:`MODES` or ``"all"``.
+        geometry: the tripod's :class:`Geometry` (None: the default).
+        tol: step-size tolerance (rad), in [0, 0.1]. max_iter: iteration cap, an integer in [1, 10000].
+        max_inconsistency: largest accepted inconsistency (rad), in [0, inf].
+        return_mask: (batch) also return the success mask. return_info: also return an :class:`FKInfo`.
+
+    Returns:
+        (..., 2) orientations (alpha_y, alpha_z); then the mask and the info, as asked.
+
+    Raises:
+        AssemblyModeError: (single) the motors are consistent only in other assembly modes.
+        UnreachableError: (single) the motor angles are inconsistent beyond ``max_inconsistency`` (in every
+            mode), or the iterate left the workspace.
+        SingularityError: (single) an actuation singularity (``|det M| < DET_GUARD``), or the solution is on
+            the workspace boundary (where :func:`ik` fails).
+        ConvergenceError: (single) no convergence within ``max_iter``.
+        InvalidInputError: non-finite, complex or wrongly shaped motors; InvalidParameterError: bad geometry,
+            mode, tol, max_iter, max_inconsistency, return_mask or return_info.
+
+    Deprecated form (legkin 0.1, one release): ``fk(q_A1, q_B1, q_C1, d, alpha, eta, *, mode, tol, max_iter,
+    max_inconsistency, return_mask)`` returns ``(alpha_y, alpha_z, inconsistency[, mask])``.
+    """
+    mode, tol, max_iter, max_inc = _options(mode, tol, max_iter, max_inconsistency)
+    return_mask = flag(return_mask, "return_mask")
+    return_info = flag(return_info, "return_info")
+    if geometry is None and not args and not legacy and type(q) is np.ndarray and q.shape == (3,) and \
+            q.dtype == np.float64 and mode != "all" and not return_mask and not return_info:  # single-call fast path
+        out, st = _fk_one(float(q[0]), float(q[1]), float(q[2]), geometry_of(None)._vector, mode, tol, max_iter,
+                          max_inc)
+        if st == OK:
+            return out[:2].copy()
+    if len(args) >= 2:
+        return _legacy_fk(q, args, legacy, geometry, mode, tol, max_iter, max_inc, return_mask)
+    if args:
+        raise TypeError("fk() takes the motors as one array q (..., 3), or (deprecated) q_A1, q_B1, q_C1")
+    geo = split_legacy(legacy, "fk", _GEOMETRY_KW) if legacy else legacy
+    g = geometry_of(geometry, geo, "fk") if geo else geometry_of(geometry)
+    qm = as_input(q, "q", (3,))
+    if qm.ndim == 1:
+        out, ok = _single((float(qm[0]), float(qm[1]), float(qm[2])), g, mode, tol, max_iter, max_inc, None)
+    else:
+        out, ok = _batch(qm, g, mode, tol, max_iter, max_inc)
+    return _finish(out, ok, return_mask, return_info)
+
+
+def _legacy_fk(q_A1: Any, args: tuple[Any, ...], legacy: dict[str, Any], geometry: Geometry | None, mode: str,
+               tol: float, max_iter: int, max_inc: float, return_mask: bool) -> Any:
+    """The deprecated ``fk(q_A1, q_B1, q_C1, d, alpha, eta, ...)``: ``(alpha_y, alpha_z, inconsistency[, mask])``."""
+    deprecated("fk(q_A1, q_B1, q_C1, d, alpha, eta)", "fk(q, geometry=...) with q (..., 3)")
+    if len(args) > 5:
+        raise TypeError("fk() takes at most 6 positional arguments in its deprecated form")
+    geo = {**dict(zip(_GEOMETRY_KW, args[2:])), **split_legacy(legacy, "fk", _GEOMETRY_KW)}
+    g = geometry_of(geometry, geo, "fk") if geo else geometry_of(geometry)
+    raw = (q_A1, args[0], args[1])
+
+    def bad() -> None:
+        as_angles(*raw, names=("q_A1", "q_B1", "q_C1"))
+
+    if all(type(v) is float for v in raw):
+        out, ok = _single(raw, g, mode, tol, max_iter, max_inc, bad)
+    else:
+        a, b, c = as_angles(*raw, names=("q_A1", "q_B1", "q_C1"))
+        if a.ndim:
+            out, ok = _batch(np.stack([a, b, c], axis=-1), g, mode, tol, max_iter, max_inc)
+        else:
+            out, ok = _single((float(a), float(b), float(c)), g, mode, tol, max_iter, max_inc, bad)
+    if out.ndim == 1:
+        res = tuple(np.float64(v) for v in out)
+    else:
+        res = tuple(np.ascontiguousarray(out[..., k]) for k in range(3))
+    return (*res, ok) if return_mask else res

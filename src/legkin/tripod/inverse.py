@@ -1,0 +1,333 @@
+"""Inverse kinematics of the tripod (seed eqs (98), (102)) and its actuation Jacobian A_u (Appendix D): the
+public wrappers over the kernels of :mod:`legkin.tripod.closure`, and the diagnosis of a failed single call."""
+
+from __future__ import annotations
+
+from typing import Any, Literal, Sequence, overload
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._batch import as_angles, as_input
+from .._kernels import OK
+from ..errors import SingularityError, UnreachableError
+from ._common import (
+    BOUNDARY_TOL, DET_GUARD, GAIN_GUARD, HOME_MODE, LEGS, MODE_ARGS, MODES, SINGULAR_TOL, ST_NONFINITE, checked_mode,
+    deprecated, flag, geometry_of, modes_sel, pick, split_legacy,
+)
+from .closure import IK_LOOP, JACOBIAN_LOOP, _k_actuation_jacobian, _k_ik
+from .geometry import Geometry
+
+__all__ = ["ik", "ik_all", "ik_joints", "jacobian", "actuation_jacobian"]
+
+_GEOMETRY_KW = ("d", "alpha", "eta")
+
+
+# ------------------------------------------------------------------------------------------ diagnosis
+def _ik_status(c2: np.ndarray, one_cc: np.ndarray) -> tuple[Any, np.ndarray, np.ndarray]:
+    """Masks: (singular platform (...), unreachable (..., 3), leg singular (..., 3))."""
+    sing = one_cc <= SINGULAR_TOL
+    with np.errstate(invalid="ignore"):
+        gap = 1.0 - np.abs(c2)
+        unreachable = ~sing[..., None] & (gap < -BOUNDARY_TOL)
+        leg_sing = ~sing[..., None] & (np.abs(gap) <= BOUNDARY_TOL)
+    return sing, unreachable, leg_sing
+
+
+def _where(ay: float, az: float) -> str:
+    return f"(alpha_y, alpha_z) = ({float(ay):.17g}, {float(az):.17g})"
+
+
+def _ik_error(ay: float, az: float, c2: np.ndarray, sing: Any, unreachable: np.ndarray,
+              leg_sing: np.ndarray) -> Exception:
+    where = _where(ay, az)
+    if sing:
+        return SingularityError(
+            f"{where} is singular: 1 + cos(alpha_y) cos(alpha_z) = 0 (platform axis turned back onto -x; "
+            "the platform centre is undefined)"
+        )
+    for k, leg in enumerate(LEGS):
+        if unreachable[k]:
+            return UnreachableError(
+                f"{where} is outside the workspace: leg {leg} would need cos q_{leg}2 = {float(c2[k]):.17g}, "
+                "outside [-1, 1] (eq 98)",
+                target=(float(ay), float(az)),
+            )
+    for k, leg in enumerate(LEGS):
+        if leg_sing[k]:
+            return SingularityError(
+                f"{where} is on the workspace boundary: leg {leg} has sin q_{leg}2 = 0 "
+                f"(cos q_{leg}2 = {float(c2[k]):.17g}); joints 1 and 3 of the leg are aligned"
+            )
+    return SingularityError(f"{where}: inverse kinematics failed")  # pragma: no cover
+
+
+def ik_one(ay: float, az: float, G: np.ndarray, mode: str) -> tuple[np.ndarray, np.ndarray, int]:
+    """The ik kernel on one orientation in one mode: joints (12,), aux (6,), status."""
+    home, e, s = MODE_ARGS[mode]
+    q, aux = np.empty(12), np.empty(6)
+    return q, aux, _k_ik(ay, az, G, home, e, s, q, aux)
+
+
+def ik_single_error(ay: float, az: float, G: np.ndarray, mode: str, aux: np.ndarray) -> Exception:
+    """The exception of a failed single ik call at (ay, az) in ``mode`` (aux: the kernel's (cos q_K2 (3),
+    1 + c_y c_z, det M, |A_u|_F))."""
+    c2, nb2 = np.asarray(aux[:3], dtype=float), np.asarray(aux[3], dtype=float).reshape(())
+    det, gain = float(aux[4]), float(aux[5])
+    sing, unreachable, leg_sing = _ik_status(c2, nb2)
+    if sing or unreachable.any() or leg_sing.any():
+        return _ik_error(ay, az, c2, sing, unreachable, leg_sing)
+    if not gain <= GAIN_GUARD:
+        return SingularityError(
+            f"{_where(ay, az)}: its motors are too sensitive to the orientation (|A_u| = {gain:.3g} > "
+            f"GAIN_GUARD = {GAIN_GUARD:g}: a leg next to its boundary near the flip); the float orientation fixes "
+            "them only to ~1e-16 |A_u| rad and fk could not reproduce it"
+        )
+    others = [m for m in MODES if m != mode and ik_one(float(ay), float(az), G, m)[2] == OK]
+    return SingularityError(
+        f"{_where(ay, az)} is an actuation singularity in mode {mode}: its motor planes have |det M| = {abs(det):.3g} "
+        f"< DET_GUARD = {DET_GUARD:g}, so the motor angles do not determine the pose (fk could not reproduce it "
+        f"to 1e-9 rad); solvable in mode(s) {', '.join(others) or 'none'}"
+    )
+
+
+# ------------------------------------------------------------------------------------------ the solve
+def _run(ay: np.ndarray, az: np.ndarray, G: np.ndarray, mode: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The ik batch loop on broadcast orientations: q (shape, m, 12), aux (shape, m, 6), status (shape, m)."""
+    shape = ay.shape
+    y, z = np.ascontiguousarray(ay, dtype=np.float64).reshape(-1), np.ascontiguousarray(az, dtype=np.float64).reshape(-1)
+    homes, es, ss = modes_sel(mode)
+    n, m = y.shape[0], homes.shape[0]
+    q, aux, status = np.empty((n, m, 12)), np.empty((n, m, 6)), np.empty((n, m), dtype=np.int64)
+    pick(IK_LOOP, n * m, "ik")(y, z, G, homes, es, ss, q, aux, status)
+    return q.reshape(shape + (m, 12)), aux.reshape(shape + (m, 6)), status.reshape(shape + (m,))
+
+
+def _solve(ay: Any, az: Any, scalar: bool, g: Geometry, mode: str, return_mask: bool, joints: bool,
+           bad_input: Any) -> Any:
+    """ik on checked orientations (floats when ``scalar``, broadcast arrays otherwise): the 12 joints or the
+    motors (``joints=False``), per the single/batch rule. ``bad_input()`` raises the InvalidInputError of a
+    non-finite scalar input."""
+    G = g._vector
+    if scalar and mode != "all":
+        q, aux, st = ik_one(ay, az, G, mode)
+        if st != OK:
+            if st == ST_NONFINITE:
+                bad_input()
+            raise ik_single_error(np.float64(ay), np.float64(az), G, mode, aux)
+        out = q if joints else q[0::4].copy()
+        return (out, np.asarray(True)) if return_mask else out
+    q, aux, status = _run(np.asarray(ay, dtype=np.float64), np.asarray(az, dtype=np.float64), G, mode)
+    ok = status == OK
+    if scalar and not ok.any():
+        raise ik_single_error(np.float64(ay), np.float64(az), G, HOME_MODE, aux[0])
+    if mode != "all":
+        q, ok = q[..., 0, :], ok[..., 0]
+    if not joints:
+        q = np.ascontiguousarray(q[..., 0::4])
+    return (q, ok) if return_mask else q
+
+
+def _target(target: ArrayLike) -> tuple[Any, Any, bool]:
+    """(alpha_y, alpha_z, scalar) of a checked target (..., 2)."""
+    if type(target) is np.ndarray and target.dtype == np.float64 and target.shape == (2,):
+        return float(target[0]), float(target[1]), True
+    t = as_input(target, "target", (2,))
+    if t.ndim == 1:
+        return float(t[0]), float(t[1]), True
+    return t[..., 0], t[..., 1], False
+
+
+def _nonfinite_target(target: ArrayLike) -> Any:
+    return lambda: as_input(target, "target", (2,))
+
+
+def _legacy_call(fn: str, target: ArrayLike, args: tuple[Any, ...], legacy: dict[str, Any],
+                 geometry: Geometry | None) -> tuple[Any, Any, bool, Geometry, Any]:
+    """The deprecated ``fn(alpha_y, alpha_z, d, alpha, eta, ...)``: (alpha_y, alpha_z, scalar, geometry, bad_input)."""
+    deprecated(f"{fn}(alpha_y, alpha_z, d, alpha, eta)", f"{fn}(target, geometry=...) with target (..., 2)")
+    if len(args) > 4:
+        raise TypeError(f"{fn}() takes at most 5 positional arguments in its deprecated form")
+    alpha_z = args[0] if args else legacy.pop("alpha_z")
+    geo = {**dict(zip(_GEOMETRY_KW, args[1:])), **split_legacy(legacy, fn, _GEOMETRY_KW)}
+    g = geometry_of(geometry, geo, fn) if geo else geometry_of(geometry)
+    raw = (target, alpha_z)
+    if type(target) is float and type(alpha_z) is float:
+        return target, alpha_z, True, g, lambda: as_angles(*raw, names=("alpha_y", "alpha_z"))
+    ay, az = as_angles(target, alpha_z, names=("alpha_y", "alpha_z"))
+    if ay.ndim:
+        return ay, az, False, g, None
+    return float(ay), float(az), True, g, None
+
+
+def _new_call(fn: str, target: ArrayLike, legacy: dict[str, Any],
+              geometry: Geometry | None) -> tuple[Any, Any, bool, Geometry, Any]:
+    geo = split_legacy(legacy, fn, _GEOMETRY_KW) if legacy else legacy
+    g = geometry_of(geometry, geo, fn) if geo else geometry_of(geometry)
+    ay, az, scalar = _target(target)
+    return ay, az, scalar, g, _nonfinite_target(target)
+
+
+# ------------------------------------------------------------------------------------------ public
+@overload
+def ik(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
+       return_mask: Literal[False] = ...) -> np.ndarray: ...
+@overload
+def ik(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
+       return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+@overload
+def ik(alpha_y: ArrayLike, alpha_z: ArrayLike, d: float = ..., alpha: float = ..., eta: Sequence[float] | None = ...,
+       *, mode: str = ..., return_mask: bool = ...) -> Any: ...
+def ik(target: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | None = None,
+       return_mask: bool = False, **legacy: Any) -> Any:
+    """The three motor angles (q_A1, q_B1, q_C1) for the platform orientation ``target = (alpha_y, alpha_z)``.
+
+    Seed eqs (98), (102) per leg K (``c_K = cos eta_K``, ``s_K = sin eta_K``), with E = (x, y, z) from
+    :func:`platform_position`:
+
+    * eq (98): ``cos q_K2 = (c_K z - s_K y) / (d s_alpha)``, ``q_K2 = acos(.) in (0, pi)``;
+    * eq (102): ``(s_K1, c_K1) = [[1 - c_alpha, s2 s_alpha], [-s2 s_alpha, 1 - c_alpha]] (x, -(c_K y + s_K z))
+      / d~``, ``q_K1 = atan2(s_K1, c_K1)``. Departures: eq (100) misses a ``c1`` in x_ee (correct:
+      ``x = d (1 - c_alpha) s1 - d c1 s2 s_alpha``, as (101) uses), and the determinant of (101) is
+      ``d^2 ((1 - c_alpha)^2 + (s2 s_alpha)^2)``; (102) is right with ``d~ = d ((1 - c_alpha)^2 + (s2 s_alpha)^2)``;
+    * ``q_K3 = q_K2`` and ``q_K4 = q_K1`` (the constant-velocity branch; every joint: :func:`ik_joints`).
+
+    That is the home assembly mode (:data:`HOME_MODE`, that of the SRDF pose ``home``). ``mode`` picks another
+    of :data:`MODES`: ``E = +L b / |b|`` when its first sign is ``+``, and ``q_K2 = -acos(.)`` for the legs
+    whose sign is ``-`` (eq 102 then uses that sin q_K2). Every mode reaches the same orientations with other
+    motors; ``mode="all"`` is :func:`ik_all`.
+
+    Args:
+        target: platform orientation(s) (..., 2) = (alpha_y, alpha_z) (rad).
+        mode: assembly mode, one of :data:`MODES` (or ``"all"``).
+        geometry: the tripod's :class:`Geometry` (None: the default).
+        return_mask: (batch) also return the success mask.
+
+    Returns:
+        (..., 3) motor angles (q_A1, q_B1, q_C1) in (-pi, pi] (``mode="all"``: (..., 16, 3)).
+
+    Raises:
+        UnreachableError: (single) ``|cos q_K2| > 1`` for some leg K (outside the workspace).
+        SingularityError: (single) ``sin q_K2 = 0`` (workspace boundary), ``1 + c_y c_z = 0``, or an actuation
+            singularity: the motors' planes have ``|det M| < DET_GUARD`` (the motors do not determine the pose,
+            so :func:`fk` could not reproduce it; the message lists the modes where the pose is solvable), or
+            ``|A_u|_F > GAIN_GUARD``.
+        InvalidInputError: non-finite, complex or wrongly shaped target; InvalidParameterError: bad geometry,
+            mode or return_mask.
+
+    Deprecated form (legkin 0.1, one release): ``ik(alpha_y, alpha_z, d, alpha, eta, *, mode, return_mask)``
+    returns every joint (..., 12), as :func:`ik_joints` does.
+    """
+    old = bool(args) or "alpha_z" in legacy
+    mode = checked_mode(mode, allow_all=True)
+    return_mask = flag(return_mask, "return_mask")
+    if old:
+        ay, az, scalar, g, bad = _legacy_call("ik", target, args, legacy, geometry)
+        return _solve(ay, az, scalar, g, mode, return_mask, True, bad)
+    if geometry is None and not legacy and type(target) is np.ndarray and target.shape == (2,) and \
+            target.dtype == np.float64 and mode != "all":  # the single-call fast path
+        q, aux, st = ik_one(float(target[0]), float(target[1]), geometry_of(None)._vector, mode)
+        if st == OK:
+            out = q[0::4].copy()
+            return (out, np.asarray(True)) if return_mask else out
+    ay, az, scalar, g, bad = _new_call("ik", target, legacy, geometry)
+    return _solve(ay, az, scalar, g, mode, return_mask, False, bad)
+
+
+@overload
+def ik_all(target: ArrayLike, *, geometry: Geometry | None = ..., return_mask: Literal[False] = ...) -> np.ndarray: ...
+@overload
+def ik_all(target: ArrayLike, *, geometry: Geometry | None = ...,
+           return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+def ik_all(target: ArrayLike, *, geometry: Geometry | None = None, return_mask: bool = False) -> Any:
+    """The motors of every assembly mode for ``target`` (..., 2): shape (..., 16, 3) in :data:`MODES` order, NaN
+    (mask False) where a mode does not solve it (every mode reaches the same orientations; a mode fails only on
+    its own actuation singularities, :data:`DET_GUARD`, :data:`GAIN_GUARD`). A single call raises only when no
+    mode solves the target. Equals :func:`ik` with ``mode="all"``."""
+    return ik(target, mode="all", geometry=geometry, return_mask=return_mask)
+
+
+@overload
+def ik_joints(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
+              return_mask: Literal[False] = ...) -> np.ndarray: ...
+@overload
+def ik_joints(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
+              return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+def ik_joints(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | None = None,
+              return_mask: bool = False) -> Any:
+    """Every joint for ``target`` (..., 2): (..., 12) ordered A_q1..A_q4, B_q1..B_q4, C_q1..C_q4 (the Pinocchio
+    order: a closed configuration of ``legkin.load("tripod")``), ``q_K3 = q_K2``, ``q_K4 = q_K1``; otherwise as
+    :func:`ik` (whose motors are columns 0, 4, 8). ``mode="all"``: (..., 16, 12)."""
+    mode = checked_mode(mode, allow_all=True)
+    return_mask = flag(return_mask, "return_mask")
+    ay, az, scalar, g, bad = _new_call("ik_joints", target, {}, geometry)
+    return _solve(ay, az, scalar, g, mode, return_mask, True, bad)
+
+
+def _jacobian(ay: Any, az: Any, scalar: bool, g: Geometry, mode: str, return_mask: bool, bad: Any) -> Any:
+    home, e, s = MODE_ARGS[mode]
+    G = g._vector
+    if not scalar:
+        shape = ay.shape
+        y, z = np.ascontiguousarray(ay).reshape(-1), np.ascontiguousarray(az).reshape(-1)
+        n = y.shape[0]
+        a, aux, status = np.empty((n, 3, 2)), np.empty((n, 4)), np.empty(n, dtype=np.int64)
+        pick(JACOBIAN_LOOP, n, "jac")(y, z, G, home, e, s, a, aux, status)
+        a, ok = a.reshape(shape + (3, 2)), (status == OK).reshape(shape)
+        return (a, ok) if return_mask else a
+    a, aux = np.empty((3, 2)), np.empty(4)
+    st = _k_actuation_jacobian(ay, az, G, home, e, s, a, aux)
+    if st != OK:
+        if st == ST_NONFINITE and bad is not None:
+            bad()
+        c2 = aux[:3].copy()
+        raise _ik_error(np.float64(ay), np.float64(az), c2, *_ik_status(c2, np.asarray(aux[3])))
+    return (a, np.asarray(True)) if return_mask else a
+
+
+@overload
+def jacobian(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
+             return_mask: Literal[False] = ...) -> np.ndarray: ...
+@overload
+def jacobian(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
+             return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+def jacobian(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | None = None,
+             return_mask: bool = False) -> Any:
+    """A_u = d(q_A1, q_B1, q_C1) / d(alpha_y, alpha_z), the Jacobian of :func:`ik`: seed Appendix D, eqs (103)-(105),
+    shape (..., 3, 2) for ``target`` (..., 2).
+
+    Row K (``c_K = cos eta_K``, ``s_K = sin eta_K``, ``s_K2 = sin q_K2`` from :func:`ik`,
+    ``f_K = tan(alpha/2) (c_K s_y + s_K c_y s_z)``, ``n = 1 + c_y c_z``,
+    ``m_K = (1 + c_alpha) s_K2^2 + 1 - c_alpha``, ``p_K = n^2 + (c_K c_y s_z - s_K s_y)^2``)::
+
+        A_K1 = -f_K (c_K (c_y + c_z) - s_K s_y s_z + (c_K c_y - s_K s_y s_z) n) / (2 s_K2 n^2 m_K)
+               - (c_K s_y s_z + s_K (c_y + c_z)) / p_K
+        A_K2 = -f_K c_y (s_K (c_y + c_z) + c_K s_y s_z + s_K c_z n) / (2 s_K2 n^2 m_K)
+               + c_y (c_K (c_y + c_z) - s_K s_y s_z) / p_K
+
+    transcribed as printed (no error found: it matches Pinocchio's closed-loop differential kinematics
+    and central differences of :func:`ik`, on the branch q_K2 in (0, pi)). A_u does not depend on d.
+    In another assembly ``mode`` (:data:`MODES`) the chain rule through that mode's IK. Undefined where the
+    pose is outside the workspace or singular (NaN / the exceptions of :func:`ik`); the actuation-singularity
+    guard of :func:`ik` (:data:`DET_GUARD`) does not apply: A_u is defined there.
+    """
+    mode = checked_mode(mode)
+    return_mask = flag(return_mask, "return_mask")
+    ay, az, scalar, g, bad = _new_call("jacobian", target, {}, geometry)
+    return _jacobian(ay, az, scalar, g, mode, return_mask, bad)
+
+
+def actuation_jacobian(target: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | None = None,
+                       return_mask: bool = False, **legacy: Any) -> Any:
+    """Deprecated alias of :func:`jacobian` (legkin 0.1, kept for one release); also in its old form
+    ``actuation_jacobian(alpha_y, alpha_z, d, alpha, eta, *, mode, return_mask)``."""
+    deprecated("actuation_jacobian", "jacobian")
+    mode = checked_mode(mode)
+    return_mask = flag(return_mask, "return_mask")
+    if args or "alpha_z" in legacy:
+        ay, az, scalar, g, bad = _legacy_call("actuation_jacobian", target, args, legacy, geometry)
+    else:
+        ay, az, scalar, g, bad = _new_call("actuation_jacobian", target, legacy, geometry)
+    return _jacobian(ay, az, scalar, g, mode, return_mask, bad)
+
+

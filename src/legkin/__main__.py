@@ -59,6 +59,13 @@ def finite_float(text: str) -> float:
     return value
 
 
+def positive_float(text: str) -> float:
+    value = finite_float(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"must be a number > 0, got {text!r}")
+    return value
+
+
 def output_file(text: str) -> str:
     """A path a file can be written to: its directory exists, and the path is not a directory."""
     path = Path(text)
@@ -145,6 +152,10 @@ def _cmd_check(args) -> int:
         progress=_show_progress(args),
     )
     print(format_table(results))
+    from .validation import mujoco_note
+
+    if mujoco_note() is not None:
+        print(mujoco_note())
     if args.json:
         write_json(results, args.json)
     if args.plots:
@@ -196,6 +207,16 @@ def _cmd_view(args) -> int:
         return 0
     show(robot, q)
     return 0
+
+
+def _cmd_export(args) -> int:
+    from .mjcf._base import DEFAULTS
+    from .mjcf.cli import run_export
+
+    args.output = str(args.mjcf)
+    if args.timestep is None:
+        args.timestep = DEFAULTS["timestep"]
+    return run_export(args)
 
 
 def _cmd_bench(args) -> int:
@@ -253,6 +274,17 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=nonnegative_int, default=0, help="random seed, an integer >= 0 (default 0)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=_cmd_bench)
+
+    from .mjcf.cli import add_export_command
+
+    add_export_command(sub)  # legkin mjcf MODEL [-o FILE] [--floating] [--timestep S] [--png FILE]
+    p = sub.add_parser("export", help="export a model to another format: --mjcf PATH (MuJoCo, loops as equalities)")
+    p.add_argument("model")
+    p.add_argument("--mjcf", metavar="PATH", type=output_file, required=True, help="write a MuJoCo MJCF to PATH")
+    p.add_argument("--floating", action="store_true", help="a free base (models that walk only)")
+    p.add_argument("--timestep", type=positive_float, default=None, help="simulation step, s (default 0.0002)")
+    p.add_argument("--png", metavar="PATH", type=output_file, help="also render q0 with MuJoCo (MUJOCO_GL=egl headless)")
+    p.set_defaults(func=_cmd_export)
     return parser
 
 

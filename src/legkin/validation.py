@@ -132,6 +132,7 @@ def run_checks(
             t0 = time.perf_counter()
             bar.set_postfix_str(f"{name}: checks ({samples} samples)")
             rows = list(module.run(samples, rng))
+            rows += _mujoco_rows(name, samples, seed)
             bar.update(1)
             if hasattr(module, "ik_robustness"):
                 n = samples if ik_targets is None else ik_targets
@@ -140,6 +141,24 @@ def run_checks(
                 bar.update(1)
             out[name] = (rows, time.perf_counter() - t0)
     return out
+
+
+def _mujoco_rows(name: str, samples: int, seed: int) -> list[CheckResult]:
+    """The MuJoCo export's rows (:func:`legkin.mjcf.check_rows`) when mujoco is installed, else none (the CLI
+    says so: :func:`mujoco_note`). At most 20 samples: each is a loop solve, the simulation rows need no more."""
+    from .mjcf import check_rows, unavailable_reason
+
+    if unavailable_reason() is not None:
+        return []
+    return list(check_rows(name, samples=min(samples, 20), rng=np.random.default_rng(seed + 2)))
+
+
+def mujoco_note() -> str | None:
+    """Why ``legkin check`` has no MuJoCo rows (mujoco not installed), or None when it has them."""
+    from .mjcf import unavailable_reason
+
+    reason = unavailable_reason()
+    return None if reason is None else f"MuJoCo export rows skipped: {reason}"
 
 
 def format_table(results) -> str:

@@ -48,7 +48,7 @@ def unavailable_reason() -> str | None:
     try:
         import mujoco  # noqa: F401
     except ImportError as exc:
-        return f"mujoco is not installed ({exc}): pip install mujoco"
+        return f"mujoco is not installed ({exc}): pip install \"legkin[mujoco]\""
     return None
 
 

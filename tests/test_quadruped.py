@@ -10,19 +10,16 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 import legkin
-from legkin.quadruped import kinematics as aq
+from legkin._rotations import wrap
 from legkin.quadruped import checks as checks
+from legkin.quadruped import configuration as cfg
+from legkin.quadruped import kinematics as aq
+from legkin.quadruped.forward import _knee_vector
 
 LEGS = aq.LEGS
 L1 = math.hypot(aq.X23, aq.Z23)
 L2 = aq.X34
-
-
-def test_checks_pass():
-    rows = checks.run(300, np.random.default_rng(7))
-    failed = [r for r in rows if not r.passed]
-    assert not failed, failed
-    assert all(r.samples > 0 for r in rows)
+G015 = aq.Geometry(foot_z=-0.015)  # POPI's own URDF value
 
 
 def test_urdf_limits_match_analytic_constants(quadruped):
@@ -35,7 +32,7 @@ def test_urdf_limits_match_analytic_constants(quadruped):
 
 def test_folded_leg_at_zero_matches_reference():
     # reference: q = 0 is a folded leg, foot at (-0.05588, 0.1077, -0.041509) from the hip
-    p = aq.foot_position(np.zeros(3), "LF") - aq.hip_position("LF")
+    p = aq.fk(np.zeros(3), "LF") - aq.hip_position("LF")
     np.testing.assert_allclose(p, [aq.X23 + aq.X34, aq.Y12, aq.Z23], atol=1e-15)
 
 
@@ -43,11 +40,11 @@ def test_jacobian_matches_central_differences(rng):
     q = rng.uniform(-3, 3, (50, 3))
     h = 1e-6
     for leg in LEGS:
-        jac = aq.foot_jacobian(q, leg, foot_z=-0.015)
+        jac = aq.jacobian(q, leg, geometry=G015)
         for k in range(3):
             dq = np.zeros(3)
             dq[k] = h
-            fd = (aq.foot_position(q + dq, leg, foot_z=-0.015) - aq.foot_position(q - dq, leg, foot_z=-0.015)) / (2 * h)
+            fd = (aq.fk(q + dq, leg, geometry=G015) - aq.fk(q - dq, leg, geometry=G015)) / (2 * h)
             np.testing.assert_allclose(jac[..., k], fd, atol=1e-9)
 
 
@@ -77,9 +74,9 @@ def test_ik_all_branches_reach_target_everywhere(leg, direction, frac, s_u, tilt
     d = p - h
     c, s = math.cos(tilt), math.sin(tilt)
     p = h + np.array([d[0], c * d[1] - s * d[2], s * d[1] + c * d[2]])
-    q_all = aq.foot_ik_all(p, leg)
+    q_all = aq.ik_all(p, leg)
     assert q_all.shape == (4, 3)
-    err = np.linalg.norm(aq.foot_position(q_all, leg) - p, axis=-1)
+    err = np.linalg.norm(aq.fk(q_all, leg) - p, axis=-1)
     assert np.all(err < 1e-12), err
 
 
@@ -92,10 +89,10 @@ def test_ik_all_branches_reach_target_everywhere(leg, direction, frac, s_u, tilt
 def test_ik_round_trip_inside_limits(leg, u):
     lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
     q = lo + np.array(u) * (hi - lo)
-    p = aq.foot_position(q, leg)
-    q_ik = aq.foot_ik(p, leg, q_ref=q)
+    p = aq.fk(q, leg)
+    q_ik = aq.ik(p, leg, q_near=q)
     assert aq.within_limits(q_ik)
-    assert np.linalg.norm(aq.foot_position(q_ik, leg) - p) < 1e-12
+    assert np.linalg.norm(aq.fk(q_ik, leg) - p) < 1e-12
     # joint agreement is conditioned by rho (distance to the abduction cylinder): 1.6e-16 m / rho
     d = p - aq.hip_position(leg)
     rho = math.sqrt(max(d[1] ** 2 + d[2] ** 2 - aq.Y12**2, 0.0))
@@ -103,76 +100,59 @@ def test_ik_round_trip_inside_limits(leg, u):
 
 
 def test_four_branches_are_distinct_solutions():
-    p = aq.foot_position(np.array([0.1, 0.8, 1.2]), "RF")
-    q_all = aq.foot_ik_all(p, "RF")
+    p = aq.fk(np.array([0.1, 0.8, 1.2]), "RF")
+    q_all = aq.ik_all(p, "RF")
     assert len({tuple(np.round(q, 9)) for q in q_all}) == 4
 
 
-def test_branch_choice_follows_q_ref_and_limits():
+def test_branch_choice_follows_q_near_and_limits():
     # a pose with large q2 has its limit-respecting solution on the s_u = +1 branch
     q = np.array([0.2, 2.9, 1.0])
-    p = aq.foot_position(q, "LH")
-    np.testing.assert_allclose(aq.foot_ik(p, "LH"), q, atol=1e-12)
-    q_all = aq.foot_ik_all(p, "LH")
+    p = aq.fk(q, "LH")
+    np.testing.assert_allclose(aq.ik(p, "LH"), q, atol=1e-12)
+    q_all = aq.ik_all(p, "LH")
     inside = aq.within_limits(q_all)
     assert inside.sum() >= 1
-    # nearest-to-q_ref picks the given branch among those inside the limits
+    # nearest-to-q_near picks the given branch among those inside the limits
     for q_in in q_all[inside]:
-        np.testing.assert_allclose(aq.foot_ik(p, "LH", q_ref=q_in), q_in, atol=1e-12)
+        np.testing.assert_allclose(aq.ik(p, "LH", q_near=q_in), q_in, atol=1e-12)
 
 
 def test_batch_returns_nan_and_mask():
-    good = aq.foot_position(np.array([0.0, 0.75, 1.5]), "LF")
+    good = aq.fk(np.array([0.0, 0.75, 1.5]), "LF")
     far = aq.hip_position("LF") + np.array([0.0, 0.0, -1.0])
     inside = aq.hip_position("LF") + np.array([0.0, 0.05, 0.0])
-    limits_only = aq.foot_position(np.array([0.0, -0.5, 1.0]), "LF")  # q2 < 0: outside the limits
+    limits_only = aq.fk(np.array([0.0, -0.5, 1.0]), "LF")  # q2 < 0: outside the limits
     p = np.stack([good, far, inside, limits_only])
-    q, mask = aq.foot_ik(p, "LF", return_mask=True)
+    q, mask = aq.ik(p, "LF", return_mask=True)
     assert mask.tolist() == [True, False, False, False]
     assert np.all(np.isfinite(q[0])) and np.all(np.isnan(q[1:]))
-    q_all, reach = aq.foot_ik_all(p, "LF", return_mask=True)
+    q_all, reach = aq.ik_all(p, "LF", return_mask=True)
     assert reach.shape == (4, 4)
     assert reach[:, 0].tolist() == [True, False, False, True]
     assert np.all(np.isnan(q_all[1:3]))
-    q_plain = aq.foot_ik(p, "LF")
+    q_plain = aq.ik(p, "LF")
     np.testing.assert_array_equal(np.isnan(q_plain), np.isnan(q))
 
 
 def test_scalar_errors_say_why_and_by_how_much():
     h = aq.hip_position("LF")
     with pytest.raises(legkin.UnreachableError, match="beyond full stretch") as info:
-        aq.foot_ik(h + np.array([0.0, 0.0, -1.0]), "LF")
+        aq.ik(h + np.array([0.0, 0.0, -1.0]), "LF")
     assert "by" in str(info.value)
     with pytest.raises(legkin.UnreachableError, match="abduction cylinder"):
-        aq.foot_ik(h + np.array([0.0, 0.05, 0.0]), "LF")
+        aq.ik(h + np.array([0.0, 0.05, 0.0]), "LF")
     with pytest.raises(legkin.UnreachableError, match="too close"):
-        aq.foot_ik(h + np.array([0.0, aq.Y12, -0.01]), "LF")
+        aq.ik(h + np.array([0.0, aq.Y12, -0.01]), "LF")
     with pytest.raises(legkin.JointLimitError, match="outside the joint limits"):
-        aq.foot_ik(aq.foot_position(np.array([0.0, -0.5, 1.0]), "LF"), "LF")
+        aq.ik(aq.fk(np.array([0.0, -0.5, 1.0]), "LF"), "LF")
     with pytest.raises(legkin.UnreachableError):
-        aq.foot_ik_all(h + np.array([0.0, 0.0, -1.0]), "LF")
-
-
-@pytest.mark.parametrize(
-    "call",
-    [
-        lambda: aq.foot_position(np.array([0.0, np.nan, 0.0]), "LF"),
-        lambda: aq.foot_position(np.zeros(2), "LF"),
-        lambda: aq.foot_jacobian(np.zeros((4, 2)), "LF"),
-        lambda: aq.foot_ik(np.array([np.inf, 0.0, 0.0]), "LF"),
-        lambda: aq.foot_ik(np.zeros(4), "LF"),
-        lambda: aq.foot_ik_all(np.zeros((2, 2)), "LF"),
-        lambda: aq.foot_ik(np.array([0.3, 0.3, -0.4]), "LF", q_ref=np.zeros(2)),
-    ],
-)
-def test_bad_input_raises_value_error(call):
-    with pytest.raises(ValueError):
-        call()
+        aq.ik_all(h + np.array([0.0, 0.0, -1.0]), "LF")
 
 
 def test_unknown_leg():
     with pytest.raises(legkin.InvalidParameterError, match="LF, LH, RF, RH"):
-        aq.foot_position(np.zeros(3), "XX")
+        aq.fk(np.zeros(3), "XX")
 
 
 # ----------------------------------------------------------------------------- seed 002
@@ -186,31 +166,31 @@ def _q_textbook_region(rng, n):
 @pytest.mark.parametrize("leg", LEGS)
 def test_textbook_ik_agrees_with_closed_form_on_its_branch(leg, rng):
     q = _q_textbook_region(rng, 2000)
-    p = aq.foot_position(q, leg)
+    p = aq.fk(q, leg)
     theta = aq.textbook_ik(aq.textbook_frame(p, leg), aq.Y12, L1, L2)
     q_tb = aq.textbook_to_joints(theta, leg)
-    q_branch = aq.foot_ik_all(p, leg)[:, 0, :]  # (s_u, k) = (-1, -1)
+    q_branch = aq.ik_all(p, leg)[:, 0, :]  # (s_u, k) = (-1, -1)
     ok = np.all(np.isfinite(q_tb), axis=-1)
     assert ok.mean() > 0.99
     np.testing.assert_allclose(q_tb[ok], q_branch[ok], atol=2e-11)
     # and it is a solution: the foot lands on the target
-    np.testing.assert_allclose(aq.foot_position(q_tb[ok], leg), p[ok], atol=1e-12)
+    np.testing.assert_allclose(aq.fk(q_tb[ok], leg), p[ok], atol=1e-12)
 
 
 @pytest.mark.xfail(strict=True, reason="seed 002 as printed uses atan(x_f/z_f): wrong for z_f < 0")
 def test_textbook_literal_atan_fails_for_negative_zf():
     # a foot above the abduction axis (z_f < 0 in seed 002's z-down frame) on the textbook branch
     q = np.array([0.3, 2.6, 1.0])
-    p = aq.foot_position(q, "LF")
+    p = aq.fk(q, "LF")
     pf = aq.textbook_frame(p, "LF")
     assert pf[2] < 0
     theta = aq.textbook_ik(pf, aq.Y12, L1, L2, literal=True)
-    np.testing.assert_allclose(aq.foot_position(aq.textbook_to_joints(theta, "LF"), "LF"), p, atol=1e-9)
+    np.testing.assert_allclose(aq.fk(aq.textbook_to_joints(theta, "LF"), "LF"), p, atol=1e-9)
 
 
 def test_textbook_literal_and_atan2_agree_for_positive_zf():
     q = np.array([0.1, 0.75, 1.5])
-    pf = aq.textbook_frame(aq.foot_position(q, "RH"), "RH")
+    pf = aq.textbook_frame(aq.fk(q, "RH"), "RH")
     assert pf[2] > 0
     np.testing.assert_allclose(
         aq.textbook_ik(pf, aq.Y12, L1, L2, literal=True), aq.textbook_ik(pf, aq.Y12, L1, L2), atol=1e-15
@@ -218,21 +198,21 @@ def test_textbook_literal_and_atan2_agree_for_positive_zf():
 
 
 # ----------------------------------------------------------------------------- input validation
-def test_scalar_target_with_batch_q_ref_is_a_batch():
-    """Rule: p and q_ref broadcast; a single target with a batch of q_ref is a batch (one answer per q_ref)."""
+def test_scalar_target_with_batch_q_near_is_a_batch():
+    """Rule: p and q_near broadcast; a single target with a batch of q_near is a batch (one answer per q_near)."""
     q_true = np.array([0.1, 0.75, 1.5])
-    p = aq.foot_position(q_true, "LF")
-    q_ref = np.array([q_true, q_true + 0.05, [0.0, 0.5, 1.0]])
-    q, ok = aq.foot_ik(p, "LF", q_ref=q_ref, return_mask=True)
+    p = aq.fk(q_true, "LF")
+    q_near = np.array([q_true, q_true + 0.05, [0.0, 0.5, 1.0]])
+    q, ok = aq.ik(p, "LF", q_near=q_near, return_mask=True)
     assert q.shape == (3, 3) and ok.shape == (3,) and ok.all()
-    np.testing.assert_allclose(q, np.broadcast_to(aq.foot_ik(p, "LF", q_ref=q_true), (3, 3)), atol=1e-12)
-    assert aq.foot_ik(p, "LF", q_ref=q_ref[None, :1]).shape == (1, 1, 3)
-    # an unreachable single target with a batch of q_ref: NaN rows and a False mask, no exception
+    np.testing.assert_allclose(q, np.broadcast_to(aq.ik(p, "LF", q_near=q_true), (3, 3)), atol=1e-12)
+    assert aq.ik(p, "LF", q_near=q_near[None, :1]).shape == (1, 1, 3)
+    # an unreachable single target with a batch of q_near: NaN rows and a False mask, no exception
     far = aq.hip_position("LF") + np.array([0.0, 0.0, -1.0])
-    q, ok = aq.foot_ik(far, "LF", q_ref=q_ref, return_mask=True)
+    q, ok = aq.ik(far, "LF", q_near=q_near, return_mask=True)
     assert not ok.any() and np.isnan(q).all()
     with pytest.raises(legkin.InvalidInputError, match="do not broadcast"):
-        aq.foot_ik(np.stack([p, p]), "LF", q_ref=q_ref)
+        aq.ik(np.stack([p, p]), "LF", q_near=q_near)
 
 
 @pytest.mark.parametrize("bad", ["abc", ["a", "b", "c"], np.zeros(3) + 1j, [[0.0, 0.0, 0.0], [0.0, 0.0]], np.zeros(2), None])
@@ -247,27 +227,46 @@ def test_within_limits_nan_rows_are_outside():
 
 
 @pytest.mark.parametrize(
-    "kw, match",
+    "value, match",
     [
-        ({"foot_z": float("nan")}, r"foot_z=nan is out of range: must be in \[-0.1, 0.1\]"),
-        ({"foot_z": 5}, r"foot_z=5.0 is out of range: must be in \[-0.1, 0.1\]"),
-        ({"foot_z": -0.2}, r"out of range: must be in \[-0.1, 0.1\]"),
-        ({"foot_z": float("inf")}, r"out of range"),
-        ({"foot_z": "0.01"}, r"foot_z must be a real number, got '0.01'; valid range \[-0.1, 0.1\]"),
-        ({"foot_z": True}, r"foot_z must be a real number"),
-        ({"foot_z": 0.01 + 0j}, r"foot_z must be a real number"),
-        ({"foot_z": [0.01]}, r"foot_z must be a real number"),
-        ({"return_mask": "yes"}, r"return_mask must be True or False"),
+        (float("nan"), r"foot_z=nan is out of range: must be in \[-0.1, 0.1\]"),
+        (5, r"foot_z=5.0 is out of range: must be in \[-0.1, 0.1\]"),
+        (-0.2, r"out of range: must be in \[-0.1, 0.1\]"),
+        (float("inf"), r"out of range"),
+        ("0.01", r"foot_z must be a real number, got '0.01'; valid range \[-0.1, 0.1\]"),
+        (True, r"foot_z must be a real number"),
+        (0.01 + 0j, r"foot_z must be a real number"),
+        ([0.01], r"foot_z must be a real number"),
     ],
 )
-def test_keyword_parameters_are_validated(kw, match):
-    p = aq.foot_position(np.array([0.0, 0.75, 1.5]), "LF")
+def test_geometry_is_validated(value, match):
+    with pytest.raises(legkin.InvalidParameterError, match=match):
+        aq.Geometry(foot_z=value)
+    with pytest.raises(legkin.InvalidParameterError, match=match):
+        aq.Geometry.from_params({"foot_z": value})
+    p = aq.fk(np.array([0.0, 0.75, 1.5]), "LF")
+    with pytest.warns(DeprecationWarning), pytest.raises(legkin.InvalidParameterError, match=match):
+        aq.foot_ik(p, "LF", foot_z=value)  # the deprecated keyword, checked the same way
+
+
+@pytest.mark.parametrize("bad", [0.0, {"foot_z": 0.0}, "default", aq.DEFAULT_GEOMETRY.foot_z])
+def test_geometry_keyword_takes_a_geometry_only(bad):
     q = np.array([0.0, 0.75, 1.5])
-    calls = [lambda: aq.foot_ik(p, "LF", **kw), lambda: aq.foot_ik_all(p, "LF", **kw)]
-    if "foot_z" in kw:
-        calls += [lambda: aq.foot_position(q, "LF", **kw), lambda: aq.foot_jacobian(q, "LF", **kw)]
-    for call in calls:
-        with pytest.raises(legkin.InvalidParameterError, match=match):
+    p = aq.fk(q, "LF")
+    for call in (
+        lambda: aq.fk(q, "LF", geometry=bad), lambda: aq.jacobian(q, "LF", geometry=bad),
+        lambda: aq.ik(p, "LF", geometry=bad), lambda: aq.ik_all(p, "LF", geometry=bad),
+        lambda: aq.hip_position("LF", geometry=bad), lambda: aq.within_limits(q, geometry=bad),
+        lambda: aq.textbook_frame(p, "LF", geometry=bad), lambda: aq.textbook_to_joints(q, "LF", geometry=bad),
+    ):
+        with pytest.raises(legkin.InvalidParameterError, match="geometry must be a legkin.quadruped.Geometry"):
+            call()
+
+
+def test_return_mask_is_validated():
+    p = aq.fk(np.array([0.0, 0.75, 1.5]), "LF")
+    for call in (lambda: aq.ik(p, "LF", return_mask="yes"), lambda: aq.ik_all(p, "LF", return_mask="yes")):
+        with pytest.raises(legkin.InvalidParameterError, match="return_mask must be True or False"):
             call()
 
 
@@ -275,13 +274,28 @@ def test_foot_z_range_is_the_registry_one():
     from legkin.quadruped.spec import SPEC
 
     param = SPEC.params["foot_z"]
-    q = np.array([0.0, 0.75, 1.5])
-    aq.foot_position(q, "LF", foot_z=param.low)
-    aq.foot_position(q, "LF", foot_z=np.float64(param.high))
-    aq.foot_position(q, "LF", foot_z=np.float32(0.0625))
-    aq.foot_position(q, "LF", foot_z=np.array(0.0))
+    assert aq.Geometry(foot_z=param.low).foot_z == param.low
+    assert aq.Geometry(foot_z=np.float64(param.high)).foot_z == param.high
+    assert type(aq.Geometry(foot_z=np.float32(0.0625)).foot_z) is float
+    assert aq.Geometry(foot_z=np.array(0.0)) == aq.Geometry() == aq.DEFAULT_GEOMETRY
+    assert aq.Geometry().foot_z == param.default
     with pytest.raises(legkin.InvalidParameterError):
-        aq.foot_position(q, "LF", foot_z=param.high * (1 + 1e-12))
+        aq.Geometry(foot_z=param.high * (1 + 1e-12))
+
+
+def test_geometry_of_a_loaded_robot_and_from_params():
+    robot = legkin.load("quadruped", foot_z=-0.015)
+    assert robot.geometry == G015
+    assert aq.Geometry.from_params(None) == aq.Geometry.from_params({}) == aq.Geometry()
+    assert aq.Geometry.from_params({"foot_z": 0.02, "not_kinematic": "x"}) == aq.Geometry(foot_z=0.02)
+    with pytest.raises(legkin.InvalidParameterError):
+        aq.Geometry.from_params([("foot_z", 0.0)])
+    with pytest.raises(AttributeError):
+        G015.foot_z = 0.0  # frozen
+    # the geometry changes the foot by foot_z along the shank's normal, and nothing at the hip
+    q = np.array([0.1, 0.75, 1.5])
+    assert np.linalg.norm(aq.fk(q, "LF", geometry=G015) - aq.fk(q, "LF")) == pytest.approx(0.015, abs=1e-15)
+    np.testing.assert_array_equal(aq.hip_position("LF", geometry=G015), aq.hip_position("LF"))
 
 
 @pytest.mark.parametrize(
@@ -294,7 +308,7 @@ def test_foot_z_range_is_the_registry_one():
         lambda: aq.textbook_ik(np.array([0.1, 0.0, 0.4]), float("nan"), L1, L2),
         lambda: aq.textbook_ik(np.array([0.1, 0.0, 0.4]), aq.Y12, L1, "x"),
         lambda: aq.textbook_ik(np.array([0.1, 0.0, 0.4]), aq.Y12, L1, L2, literal="no"),
-        lambda: aq.foot_ik(np.zeros(3), 3),
+        lambda: aq.ik(np.zeros(3), 3),
     ],
 )
 def test_other_parameters_are_validated(call):
@@ -305,12 +319,11 @@ def test_other_parameters_are_validated(call):
 @pytest.mark.parametrize(
     "call",
     [
-        lambda: aq.foot_ik(np.zeros(3) + 1j, "LF"),
-        lambda: aq.foot_ik(np.array([0.3, 0.3, -0.4]), "LF", q_ref=np.zeros(3) + 0j),
-        lambda: aq.foot_ik("abc", "LF"),
-        lambda: aq.foot_ik([[0.3, 0.3, -0.4], [0.3, 0.3]], "LF"),
-        lambda: aq.foot_ik(np.array([0.3, 0.3, -0.4]), "LF", q_ref=[0.0, np.nan, 0.0]),
-        lambda: aq.foot_position(np.array([1.0, 2.0, 3.0], dtype=object), "LF"),
+        lambda: aq.ik(np.array([0.3, 0.3, -0.4]), "LF", q_near=np.zeros(3) + 0j),
+        lambda: aq.ik([[0.3, 0.3, -0.4], [0.3, 0.3]], "LF"),
+        lambda: aq.ik(np.array([0.3, 0.3, -0.4]), "LF", q_near=np.zeros(2)),
+        lambda: aq.ik(np.array([0.3, 0.3, -0.4]), "LF", q_near=[0.0, np.nan, 0.0]),
+        lambda: aq.fk(np.array([1.0, 2.0, 3.0], dtype=object), "LF"),
         lambda: aq.textbook_frame(np.zeros(3) + 1j, "LF"),
         lambda: aq.textbook_to_joints(np.zeros(3) + 1j, "LF"),
     ],
@@ -341,14 +354,14 @@ def _check_answer(q, p, leg, tol=ATOL_CONTRACT):
     """Contract (a) and (c) for one answer."""
     assert q.shape == (3,) and np.all(np.isfinite(q))
     assert np.all(q >= LO) and np.all(q <= HI), q  # inside the URDF limits, no slack
-    assert np.linalg.norm(aq.foot_position(q, leg) - p) <= tol
+    assert np.linalg.norm(aq.fk(q, leg) - p) <= tol
 
 
 def _near_cylinder_joints(q, log_rho, sign):
     """Replace q2 of q so that the foot is rho = sign 10**log_rho from the abduction cylinder (u_z = rho)."""
-    vx, vz = aq._knee_vector(q[2], 0.0)
+    vx, vz = _knee_vector(q[2], 0.0)
     r, rho = math.hypot(vx, vz), sign * 10.0**log_rho
-    return np.array([q[0], float(aq._wrap(math.atan2(rho, math.sqrt(r * r - rho * rho)) - math.atan2(vz, vx))), q[2]])
+    return np.array([q[0], float(wrap(math.atan2(rho, math.sqrt(r * r - rho * rho)) - math.atan2(vz, vx))), q[2]])
 
 
 @settings(max_examples=400, deadline=None)
@@ -370,10 +383,10 @@ def test_contract_targets_made_by_fk_are_solved(leg, q1, q2, q3, log_rho, sign, 
         q = _near_cylinder_joints(q, log_rho, sign)
         if not aq.within_limits(q, 0.0):
             return
-    p = aq.foot_position(q, leg)
-    q_ik = aq.foot_ik(p, leg, q_ref=q if with_ref else None)
+    p = aq.fk(q, leg)
+    q_ik = aq.ik(p, leg, q_near=q if with_ref else None)
     _check_answer(q_ik, p, leg)
-    qb, ok = aq.foot_ik(p[None], leg, q_ref=q[None] if with_ref else None, return_mask=True)
+    qb, ok = aq.ik(p[None], leg, q_near=q[None] if with_ref else None, return_mask=True)
     assert ok.tolist() == [True] and np.array_equal(qb[0], q_ik)
 
 
@@ -406,11 +419,11 @@ def test_contract_random_targets(leg, kind, a, b, c, hair):
     batch call agrees with it item by item (NaN + mask False where the single call raises)."""
     p = _target(leg, kind, a, b, c, hair)
     try:
-        q = aq.foot_ik(p, leg)
+        q = aq.ik(p, leg)
     except legkin.UnreachableError as exc:  # JointLimitError included
         assert exc.target is not None
         q = None
-    qb, ok = aq.foot_ik(np.stack([p, p]), leg, return_mask=True)
+    qb, ok = aq.ik(np.stack([p, p]), leg, return_mask=True)
     if q is None:
         assert not ok.any() and np.isnan(qb).all()
     else:
@@ -424,21 +437,22 @@ finite = st.floats(allow_nan=False, allow_infinity=False)
 @settings(max_examples=300, deadline=None)
 @given(
     p=st.tuples(finite, finite, finite),
-    q_ref=st.one_of(st.none(), st.tuples(finite, finite, finite)),
+    q_near=st.one_of(st.none(), st.tuples(finite, finite, finite)),
     leg=st.sampled_from(LEGS),
     foot_z=st.floats(-0.1, 0.1),
 )
-def test_no_foreign_exception_or_warning_on_any_finite_input(p, q_ref, leg, foot_z):
+def test_no_foreign_exception_or_warning_on_any_finite_input(p, q_near, leg, foot_z):
     """Huge or tiny finite inputs: only legkin errors, and no numpy warning (overflow etc.) either."""
     import warnings
 
+    geometry = aq.Geometry(foot_z=foot_z)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         for call in (
-            lambda: aq.foot_ik(np.array(p), leg, q_ref=q_ref, foot_z=foot_z),
-            lambda: aq.foot_ik_all(np.array(p), leg, foot_z=foot_z),
-            lambda: aq.foot_position(np.array(p), leg, foot_z=foot_z),
-            lambda: aq.foot_jacobian(np.array(p), leg, foot_z=foot_z),
+            lambda: aq.ik(np.array(p), leg, q_near=q_near, geometry=geometry),
+            lambda: aq.ik_all(np.array(p), leg, geometry=geometry),
+            lambda: aq.fk(np.array(p), leg, geometry=geometry),
+            lambda: aq.jacobian(np.array(p), leg, geometry=geometry),
             lambda: aq.within_limits(np.array(p)),
             lambda: aq.textbook_to_joints(np.array(p), leg),
         ):
@@ -446,7 +460,7 @@ def test_no_foreign_exception_or_warning_on_any_finite_input(p, q_ref, leg, foot
                 call()
             except legkin.LegkinError:
                 pass
-        q, ok = aq.foot_ik(np.array([p, p]), leg, q_ref=q_ref, foot_z=foot_z, return_mask=True)
+        q, ok = aq.ik(np.array([p, p]), leg, q_near=q_near, geometry=geometry, return_mask=True)
         assert q.shape == (2, 3) and ok.shape == (2,)
 
 
@@ -464,58 +478,58 @@ def test_ik_robustness_row_passes():
 # ----------------------------------------------------------------------------- compiled kernels (issue 16)
 def test_batch_is_the_single_call_kernel_item_by_item(rng):
     """The batch is a compiled loop over the single-call kernel: identical answers, bit for bit, on both
-    the serial (small) and the parallel (large) path, with and without q_ref, and on non-contiguous input."""
+    the serial (small) and the parallel (large) path, with and without q_near, and on non-contiguous input."""
     from legkin._kernels import SERIAL_BELOW
 
     lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
     n = SERIAL_BELOW + 44
     q = rng.uniform(lo - 0.05, hi + 0.05, (n, 3))
-    p = aq.foot_position(q, "RH", foot_z=-0.015)
-    q_ref = rng.uniform(lo, hi, (n, 3))
+    p = aq.fk(q, "RH", geometry=G015)
+    q_near = rng.uniform(lo, hi, (n, 3))
     for rows in (p[:7], p):
-        qb, ok = aq.foot_ik(rows, "RH", foot_z=-0.015, return_mask=True)
-        qr = aq.foot_ik(rows, "RH", q_ref[: len(rows)], foot_z=-0.015)
+        qb, ok = aq.ik(rows, "RH", geometry=G015, return_mask=True)
+        qr = aq.ik(rows, "RH", q_near=q_near[: len(rows)], geometry=G015)
         for i in range(len(rows)):
             try:
-                single = aq.foot_ik(rows[i], "RH", foot_z=-0.015)
+                single = aq.ik(rows[i], "RH", geometry=G015)
                 assert ok[i] and np.array_equal(single, qb[i])
-                assert np.array_equal(aq.foot_ik(rows[i], "RH", q_ref[i], foot_z=-0.015), qr[i])
+                assert np.array_equal(aq.ik(rows[i], "RH", q_near=q_near[i], geometry=G015), qr[i])
             except legkin.UnreachableError:
                 assert not ok[i] and np.isnan(qb[i]).all()
-        np.testing.assert_array_equal(aq.foot_ik(np.asfortranarray(rows), "RH", foot_z=-0.015), qb)
-    fp = aq.foot_position(q, "LF")
-    assert all(np.array_equal(aq.foot_position(q[i], "LF"), fp[i]) for i in range(0, n, 37))
-    jac = aq.foot_jacobian(q[::2], "LF")
-    assert np.array_equal(jac[3], aq.foot_jacobian(q[6], "LF"))
+        np.testing.assert_array_equal(aq.ik(np.asfortranarray(rows), "RH", geometry=G015), qb)
+    fp = aq.fk(q, "LF")
+    assert all(np.array_equal(aq.fk(q[i], "LF"), fp[i]) for i in range(0, n, 37))
+    jac = aq.jacobian(q[::2], "LF")
+    assert np.array_equal(jac[3], aq.jacobian(q[6], "LF"))
 
 
 def test_list_input_and_float64_fast_path_agree():
     q = [0.1, 0.75, 1.5]
-    p = aq.foot_position(np.array(q), "LF")
-    np.testing.assert_array_equal(aq.foot_position(q, "LF"), p)
+    p = aq.fk(np.array(q), "LF")
+    np.testing.assert_array_equal(aq.fk(q, "LF"), p)
     strided = np.repeat(np.array(q), 2)[::2]  # a non-contiguous (3,) view
-    np.testing.assert_array_equal(aq.foot_position(strided, "LF"), p)
-    np.testing.assert_array_equal(aq.foot_position(np.array(q, dtype=np.float32), "LF"),
-                                  aq.foot_position(np.array(q, dtype=np.float32).astype(np.float64), "LF"))
-    np.testing.assert_array_equal(aq.foot_ik(p.tolist(), "LF"), aq.foot_ik(p, "LF"))
-    np.testing.assert_array_equal(aq.foot_ik_all([p.tolist()], "LF")[0], aq.foot_ik_all(p, "LF"))
+    np.testing.assert_array_equal(aq.fk(strided, "LF"), p)
+    np.testing.assert_array_equal(aq.fk(np.array(q, dtype=np.float32), "LF"),
+                                  aq.fk(np.array(q, dtype=np.float32).astype(np.float64), "LF"))
+    np.testing.assert_array_equal(aq.ik(p.tolist(), "LF"), aq.ik(p, "LF"))
+    np.testing.assert_array_equal(aq.ik_all([p.tolist()], "LF")[0], aq.ik_all(p, "LF"))
     assert aq.within_limits(np.array(q)) == aq.within_limits(q) == True  # noqa: E712
     q3d = np.tile(np.array(q), (2, 3, 1))
-    assert aq.foot_position(q3d, "LF").shape == (2, 3, 3) and aq.foot_jacobian(q3d, "LF").shape == (2, 3, 3, 3)
-    assert aq.foot_ik(np.zeros((0, 3)), "LF").shape == (0, 3)
+    assert aq.fk(q3d, "LF").shape == (2, 3, 3) and aq.jacobian(q3d, "LF").shape == (2, 3, 3, 3)
+    assert aq.ik(np.zeros((0, 3)), "LF").shape == (0, 3)
 
 
 def test_thread_count_does_not_change_results(rng):
     import numba
 
     lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
-    p = aq.foot_position(rng.uniform(lo, hi, (2000, 3)), "LF")
+    p = aq.fk(rng.uniform(lo, hi, (2000, 3)), "LF")
     before = numba.get_num_threads()
     try:
         numba.set_num_threads(1)
-        one = aq.foot_ik(p, "LF")
+        one = aq.ik(p, "LF")
         numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
-        np.testing.assert_array_equal(aq.foot_ik(p, "LF"), one)
+        np.testing.assert_array_equal(aq.ik(p, "LF"), one)
     finally:
         numba.set_num_threads(before)
 
@@ -526,3 +540,81 @@ def test_importing_legkin_does_not_import_numba():
 
     code = "import sys, legkin; assert 'numba' not in sys.modules, 'numba imported by import legkin'"
     subprocess.run([sys.executable, "-c", code], check=True)
+
+
+# ----------------------------------------------------------------------------- legkin 0.1 names (deprecated)
+def test_deprecated_names_warn_and_give_the_new_answers(rng):
+    q = cfg.sample_joints(rng, 5)
+    p = aq.fk(q, "RF", geometry=G015)
+    cases = [
+        (lambda: aq.foot_position(q, "RF", foot_z=-0.015), aq.fk(q, "RF", geometry=G015)),
+        (lambda: aq.foot_position(q, "RF", geometry=G015), aq.fk(q, "RF", geometry=G015)),
+        (lambda: aq.foot_jacobian(q, "RF"), aq.jacobian(q, "RF")),
+        (lambda: aq.foot_ik(p, "RF", q + 0.01, foot_z=-0.015), aq.ik(p, "RF", q_near=q + 0.01, geometry=G015)),
+        (lambda: aq.foot_ik(p, "RF", q_ref=q, foot_z=-0.015, return_mask=True)[0], aq.ik(p, "RF", geometry=G015)),
+        (lambda: aq.foot_ik_all(p, "RF", foot_z=-0.015), aq.ik_all(p, "RF", geometry=G015)),
+    ]
+    for old, new in cases:
+        with pytest.warns(DeprecationWarning, match="deprecated"):
+            np.testing.assert_array_equal(old(), new)
+    with pytest.warns(DeprecationWarning), pytest.raises(legkin.InvalidParameterError, match="not both"):
+        aq.foot_position(q, "RF", foot_z=0.0, geometry=G015)
+
+
+def test_deprecated_module_and_attribute_paths_still_work():
+    import importlib
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)
+        old = importlib.import_module("legkin.analytic.quadruped")
+    for name in aq.__all__:
+        assert getattr(old, name) is getattr(aq, name) is getattr(legkin.quadruped, name), name
+    assert legkin.quadruped.kinematics.fk is aq.fk
+
+
+def test_deprecation_warning_points_at_the_caller():
+    with pytest.warns(DeprecationWarning) as record:
+        aq.foot_position(np.zeros(3), "LF")
+    assert record[0].filename == __file__
+
+
+# ----------------------------------------------------------------------------- seed 002 with a geometry
+@pytest.mark.parametrize("foot_z", [-0.015, 0.05])
+def test_textbook_ik_with_a_foot_drop(foot_z, rng):
+    """Seed 002 with c = |t34| = hypot(x34, foot_z) and the foot's angle beta in textbook_to_joints: still the
+    (s_u, k) = (-1, -1) branch of the closed form."""
+    g = aq.Geometry(foot_z=foot_z)
+    q = cfg.sample_joints(rng, 2000)
+    p = aq.fk(q, "LH", geometry=g)
+    theta = aq.textbook_ik(aq.textbook_frame(p, "LH", geometry=g), aq.Y12, L1, math.hypot(L2, foot_z))
+    q_tb = aq.textbook_to_joints(theta, "LH", geometry=g)
+    ok = np.all(np.isfinite(q_tb), axis=-1)
+    assert ok.mean() > 0.95
+    np.testing.assert_allclose(q_tb[ok], aq.ik_all(p, "LH", geometry=g)[ok, 0], atol=2e-11)
+    # without the geometry the knee is off by beta: the test can fail
+    assert np.abs(aq.textbook_to_joints(theta, "LH")[ok, 2] - q_tb[ok, 2]).min() > 0.04
+
+
+# ----------------------------------------------------------------------------- configuration helpers
+def test_configuration_helpers(quadruped, rng):
+    assert cfg.joint_names("RH") == ("RH_HAA", "RH_HFE", "RH_KFE")
+    with pytest.raises(legkin.InvalidParameterError):
+        cfg.joint_names("XX")
+    q = cfg.sample_joints(rng, 7)
+    assert aq.within_limits(q).all()
+    full = cfg.configuration(quadruped, {"LF": q, "RH": q[0]})
+    assert full.shape == (7, quadruped.model.nq)
+    np.testing.assert_array_equal(full[:, cfg.leg_slice(quadruped, "LF")], q)
+    np.testing.assert_array_equal(full[:, cfg.leg_slice(quadruped, "RH")], np.broadcast_to(q[0], (7, 3)))
+    np.testing.assert_array_equal(full[:, cfg.leg_slice(quadruped, "LH")], np.broadcast_to(quadruped.q0[cfg.leg_slice(quadruped, "LH")], (7, 3)))
+    for leg in LEGS:
+        placement = quadruped.frame_placement(full[3], f"{leg}_FOOT")
+        np.testing.assert_allclose(placement.translation, aq.fk(full[3, cfg.leg_slice(quadruped, leg)], leg), atol=1e-15)
+    near = cfg.near_singular_joints(50, "RF", rng)
+    r = cfg.rho(aq.fk(near, "RF"), "RF")
+    assert aq.within_limits(near, 0.0).all() and (r < 1.1e-3).all() and (r > 0.9e-6).all()
+    made = cfg.made_joints(200, rng)
+    assert aq.within_limits(made, 0.0).all()
+    legs = np.asarray(LEGS)[rng.integers(0, 4, 100)]
+    assert cfg.random_targets(100, rng, legs).shape == (100, 3)

@@ -1,8 +1,10 @@
 """The 12-DOF quadruped with POPI's leg geometry (seeds 004 + 002).
 
-The package is the mechanism: its registry entry (``spec``), its kinematics (re-exported here, imported on first use so that
-``import legkin`` stays light), its
-checks against Pinocchio (``checks``), bench (``bench``), figures (``figures``) and clips (``clips``).
+The package is the mechanism: its registry entry (``spec``), its geometry (``Geometry``), its kinematics
+(``fk``, ``jacobian``, ``ik``, ``ik_all``, ... re-exported here from :mod:`legkin.quadruped.kinematics`,
+imported on first use so that ``import legkin`` stays light: no numba), the helpers of ``configuration``,
+the ``contract`` of the generic test, its checks against Pinocchio (``checks``), bench (``bench``), figures
+(``figures``) and clips (``clips``).
 """
 
 from __future__ import annotations
@@ -16,12 +18,19 @@ if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they l
     from . import kinematics
     from .kinematics import *  # noqa: F403
 
-_SUBMODULES = ("kinematics", "checks", "bench", "figures", "clips")
+_SUBMODULES = (
+    "kinematics", "geometry", "constants", "forward", "closed_form", "inverse", "repair", "limits", "textbook",
+    "deprecated", "configuration", "contract", "checks", "bench", "figures", "clips",
+)
+#: Names served without importing the kernels (numba).
+_LIGHT = {"Geometry": "geometry", "DEFAULT_GEOMETRY": "geometry"}
 
 
 def __getattr__(name: str) -> Any:
     if name in _SUBMODULES:
         return importlib.import_module(f"{__name__}.{name}")
+    if name in _LIGHT:
+        return getattr(importlib.import_module(f"{__name__}.{_LIGHT[name]}"), name)
     kinematics = importlib.import_module(f"{__name__}.kinematics")
     if name == "__all__":
         return ["SPEC", *kinematics.__all__]

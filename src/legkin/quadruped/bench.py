@@ -6,8 +6,8 @@ method's answer is scored the same way: Pinocchio's foot position at the returne
 into the limits) against the target; solved = error <= SOLVE_TOL and joints inside the limits.
 
 The floor of the batch closed form is its transcendental calls alone (:func:`transcendental_floor`: per
-target the 2 sqrt, 1 acos and 2 atan2 calls of ``foot_ik``'s first branch, in the same compiled ``prange``
-loop shape), not ``foot_position`` (which needs no inverse trig). :func:`single_calls` gives the single-call
+target the 2 sqrt, 1 acos and 2 atan2 calls of ``ik``'s first branch, in the same compiled ``prange``
+loop shape), not ``fk`` (which needs no inverse trig). :func:`single_calls` gives the single-call
 table (one entry per public function of :mod:`legkin.quadruped`).
 """
 
@@ -20,6 +20,7 @@ import numpy as np
 
 from .. import load
 from . import kinematics as aq
+from .configuration import configuration, leg_slice, sample_joints
 from ..bench import Method, MethodResult, ModelBench, Score
 from ..errors import UnreachableError
 from .._benchkit import SOLVE_TOL, missing, pinocchio_positions, quiet_stdout, sizes
@@ -51,22 +52,26 @@ def single_calls() -> list[SingleCall]:
     """One single call per public function of :mod:`legkin.quadruped`, inputs bound (leg LF, q0).
 
     Yardsticks: Pinocchio ``forwardKinematics`` + ``updateFramePlacement`` on the 12-DOF quadruped
-    (``quadruped_fk``), and ``computeFrameJacobian`` (``jacobian``) for ``foot_jacobian``.
+    (``quadruped_fk``; issue 16's yardstick for ``fk``, ``jacobian`` and ``ik`` alike).
     """
     q = SINGLE_Q.copy()
-    p = aq.foot_position(q, LEG)
-    q_ref = q + 0.01
+    p = aq.fk(q, LEG)
+    q_near = q + 0.01
     pf = aq.textbook_frame(p, LEG)
     a, b, c = aq.Y12, math.hypot(aq.X23, aq.Z23), aq.X34
     theta = aq.textbook_ik(pf, a, b, c)
-    fp, fj, fi, fa, wl = aq.foot_position, aq.foot_jacobian, aq.foot_ik, aq.foot_ik_all, aq.within_limits
+    batch = np.stack([p] * 8)
+    geometry = aq.Geometry(foot_z=-0.015)
+    fk, jac, ik, ik_all, wl = aq.fk, aq.jacobian, aq.ik, aq.ik_all, aq.within_limits
     hp, tf, ti, tj = aq.hip_position, aq.textbook_frame, aq.textbook_ik, aq.textbook_to_joints
     return [
-        SingleCall("foot_position", lambda: fp(q, LEG), "quadruped_fk"),
-        SingleCall("foot_jacobian", lambda: fj(q, LEG), "jacobian"),
-        SingleCall("foot_ik", lambda: fi(p, LEG), "quadruped_fk"),
-        SingleCall("foot_ik (q_ref)", lambda: fi(p, LEG, q_ref), "quadruped_fk"),
-        SingleCall("foot_ik_all", lambda: fa(p, LEG), "quadruped_fk"),
+        SingleCall("fk", lambda: fk(q, LEG), "quadruped_fk"),
+        SingleCall("fk (geometry)", lambda: fk(q, LEG, geometry=geometry), "quadruped_fk"),
+        SingleCall("jacobian", lambda: jac(q, LEG), "quadruped_fk"),
+        SingleCall("ik", lambda: ik(p, LEG), "quadruped_fk"),
+        SingleCall("ik (q_near)", lambda: ik(p, LEG, q_near=q_near), "quadruped_fk"),
+        SingleCall("ik, batch of 8", lambda: ik(batch, LEG), "quadruped_fk"),
+        SingleCall("ik_all", lambda: ik_all(p, LEG), "quadruped_fk"),
         SingleCall("within_limits", lambda: wl(q), "quadruped_fk"),
         SingleCall("hip_position", lambda: hp(LEG), "quadruped_fk"),
         SingleCall("textbook_frame", lambda: tf(p, LEG), "quadruped_fk"),
@@ -80,7 +85,7 @@ _FLOOR = None
 
 def transcendental_floor():
     """The compiled floor loop ``floor(p, out)``: per target row of ``p`` (n, 3), the transcendental calls of
-    ``foot_ik``'s closed form alone (2 sqrt, 1 acos, 2 atan2, on the target's coordinates), written to ``out``
+    ``ik``'s closed form alone (2 sqrt, 1 acos, 2 atan2, on the target's coordinates), written to ``out``
     (n, 3); a ``prange`` loop like the batch kernels (numba's thread count), compiled on first use."""
     global _FLOOR
     if _FLOOR is None:
@@ -103,13 +108,11 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
     robot = load("quadruped")
     model, data = robot.model, robot.data
     fid = robot.frame_id(f"{LEG}_FOOT")
-    iq = robot.idx_q(f"{LEG}_HAA")
-    q0_leg = robot.q0[iq : iq + 3].copy()
+    cols = leg_slice(robot, LEG)
+    q0_leg = robot.q0[cols].copy()
 
-    q_gen = rng.uniform(aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1], (n_batch, 3))
-    full = np.tile(robot.q0, (n_batch, 1))
-    full[:, iq : iq + 3] = q_gen
-    targets, target_rot = pinocchio_positions(model, data, fid, full)
+    q_gen = sample_joints(rng, n_batch)
+    targets, target_rot = pinocchio_positions(model, data, fid, configuration(robot, {LEG: q_gen}))
 
     def joints_score(p: np.ndarray, out) -> Score:
         qs, iters = out if isinstance(out, tuple) else (out, None)
@@ -117,9 +120,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         inside = np.all(np.isfinite(qs), axis=-1)
         qw = np.where(inside[:, None], _into_limits(np.nan_to_num(qs)), np.nan)
         inside &= aq.within_limits(np.nan_to_num(qw, nan=1e9))
-        f = np.tile(robot.q0, (len(qs), 1))
-        f[:, iq : iq + 3] = qs
-        pos, _ = pinocchio_positions(model, data, fid, f)
+        pos, _ = pinocchio_positions(model, data, fid, configuration(robot, {LEG: qs}))
         err = np.linalg.norm(pos - p, axis=-1)
         fk = None if iters is None else iters + 1
         reached = err <= SOLVE_TOL
@@ -141,7 +142,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
 
     # ---------------------------------------------------------------- legkin
     def batch_ik(p):
-        return aq.foot_ik(p, LEG)
+        return aq.ik(p, LEG)
 
     def batch_ik_one_thread(p):  # the same call on one numba thread (the thread count restored after)
         import numba
@@ -149,7 +150,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         before = numba.get_num_threads()
         numba.set_num_threads(1)
         try:
-            return aq.foot_ik(p, LEG)
+            return aq.ik(p, LEG)
         finally:
             numba.set_num_threads(before)
 
@@ -157,7 +158,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         out = np.full((len(p), 3), np.nan)
         for i, pi in enumerate(p):
             try:
-                out[i] = aq.foot_ik(pi, LEG)
+                out[i] = aq.ik(pi, LEG)
             except UnreachableError:
                 pass
         return out
@@ -183,19 +184,19 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
                     v = -J.T.dot(np.linalg.solve(J.dot(J.T) + damp_eye, err))
                     q = pin.integrate(model, q, v * dt)
                     i += 1
-                out[k] = q[iq : iq + 3]
+                out[k] = q[cols]
                 iters[k] = i
             return out, iters
 
         return run
 
     methods = [
-        Method(f"legkin batch closed form (foot_ik, {n_batch} at once)", targets, batch_ik, joints_score, repeats=7),
+        Method(f"legkin batch closed form (ik, {n_batch} at once)", targets, batch_ik, joints_score, repeats=7),
         Method("legkin batch closed form, 1 thread (numba.set_num_threads(1))", targets, batch_ik_one_thread,
                joints_score, repeats=7),
-        Method("legkin batch FK (foot_position)", q_gen, lambda q: aq.foot_position(q, LEG), fk_score,
+        Method("legkin batch FK (fk)", q_gen, lambda q: aq.fk(q, LEG), fk_score,
                repeats=7),
-        Method("floor: foot_ik's transcendental calls alone (2 sqrt, acos, 2 atan2)", targets, floor_run,
+        Method("floor: ik's transcendental calls alone (2 sqrt, acos, 2 atan2)", targets, floor_run,
                floor_score, group="floor", repeats=7),
         Method("legkin scalar closed form, Python loop", targets, scalar_ik, joints_score, max_targets=n_scalar,
                repeats=3),
@@ -258,7 +259,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         f"targets: Pinocchio FK of {LEG}_FOOT for {n_batch} joint vectors of leg {LEG} uniform in its limits "
         f"(the other legs at q0); slow methods solve the first {n_scalar} (scalar loop) or {n_iter} (iterative) "
         "of the same targets",
-        "floor: a compiled prange loop making, per target, the transcendental calls of foot_ik's closed form "
+        "floor: a compiled prange loop making, per target, the transcendental calls of ik's closed form "
         "(first branch: 2 sqrt, 1 acos, 2 atan2) and nothing else; no answer to score (time only); threads: "
         "numba's setting (numba.set_num_threads / NUMBA_NUM_THREADS), the same for the batch rows",
         "errors: Pinocchio FK of the returned joints vs the target; FK/solve = mean forward-kinematics "

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import kinematics as aq
+from .configuration import leg_slice
 
 
 def foot_circles(robot, frames: int = 90, radius: float = 0.06) -> list[np.ndarray]:
@@ -12,12 +13,12 @@ def foot_circles(robot, frames: int = 90, radius: float = 0.06) -> list[np.ndarr
     t = np.linspace(0.0, 2.0 * np.pi, frames, endpoint=False)
     qs = np.tile(robot.q0, (frames, 1))
     for k, leg in enumerate(aq.LEGS):
-        iq = robot.idx_q(f"{leg}_HAA")
-        q_stand = robot.q0[iq : iq + 3]
-        centre = aq.foot_position(q_stand, leg)
+        cols = leg_slice(robot, leg)
+        q_stand = robot.q0[cols]
+        centre = aq.fk(q_stand, leg, geometry=robot.geometry)
         phase = t + (np.pi if k in (1, 2) else 0.0)  # trot-like: LF/RH together, LH/RF together
         p = centre + radius * np.stack([np.cos(phase), np.zeros_like(t), np.sin(phase)], axis=-1)
-        qs[:, iq : iq + 3] = aq.foot_ik(p, leg, q_ref=q_stand)
+        qs[:, cols] = aq.ik(p, leg, q_near=q_stand, geometry=robot.geometry)
     return list(qs)
 
 

@@ -21,7 +21,7 @@ REGIONS = (
 
 def branch_regions(points: np.ndarray, leg: str) -> np.ndarray:
     """Region code (index into :data:`REGIONS`) of each foot target (..., 3)."""
-    q_all, reach = aq.foot_ik_all(points, leg, return_mask=True)
+    q_all, reach = aq.ik_all(points, leg, return_mask=True)
     inside = aq.within_limits(q_all) & reach
     below = inside[..., 0] | inside[..., 1]
     above = inside[..., 2] | inside[..., 3]

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Sequence
+from typing import TYPE_CHECKING, Any, Sequence
 
 import numpy as np
 import pinocchio as pin
@@ -146,7 +146,8 @@ def passive_joints(robot: "Robot", q: np.ndarray) -> tuple[list[str], list[str]]
     """
     jac = robot.constraint_jacobian(q) if robot.loops else np.zeros((0, robot.model.nv))
     scale = max(float(np.abs(jac).max(initial=0.0)), 1e-300)
-    driven, idle = [], []
+    driven: list[str] = []
+    idle: list[str] = []
     for name in robot.joint_names:
         j = robot.model.joints[robot.joint_id(name)]
         if j.nv != 1 or name in robot.actuated_joints:
@@ -156,7 +157,7 @@ def passive_joints(robot: "Robot", q: np.ndarray) -> tuple[list[str], list[str]]
     return driven, idle
 
 
-def drive_clip(mech: MujocoMechanism, qs: Sequence[np.ndarray], frame_time: float = 0.02) -> dict[str, np.ndarray]:
+def drive_clip(mech: MujocoMechanism, qs: Sequence[np.ndarray], frame_time: float = 0.02) -> dict[str, Any]:
     """Drive the actuators through the clip ``qs`` and compare the passive joints with Pinocchio.
 
     The simulation starts at rest at ``qs[0]``; the actuator targets go linearly from one frame's actuated
@@ -204,10 +205,7 @@ def drive_clip(mech: MujocoMechanism, qs: Sequence[np.ndarray], frame_time: floa
 
 def _clip_frames(robot: "Robot") -> tuple[str | None, list[np.ndarray]]:
     """The first clip of the model (name, configurations), or ``(None, [])``."""
-    try:
-        from ..clips import available, frames
-    except ImportError:
-        from ..animations import available, frames
+    from ..clips import available, frames
     clips = available(robot.name)
     if not clips:
         return None, []

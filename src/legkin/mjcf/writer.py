@@ -26,7 +26,7 @@ class _Joint:
 
     name: str
     kind: str  # hinge, slide, ball, free, hinge_rub (continuous: cos/sin in Pinocchio)
-    axis: tuple[float, float, float]
+    axis: tuple[float, ...]
     idx_q: int
     nq: int
     idx_v: int
@@ -37,7 +37,7 @@ def _joint(model: pin.Model, i: int) -> _Joint:
     jm = model.joints[i]
     short = jm.shortname()
     kind = None
-    axis = (0.0, 0.0, 1.0)
+    axis: tuple[float, ...] = (0.0, 0.0, 1.0)
     for prefix, k in (("JointModelRUB", "hinge_rub"), ("JointModelR", "hinge"), ("JointModelP", "slide")):
         if short.startswith(prefix) and short[len(prefix):] in _AXES:
             kind, axis = k, _AXES[short[len(prefix):]]
@@ -194,7 +194,7 @@ def _gains(robot: "Robot", joints: Sequence[_Joint], o: Mapping[str, Any]) -> tu
 
 def _build_xml(robot: "Robot", o: Mapping[str, Any]) -> str:
     model = robot.model
-    joints = [None] + [_joint(model, i) for i in range(1, model.njoints)]
+    joints: list[Any] = [None] + [_joint(model, i) for i in range(1, model.njoints)]  # 0: the universe
     root = ET.Element("mujoco", model=robot.name)
     root.append(ET.Comment(
         f" legkin {robot.name}: written by legkin.mjcf.to_mjcf from {robot.urdf_path.name} "
@@ -327,9 +327,9 @@ def _lowest_point(robot: "Robot") -> float:
     return float(f"{min(zs) - 0.05:.3g}")
 
 
-def _qpos(joints: Sequence[_Joint | None], q: np.ndarray) -> np.ndarray:
+def _qpos(joints: Sequence[Any], q: np.ndarray) -> np.ndarray:
     """MuJoCo ``qpos`` (joints in the same depth-first order) of a Pinocchio configuration."""
-    out = []
+    out: list[Any] = []
     for j in joints[1:]:
         x = q[j.idx_q : j.idx_q + j.nq]
         if j.kind == "hinge_rub":

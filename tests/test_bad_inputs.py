@@ -18,7 +18,7 @@ from legkin.tripod import kinematics as at
 from legkin.wheel_leg import kinematics as wl
 
 P_LF = aq.foot_position([0.1, 1.0, 1.0], "LF")
-T_FL = wl.contact_point([1.0, 0.1, 0.0], 0.0, 0.0, "FL")
+T_FL = wl.fk([1.0, 0.1, 0.0], "FL")
 NAN = float("nan")
 
 #: (mechanism, call as written, thunk, expected legkin error class)
@@ -59,27 +59,35 @@ CASES = [
     ("tripod", "ik(0, pi)  (the flip)", lambda: at.ik(0.0, math.pi), legkin.SingularityError),
     ("tripod", "ik(0.2 + 1j, 0)", lambda: at.ik(0.2 + 1j, 0.0), legkin.InvalidInputError),
     # ---- wheel_leg
-    ("wheel_leg", "ik(t, 0, 0, 'FL', tol=nan)", lambda: wl.ik(T_FL, 0.0, 0.0, "FL", tol=NAN),
+    ("wheel_leg", "IKOptions(tol=nan)", lambda: wl.IKOptions(tol=NAN), legkin.InvalidParameterError),
+    ("wheel_leg", "IKOptions(max_iter=0)", lambda: wl.IKOptions(max_iter=0), legkin.InvalidParameterError),
+    ("wheel_leg", "ik(t, 'FL', options={'tol': 1e-9})", lambda: wl.ik(T_FL, "FL", options={"tol": 1e-9}),
      legkin.InvalidParameterError),
-    ("wheel_leg", "ik(t, 0, 0, 'FL', max_iter=0)", lambda: wl.ik(T_FL, 0.0, 0.0, "FL", max_iter=0),
-     legkin.InvalidParameterError),
-    ("wheel_leg", "ik(t, 0, 0, 'FL', method=array(['radial']))",
-     lambda: wl.ik(T_FL, 0.0, 0.0, "FL", method=np.array(["radial"])), legkin.InvalidParameterError),
-    ("wheel_leg", "contact_point(q, 0, 0, 'FL', radius=nan)",
-     lambda: wl.contact_point([1.0, 0.1, 0.0], 0.0, 0.0, "FL", radius=NAN), legkin.InvalidParameterError),
+    ("wheel_leg", "ik(t, 'FL', method=array(['radial']))",
+     lambda: wl.ik(T_FL, "FL", method=np.array(["radial"])), legkin.InvalidParameterError),
+    ("wheel_leg", "ik(t, 'FL', q_start=q)  (radial takes q_near)",
+     lambda: wl.ik(T_FL, "FL", q_start=[1.0, 0.1, 0.0]), legkin.InvalidParameterError),
+    ("wheel_leg", "fk(q, 'FL', radius=nan)",
+     lambda: wl.fk([1.0, 0.1, 0.0], "FL", radius=NAN), legkin.InvalidParameterError),
+    ("wheel_leg", "fk(q, 'FL', rim='five_arcs')",
+     lambda: wl.fk([1.0, 0.1, 0.0], "FL", rim="five_arcs"), legkin.InvalidParameterError),
     ("wheel_leg", "Geometry(R=-0.1)", lambda: wl.Geometry(R=-0.1), legkin.InvalidParameterError),
-    ("wheel_leg", "ik(t, 0, 0, 'FL', geometry={'R': 0.1})", lambda: wl.ik(T_FL, 0.0, 0.0, "FL", geometry={"R": 0.1}),
+    ("wheel_leg", "ik(t, 'FL', geometry={'R': 0.1})", lambda: wl.ik(T_FL, "FL", geometry={"R": 0.1}),
      legkin.InvalidParameterError),
-    ("wheel_leg", "ik(zeros((3, 3)), 0, 0, 'FL', q0=zeros((2, 3)))",
-     lambda: wl.ik(np.zeros((3, 3)), 0.0, 0.0, "FL", q0=np.zeros((2, 3))), legkin.InvalidInputError),
-    ("wheel_leg", "ik([1+1j, 0.2, -0.2], 0, 0, 'FL')", lambda: wl.ik([1 + 1j, 0.2, -0.2], 0.0, 0.0, "FL"),
+    ("wheel_leg", "ik(zeros((3, 3)), 'FL', q_near=zeros((2, 3)))",
+     lambda: wl.ik(np.zeros((3, 3)), "FL", q_near=np.zeros((2, 3))), legkin.InvalidInputError),
+    ("wheel_leg", "ik([1+1j, 0.2, -0.2], 'FL')", lambda: wl.ik([1 + 1j, 0.2, -0.2], "FL"),
      legkin.InvalidInputError),
-    ("wheel_leg", "ik(t, 0, 0.05, 'FL')  (w beyond T/2)", lambda: wl.ik(T_FL, 0.0, 0.05, "FL"),
+    ("wheel_leg", "ik(t, 'FL', w=0.05)  (w beyond T/2)", lambda: wl.ik(T_FL, "FL", w=0.05),
      legkin.InvalidInputError),
-    ("wheel_leg", "ik(t, 0, 0, 'FL') for a foot turned up (gamma ~ 162 deg)",
-     lambda: wl.ik(wl.contact_point([0.39896854737191256, 2.6257815016632486, 2.829530947384123], 0.0, 0.0, "FL"),
-                   0.0, 0.0, "FL"), legkin.JointLimitError),
-    ("wheel_leg", "ik([0.3, 0.2, -0.6], 0, 0, 'FL')  (too far)", lambda: wl.ik([0.3, 0.2, -0.6], 0.0, 0.0, "FL"),
+    ("wheel_leg", "fk([0.2, 0, 0], 'FL')  (theta below 17 deg)", lambda: wl.fk([0.2, 0.0, 0.0], "FL"),
+     legkin.InvalidInputError),
+    ("wheel_leg", "ik(t, 'FL') for a foot turned up (gamma ~ 162 deg)",
+     lambda: wl.ik(wl.fk([0.39896854737191256, 2.6257815016632486, 2.829530947384123], "FL"), "FL"),
+     legkin.JointLimitError),
+    ("wheel_leg", "ik([0.3, 0.2, -0.6], 'FL')  (too far)", lambda: wl.ik([0.3, 0.2, -0.6], "FL"),
+     legkin.UnreachableError),
+    ("wheel_leg", "ik_all([0.3, 0.2, -0.6], 'FL')  (too far)", lambda: wl.ik_all([0.3, 0.2, -0.6], "FL"),
      legkin.UnreachableError),
     # ---- hybrid_leg
     ("hybrid_leg", "foot_ik(p, ll_branch=array([1, -1]))",

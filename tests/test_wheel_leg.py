@@ -13,6 +13,7 @@ import legkin
 from legkin import _generate
 from legkin.wheel_leg import kinematics as wl
 from legkin.wheel_leg import checks as checks
+from legkin.wheel_leg import configuration
 from legkin.wheel_leg.spec import SPEC, annular_sector, rim_meshes
 
 DEG = math.pi / 180
@@ -186,18 +187,18 @@ def test_seed_rim_jump_matches_reference():
 
 
 @given(st.floats(17 * DEG, 160 * DEG), st.floats(-math.pi, math.pi), st.floats(-0.6, 0.6),
-       st.floats(-math.pi, math.pi), st.floats(-0.02, 0.02), st.sampled_from(wl.LEGS), st.sampled_from(["continuous", "seed"]))
+       st.floats(-math.pi, math.pi), st.floats(-0.02, 0.02), st.sampled_from(wl.LEGS), st.sampled_from(["continuous", "three_arc"]))
 @settings(max_examples=60, deadline=None)
 def test_contact_jacobian_matches_central_differences(theta, beta, gamma, alpha, w, leg, rim):
     q = np.array([theta, beta, gamma])
-    J = wl.contact_jacobian(q, alpha, w, leg, rim=rim)
+    J = wl.jacobian(q, leg, alpha=alpha, w=w, rim=rim)
     h = 1e-6
     for k in range(3):
         dq = np.zeros(3)
         dq[k] = h
         lo, hi = q - dq, q + dq
         lo[0], hi[0] = max(lo[0], wl.THETA_MIN), min(hi[0], wl.THETA_MAX)
-        fd = (wl.contact_point(hi, alpha, w, leg, rim=rim) - wl.contact_point(lo, alpha, w, leg, rim=rim)) / (hi[k] - lo[k])
+        fd = (wl.fk(hi, leg, alpha=alpha, w=w, rim=rim) - wl.fk(lo, leg, alpha=alpha, w=w, rim=rim)) / (hi[k] - lo[k])
         assert np.abs(fd - J[:, k]).max() < (1e-8 if hi[0] - lo[0] == 2 * h or k else 1e-5)
 
 
@@ -208,9 +209,9 @@ def test_frame_conventions():
         for e, expect in (([1, 0, 0], [-1, 0, 0]), ([0, 1, 0], [0, 0, 1]), ([0, 0, 1], [0, 1, 0])):
             assert np.allclose(wl.leg_frame_to_robot(e, 0.0, leg) - o, expect, atol=1e-15)
         q = np.array([90 * DEG, 0.0, 0.0])
-        toe = wl.contact_point(q, 0.0, 0.0, leg)
-        back = wl.contact_point(q + [0, 0.1, 0], 0.0, 0.0, leg)
-        out = wl.contact_point(q + [0, 0, 0.1], 0.0, 0.0, leg)
+        toe = wl.fk(q, leg)
+        back = wl.fk(q + [0, 0.1, 0], leg)
+        out = wl.fk(q + [0, 0, 0.1], leg)
         side = 1.0 if leg in ("FL", "RL") else -1.0
         assert back[0] < toe[0]  # beta > 0 moves the foot backward
         assert side * (out[1] - toe[1]) > 0  # gamma > 0 swings the foot outward
@@ -218,35 +219,23 @@ def test_frame_conventions():
 
 
 # ---------------------------------------------------------------- IK
-@given(st.floats(17 * DEG, 160 * DEG), st.floats(-math.pi, math.pi), st.floats(-0.6, 0.6),
-       st.one_of(st.floats(-math.pi, math.pi), st.sampled_from([-math.pi, -50 * DEG, 0.0, 50 * DEG, math.pi])),
-       st.one_of(st.floats(-0.02, 0.02), st.sampled_from([-0.02, 0.02])), st.sampled_from(wl.LEGS))
-@settings(max_examples=80, deadline=None)
-def test_ik_round_trip(theta, beta, gamma, alpha, w, leg):
-    target = wl.contact_point([theta, beta, gamma], alpha, w, leg)
-    q, info = wl.ik(target, alpha, w, leg, return_info=True)
-    assert wl.THETA_MIN <= q[0] <= wl.THETA_MAX
-    assert np.linalg.norm(wl.contact_point(q, alpha, w, leg) - target) <= 1e-12
-    assert info.iterations <= 200
-
-
 @pytest.mark.parametrize("theta", [17 * DEG, 160 * DEG])
 def test_ik_at_the_theta_bounds(theta):
-    target = wl.contact_point([theta, 0.3, -0.2], 0.0, 0.01, "RR")
-    q = wl.ik(target, 0.0, 0.01, "RR")
+    target = wl.fk([theta, 0.3, -0.2], "RR", alpha=0.0, w=0.01)
+    q = wl.ik(target, "RR", alpha=0.0, w=0.01)
     assert q[0] == pytest.approx(theta, abs=1e-9)
-    q_seed = wl.ik(target, 0.0, 0.01, "RR", method="seed", rim="continuous")
-    assert np.linalg.norm(wl.contact_point(q_seed, 0.0, 0.01, "RR") - target) <= 1e-12
-    q_rad = wl.ik(target, 0.0, 0.01, "RR", method="radial")
+    q_seed = wl.ik(target, "RR", alpha=0.0, w=0.01, method="gauss_newton_fd", rim="continuous")
+    assert np.linalg.norm(wl.fk(q_seed, "RR", alpha=0.0, w=0.01) - target) <= 1e-12
+    q_rad = wl.ik(target, "RR", alpha=0.0, w=0.01, method="radial")
     assert q_rad == pytest.approx([theta, 0.3, -0.2], abs=1e-9)
-    assert np.linalg.norm(wl.contact_point(q_rad, 0.0, 0.01, "RR") - target) <= 1e-12
+    assert np.linalg.norm(wl.fk(q_rad, "RR", alpha=0.0, w=0.01) - target) <= 1e-12
 
 
 # ---------------------------------------------------------------- radial IK
 def _solution_error(sols, alpha, w, leg, rim, target):
     """Contact error of every listed solution (NaN rows dropped)."""
     sols = sols[~np.isnan(sols[:, 0])]
-    return np.linalg.norm(wl.contact_point(sols, alpha, w, leg, rim=rim) - target, axis=-1), sols
+    return np.linalg.norm(wl.fk(sols, leg, alpha=alpha, w=w, rim=rim) - target, axis=-1), sols
 
 
 @given(st.one_of(st.floats(17 * DEG, 160 * DEG), st.sampled_from([17 * DEG, 160 * DEG])), st.floats(-math.pi, math.pi),
@@ -254,19 +243,19 @@ def _solution_error(sols, alpha, w, leg, rim, target):
        st.one_of(st.floats(-math.pi, math.pi),
                  st.sampled_from([-math.pi, -50 * DEG, -40 * DEG, 0.0, 40 * DEG, 50 * DEG, math.pi])),
        st.one_of(st.floats(-0.02, 0.02), st.sampled_from([-0.02, 0.02])), st.sampled_from(wl.LEGS),
-       st.sampled_from(["continuous", "seed"]))
+       st.sampled_from(["continuous", "three_arc"]))
 @settings(max_examples=120, deadline=None)
 # issue 15: a root at theta = THETA_MAX lost when the end cell also holds an interior root
 @example(theta=160 * DEG, beta=0.0, gamma=0.0, alpha=2.0, w=0.0, leg="FL", rim="continuous")
-@example(theta=160 * DEG, beta=0.0, gamma=0.0, alpha=1.6, w=0.0, leg="FL", rim="seed")
+@example(theta=160 * DEG, beta=0.0, gamma=0.0, alpha=1.6, w=0.0, leg="FL", rim="three_arc")
 @example(theta=17 * DEG, beta=0.0, gamma=0.0, alpha=2.0, w=0.0, leg="FR", rim="continuous")
-@example(theta=17 * DEG, beta=0.3, gamma=-0.2, alpha=1.6, w=0.01, leg="RL", rim="seed")
+@example(theta=17 * DEG, beta=0.3, gamma=-0.2, alpha=1.6, w=0.01, leg="RL", rim="three_arc")
 def test_radial_ik_finds_every_solution(theta, beta, gamma, alpha, w, leg, rim):
     q_true = np.array([theta, beta, gamma])
-    target = wl.contact_point(q_true, alpha, w, leg, rim=rim)
-    q, info = wl.ik(target, alpha, w, leg, method="radial", rim=rim, return_info=True)
+    target = wl.fk(q_true, leg, alpha=alpha, w=w, rim=rim)
+    q, info = wl.ik(target, leg, alpha=alpha, w=w, method="radial", rim=rim, return_info=True)
     assert wl.THETA_MIN <= q[0] <= wl.THETA_MAX
-    assert np.linalg.norm(wl.contact_point(q, alpha, w, leg, rim=rim) - target) <= 1e-12
+    assert np.linalg.norm(wl.fk(q, leg, alpha=alpha, w=w, rim=rim) - target) <= 1e-12
     assert info.error <= 1e-12 and info.solutions.ndim == 2 and info.solutions.shape[1] == 3
     # every listed solution reaches the target, the returned one is the first, the sampled q is among them
     err, sols = _solution_error(info.solutions, alpha, w, leg, rim, target)
@@ -274,16 +263,16 @@ def test_radial_ik_finds_every_solution(theta, beta, gamma, alpha, w, leg, rim):
     assert err.max() <= 1e-12 and np.abs(q - first_in_limits).max() <= 1e-12 and abs(q[2]) <= wl.ABAD_LIMIT
     d = sols - q_true
     d[:, 1:] = np.angle(np.exp(1j * d[:, 1:]))
-    sigma = np.linalg.svd(wl.contact_jacobian(q_true, alpha, w, leg, rim=rim), compute_uv=False)[-1]
+    sigma = np.linalg.svd(wl.jacobian(q_true, leg, alpha=alpha, w=w, rim=rim), compute_uv=False)[-1]
     assert np.abs(d).max(axis=1).min() * sigma <= 1e-12  # q distance scaled by the conditioning: metres
     # the other methods' answer (when they converge) is one of the solutions too
-    q_d = wl.ik(target, alpha, w, leg, rim=rim)
+    q_d = wl.ik(target, leg, alpha=alpha, w=w, rim=rim)
     d = sols - q_d
     d[:, 1:] = np.angle(np.exp(1j * d[:, 1:]))
     assert np.abs(d).max(axis=1).min() * sigma <= 1e-12
 
 
-@pytest.mark.parametrize("rim", ["continuous", "seed"])
+@pytest.mark.parametrize("rim", ["continuous", "three_arc"])
 def test_radial_ik_lists_the_sampled_configuration_at_the_theta_ends(rim):
     """theta drawn from {17 deg, 160 deg} (two thirds) and uniform in between: the sampled configuration is
     always among ``info.solutions`` (issue 15: 1.3 % of end samples were missing before the fix)."""
@@ -295,37 +284,34 @@ def test_radial_ik_lists_the_sampled_configuration_at_the_theta_ends(rim):
         theta[mid] = rng.uniform(wl.THETA_MIN, wl.THETA_MAX, mid.sum())
         q = np.stack([theta, rng.uniform(-math.pi, math.pi, n), rng.uniform(-math.pi / 2, math.pi / 2, n)], -1)
         alpha, w = rng.uniform(-math.pi, math.pi, n), rng.uniform(-0.02, 0.02, n)
-        target = wl.contact_point(q, alpha, w, leg, rim=rim)
-        _, ok, info = wl.ik(target, alpha, w, leg, method="radial", rim=rim, return_mask=True, return_info=True)
+        target = wl.fk(q, leg, alpha=alpha, w=w, rim=rim)
+        _, ok, info = wl.ik(target, leg, alpha=alpha, w=w, method="radial", rim=rim, return_mask=True, return_info=True)
         assert ok.all()
         d = info.solutions - q[:, None, :]
         d[..., 1:] = np.angle(np.exp(1j * d[..., 1:]))
         dist = np.nanmin(np.abs(d).max(axis=-1), axis=1)
-        sigma = np.linalg.svd(wl.contact_jacobian(q, alpha, w, leg, rim=rim), compute_uv=False)[:, -1]
+        sigma = np.linalg.svd(wl.jacobian(q, leg, alpha=alpha, w=w, rim=rim), compute_uv=False)[:, -1]
         missing = np.flatnonzero(~(dist * sigma <= 1e-12))
         assert missing.size == 0, (leg, q[missing[:3]], alpha[missing[:3]], w[missing[:3]])
 
 
 def test_radial_ik_batch_matches_scalar_and_other_methods():
     rng = np.random.default_rng(11)
-    q = checks.sample_leg_q(300, rng)
+    q = configuration.sample_leg_q(300, rng)
     alpha, w = rng.uniform(-math.pi, math.pi, 300), rng.uniform(-0.02, 0.02, 300)
-    for rim in ("continuous", "seed"):
-        t = wl.contact_point(q, alpha, w, "RL", rim=rim)
-        qs, ok, info = wl.ik(t, alpha, w, "RL", method="radial", rim=rim, return_mask=True, return_info=True)
+    for rim in ("continuous", "three_arc"):
+        t = wl.fk(q, "RL", alpha=alpha, w=w, rim=rim)
+        qs, ok, info = wl.ik(t, "RL", alpha=alpha, w=w, method="radial", rim=rim, return_mask=True, return_info=True)
         assert ok.all() and info.error.max() <= 1e-12 and info.iterations.shape == (300,)
-        assert np.linalg.norm(wl.contact_point(qs, alpha, w, "RL", rim=rim) - t, axis=-1).max() <= 1e-12
-        for i in range(0, 300, 37):  # the scalar call is the batch path on one item
-            assert np.abs(wl.ik(t[i], alpha[i], w[i], "RL", method="radial", rim=rim) - qs[i]).max() <= 1e-12
-        qd, okd = wl.ik(t, alpha, w, "RL", rim=rim, return_mask=True)
+        assert np.linalg.norm(wl.fk(qs, "RL", alpha=alpha, w=w, rim=rim) - t, axis=-1).max() <= 1e-12
+        qd, okd = wl.ik(t, "RL", alpha=alpha, w=w, rim=rim, return_mask=True)
         same = np.abs(np.angle(np.exp(1j * (qd - qs)))).max(axis=1) <= 1e-9
         assert same[okd].mean() > 0.9  # both take the branch y_L <= 0; they differ only where several theta exist
         assert np.all(np.isnan(info.solutions[:, :, 0]).sum(axis=1) < info.solutions.shape[1])
     # leading dimensions kept
-    q2, info2 = wl.ik(t.reshape(3, 100, 3), alpha.reshape(3, 100), w.reshape(3, 100), "RL", method="radial",
-                      rim="seed", return_info=True)
+    q2, info2 = wl.ik(t.reshape(3, 100, 3), "RL", alpha=alpha.reshape(3, 100), w=w.reshape(3, 100), method="radial", rim="three_arc", return_info=True)
     assert q2.shape == (3, 100, 3) and info2.solutions.shape[:2] == (3, 100) and info2.error.shape == (3, 100)
-    assert wl.ik(t[0], alpha[0], w[0], "RL", method="damped", rim="seed", return_info=True)[1].solutions is None
+    assert wl.ik(t[0], "RL", alpha=alpha[0], w=w[0], method="damped", rim="three_arc", return_info=True)[1].solutions is None
 
 
 def test_radial_ik_two_roots_near_a_fold():
@@ -337,53 +323,52 @@ def test_radial_ik_two_roots_near_a_fold():
     assert 0 < k < th.size - 1  # an interior maximum
     for dth in (3e-2, 1e-3, 2e-5):
         q_true = np.array([th[k] - dth, 0.2, 0.1])
-        target = wl.contact_point(q_true, alpha, 0.0, "FL")
-        q, info = wl.ik(target, alpha, 0.0, "FL", method="radial", return_info=True)
+        target = wl.fk(q_true, "FL", alpha=alpha, w=0.0)
+        q, info = wl.ik(target, "FL", alpha=alpha, w=0.0, method="radial", return_info=True)
         err, sols = _solution_error(info.solutions, alpha, 0.0, "FL", "continuous", target)
         assert err.max() <= 1e-12
         lower = sols[: len(sols) // 2]  # branch y_L <= 0
         assert len(lower) == 2 and lower[0, 0] < th[k] < lower[1, 0]
         assert abs(lower[0, 0] - q_true[0]) <= 1e-6 and q[0] == lower[0, 0]
     # exactly at the top: one (double) root, reached within tolerance
-    target = wl.contact_point([th[k], 0.2, 0.1], alpha, 0.0, "FL")
-    q, info = wl.ik(target, alpha, 0.0, "FL", method="radial", return_info=True)
-    assert np.linalg.norm(wl.contact_point(q, alpha, 0.0, "FL") - target) <= 1e-12
+    target = wl.fk([th[k], 0.2, 0.1], "FL", alpha=alpha, w=0.0)
+    q, info = wl.ik(target, "FL", alpha=alpha, w=0.0, method="radial", return_info=True)
+    assert np.linalg.norm(wl.fk(q, "FL", alpha=alpha, w=0.0) - target) <= 1e-12
     # above the top: unreachable for this alpha
     above = wl.leg_frame_to_robot(wl.rim_point(th[k], 0.2, alpha) * [1.001, 1.001, 1.0], 0.1, "FL")
     with pytest.raises(legkin.UnreachableError):
-        wl.ik(above, alpha, 0.0, "FL", method="radial")
+        wl.ik(above, "FL", alpha=alpha, w=0.0, method="radial")
 
 
 def test_radial_ik_q0_picks_the_nearest_solution():
     q_true = np.array([1.4, 0.4, -0.3])
-    target = wl.contact_point(q_true, 0.3, 0.01, "FR")
-    q, info = wl.ik(target, 0.3, 0.01, "FR", method="radial", return_info=True)
+    target = wl.fk(q_true, "FR", alpha=0.3, w=0.01)
+    q, info = wl.ik(target, "FR", alpha=0.3, w=0.01, method="radial", return_info=True)
     assert q == pytest.approx(q_true, abs=1e-12)
     other = info.solutions[1]  # the same theta on the other out-of-plane branch (y_L > 0)
     assert other[0] == pytest.approx(q_true[0], abs=1e-12) and abs(other[2] - q_true[2]) > 1.0
-    assert np.linalg.norm(wl.contact_point(other, 0.3, 0.01, "FR") - target) <= 1e-12
+    assert np.linalg.norm(wl.fk(other, "FR", alpha=0.3, w=0.01) - target) <= 1e-12
     q0 = other + [0.05, 2 * math.pi, -2 * math.pi]
-    q1 = wl.ik(target, 0.3, 0.01, "FR", method="radial", q0=q0, limits=False)
+    q1 = wl.ik(target, "FR", alpha=0.3, w=0.01, method="radial", q_near=q0, limits=False)
     assert q1 == pytest.approx(other + [0.0, 2 * math.pi, -2 * math.pi], abs=1e-12)  # within pi of q0's angles
     # with the ABAD limits (default) the other branch's gamma is out of [-pi/2, pi/2]: the in-limit answer
     assert abs(other[2]) > wl.ABAD_LIMIT
-    q1 = wl.ik(target, 0.3, 0.01, "FR", method="radial", q0=q0)
+    q1 = wl.ik(target, "FR", alpha=0.3, w=0.01, method="radial", q_near=q0)
     assert q1 == pytest.approx(q_true + [0.0, 2 * math.pi, 0.0], abs=1e-12)
-    q2 = wl.ik(target, 0.3, 0.01, "FR", method="radial", q0=q_true + 0.1)
+    q2 = wl.ik(target, "FR", alpha=0.3, w=0.01, method="radial", q_near=q_true + 0.1)
     assert q2 == pytest.approx(q_true, abs=1e-12)
 
 
 def test_radial_ik_unreachable():
     far = np.array([0.3, 0.2, -0.6])
     with pytest.raises(legkin.UnreachableError) as info:
-        wl.ik(far, 0.0, 0.0, "FL", method="radial")
+        wl.ik(far, "FL", method="radial")
     assert info.value.closest is not None and np.linalg.norm(info.value.closest - far) > 0.2
     assert "radial" in str(info.value) and "closest" in str(info.value)
     near = wl.leg_frame_to_robot([0.0, -0.03, 0.0], 0.0, "FL")  # inside the wheel radius
-    inside = wl.contact_point([1.0, 0.1, 0.0], 0.0, 0.0, "FL")
+    inside = wl.fk([1.0, 0.1, 0.0], "FL")
     on_axis = wl.module_origin("FL") + [-0.05, 0.0, 0.0]  # closer to the ABAD axis than d_wheel
-    qs, ok, info = wl.ik(np.stack([far, inside, near, on_axis]), 0.0, 0.0, "FL", method="radial", return_mask=True,
-                         return_info=True)
+    qs, ok, info = wl.ik(np.stack([far, inside, near, on_axis]), "FL", method="radial", return_mask=True, return_info=True)
     assert ok.tolist() == [False, True, False, False]
     assert np.all(np.isnan(qs[~ok])) and np.all(np.isfinite(qs[1]))
     assert np.all(np.isnan(info.solutions[[0, 2, 3]])) and np.all(info.error[~ok] > 1e-3)
@@ -391,34 +376,34 @@ def test_radial_ik_unreachable():
 
 def test_ik_batch_and_methods():
     rng = np.random.default_rng(3)
-    q = checks.sample_leg_q(200, rng)
+    q = configuration.sample_leg_q(200, rng)
     alpha = rng.uniform(-math.pi, math.pi, 200)
-    for rim in ("continuous", "seed"):
-        t = wl.contact_point(q, alpha, 0.0, "FR", rim=rim)
-        for method in ("damped", "seed", "radial"):
-            qs, ok, info = wl.ik(t, alpha, 0.0, "FR", method=method, rim=rim, return_mask=True, return_info=True)
+    for rim in ("continuous", "three_arc"):
+        t = wl.fk(q, "FR", alpha=alpha, w=0.0, rim=rim)
+        for method in ("damped", "gauss_newton_fd", "radial"):
+            qs, ok, info = wl.ik(t, "FR", alpha=alpha, w=0.0, method=method, rim=rim, return_mask=True, return_info=True)
             assert qs.shape == (200, 3) and ok.shape == (200,) and info.iterations.shape == (200,)
             assert np.all(np.isnan(qs[~ok]))
-            assert ok.mean() > {"damped": 0.999, "seed": 0.95, "radial": 0.9999}[method]
-            err = np.linalg.norm(wl.contact_point(qs[ok], alpha[ok], 0.0, "FR", rim=rim) - t[ok], axis=-1)
+            assert ok.mean() > {"damped": 0.999, "gauss_newton_fd": 0.95, "radial": 0.9999}[method]
+            err = np.linalg.norm(wl.fk(qs[ok], "FR", alpha=alpha[ok], w=0.0, rim=rim) - t[ok], axis=-1)
             assert err.max() <= 1e-12
 
 
 def test_ik_unreachable():
     far = np.array([0.3, 0.2, -0.6])  # 0.65 m below the FL hip: the leg reaches at most ~0.35 m
     with pytest.raises(legkin.UnreachableError) as info:
-        wl.ik(far, 0.0, 0.0, "FL")
+        wl.ik(far, "FL")
     assert info.value.closest is not None and np.linalg.norm(info.value.closest - far) > 0.2
     assert "closest" in str(info.value)
-    inside = wl.contact_point([1.0, 0.1, 0.0], 0.0, 0.0, "FL")
-    qs, ok = wl.ik(np.stack([far, inside]), 0.0, 0.0, "FL", return_mask=True)
+    inside = wl.fk([1.0, 0.1, 0.0], "FL")
+    qs, ok = wl.ik(np.stack([far, inside]), "FL", return_mask=True)
     assert ok.tolist() == [False, True] and np.all(np.isnan(qs[0])) and np.all(np.isfinite(qs[1]))
     with pytest.raises(legkin.UnreachableError):
-        wl.ik(far, 0.0, 0.0, "FL", method="seed")
+        wl.ik(far, "FL", method="gauss_newton_fd")
     # too close to the motor axis: inside the wheel radius
     near = wl.leg_frame_to_robot([0.0, -0.03, 0.0], 0.0, "FL")
     with pytest.raises(legkin.UnreachableError):
-        wl.ik(near, 0.0, 0.0, "FL")
+        wl.ik(near, "FL")
 
 
 # ---------------------------------------------------------------- input errors
@@ -431,20 +416,18 @@ def test_ik_unreachable():
         lambda: wl.rim_point(1.0, 0.0, 0.0, 0.03),
         lambda: wl.rim_point(1.0, 0.0, 3.2, 0.0),
         lambda: wl.rim_point_seed(0.1, 0.0, 0.0, 0.0),
-        lambda: wl.contact_point([1.0, 0.0, 0.0], 0.0, -0.021, "FL"),
-        lambda: wl.contact_point([0.2, 0.0, 0.0], 0.0, 0.0, "FL"),
-        lambda: wl.contact_jacobian([1.0, 0.0], 0.0, 0.0, "FL"),
-        lambda: wl.contact_point([1.0, np.nan, 0.0], 0.0, 0.0, "FL"),
-        lambda: wl.contact_point(np.ones((2, 3)), np.zeros(3), 0.0, "FL"),
-        lambda: wl.ik([0.1, np.inf, 0.0], 0.0, 0.0, "FL"),
-        lambda: wl.ik([0.1, 0.1], 0.0, 0.0, "FL"),
-        lambda: wl.ik([0.1, 0.1, -0.2], 0.0, 0.05, "FL"),
-        lambda: wl.ik([0.1, 0.1, -0.2], 0.0, 0.0, "FL", q0=[0.1, 0.0, 0.0]),
-        lambda: wl.ik([0.1, 0.1, -0.2], 0.0, 0.0, "FL", method="radial", q0=[0.1, 0.0, 0.0]),
-        lambda: wl.ik([0.1, np.nan, -0.2], 0.0, 0.0, "FL", method="radial"),
-        lambda: wl.ik([0.1, 0.1, -0.2], 3.5, 0.0, "FL", method="radial"),
-        lambda: wl.ik(np.zeros((2, 3)), np.zeros(3), 0.0, "FL", method="radial"),
+        lambda: wl.fk([1.0, 0.0, 0.0], "FL", alpha=0.0, w=-0.021),
+        lambda: wl.fk([0.2, 0.0, 0.0], "FL"),
+        lambda: wl.fk(np.ones((2, 3)), "FL", alpha=np.zeros(3), w=0.0),
+        lambda: wl.ik([0.1, 0.1, -0.2], "FL", alpha=0.0, w=0.05),
+        lambda: wl.ik([0.1, 0.1, -0.2], "FL", q_near=[0.1, 0.0, 0.0]),
+        lambda: wl.ik([0.1, 0.1, -0.2], "FL", method="radial", q_near=[0.1, 0.0, 0.0]),
+        lambda: wl.ik([0.1, 0.1, -0.2], "FL", alpha=3.5, w=0.0, method="radial"),
+        lambda: wl.ik(np.zeros((2, 3)), "FL", alpha=np.zeros(3), w=0.0, method="radial"),
         lambda: wl.rim_jump_seed(np.nan),
+        lambda: wl.ik([0.1, [0.2]], "FL"),
+        lambda: wl.ik([0.1, 0.1, -0.2], "FL", q_start=[1.0, 0.0, 0.0], method="damped", alpha=np.zeros(2),
+                      w=np.zeros(3)),
     ],
 )
 def test_invalid_inputs(call):
@@ -455,12 +438,12 @@ def test_invalid_inputs(call):
 
 def test_invalid_choices():
     for call in (
-        lambda: wl.contact_point([1.0, 0.0, 0.0], 0.0, 0.0, "XX"),
-        lambda: wl.contact_point([1.0, 0.0, 0.0], 0.0, 0.0, 4),
-        lambda: wl.contact_point([1.0, 0.0, 0.0], 0.0, 0.0, "FL", rim="five_arcs"),
-        lambda: wl.ik([0.1, 0.1, -0.2], 0.0, 0.0, "FL", method="newton"),
-        lambda: wl.ik([0.1, 0.1, -0.2], 0.0, 0.0, "FL", method="radial", rim="five_arcs"),
-        lambda: wl.ik([0.1, 0.1, -0.2], 0.0, 0.0, "XX", method="radial"),
+        lambda: wl.fk([1.0, 0.0, 0.0], "XX"),
+        lambda: wl.fk([1.0, 0.0, 0.0], 4),
+        lambda: wl.fk([1.0, 0.0, 0.0], "FL", rim="five_arcs"),
+        lambda: wl.ik([0.1, 0.1, -0.2], "FL", method="newton"),
+        lambda: wl.ik([0.1, 0.1, -0.2], "FL", method="radial", rim="five_arcs"),
+        lambda: wl.ik([0.1, 0.1, -0.2], "XX", method="radial"),
     ):
         with pytest.raises(legkin.InvalidParameterError):
             call()
@@ -484,14 +467,14 @@ SINGULAR_STEP_TARGETS = [
 @pytest.mark.parametrize("method", ["damped", "radial"])
 def test_ik_singular_step_is_a_legkin_answer(target, alpha, w, leg, method):
     try:
-        q = wl.ik(target, alpha, w, leg, method=method)
+        q = wl.ik(target, leg, alpha=alpha, w=w, method=method)
     except legkin.UnreachableError:
         pass
     else:
-        assert np.linalg.norm(wl.contact_point(q, alpha, w, leg) - target) <= 1e-12
-    inside = wl.contact_point([1.0, 0.1, 0.0], 0.0, 0.0, leg)
+        assert np.linalg.norm(wl.fk(q, leg, alpha=alpha, w=w) - target) <= 1e-12
+    inside = wl.fk([1.0, 0.1, 0.0], leg)
     batch = np.array([target, inside])
-    qs, ok = wl.ik(batch, [alpha, 0.0], [w, 0.0], leg, method=method, return_mask=True)
+    qs, ok = wl.ik(batch, leg, alpha=[alpha, 0.0], w=[w, 0.0], method=method, return_mask=True)
     assert ok[1] and np.all(np.isnan(qs[~ok]))
 
 
@@ -521,36 +504,36 @@ def test_ik_answers_inside_the_abad_limits(method):
     for leg in wl.LEGS:
         q = _in_limit_joints(n, rng)
         alpha, w = rng.uniform(-math.pi, math.pi, n), rng.uniform(-0.02, 0.02, n)
-        target = wl.contact_point(q, alpha, w, leg)
-        qs, ok = wl.ik(target, alpha, w, leg, method=method, return_mask=True)
+        target = wl.fk(q, leg, alpha=alpha, w=w)
+        qs, ok = wl.ik(target, leg, alpha=alpha, w=w, method=method, return_mask=True)
         assert ok.all()
         assert np.abs(qs[:, 2]).max() <= wl.ABAD_LIMIT
-        assert np.linalg.norm(wl.contact_point(qs, alpha, w, leg) - target, axis=-1).max() <= 1e-12
+        assert np.linalg.norm(wl.fk(qs, leg, alpha=alpha, w=w) - target, axis=-1).max() <= 1e-12
 
 
 def test_ik_reachable_only_outside_the_abad_limits():
     q = np.array([0.39896854737191256, 2.6257815016632486, 2.829530947384123])  # foot turned up, gamma ~ 162 deg
-    target = wl.contact_point(q, 0.0, 0.0, "FL")
-    sols = wl.ik(target, 0.0, 0.0, "FL", limits=False, return_info=True)[1].solutions
+    target = wl.fk(q, "FL")
+    sols = wl.ik(target, "FL", limits=False, return_info=True)[1].solutions
     sols = sols[~np.isnan(sols[:, 0])]
     assert sols.shape[0] >= 1 and np.all(np.abs(sols[:, 2]) > wl.ABAD_LIMIT)  # every solution outside the limits
     with pytest.raises(legkin.JointLimitError, match=r"ABAD angle outside its limits \[-pi/2, pi/2\]"):
-        wl.ik(target, 0.0, 0.0, "FL")
-    qs, ok = wl.ik(np.stack([target, target]), 0.0, 0.0, "FL", return_mask=True)
+        wl.ik(target, "FL")
+    qs, ok = wl.ik(np.stack([target, target]), "FL", return_mask=True)
     assert not ok.any() and np.isnan(qs).all()
-    assert np.linalg.norm(wl.contact_point(wl.ik(target, 0.0, 0.0, "FL", limits=False), 0.0, 0.0, "FL")
+    assert np.linalg.norm(wl.fk(wl.ik(target, "FL", limits=False), "FL")
                           - target) <= 1e-12
 
 
 def test_ik_scalar_target_with_batch_q0():
     q = np.array([[1.0, 0.2, 0.1], [1.5, -0.3, -0.2]])
-    target = wl.contact_point(q[0], 0.0, 0.0, "FL")
+    target = wl.fk(q[0], "FL")
     for method in ("radial", "damped"):
-        qs = wl.ik(target, 0.0, 0.0, "FL", q0=q, method=method)
+        qs = wl.ik(target, "FL", q_near=q, method=method)
         assert qs.shape == (2, 3)
-        assert np.linalg.norm(wl.contact_point(qs, 0.0, 0.0, "FL") - target, axis=-1).max() <= 1e-12
-    with pytest.raises(legkin.InvalidInputError, match="q0"):
-        wl.ik(np.zeros((3, 3)), 0.0, 0.0, "FL", q0=q)
+        assert np.linalg.norm(wl.fk(qs, "FL") - target, axis=-1).max() <= 1e-12
+    with pytest.raises(legkin.InvalidInputError, match="q_near"):
+        wl.ik(np.zeros((3, 3)), "FL", q_near=q)
 
 
 @pytest.mark.parametrize("kwargs, match", [
@@ -560,15 +543,16 @@ def test_ik_scalar_target_with_batch_q0():
     ({"method": np.array(["radial"])}, "method"), ({"geometry": {"R": 0.1}}, "geometry"),
 ])
 def test_ik_keywords_are_validated(kwargs, match):
-    target = wl.contact_point([1.0, 0.1, 0.0], 0.0, 0.0, "FL")
+    target = wl.fk([1.0, 0.1, 0.0], "FL")
+    tuning = {k: kwargs.pop(k) for k in ("tol", "max_iter", "delta") if k in kwargs}
     with pytest.raises(legkin.InvalidParameterError, match=match):
-        wl.ik(target, 0.0, 0.0, "FL", **kwargs)
+        wl.ik(target, "FL", options=wl.IKOptions(**tuning), **kwargs)
 
 
-@pytest.mark.parametrize("fn", [wl.contact_point, wl.contact_jacobian])
+@pytest.mark.parametrize("fn", [wl.fk, wl.jacobian])
 def test_contact_radius_is_validated(fn):
     with pytest.raises(legkin.InvalidParameterError, match=r"radius=nan .* \(0, 0.2\]"):
-        fn([1.0, 0.1, 0.0], 0.0, 0.0, "FL", radius=float("nan"))
+        fn([1.0, 0.1, 0.0], "FL", radius=float("nan"))
 
 
 @pytest.mark.parametrize("name, value", [("R", float("nan")), ("R", -0.1), ("T", 0.0), ("d_wheel", float("inf")),
@@ -578,45 +562,136 @@ def test_geometry_is_validated(name, value):
         wl.Geometry(**{name: value})
 
 
-@pytest.mark.parametrize("bad", [np.array([1.0 + 1j, 0.2, -0.2]), "abc", [0.1, [0.2]], [np.nan, 0.0, 0.0]])
-def test_ik_bad_targets(bad):
-    with pytest.raises(legkin.InvalidInputError):
-        wl.ik(bad, 0.0, 0.0, "FL")
-
-
 @settings(max_examples=150)
 @given(st.floats(17 * DEG, 160 * DEG), st.floats(-math.pi, math.pi),
        st.one_of(st.floats(-math.pi / 2, math.pi / 2), st.sampled_from([-math.pi / 2, math.pi / 2])),
        st.one_of(st.floats(-math.pi, math.pi), st.sampled_from([-math.pi, -40 * DEG, 0.0, 40 * DEG, math.pi])),
-       st.floats(-0.02, 0.02), st.sampled_from(wl.LEGS), st.sampled_from(["continuous", "seed"]),
+       st.floats(-0.02, 0.02), st.sampled_from(wl.LEGS), st.sampled_from(["continuous", "three_arc"]),
        st.one_of(st.just(0.0), st.floats(1e-4, 0.05)), st.integers(0, 2))
 def test_ik_contract_property(theta, beta, gamma, alpha, w, leg, rim, offset, axis):
     """Targets made by FK from in-limit joints are solved inside the limits; targets pushed off by up to
     5 cm are either solved and reproduced, or raise a legkin UnreachableError (never another exception)."""
     q_true = np.array([theta, beta, gamma])
-    target = wl.contact_point(q_true, alpha, w, leg, rim=rim)
+    target = wl.fk(q_true, leg, alpha=alpha, w=w, rim=rim)
     if offset == 0.0:
-        q = wl.ik(target, alpha, w, leg, rim=rim)
+        q = wl.ik(target, leg, alpha=alpha, w=w, rim=rim)
         assert abs(q[2]) <= wl.ABAD_LIMIT and wl.THETA_MIN <= q[0] <= wl.THETA_MAX
-        assert np.linalg.norm(wl.contact_point(q, alpha, w, leg, rim=rim) - target) <= 1e-12
+        assert np.linalg.norm(wl.fk(q, leg, alpha=alpha, w=w, rim=rim) - target) <= 1e-12
         return
     target = target + offset * np.eye(3)[axis]
     for method in ("radial", "damped"):
         try:
-            q = wl.ik(target, alpha, w, leg, rim=rim, method=method)
+            q = wl.ik(target, leg, alpha=alpha, w=w, rim=rim, method=method)
         except legkin.UnreachableError:
             continue
         assert abs(q[2]) <= wl.ABAD_LIMIT and wl.THETA_MIN <= q[0] <= wl.THETA_MAX
-        assert np.linalg.norm(wl.contact_point(q, alpha, w, leg, rim=rim) - target) <= 1e-12
+        assert np.linalg.norm(wl.fk(q, leg, alpha=alpha, w=w, rim=rim) - target) <= 1e-12
 
 
 def test_ik_info_counts_evaluations():
     q = np.array([[1.0, 0.2, 0.1], [1.5, -0.3, -0.2]])
-    target = wl.contact_point(q, 0.3, 0.01, "FL")
-    for method in ("radial", "damped", "seed"):
-        _, info = wl.ik(target, 0.3, 0.01, "FL", method=method, return_info=True)
+    target = wl.fk(q, "FL", alpha=0.3, w=0.01)
+    for method in ("radial", "damped", "gauss_newton_fd"):
+        _, info = wl.ik(target, "FL", alpha=0.3, w=0.01, method=method, return_info=True)
         assert info.evaluations.shape == (2,) and (info.evaluations >= 1).all()
-        _, one = wl.ik(target[0], 0.3, 0.01, "FL", method=method, return_info=True)
+        _, one = wl.ik(target[0], "FL", alpha=0.3, w=0.01, method=method, return_info=True)
         assert int(one.evaluations) == int(info.evaluations[0])
         if method == "radial":
             np.testing.assert_array_equal(info.evaluations, info.iterations + 1)
+
+
+# ---------------------------------------------------------------- API of 0.2: new names, old names kept
+def test_ik_all_lists_every_solution_and_ik_picks_the_first_in_limits():
+    q_true = np.array([1.4, 0.4, -0.3])
+    target = wl.fk(q_true, "FR", alpha=0.3, w=0.01)
+    sols = wl.ik_all(target, "FR", alpha=0.3, w=0.01)
+    assert sols.ndim == 2 and sols.shape[1] == 3 and np.isfinite(sols).all()
+    assert np.linalg.norm(wl.fk(sols, "FR", alpha=0.3, w=0.01) - target, axis=-1).max() <= 1e-12
+    inside = wl.ik_all(target, "FR", alpha=0.3, w=0.01, limits=True)
+    assert len(inside) < len(sols) and np.abs(inside[:, 2]).max() <= wl.ABAD_LIMIT
+    np.testing.assert_array_equal(wl.ik(target, "FR", alpha=0.3, w=0.01), inside[0])
+    far = np.array([0.3, 0.2, -0.6])
+    batch, ok = wl.ik_all(np.stack([target, far]), "FR", alpha=0.3, w=0.01, return_mask=True)
+    assert ok.tolist() == [True, False] and np.isnan(batch[1]).all()
+    np.testing.assert_array_equal(batch[0, : len(sols)], sols)
+    with pytest.raises(legkin.UnreachableError):
+        wl.ik_all(far, "FR", alpha=0.3, w=0.01)
+
+
+def test_ik_q_start_for_the_iterative_methods_only():
+    q_true = np.array([1.1, -0.2, 0.3])
+    target = wl.fk(q_true, "RL", alpha=-0.4)
+    for method in ("damped", "gauss_newton_fd"):
+        q, info = wl.ik(target, "RL", alpha=-0.4, method=method, q_start=q_true + 0.05, return_info=True)
+        assert q == pytest.approx(q_true, abs=1e-9) and info.iterations >= 1
+    with pytest.raises(legkin.InvalidParameterError, match="q_near"):
+        wl.ik(target, "RL", alpha=-0.4, q_start=q_true)
+
+
+def test_ik_options_are_frozen_and_validated():
+    opts = wl.IKOptions(tol=1e-10, max_iter=5)
+    with pytest.raises(AttributeError):
+        opts.tol = 1.0  # type: ignore[misc]
+    with pytest.raises(legkin.InvalidParameterError, match="options"):
+        wl.ik(wl.fk([1.0, 0.1, 0.0], "FL"), "FL", options={"tol": 1e-10})
+    q, info = wl.ik(wl.fk([1.0, 0.1, 0.0], "FL"), "FL", method="damped", options=opts, return_info=True)
+    assert info.error <= 1e-10
+
+
+def test_geometry_from_params_and_keyword():
+    robot = legkin.load("wheel_leg")
+    geo = wl.Geometry.from_params(robot.params)
+    assert geo == wl.Geometry() and wl.Geometry.from_params(None) == geo
+    assert wl.Geometry.from_params({"R": 0.12, "chassis_length": 1.0}).R == 0.12  # non-kinematic keys ignored
+    big = wl.Geometry(R=0.12)
+    q = np.array([1.0, 0.1, 0.2])
+    p = wl.fk(q, "FL", geometry=big)
+    assert np.linalg.norm(p - wl.fk(q, "FL")) > 1e-3
+    assert wl.ik(p, "FL", geometry=big) == pytest.approx(q, abs=1e-9)
+    for fn in (lambda: wl.fk(q, "FL", geometry={"R": 0.1}), lambda: wl.linkage_points(1.0, geometry=0.1)):
+        with pytest.raises(legkin.InvalidParameterError, match="Geometry"):
+            fn()
+
+
+def test_legkin_01_calls_warn_and_agree():
+    q = np.array([1.2, 0.3, 0.2])
+    target = wl.fk(q, "FL", alpha=0.5, w=0.01)
+    with pytest.warns(DeprecationWarning, match="fk"):
+        np.testing.assert_array_equal(wl.contact_point(q, 0.5, 0.01, "FL"), target)
+    with pytest.warns(DeprecationWarning, match="jacobian"):
+        np.testing.assert_array_equal(wl.contact_jacobian(q, 0.5, 0.01, "FL"), wl.jacobian(q, "FL", alpha=0.5, w=0.01))
+    new = wl.ik(target, "FL", alpha=0.5, w=0.01)
+    for call in (lambda: wl.ik(target, 0.5, 0.01, "FL"), lambda: wl.ik(target, 0.5, 0.01, leg="FL"),
+                 lambda: wl.ik(target, alpha=0.5, w=0.01), lambda: wl.ik(target, "FL", alpha=0.5, w=0.01, tol=1e-12),
+                 lambda: wl.ik(target, 0.5, 0.01, "FL", q0=q + 0.01)):
+        with pytest.warns(DeprecationWarning, match="legkin 0.1"):
+            np.testing.assert_array_equal(call(), new)
+    with pytest.warns(DeprecationWarning, match="gauss_newton_fd"):
+        old = wl.ik(target, "FL", alpha=0.5, w=0.01, method="seed")
+    np.testing.assert_array_equal(old, wl.ik(target, "FL", alpha=0.5, w=0.01, method="gauss_newton_fd"))
+    with pytest.warns(DeprecationWarning, match="three_arc"):
+        old = wl.fk(q, "FL", alpha=0.5, rim="seed")
+    np.testing.assert_array_equal(old, wl.fk(q, "FL", alpha=0.5, rim="three_arc"))
+    with pytest.raises(TypeError, match="unexpected keyword"):
+        wl.ik(target, "FL", q00=q)
+
+
+def test_no_warning_from_the_new_api():
+    import warnings
+
+    q = np.array([1.2, 0.3, 0.2])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        target = wl.fk(q, "FL", alpha=0.5, w=0.01)
+        wl.ik(target, "FL", alpha=0.5, w=0.01, q_near=q)
+        wl.ik(target, leg="FL", alpha=0.5, w=0.01, method="gauss_newton_fd", rim="continuous")
+        wl.ik(target[None], 0, alpha=0.5, w=0.01, return_mask=True)
+
+
+def test_kinematics_module_reexports_the_public_api():
+    from legkin import wheel_leg
+    from legkin.wheel_leg import kinematics
+
+    for name in kinematics.__all__:
+        assert getattr(wheel_leg, name) is getattr(kinematics, name)
+    assert {"fk", "ik", "ik_all", "jacobian", "Geometry", "IKOptions", "contact_point"} <= set(kinematics.__all__)

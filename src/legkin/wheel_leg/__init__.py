@@ -1,8 +1,10 @@
 """The Corgi leg-wheel robot of BioRoLa (wheel-leg, seed 001).
 
-The package is the mechanism: its registry entry (``spec``), its kinematics (re-exported here, imported on first use so that
-``import legkin`` stays light), its
-checks against Pinocchio (``checks``), bench (``bench``), figures (``figures``) and clips (``clips``).
+The package is the mechanism: its registry entry (``spec``), its geometry (``geometry``), its kinematics (``linkage``,
+``rim``, ``frames``, ``inverse``, ``ik_radial``, ``ik_iterative``; the public API re-exported by ``kinematics`` and
+here, imported on first use so that ``import legkin`` stays light), helpers (``configuration``), its contract
+(``contract``), its checks against Pinocchio (``checks``), bench (``bench``), figures (``figures``) and clips
+(``clips``).
 """
 
 from __future__ import annotations
@@ -16,7 +18,10 @@ if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they l
     from . import kinematics
     from .kinematics import *  # noqa: F403
 
-_SUBMODULES = ("kinematics", "checks", "bench", "figures", "clips")
+_SUBMODULES = (
+    "kinematics", "geometry", "linkage", "rim", "frames", "inverse", "ik_radial", "ik_iterative", "configuration",
+    "contract", "checks", "bench", "figures", "clips",
+)
 
 
 def __getattr__(name: str) -> Any:

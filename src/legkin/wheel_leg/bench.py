@@ -14,7 +14,7 @@ import numpy as np
 from .. import load
 from . import kinematics as wl
 from ..bench import Method, MethodResult, ModelBench, Score
-from .checks import SEGMENT_LINKS, configuration, leg_joint_names, local_contact_point, sample_leg_q
+from .configuration import SEGMENT_LINKS, configuration, ik_start, leg_joint_names, local_contact_point, sample_leg_q
 from ..errors import UnreachableError
 from .._benchkit import SOLVE_TOL, levenberg_marquardt, sizes
 from .._single_call import SingleCall
@@ -23,6 +23,7 @@ LEG = "FL"
 #: Every iterative method is asked for the same position tolerance (m) (wl.ik's default).
 TOL = 1e-12
 MAX_ITER = 100
+OPTIONS = wl.IKOptions(tol=TOL)
 
 
 def _sizes(n: int | None, quick: bool) -> tuple[int, int, int]:
@@ -47,7 +48,7 @@ def single_calls() -> list[SingleCall]:
     theta, beta, gamma = (float(v) for v in q)
     alpha, w = SINGLE_ALPHA, SINGLE_W
     phi_L, phi_R = (float(v) for v in wl.motor_angles(theta, beta))
-    target = wl.contact_point(q, alpha, w, LEG)
+    target = wl.fk(q, LEG, alpha=alpha, w=w)
     p_L = wl.rim_point(theta, beta, alpha, w)
     cf, it = "quadruped_fk", "solve_loops"
     return [
@@ -60,13 +61,16 @@ def single_calls() -> list[SingleCall]:
         SingleCall("rim_point_seed", lambda: wl.rim_point_seed(theta, beta, alpha, w), cf),
         SingleCall("rim_jump_seed", lambda: wl.rim_jump_seed(theta), cf),
         SingleCall("rim_segment", lambda: wl.rim_segment(alpha), cf),
-        SingleCall("contact_point", lambda: wl.contact_point(q, alpha, w, LEG), cf),
-        SingleCall("contact_jacobian", lambda: wl.contact_jacobian(q, alpha, w, LEG), cf),
+        SingleCall("fk", lambda: wl.fk(q, LEG, alpha=alpha, w=w), cf),
+        SingleCall("jacobian", lambda: wl.jacobian(q, LEG, alpha=alpha, w=w), cf),
         SingleCall("leg_frame_to_robot", lambda: wl.leg_frame_to_robot(p_L, gamma, LEG), cf),
         SingleCall("module_origin", lambda: wl.module_origin(LEG), cf),
-        SingleCall("ik", lambda: wl.ik(target, alpha, w, LEG), it, iterative=True),
-        SingleCall("ik (method='damped')", lambda: wl.ik(target, alpha, w, LEG, method="damped"), it, iterative=True),
-        SingleCall("ik (method='seed')", lambda: wl.ik(target, alpha, w, LEG, method="seed"), it, iterative=True),
+        SingleCall("ik", lambda: wl.ik(target, LEG, alpha=alpha, w=w), it, iterative=True),
+        SingleCall("ik_all", lambda: wl.ik_all(target, LEG, alpha=alpha, w=w), it, iterative=True),
+        SingleCall("ik (method='damped')", lambda: wl.ik(target, LEG, alpha=alpha, w=w, method="damped"), it,
+                   iterative=True),
+        SingleCall("ik (method='gauss_newton_fd')",
+                   lambda: wl.ik(target, LEG, alpha=alpha, w=w, method="gauss_newton_fd"), it, iterative=True),
     ]
 
 
@@ -122,12 +126,13 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         def run(inp):
             t, a, ww = inp
             if not scalar:
-                return wl.ik(t, a, ww, LEG, method=method, tol=TOL, geometry=geo, return_info=True)
+                return wl.ik(t, LEG, alpha=a, w=ww, method=method, options=OPTIONS, geometry=geo, return_info=True)
             q, its = np.full((len(t), 3), np.nan), np.zeros(len(t), dtype=int)
             evals = np.full(len(t), np.nan)
             for i in range(len(t)):
                 try:
-                    q[i], info = wl.ik(t[i], a[i], ww[i], LEG, method=method, tol=TOL, geometry=geo, return_info=True)
+                    q[i], info = wl.ik(t[i], LEG, alpha=a[i], w=ww[i], method=method, options=OPTIONS, geometry=geo,
+                                       return_info=True)
                     its[i], evals[i] = info.iterations, info.evaluations
                 except UnreachableError:
                     pass
@@ -155,7 +160,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
     def pin_ik(inp):
         t, a, ww = inp
         k = len(t)
-        starts = wl._initial_guesses(t, a, ww, LEG, "continuous", geo, None, 1)[0]  # the analytic IK's start
+        starts = ik_start(t, LEG, alpha=a, w=ww, geometry=geo)  # the analytic IK's start
         qs = np.full((k, model.nq), np.nan)
         iters, evals = np.full(k, np.nan), np.full(k, np.nan)
         q_start = full_config(np.column_stack([np.clip(starts[:, 0], wl.THETA_MIN, wl.THETA_MAX), starts[:, 1:]]))
@@ -183,16 +188,16 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         return score_configs(inp, qs, theta, iters, evals)
 
     run_d, score_d = analytic("damped")
-    run_s, score_s = analytic("seed")
+    run_s, score_s = analytic("gauss_newton_fd")
     run_r, score_r = analytic("radial")
     run_d1, score_d1 = analytic("damped", scalar=True)
-    run_s1, score_s1 = analytic("seed", scalar=True)
+    run_s1, score_s1 = analytic("gauss_newton_fd", scalar=True)
     run_r1, score_r1 = analytic("radial", scalar=True)
     methods = [
         Method(f"legkin batch ik, analytic Jacobian (method='damped'; {n_batch} at once)", inputs, run_d, score_d,
                repeats=5),
         Method(f"legkin batch ik, radial (method='radial'; {n_batch} at once)", inputs, run_r, score_r, repeats=5),
-        Method(f"seed Gauss-Newton, forward differences (method='seed'; batch)", inputs, run_s, score_s, repeats=5),
+        Method("seed Gauss-Newton, forward differences (method='gauss_newton_fd'; batch)", inputs, run_s, score_s, repeats=5),
         Method("legkin scalar ik (damped), Python loop", inputs, run_d1, score_d1, max_targets=n_scalar, repeats=3),
         Method("legkin scalar ik (radial), Python loop", inputs, run_r1, score_r1, max_targets=n_scalar, repeats=3),
         Method("seed forward-difference Gauss-Newton, scalar calls in a loop", inputs, run_s1, score_s1,

@@ -7,6 +7,7 @@ import numpy as np
 from .. import load
 from . import kinematics as wl
 from ..validation import CheckResult, compare, per_sample, pinocchio_frames
+from .configuration import SEGMENT_LINKS, configuration, leg_joint_names, local_contact_point, sample_leg_q
 
 TOL = 1e-12
 #: Loop solver: passive angles after solve_loops (its own stopping tolerance is 1e-12 on the residual).
@@ -29,52 +30,6 @@ FRAME_POINTS = {
     "F_L": "F_L", "F_R": "F_R", "G": "G", "G_cut": "G", "H_L": "H_L", "H_R": "H_R",
     "U_L": "U_L", "U_R": "U_R", "L_L": "L_L", "L_R": "L_R", "leg": "O",
 }  # fmt: skip
-
-#: Rim link of each segment of :func:`wl.rim_point` and the point where that link's frame sits.
-SEGMENT_LINKS = (("rim_upper_L", "B_L"), ("rim_lower_L", "F_L"), ("rim_lower_R", "F_R"), ("rim_upper_R", "B_R"))
-
-
-def sample_leg_q(n: int, rng: np.random.Generator) -> np.ndarray:
-    """(n, 3) random (theta, beta, gamma): theta over [17, 160] deg, beta in [-pi, pi], |gamma| <= 0.6."""
-    return np.stack(
-        [rng.uniform(wl.THETA_MIN, wl.THETA_MAX, n), rng.uniform(-np.pi, np.pi, n),
-         rng.uniform(-GAMMA_RANGE, GAMMA_RANGE, n)], -1,
-    )  # fmt: skip
-
-
-def configuration(robot, leg_q: np.ndarray) -> np.ndarray:
-    """Configurations (..., nq) closing every loop, from per-leg (theta, beta, gamma) of shape (..., 4, 3).
-
-    Every tree joint from :func:`wl.passive_angles`; the ABAD joint is gamma.
-    """
-    leg_q = np.asarray(leg_q, dtype=float)
-    geo = wl.Geometry.from_params(robot.params)
-    q = np.broadcast_to(robot.q0, leg_q.shape[:-2] + (robot.model.nq,)).copy()
-    for k, leg in enumerate(wl.LEGS):
-        ang = wl.passive_angles(leg_q[..., k, 0], leg_q[..., k, 1], geometry=geo)
-        for j, v in ang.items():
-            q[..., robot.idx_q(f"{leg}_{j}")] = v
-        q[..., robot.idx_q(f"{leg}_abad")] = leg_q[..., k, 2]
-    return q
-
-
-def leg_joint_names(leg: str) -> list[str]:
-    return [f"{leg}_abad"] + [f"{leg}_{j}" for j in wl.PASSIVE_JOINTS]
-
-
-def local_contact_point(alpha: np.ndarray, w: np.ndarray, geo: wl.Geometry, rim: str = "continuous"):
-    """The contact point in its rim link's frame: fixed, from the closed form at the wheel-mode reference
-    (where every link frame is parallel to {L} and sits at its parent hinge)."""
-    th0 = np.full(np.shape(alpha), wl.THETA0)
-    fn = wl.rim_point if rim == "continuous" else wl.rim_point_seed
-    p = fn(th0, 0.0, alpha, w, geometry=geo)
-    pts = wl.linkage_points(th0, geometry=geo)
-    seg = wl.rim_segment(alpha) if rim == "continuous" else np.where(alpha > 0, 3, 0)
-    origin = np.zeros_like(p)
-    for k, (_, pt) in enumerate(SEGMENT_LINKS):
-        origin[seg == k] = pts[pt][seg == k]
-    return p - origin, seg
-
 
 def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     robot = load("wheel_leg")
@@ -140,27 +95,27 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     ana = np.empty((n, 3))
     for k, leg in enumerate(wl.LEGS):
         m = legs == k
-        ana[m] = wl.contact_point(q3[m], alpha[m], w[m], leg, geometry=geo)
-    rows.append(compare("contact_point vs rim link oMf * local point (alpha over the whole rim)",
+        ana[m] = wl.fk(q3[m], leg, alpha=alpha[m], w=w[m], geometry=geo)
+    rows.append(compare("fk (contact point) vs rim link oMf * local point (alpha over the whole rim)",
                         per_sample(ana - pin_p), TOL))
 
     # seed rim: its upper-rim arcs are fixed in the upper rims (the toe arc about O_r is in no link)
     up = np.abs(alpha) > wl.PSI_FG
-    local_s, seg_s = local_contact_point(alpha[up], w[up], geo, rim="seed")
+    local_s, seg_s = local_contact_point(alpha[up], w[up], geo, rim="three_arc")
     idx_s = legs[up] * 4 + seg_s
     pin_s = fpos[up][np.arange(up.sum()), idx_s] + np.einsum("nij,nj->ni", frot[up][np.arange(up.sum()), idx_s], local_s)
     ana_s = np.empty((up.sum(), 3))
     for k, leg in enumerate(wl.LEGS):
         m = legs[up] == k
-        ana_s[m] = wl.contact_point(q3[up][m], alpha[up][m], w[up][m], leg, rim="seed", geometry=geo)
-    rows.append(compare("contact_point(rim='seed'), upper-rim arcs |alpha| > psi_FG vs upper rim oMf",
+        ana_s[m] = wl.fk(q3[up][m], leg, alpha=alpha[up][m], w=w[up][m], rim="three_arc", geometry=geo)
+    rows.append(compare("fk(rim='three_arc'), upper-rim arcs |alpha| > psi_FG vs upper rim oMf",
                         per_sample(ana_s - pin_s), TOL))
 
     # ---------------------------------------------------------------- contact Jacobian
     jac = np.empty((n, 3, 3))
     for k, leg in enumerate(wl.LEGS):
         m = legs == k
-        jac[m] = wl.contact_jacobian(q3[m], alpha[m], w[m], leg, geometry=geo)
+        jac[m] = wl.jacobian(q3[m], leg, alpha=alpha[m], w=w[m], geometry=geo)
     fd = np.empty_like(jac)
     for c in range(3):
         dq = np.zeros(3)
@@ -168,12 +123,12 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         for k, leg in enumerate(wl.LEGS):
             m = legs == k
             qm = q3[m]
-            plus = wl.contact_point(np.clip(qm + dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9]), alpha[m], w[m], leg, geometry=geo)
-            minus = wl.contact_point(np.clip(qm - dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9]), alpha[m], w[m], leg, geometry=geo)
+            plus = wl.fk(np.clip(qm + dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9]), leg, alpha=alpha[m], w=w[m], geometry=geo)
+            minus = wl.fk(np.clip(qm - dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9]), leg, alpha=alpha[m], w=w[m], geometry=geo)
             step = np.clip(qm + dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9])[:, c] - np.clip(
                 qm - dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9])[:, c]
             fd[m, :, c] = (plus - minus) / step[:, None]
-    rows.append(compare(f"contact_jacobian vs central differences (h = {FD_STEP:g})",
+    rows.append(compare(f"jacobian vs central differences (h = {FD_STEP:g})",
                         np.abs(jac - fd).max(axis=(1, 2)), TOL_FD))
 
     nj = min(n, JACOBIAN_SAMPLES)
@@ -200,33 +155,33 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         S_pas = -np.linalg.pinv(Jc[:, pv], rcond=1e-10) @ (Jc[:, iv] @ S_ind)
         J_pin = Jp[:, iv] @ S_ind + Jp[:, pv] @ S_pas
         jerr[i] = np.abs(J_pin - jac[i]).max()
-    rows.append(compare(f"contact_jacobian vs Pinocchio closed-loop Jacobian (constraint null space), {nj} samples",
+    rows.append(compare(f"jacobian vs Pinocchio closed-loop Jacobian (constraint null space), {nj} samples",
                         jerr, TOL))
 
     # ---------------------------------------------------------------- IK round trips
-    for method in ("damped", "seed", "radial"):
-        for rim in ("continuous", "seed"):
+    for method in ("damped", "gauss_newton_fd", "radial"):
+        for rim in ("continuous", "three_arc"):
             errs = np.full(n, np.nan)
             its = np.zeros(n, dtype=int)
             ok_all = np.zeros(n, dtype=bool)
             found = np.full(n, np.nan)
             for k, leg in enumerate(wl.LEGS):
                 m = legs == k
-                if rim == "seed":
-                    target = wl.contact_point(q3[m], alpha[m], w[m], leg, rim="seed", geometry=geo)
+                if rim == "three_arc":
+                    target = wl.fk(q3[m], leg, alpha=alpha[m], w=w[m], rim="three_arc", geometry=geo)
                 else:
                     target = ana[m]
-                qk, ok, info = wl.ik(target, alpha[m], w[m], leg, method=method, rim=rim, geometry=geo,
+                qk, ok, info = wl.ik(target, leg, alpha=alpha[m], w=w[m], method=method, rim=rim, geometry=geo,
                                      return_mask=True, return_info=True)
-                reached = wl.contact_point(np.where(ok[:, None], qk, q3[m]), alpha[m], w[m], leg, rim=rim, geometry=geo)
+                reached = wl.fk(np.where(ok[:, None], qk, q3[m]), leg, alpha=alpha[m], w=w[m], rim=rim, geometry=geo)
                 errs[m] = np.where(ok, per_sample(reached - target), np.nan)
                 its[m], ok_all[m] = info.iterations, ok
                 if method == "radial":
                     found[m] = solution_distance(info.solutions, q3[m]) * np.linalg.svd(
-                        wl.contact_jacobian(q3[m], alpha[m], w[m], leg, rim=rim, geometry=geo), compute_uv=False)[:, -1]
+                        wl.jacobian(q3[m], leg, alpha=alpha[m], w=w[m], rim=rim, geometry=geo), compute_uv=False)[:, -1]
             name = (f"ik(method='{method}', rim='{rim}') round trip: {ok_all.sum()}/{n} converged in [17, 160] deg, "
                     f"iterations mean {its.mean():.2f} max {its.max()}")
-            if method == "seed":
+            if method == "gauss_newton_fd":
                 # The baseline is measured, not required to succeed: the row covers the converged targets.
                 rows.append(compare(name + " (converged targets)", errs[ok_all], TOL))
             else:
@@ -244,7 +199,7 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     ok_rad = np.zeros(n, dtype=bool)
     for k, leg in enumerate(wl.LEGS):
         m = np.flatnonzero(legs == k)
-        qk, ok_rad[m] = wl.ik(pin_p[m], alpha[m], w[m], leg, method="radial", geometry=geo, return_mask=True)
+        qk, ok_rad[m] = wl.ik(pin_p[m], leg, alpha=alpha[m], w=w[m], method="radial", geometry=geo, return_mask=True)
         q_rad[m[ok_rad[m]], k] = qk[ok_rad[m]]
     fpos_r, frot_r = pinocchio_frames(robot, configuration(robot, q_rad), seg_frames)
     pin_r = fpos_r[np.arange(n), idx] + np.einsum("nij,nj->ni", frot_r[np.arange(n), idx], local)
@@ -288,7 +243,7 @@ def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 20
     exceptions = 0
     for k, leg in enumerate(wl.LEGS):
         m = np.flatnonzero(legs == k)
-        t = wl.contact_point(q[m], alpha[m], w[m], leg)
+        t = wl.fk(q[m], leg, alpha=alpha[m], w=w[m])
         push = kind[m] == 1
         d = rng.normal(size=(push.sum(), 3))
         t[push] += d / np.linalg.norm(d, axis=1, keepdims=True) * rng.uniform(0.0, 0.05, (push.sum(), 1))
@@ -296,15 +251,15 @@ def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 20
         t[box] = wl.module_origin(leg) + rng.uniform(-0.4, 0.4, (box.sum(), 3))
         target[m] = t
         try:
-            qs, ok = wl.ik(t, alpha[m], w[m], leg, return_mask=True)
+            qs, ok = wl.ik(t, leg, alpha=alpha[m], w=w[m], return_mask=True)
         except Exception:  # noqa: BLE001 - a foreign exception from the batch is a defect, counted
             exceptions += 1
             continue
         solved[m] = ok
-        error[m[ok]] = per_sample(wl.contact_point(qs[ok], alpha[m[ok]], w[m[ok]], leg) - t[ok])
+        error[m[ok]] = per_sample(wl.fk(qs[ok], leg, alpha=alpha[m[ok]], w=w[m[ok]]) - t[ok])
     unsolved = np.flatnonzero(~solved)
     pick = unsolved if classify is None else unsolved[: max(int(classify), 0)]
     reasons, single_exc = classify_failures(
-        lambda i: wl.ik(target[i], alpha[i], w[i], wl.LEGS[legs[i]]), pick)
+        lambda i: wl.ik(target[i], wl.LEGS[legs[i]], alpha=alpha[i], w=w[i]), pick)
     return robustness_row("wheel_leg", made=kind == 0, solved=solved, error=error, reasons=reasons,
                           classified=len(pick), exceptions=exceptions + single_exc)

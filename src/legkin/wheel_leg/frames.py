@@ -1,0 +1,365 @@
+"""Leg frame to robot frame (seed 1.2) and the contact point in the robot frame with its Jacobian."""
+
+from __future__ import annotations
+
+import math
+import warnings
+from functools import lru_cache
+from typing import Literal, NamedTuple, overload
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._batch import as_input, check_choice, check_flag, check_number, finish
+from .._kernels import OK, as_rows, kernel, prange
+from ..errors import InvalidInputError
+from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, _loop, rim_name
+from .geometry import _DEFAULT_GEOMETRY, FOOT_OFFSET, THETA_MAX, THETA_MIN, Geometry, _geometry, _leg
+from .linkage import _Const, _constants, _kconst
+from .rim import _k_plane, _k_select, _Sel, _select
+
+
+# ---------------------------------------------------------------- leg frame -> robot frame
+_R_LM = {  # columns: x_L, y_L, z_L in {M}
+    "L": np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]),
+    "R": np.array([[0.0, 0.0, -1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]),
+}
+_R_0 = {  # columns: x_M, y_M, z_M in {R} at gamma = 0
+    "L": np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
+    "R": np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
+}
+
+
+
+def module_origin(leg, geometry: Geometry | None = None) -> np.ndarray:
+    """Origin of the module frame {M_i} in {R}: (+-L_body/2, +-W_body/2, d_abad)."""
+    geo = _geometry(geometry)
+    _, side, sx = _leg(leg)
+    sy = 1.0 if side == "L" else -1.0
+    return np.array([sx * geo.L_body / 2, sy * geo.W_body / 2, geo.d_abad])
+
+
+@kernel
+def _k_frame(p, gamma, RLM, R0, dwheel, o, out):
+    """:func:`leg_frame_to_robot` for one point: ``out = o + R0 Rz(gamma) (RLM p + (d_wheel, 0, 0))``."""
+    pm = np.empty(3)
+    for i in range(3):
+        pm[i] = RLM[i, 0] * p[0] + RLM[i, 1] * p[1] + RLM[i, 2] * p[2]
+    pm[0] += dwheel
+    c, s_ = math.cos(gamma), math.sin(gamma)
+    r0, r1, r2 = c * pm[0] - s_ * pm[1], s_ * pm[0] + c * pm[1], pm[2]
+    for i in range(3):
+        out[i] = o[i] + R0[i, 0] * r0 + R0[i, 1] * r1 + R0[i, 2] * r2
+
+
+@_loop(32768)
+def _k_frame_batch(p, gamma, RLM, R0, dwheel, o, out):
+    """:func:`_k_frame` over p (n, 3), gamma (n,) into out (n, 3)."""
+    for i in prange(p.shape[0]):
+        _k_frame(p[i], gamma[i], RLM, R0, dwheel, o, out[i])
+
+
+def leg_frame_to_robot(p_L, gamma, leg, *, geometry: Geometry | None = None) -> np.ndarray:
+    """Map points (..., 3) of the leg frame {L} to {R} (seed section 1.2).
+
+    ``p_M = T_L^M p_L`` (the seed's matrices, offset d_wheel), ``p_R = o_i + R0_i Rz(gamma) p_M``; the
+    seed does not print ``T_M^R``: this is the module placement of "Coord definitions".
+    """
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    _, side, _ = _leg(leg)
+    o = module_origin(leg, geo)
+    if (type(p_L) is np.ndarray and p_L.shape == (3,) and p_L.dtype == np.float64 and type(gamma) in _SCALARS
+            and math.isfinite(gamma) and np.isfinite(p_L).all()):
+        out = np.empty(3)
+        _k_frame(p_L, float(gamma), _R_LM[side], _R_0[side], geo.d_wheel, o, out)
+        return out
+    p_L = as_input(p_L, "p_L", (3,))
+    gamma = as_input(gamma, "gamma")
+    try:
+        shape = np.broadcast_shapes(p_L.shape[:-1], gamma.shape)
+    except ValueError:  # the error numpy gave before
+        shape = np.broadcast_shapes(p_L.shape, gamma.shape + (1,))[:-1]
+    n = int(np.prod(shape, dtype=int))
+    out = np.empty((n, 3))
+    _k_frame_batch(as_rows(np.broadcast_to(p_L, shape + (3,)), 3), as_rows(np.broadcast_to(gamma, shape), 1)[:, 0],
+                   _R_LM[side], _R_0[side], geo.d_wheel, o, out)
+    return out.reshape(shape + (3,))
+
+
+class _Ctx(NamedTuple):
+    """Everything the contact FK needs besides q, prepared once per call (the IK iterates on it)."""
+
+    sel: _Sel
+    w: np.ndarray
+    c: _Const
+    geo: Geometry
+    origin: np.ndarray  # module origin in {R}
+    s: float  # +1 left legs, -1 right legs
+    seed: bool
+
+    def take(self, idx) -> "_Ctx":
+        return self._replace(sel=self.sel.take(idx), w=self.w[idx])
+
+
+def _rim_kind(rim: str) -> bool:
+    """True for the three-arc rim (``rim`` already normalised by :func:`rim_name`)."""
+    return check_choice(rim, "rim", RIMS) == "three_arc"
+
+
+def _context(alpha, w, leg, rim, geo, radius) -> _Ctx:
+    seed = _rim_kind(rim)
+    _, side, _ = _leg(leg)
+    if radius is None:
+        rho = geo.R + FOOT_OFFSET if seed else geo.R
+    else:
+        rho = check_number(radius, "radius", 0.0, 2.0 * geo.R, low_open=True)
+    sel = _select(alpha, seed, rho, geo.R)
+    return _Ctx(sel, np.asarray(w, dtype=float), _constants(geo.R), geo, module_origin(leg, geo),
+                1.0 if side == "L" else -1.0, seed)
+
+
+def _fk(q: np.ndarray, ctx: _Ctx, want_jac: bool):
+    """Contact point in {R} (..., 3) and, if asked, d/d(theta, beta, gamma) (..., 3, 3): the batch of the
+    kernel :func:`_k_fk`.
+
+    Same map as :func:`leg_frame_to_robot` written out for the signed permutation ``R0``: with the rotated
+    leg-plane point ``x + i y``, ``a = d_wheel + s w`` (s = +1 left, -1 right), ``m0 = cos(gamma) a -
+    sin(gamma) y``, ``m1 = sin(gamma) a + cos(gamma) y``: ``p = o + (-x, s m0, m1)``.
+    """
+    q = np.asarray(q, dtype=np.float64)
+    shape = np.broadcast_shapes(q.shape[:-1], ctx.sel.e.shape, ctx.w.shape)
+    flat = as_rows(np.broadcast_to(q, shape + (3,)), 3)
+    n = flat.shape[0]
+
+    def items(x, dtype):
+        return np.ascontiguousarray(np.broadcast_to(x, shape).reshape(n), dtype=dtype)
+
+    sel = ctx.sel
+    a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)
+    K, KC = _kconst(ctx.c.R, ctx.geo.R + FOOT_OFFSET)
+    P = np.empty((n, 3))
+    J = np.empty((n, 9) if want_jac else (n, 0))
+    o = ctx.origin
+    _k_fk_batch.serial(flat, items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128), a,
+                ctx.seed, K, KC, ctx.s, float(o[0]), float(o[1]), float(o[2]), bool(want_jac), P, J)
+    p = P.reshape(shape + (3,))
+    return p, (J.reshape(shape + (3, 3)) if want_jac else None)
+
+
+def _q_inputs(q, alpha, w, geo):
+    q = as_input(q, "q", (3,))
+    alpha = as_input(alpha, "alpha")
+    w = as_input(w, "w")
+    try:
+        shape = np.broadcast_shapes(q.shape[:-1], alpha.shape, w.shape)
+    except ValueError as exc:
+        raise InvalidInputError(
+            f"inputs do not broadcast together: q{q.shape}, alpha{alpha.shape}, w{w.shape}"
+        ) from exc
+    q = np.broadcast_to(q, shape + (3,))
+    alpha, w = np.broadcast_to(alpha, shape), np.broadcast_to(w, shape)
+    _check_theta(q[..., 0], "theta (q[..., 0])")
+    _check_alpha(alpha)
+    _check_w(w, geo)
+    return q, alpha, w
+
+
+@lru_cache(maxsize=64)
+def _kctx_cached(leg, rim, radius, geo: Geometry):
+    ctx = _context(np.zeros(()), 0.0, leg, rim, geo, radius)
+    if radius is None:
+        rho = geo.R + FOOT_OFFSET if ctx.seed else geo.R
+    else:
+        rho = float(radius)
+    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    o = ctx.origin
+    return (ctx.seed, rho, K, KC, ctx.s, geo.d_wheel, geo.T / 2, float(o[0]), float(o[1]), float(o[2]))
+
+
+def _kctx(leg, rim, radius, geo: Geometry):
+    """The contact kernels' per-call constants (validated: leg, rim, radius), cached per keyword set."""
+    try:
+        return _kctx_cached(leg, rim, radius, geo)
+    except TypeError:  # unhashable: let the checks name it
+        _context(np.zeros(()), 0.0, leg, rim, geo, radius)
+        raise
+
+
+
+
+
+def _contact_call(q, alpha, w, leg, rim, radius, geometry, want_jac, return_mask=False):
+    """The wrapper of :func:`fk` / :func:`jacobian`: kernel for a single item (fast path: a float64 (3,) q and
+    number alpha, w), batch kernel otherwise; any failure status -> the checks' error."""
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    if (type(q) is np.ndarray and q.shape == (3,) and q.dtype == np.float64 and type(alpha) in _SCALARS
+            and type(w) in _SCALARS and return_mask is False):
+        try:
+            kc = _kctx(leg, rim, radius, geo)
+        except Exception:  # noqa: BLE001 - the full checks below raise the documented error in order
+            kc = None
+        if kc is not None:
+            p = np.empty(3)
+            J = np.empty(9) if want_jac else _NO_JAC
+            if _k_contact(q, float(alpha), float(w), *kc, want_jac, p, J) == OK:
+                return J.reshape(3, 3) if want_jac else p
+    return_mask = check_flag(return_mask, "return_mask")
+    q, alpha, w = _q_inputs(q, alpha, w, geo)  # raises the documented error for a bad input
+    kc = _kctx(leg, rim, radius, geo)
+    shape = q.shape[:-1]
+    n = int(np.prod(shape, dtype=int))
+    P = np.empty((n, 3))
+    J = np.empty((n, 9) if want_jac else (n, 0))
+    status = np.empty(n, dtype=np.int64)
+    _k_contact_batch(as_rows(q, 3), as_rows(alpha, 1)[:, 0], as_rows(w, 1)[:, 0], *kc, want_jac, P, J, status)
+    ok = (status == OK).reshape(shape)
+    value = J.reshape(shape + (3, 3)) if want_jac else P.reshape(shape + (3,))
+    value[~ok] = np.nan
+
+    def error() -> Exception:
+        return InvalidInputError(f"the contact {'Jacobian' if want_jac else 'point'} is not finite at q={q.tolist()}")
+
+    return finish(value, ok, shape == (), return_mask, error)
+
+
+_NO_JAC = np.empty(0)
+
+
+@overload
+def fk(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
+       radius: float | None = None, geometry: Geometry | None = None,
+       return_mask: Literal[False] = False) -> np.ndarray: ...
+@overload
+def fk(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
+       radius: float | None = None, geometry: Geometry | None = None,
+       return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+def fk(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
+       radius: float | None = None, geometry: Geometry | None = None,
+       return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """Contact point in the robot frame {R} for q = (theta, beta, gamma) (seed section 1, FK).
+
+    The leg-frame point of :func:`~legkin.wheel_leg.rim_point` (``rim="continuous"``, default) or of the
+    seed's three-arc formula :func:`~legkin.wheel_leg.rim_point_seed` (``rim="three_arc"``), then
+    :func:`leg_frame_to_robot`.
+
+    Args:
+        q: (..., 3) (theta, beta, gamma) in rad, theta in [17 deg, 160 deg].
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        alpha: rim parameter (rad) in [-pi, pi]; w: lateral coordinate (m) in [-T/2, T/2]; broadcast with q's
+            leading shape.
+        rim: ``"continuous"`` (the four rim links) or ``"three_arc"`` (seed 1.1's formula).
+        radius: arc radius (m) in (0, 2 R] (None: the rim's own, see :func:`~legkin.wheel_leg.rim_point`).
+        geometry: robot parameters (None: the default geometry).
+        return_mask: also return the mask of finite results (all True for valid inputs).
+
+    Returns:
+        (..., 3) point in {R} (and the mask).
+
+    Raises:
+        InvalidInputError: NaN/inf, complex or wrong shapes; theta, alpha or w out of range.
+        InvalidParameterError: unknown ``leg`` or ``rim``, ``radius`` out of range, not a Geometry.
+    """
+    return _contact_call(q, alpha, w, leg, rim_name(rim), radius, geometry, False, return_mask)
+
+
+@overload
+def jacobian(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
+             radius: float | None = None, geometry: Geometry | None = None,
+             return_mask: Literal[False] = False) -> np.ndarray: ...
+@overload
+def jacobian(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
+             radius: float | None = None, geometry: Geometry | None = None,
+             return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+def jacobian(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
+             radius: float | None = None, geometry: Geometry | None = None,
+             return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """Analytic d(contact point in {R}) / d(theta, beta, gamma) of :func:`fk`, shape (..., 3, 3).
+
+    Replaces the seed's forward-difference Jacobian (seed 2.3) by the exact one: the closed form's
+    theta-derivatives are carried through every step (forward mode by hand,
+    :func:`~legkin.wheel_leg.linkage._k_closed`), d/dbeta is ``i z`` in the leg plane and d/dgamma is
+    ``R0 Rz(gamma) (e_z x p_M)``. Arguments as :func:`fk`.
+    """
+    return _contact_call(q, alpha, w, leg, rim_name(rim), radius, geometry, True, return_mask)
+
+
+def contact_point(q: ArrayLike, alpha: ArrayLike, w: ArrayLike, leg: Leg, *, rim: str = "continuous",
+                  radius: float | None = None, geometry: Geometry | None = None) -> np.ndarray:
+    """Deprecated (legkin 0.1): ``fk(q, leg, alpha=alpha, w=w, ...)``."""
+    warnings.warn("contact_point(q, alpha, w, leg) is deprecated; use fk(q, leg, alpha=alpha, w=w)",
+                  DeprecationWarning, stacklevel=2)
+    return _contact_call(q, alpha, w, leg, rim_name(rim, 3), radius, geometry, False)
+
+
+def contact_jacobian(q: ArrayLike, alpha: ArrayLike, w: ArrayLike, leg: Leg, *, rim: str = "continuous",
+                     radius: float | None = None, geometry: Geometry | None = None) -> np.ndarray:
+    """Deprecated (legkin 0.1): ``jacobian(q, leg, alpha=alpha, w=w, ...)``."""
+    warnings.warn("contact_jacobian(q, alpha, w, leg) is deprecated; use jacobian(q, leg, alpha=alpha, w=w)",
+                  DeprecationWarning, stacklevel=2)
+    return _contact_call(q, alpha, w, leg, rim_name(rim, 3), radius, geometry, True)
+
+
+#: Kernel status codes (besides :data:`OK`): NaN/inf input or result, theta / alpha / w out of range.
+_NONFINITE, _THETA_RANGE, _ALPHA_RANGE, _W_RANGE = 1, 2, 3, 4
+
+
+@kernel
+def _k_fk(theta, beta, gamma, upper, right, e, seed, K, KC, s, a, o0, o1, o2, want_jac, p, J):
+    """The contact FK for one item (:func:`_fk` states the map) into ``p`` (3,) and ``J`` (9,) (row-major
+    d p / d(theta, beta, gamma)); returns :data:`OK` or :data:`_NONFINITE`."""
+    z, dz = _k_plane(theta, upper, right, e, seed, K, KC, want_jac, True)
+    rot = complex(math.cos(beta + math.pi / 2), math.sin(beta + math.pi / 2))
+    zr = rot * z
+    x, y = zr.real, zr.imag
+    cg, sg = math.cos(gamma), math.sin(gamma)
+    m0 = cg * a - sg * y
+    m1 = sg * a + cg * y
+    p[0] = o0 - x
+    p[1] = o1 + s * m0
+    p[2] = o2 + m1
+    status = OK if (math.isfinite(p[0]) and math.isfinite(p[1]) and math.isfinite(p[2])) else _NONFINITE
+    if want_jac:
+        dzr = rot * dz
+        dx, dy = dzr.real, dzr.imag
+        ssg = s * sg
+        J[0], J[1], J[2] = -dx, y, 0.0
+        J[3], J[4], J[5] = -ssg * dy, -ssg * x, -s * m1
+        J[6], J[7], J[8] = cg * dy, cg * x, m0
+        for k in range(9):
+            if not math.isfinite(J[k]):
+                status = _NONFINITE
+    return status
+
+
+@kernel
+def _k_contact(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac, p, J):
+    """:func:`contact_point` / :func:`contact_jacobian` for one item, inputs range-checked (status codes)."""
+    theta = q[0]
+    if not (math.isfinite(theta) and math.isfinite(q[1]) and math.isfinite(q[2]) and math.isfinite(alpha)
+            and math.isfinite(w)):
+        return _NONFINITE
+    if theta < THETA_MIN - 1e-12 or theta > THETA_MAX + 1e-12:
+        return _THETA_RANGE
+    if abs(alpha) > math.pi + 1e-12:
+        return _ALPHA_RANGE
+    if abs(w) > half_T + 1e-15:
+        return _W_RANGE
+    upper, right, e = _k_select(alpha, seed, rho, K[0])
+    return _k_fk(theta, q[1], q[2], upper, right, e, seed, K, KC, s, dwheel + s * w, o0, o1, o2, want_jac, p, J)
+
+
+@_loop(32768)
+def _k_contact_batch(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac, P, J, status):
+    """:func:`_k_contact` over q (n, 3), alpha, w (n,) into P (n, 3), J (n, 9), status (n,)."""
+    for i in prange(q.shape[0]):
+        status[i] = _k_contact(q[i], alpha[i], w[i], seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac,
+                               P[i], J[i])
+
+
+@_loop(32768)
+def _k_fk_batch(q, upper, right, e, a, seed, K, KC, s, o0, o1, o2, want_jac, P, J):
+    """:func:`_k_fk` over q (n, 3) and the prepared arc choice (:class:`_Sel`) into P (n, 3), J (n, 9)."""
+    for i in prange(q.shape[0]):
+        _k_fk(q[i, 0], q[i, 1], q[i, 2], upper[i], right[i], e[i], seed, K, KC, s, a[i], o0, o1, o2, want_jac,
+              P[i], J[i])
+

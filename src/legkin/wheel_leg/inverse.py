@@ -1,0 +1,358 @@
+"""Inverse kinematics of the rim contact point: :func:`ik` (the default answer), :func:`ik_all` (every solution).
+
+Methods (``method=``):
+
+* ``"radial"`` (default): gamma and beta in closed form, theta from the 1-D equation ``|c(theta, alpha)| = r``
+  by a bracketed Newton (:mod:`legkin.wheel_leg.ik_radial`); every solution is found.
+* ``"damped"``: Gauss-Newton on the 3x3 system with the analytic Jacobian and Levenberg-Marquardt damping.
+* ``"gauss_newton_fd"`` (legkin 0.1: ``"seed"``): seed 2.2-2.3 as printed, forward-difference Jacobian, full
+  steps (the baseline). Both iterative methods are in :mod:`legkin.wheel_leg.ik_iterative`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Literal, NamedTuple, overload
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._batch import as_input, check_choice, check_flag, check_integer, check_number, finish
+from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
+from . import ik_iterative
+from ._common import _LIMITS, _SCALARS, _SOLVED, Leg, Rim, _check_alpha, _check_theta, _check_w, rim_name
+from ._legacy import legacy_ik_call, method_name
+from .frames import _context, _fk, _kctx_cached
+from .geometry import _DEFAULT_GEOMETRY, ABAD_LIMIT, THETA_MAX, THETA_MIN, Geometry, _geometry, _leg
+from .ik_radial import _NO_Q0, _RADIAL_SOLS, _ik_radial, _k_ik_radial, _radial_table
+from .rim import _k_select
+
+Method = Literal["radial", "damped", "gauss_newton_fd"]
+METHODS = ("radial", "damped", "gauss_newton_fd")
+
+
+@dataclass(frozen=True)
+class IKOptions:
+    """Solver tuning of :func:`ik` and :func:`ik_all` (validated on construction).
+
+    Attributes:
+        tol: position tolerance (m), in (0, 1e-3]: solved means ``|fk(q) - target| <= tol``.
+        max_iter: iteration bound, an integer in [1, 100000]; None: the method's default (radial: 60 Newton
+            steps per root; damped: 60 per start; gauss_newton_fd: 100 per start).
+        delta: forward-difference step (rad) of ``method="gauss_newton_fd"``, in (0, 0.1].
+    """
+
+    tol: float = 1e-12
+    max_iter: int | None = None
+    delta: float = 1e-6
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "tol", check_number(self.tol, "tol", 0.0, 1e-3, low_open=True))
+        if self.max_iter is not None:
+            object.__setattr__(self, "max_iter", check_integer(self.max_iter, "max_iter", 1, 100_000))
+        object.__setattr__(self, "delta", check_number(self.delta, "delta", 0.0, 0.1, low_open=True))
+
+
+_DEFAULT_OPTIONS = IKOptions()
+
+
+class IKInfo(NamedTuple):
+    """What :func:`ik` did, per target (arrays of the batch shape).
+
+    Attributes:
+        iterations: iterations used, restarts included (radial: Newton and bracketing steps summed over the
+            target's roots).
+        error: final position error ``|fk(q) - target|`` (m).
+        solutions: ``method="radial"`` only (else None): (..., S, 3), every solution found, NaN-padded: the
+            branch ``y_L <= 0`` by increasing theta, then the branch ``y_L > 0`` (as :func:`ik_all`).
+        evaluations: linkage evaluations per target: rows of the contact FK (with or without its Jacobian)
+            for the iterative methods; radial: evaluations of the leg-plane closed form with its
+            theta-derivative (Newton and extremum steps) plus the final contact FK that checks the answer
+            (the grid and start tables are not counted).
+    """
+
+    iterations: np.ndarray
+    error: np.ndarray
+    solutions: np.ndarray | None = None
+    evaluations: np.ndarray | None = None
+
+
+def _options(options: object) -> IKOptions:
+    if options is None:
+        return _DEFAULT_OPTIONS
+    if not isinstance(options, IKOptions):
+        raise InvalidParameterError(f"options must be a wheel_leg.IKOptions, got {type(options).__name__}")
+    return options
+
+
+# ---------------------------------------------------------------- single-target fast paths
+@lru_cache(maxsize=64)
+def _single_ctx(leg, rim, radius, geo: Geometry, method: str):
+    """The contact kernels' constants and the method's tables for one keyword set (validated)."""
+    kc = _kctx_cached(leg, rim, radius, geo)
+    if method == "radial":
+        return kc, _radial_table(geo.R, kc[0])
+    return kc, ik_iterative.guess_table(geo.R, kc[0])
+
+
+def _single(target, alpha, w, leg, rim, radius, geo, method, opts, return_mask, return_info):
+    """One target with default keywords: the method's kernel called directly. None (the general path then
+    decides, and raises) unless solved."""
+    if not (abs(alpha) <= math.pi + 1e-12 and abs(w) <= geo.T / 2 + 1e-15):
+        return None
+    try:
+        kc, tables = _single_ctx(leg, rim, radius, geo, method)
+    except Exception:  # noqa: BLE001 - the general path raises the documented error
+        return None
+    seed, rho, K, KC, s, dwheel, _half_T, o0, o1, o2 = kc
+    upper, right, e = _k_select(alpha, seed, rho, K[0])
+    q = np.empty(3)
+    a = dwheel + s * w
+    sols = None
+    if method == "radial":
+        max_iter = 60 if opts.max_iter is None else opts.max_iter
+        sols = np.empty((_RADIAL_SOLS, 3))
+        its, err, reason, _nr, nsol = _k_ik_radial(target, upper, right, e, a, seed, K, KC, s, o0, o1, o2, *tables,
+                                                   opts.tol, max_iter, _NO_Q0[0], False, True, q, sols)
+        ev = its + 1
+        if reason == _SOLVED and return_info and nsol > _RADIAL_SOLS:
+            sols = np.empty((nsol, 3))
+            _k_ik_radial(target, upper, right, e, a, seed, K, KC, s, o0, o1, o2, *tables, opts.tol, max_iter,
+                         _NO_Q0[0], False, True, np.empty(3), sols)
+        sols = sols[:nsol]
+    else:
+        max_iter = ik_iterative.DEFAULT_MAX_ITER[method] if opts.max_iter is None else opts.max_iter
+        its, err, reason, ev = ik_iterative._k_ik_iterative(
+            target, upper, right, e, a, seed, K, KC, s, o0, o1, o2, *tables, ik_iterative.METHOD_IDS[method],
+            ik_iterative._STARTS[method], opts.tol, max_iter, opts.delta, ik_iterative._NO_START[0], False, True, q)
+    if reason != _SOLVED:
+        return None
+    out = (q, np.array(True)) if return_mask else q
+    if not return_info:
+        return out
+    info = IKInfo(np.array(its), np.array(err), sols, np.array(ev))
+    return (*out, info) if return_mask else (out, info)
+
+
+# ---------------------------------------------------------------- the general path
+class _Run(NamedTuple):
+    q: np.ndarray  # (..., 3), NaN where not solved
+    ok: np.ndarray
+    reason: np.ndarray
+    info: IKInfo
+    target: np.ndarray
+    closest: np.ndarray | None  # single unsolved target: the point reached
+
+
+def _broadcast(target, alpha, w, q_near, q_start):
+    """Inputs checked and broadcast together: (target, alpha, w, q_near, q_start, shape)."""
+    target = as_input(target, "target", (3,))
+    alpha, w = as_input(alpha, "alpha"), as_input(w, "w")
+    q_near = None if q_near is None else as_input(q_near, "q_near", (3,))
+    q_start = None if q_start is None else as_input(q_start, "q_start", (3,))
+    extra = [x for x in (q_near, q_start) if x is not None]
+    try:
+        shape = np.broadcast_shapes(target.shape[:-1], alpha.shape, w.shape, *(x.shape[:-1] for x in extra))
+    except ValueError as exc:
+        names = f"target{target.shape}, alpha{alpha.shape}, w{w.shape}" + "".join(
+            f", {n}{x.shape}" for n, x in (("q_near", q_near), ("q_start", q_start)) if x is not None)
+        raise InvalidInputError(f"inputs do not broadcast together: {names}") from exc
+    n = int(np.prod(shape, dtype=int))
+
+    def rows(x, name):
+        if x is None:
+            return None
+        x = np.array(np.broadcast_to(x, shape + (3,)), dtype=float)
+        _check_theta(x[..., 0], f"theta ({name}[..., 0])")
+        return x.reshape(n, 3)
+
+    target = np.broadcast_to(target, shape + (3,)).astype(float)
+    alpha, w = np.broadcast_to(alpha, shape).astype(float), np.broadcast_to(w, shape).astype(float)
+    return target, alpha, w, rows(q_near, "q_near"), rows(q_start, "q_start"), shape
+
+
+def _run(target, alpha, w, leg, q_near, q_start, method, rim, radius, limits, opts, geo, all_solutions=False):
+    limits = check_flag(limits, "limits")
+    target, alpha, w, q_near, q_start, shape = _broadcast(target, alpha, w, q_near, q_start)
+    _check_alpha(alpha)
+    _check_w(w, geo)
+    check_choice(method, "method", METHODS)
+    _leg(leg)
+    if method == "radial" and q_start is not None:
+        raise InvalidParameterError("q_start is the start of an iteration (methods 'damped', 'gauss_newton_fd'); "
+                                    "the radial method takes q_near (the configuration to stay near)")
+    n = int(np.prod(shape, dtype=int))
+    ctx = _context(alpha.reshape(n), w.reshape(n), leg, rim, geo, radius)  # validated once
+    flat = target.reshape(n, 3)
+    solutions = None
+    if method == "radial":
+        q, it, err, ok, solutions, reason = _ik_radial(flat, ctx, opts.tol, opts.max_iter, q_near, limits)
+        solutions = solutions.reshape(shape + solutions.shape[1:])
+        ev = it + 1
+    else:
+        start = q_start if q_start is not None else q_near
+        q, it, err, ok, reason, ev = ik_iterative.solve(flat, ctx, start, method, opts.tol, opts.max_iter,
+                                                        opts.delta, limits)
+    q = q.reshape(shape + (3,))
+    it, err, ok, reason, ev = (x.reshape(shape) for x in (it, err, ok, reason, ev))
+    closest = None
+    if shape == () and not bool(ok) and not all_solutions:
+        with np.errstate(invalid="ignore"):
+            qc = q.copy()
+            qc[0] = np.clip(qc[0], THETA_MIN, THETA_MAX)
+            closest = _fk(qc, ctx.take(0), False)[0] if np.all(np.isfinite(qc)) else None
+    q_out = np.where(ok[..., None], q, np.nan)
+    return _Run(q_out, ok, reason, IKInfo(it, err, solutions, ev), target, closest), q
+
+
+def _error(run: _Run, q_raw, leg, alpha, w, method, tol) -> Exception:
+    target = np.asarray(run.target).reshape(3)
+    where = f"target {target.tolist()} for leg {leg!r} (alpha={float(alpha)!r}, w={float(w)!r})"
+    if int(run.reason) == _LIMITS:
+        return JointLimitError(
+            f"{where} is reachable only with the ABAD angle outside its limits [-pi/2, pi/2] "
+            f"(gamma={float(q_raw[2]):.6g} rad); pass limits=False to accept it",
+            target=target, closest=run.closest,
+        )
+    closest = run.closest
+    return UnreachableError(
+        f"{where} not reached with method {method!r}: final error {float(run.info.error):.3e} m after "
+        f"{int(run.info.iterations)} iterations (tolerance {tol:.1e} m, theta in [17, 160] deg); closest point "
+        f"reached {None if closest is None else closest.tolist()}",
+        target=target, closest=closest,
+    )
+
+
+# ---------------------------------------------------------------- public
+@overload
+def ik(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, q_near: ArrayLike | None = None,
+       q_start: ArrayLike | None = None, method: Method = "radial", rim: Rim = "continuous",
+       radius: float | None = None, limits: bool = True, options: IKOptions | None = None,
+       geometry: Geometry | None = None, return_mask: Literal[False] = False,
+       return_info: Literal[False] = False) -> np.ndarray: ...
+@overload
+def ik(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, q_near: ArrayLike | None = None,
+       q_start: ArrayLike | None = None, method: Method = "radial", rim: Rim = "continuous",
+       radius: float | None = None, limits: bool = True, options: IKOptions | None = None,
+       geometry: Geometry | None = None, return_mask: Literal[True],
+       return_info: Literal[False] = False) -> tuple[np.ndarray, np.ndarray]: ...
+@overload
+def ik(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, q_near: ArrayLike | None = None,
+       q_start: ArrayLike | None = None, method: Method = "radial", rim: Rim = "continuous",
+       radius: float | None = None, limits: bool = True, options: IKOptions | None = None,
+       geometry: Geometry | None = None, return_mask: Literal[False] = False,
+       return_info: Literal[True]) -> tuple[np.ndarray, IKInfo]: ...
+@overload
+def ik(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, q_near: ArrayLike | None = None,
+       q_start: ArrayLike | None = None, method: Method = "radial", rim: Rim = "continuous",
+       radius: float | None = None, limits: bool = True, options: IKOptions | None = None,
+       geometry: Geometry | None = None, return_mask: Literal[True],
+       return_info: Literal[True]) -> tuple[np.ndarray, np.ndarray, IKInfo]: ...
+def ik(target, leg=None, /, *args, alpha=0.0, w=0.0, q_near=None, q_start=None, method="radial",  # type: ignore[misc]
+       rim="continuous", radius=None, limits=True, options=None, geometry=None, return_mask=False,
+       return_info=False, **deprecated):
+    """(theta, beta, gamma) placing the rim point (alpha, w) of ``leg`` at ``target`` in {R} (seed 2).
+
+    ``method="radial"`` (default) finds every theta in [17 deg, 160 deg] that reaches the target, for both
+    signs of the out-of-plane square root (:func:`ik_all` lists them: the branch ``y_L <= 0`` by increasing
+    theta, then ``y_L > 0``). Without ``q_near`` it returns the first of them whose gamma is inside the ABAD
+    limits; with ``q_near`` the usable one nearest ``q_near`` (distance ``sqrt(dtheta^2 + dbeta^2 +
+    dgamma^2)``, angle differences wrapped), beta shifted by a multiple of 2 pi to lie within pi of
+    ``q_near``'s. The iterative methods (``"damped"``, ``"gauss_newton_fd"``) start from ``q_start`` (else
+    ``q_near``, else geometric guesses: gamma exact, theta from a grid; the damped method restarts a failed
+    target from the next guesses and then from the other out-of-plane branch).
+
+    The contract (docs/wheel_leg.md): every answer marked solved is reproduced by :func:`fk` with the same
+    ``alpha, w, leg, rim, radius`` to ``options.tol``; with ``limits=True`` (default) its gamma lies inside the
+    ABAD joint's URDF limits [-pi/2, pi/2] (:data:`ABAD_LIMIT`) and theta in [17 deg, 160 deg]; the default
+    method solves every target that :func:`fk` makes from such joints.
+
+    Args:
+        target: (..., 3) points in {R}; alpha (rad), w (m), q_near, q_start broadcast with its leading shape.
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        q_near: (..., 3) the configuration to stay near.
+        q_start: (..., 3) the start of the iteration (iterative methods only).
+        method: ``"radial"``, ``"damped"`` or ``"gauss_newton_fd"``.
+        rim, radius: the rim model and arc radius, as in :func:`fk`.
+        limits: keep only answers inside the ABAD joint limits (False: any gamma).
+        options: :class:`IKOptions` (tolerance, iteration bound, forward-difference step).
+        return_mask: also return the mask of solved targets (batch).
+        return_info: also return an :class:`IKInfo`.
+
+    legkin 0.1's call ``ik(target, alpha, w, leg, q0, tol=, max_iter=, delta=)`` (a number as second
+    argument, ``leg=`` after alpha and w, or ``q0=``, ``tol=``, ``max_iter=``, ``delta=``) still works for
+    one release and warns (DeprecationWarning); so do ``method="seed"`` and ``rim="seed"``.
+
+    Raises:
+        JointLimitError: single target reachable, but only with gamma outside the ABAD limits.
+        UnreachableError: single target not reached (``closest`` = the point reached).
+        InvalidInputError: NaN/inf, complex or wrong shapes, alpha or w out of range.
+        InvalidParameterError: unknown ``method``, ``rim`` or ``leg``; a keyword out of its range.
+    """
+    if args or deprecated or leg is None or not isinstance(leg, (str, int, np.integer)) or isinstance(leg, bool):
+        leg, alpha, w, q_near, q_start, options = legacy_ik_call(
+            leg, args, deprecated, alpha=alpha, w=w, q_near=q_near, q_start=q_start, method=method, options=options)
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    opts = _options(options)
+    method = method_name(method)
+    rim = rim_name(rim)
+    if (q_near is None and q_start is None and limits is True and type(target) is np.ndarray
+            and target.shape == (3,) and target.dtype == np.float64 and type(alpha) in _SCALARS
+            and type(w) in _SCALARS and type(method) is str and return_mask in (True, False)
+            and return_info in (True, False)):
+        out = _single(target, float(alpha), float(w), leg, rim, radius, geo, method, opts, return_mask, return_info)
+        if out is not None:
+            return out
+    return_mask = check_flag(return_mask, "return_mask")
+    return_info = check_flag(return_info, "return_info")
+    run, q_raw = _run(target, alpha, w, leg, q_near, q_start, method, rim, radius, limits, opts, geo)
+    out = finish(run.q, run.ok, run.ok.shape == (), return_mask,
+                 lambda: _error(run, q_raw, leg, alpha, w, method, opts.tol))
+    if return_info:
+        return (*out, run.info) if isinstance(out, tuple) else (out, run.info)
+    return out
+
+
+@overload
+def ik_all(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
+           radius: float | None = None, limits: bool = False, options: IKOptions | None = None,
+           geometry: Geometry | None = None, return_mask: Literal[False] = False) -> np.ndarray: ...
+@overload
+def ik_all(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
+           radius: float | None = None, limits: bool = False, options: IKOptions | None = None,
+           geometry: Geometry | None = None, return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+def ik_all(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
+           radius: float | None = None, limits: bool = False, options: IKOptions | None = None,
+           geometry: Geometry | None = None, return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """Every (theta, beta, gamma) placing the rim point (alpha, w) of ``leg`` at ``target``: (..., S, 3).
+
+    The radial method's solutions (:func:`ik`): for each root theta in [17 deg, 160 deg] by increasing theta
+    the branch ``y_L <= 0``, then the same roots on the branch ``y_L > 0`` (absent when ``y_L = 0``); NaN
+    rows pad the batch to the largest count S. ``limits=True`` keeps only those with gamma inside the ABAD
+    limits (in the same order). A single target without any solution raises :class:`UnreachableError`; in a
+    batch its rows are all NaN (mask False). Arguments as :func:`ik`.
+    """
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    opts = _options(options)
+    return_mask = check_flag(return_mask, "return_mask")
+    limits = check_flag(limits, "limits")
+    run, _q = _run(target, alpha, w, leg, None, None, "radial", rim_name(rim), radius, False, opts, geo, True)
+    sols = run.info.solutions
+    assert sols is not None
+    keep = np.isfinite(sols).all(axis=-1)
+    if limits:
+        keep &= np.abs(np.nan_to_num(sols[..., 2])) <= ABAD_LIMIT
+    order = np.argsort(~keep, axis=-1, kind="stable")  # the kept ones first, in their order
+    sols = np.take_along_axis(np.where(keep[..., None], sols, np.nan), order[..., None], axis=-2)
+    count = keep.sum(axis=-1)
+    sols = sols[..., : int(count.max()) if count.size else 0, :]
+    ok = count > 0
+
+    def error() -> Exception:
+        t = np.asarray(run.target).reshape(3)
+        return UnreachableError(f"target {t.tolist()} for leg {leg!r} has no solution"
+                                + (" inside the ABAD limits" if limits else ""), target=t)
+
+    return finish(sols, ok, ok.shape == (), return_mask, error)

@@ -13,8 +13,22 @@ from hypothesis import strategies as st
 
 import legkin
 from legkin import InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
+from legkin._rotations import wrap
 from legkin.tripod import kinematics as at
 from legkin.tripod import checks as ct
+from legkin.tripod.forward_kernels import STEP_RCOND, _k_gn_step, _k_initial_guess
+from legkin.tripod.inverse import _run
+
+# Many tests below call the deprecated 0.1 forms on purpose (they must keep working for one release).
+pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
+
+
+def _ik_aux(ay, az, alpha=at.ALPHA):
+    """ik's kernel output without its guards, home mode: (joints (..., 12), aux (..., 6) = cos q_K2 (3),
+    1 + c_y c_z, det M, |A_u|_F)."""
+    ay, az = np.broadcast_arrays(np.asarray(ay, dtype=float), np.asarray(az, dtype=float))
+    q, aux, _ = _run(ay, az, at.Geometry(alpha=alpha)._vector, at.HOME_MODE)
+    return q[..., 0, :], aux[..., 0, :]
 
 ALPHAS = (math.pi / 4, math.pi / 3, math.pi / 2)
 
@@ -174,7 +188,7 @@ def test_workspace_matches_ik():
         assert np.array_equal(ok, ws.reachable)
         b = ws.boundary[np.all(np.isfinite(ws.boundary), axis=1)]
         if len(b):
-            _, c2, _ = at._ik_core(b[:, 0], b[:, 1], at.D, alpha, np.array(at.ETA))
+            c2 = _ik_aux(b[:, 0], b[:, 1], alpha)[1][:, :3]
             c2 = c2[np.all(np.isfinite(c2), axis=-1)]  # points at the flip (tilt pi) have no E
             assert len(c2) > 100 and np.allclose(np.abs(c2).max(axis=-1), 1.0, atol=1e-9)
     assert at.workspace(alpha=math.pi / 2).reachable.mean() < at.workspace(alpha=math.pi / 4).reachable.mean()
@@ -274,9 +288,7 @@ def _random_a(rng, cond: float) -> np.ndarray:
 
 
 def _step(a: np.ndarray, r: np.ndarray) -> np.ndarray:
-    with np.errstate(invalid="ignore", divide="ignore"):  # as fk calls it (0/0 on the rank-1 branch, replaced)
-        s0, s1 = at._gauss_newton_step(a[None, :, 0], a[None, :, 1], r[None])
-    return np.array([s0[0, 0], s1[0, 0]])
+    return np.array(_k_gn_step(np.ascontiguousarray(a[:, 0]), np.ascontiguousarray(a[:, 1]), np.ascontiguousarray(r)))
 
 
 @pytest.mark.parametrize("cond", [1.0, 1e4, 1e8])
@@ -296,12 +308,12 @@ def test_gauss_newton_step_matches_pinv_including_rank_deficient():
     rng = np.random.default_rng(7)
     for _ in range(200):  # inconsistent r (both differ from the exact step by ~1e-16 cond^2 here): same as pinv
         a, r = _random_a(rng, 10.0 ** rng.uniform(0, 1)), rng.normal(size=3)
-        ref = -np.linalg.pinv(a, rcond=at.STEP_RCOND) @ r
+        ref = -np.linalg.pinv(a, rcond=STEP_RCOND) @ r
         assert np.abs(_step(a, r) - ref).max() <= 1e-13 * np.abs(ref).max()
     a1 = rng.normal(size=3)
     for a2 in (np.zeros(3), 1e-14 * rng.normal(size=3), 3.0 * a1):  # sigma_2 <= 1e-12 sigma_1: rank-1 pinv
         a, r = np.stack([a1, a2], axis=-1), rng.normal(size=3)
-        ref = -np.linalg.pinv(a, rcond=at.STEP_RCOND) @ r
+        ref = -np.linalg.pinv(a, rcond=STEP_RCOND) @ r
         assert np.abs(_step(a, r) - ref).max() <= 1e-12 * np.abs(ref).max()
     assert np.array_equal(_step(np.zeros((3, 2)), rng.normal(size=3)), [0.0, 0.0])
 
@@ -315,20 +327,22 @@ def _planes_lstsq_u(q):
     return at.orientation_from_axis(2 * e[0] * e - np.array([1.0, 0.0, 0.0]))
 
 
-def test_initial_guess_adjugate_and_parallel_planes_fallback():
-    geo = at._geometry(at.D, at.ALPHA, np.array(at.ETA))
+def test_initial_guess_is_the_planes_intersection():
+    G = at.Geometry()._vector
     h = math.pi / 2
-    motors = [(0.3, -1.0, 2.0), (-2.5, 0.4, 1.1), (h, h, h), (h, -h, h), (0.0, 0.0, 0.0), (h + 1e-5, h - 2e-5, h)]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ay, az = at._initial_guess(np.array(motors), geo)
-    for k, q in enumerate(motors):  # the last four have |det M| <= PLANES_DET_MIN: pinv fallback
+    for q in [(0.3, -1.0, 2.0), (-2.5, 0.4, 1.1), (0.2, 1.4, -0.7)]:  # regular planes (|det M| >> DET_GUARD)
+        ay, az, det = _k_initial_guess(*q, G)
+        assert abs(det) > 1e-3
         ry, rz = _planes_lstsq_u(np.array(q))
-        assert np.abs(at.platform_rotation(ay[k, 0], az[k, 0]) - at.platform_rotation(ry, rz)).max() < 1e-12, q
+        assert np.abs(at.platform_rotation(ay, az) - at.platform_rotation(ry, rz)).max() < 1e-12, q
+    for q in [(h, h, h), (h, -h, h), (0.0, 0.0, 0.0)]:  # parallel planes: det M = 0, fk refuses them
+        assert abs(_k_initial_guess(*q, G)[2]) < 1e-12
+        with pytest.raises(SingularityError, match="actuation singularity"):
+            at.fk(np.array(q))
     u = np.array([[0.4, -2.0], [-1.2, 0.7], [1.5, 3.0]])  # consistent motors: the start is already the pose
-    q = at.ik(u[:, 0], u[:, 1])[:, [0, 4, 8]]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ay, az = at._initial_guess(q, geo)
-    assert np.abs(at.platform_rotation(ay[:, 0], az[:, 0]) - at.platform_rotation(u[:, 0], u[:, 1])).max() < 1e-13
+    for row, q in zip(u, at.ik(u)):
+        ay, az, _ = _k_initial_guess(*q, G)
+        assert np.abs(at.platform_rotation(ay, az) - at.platform_rotation(*row)).max() < 1e-13
 
 
 def test_fk_scalar_is_a_batch_of_one():
@@ -361,11 +375,11 @@ def test_fk_scalar_is_a_batch_of_one():
         ({"alpha": "pi"}, r"alpha must be a real number"),
         ({"eta": "abc"}, r"eta must be three finite real angles"),
         ({"eta": [0.0, 1.0, 2.0j]}, r"eta must be three finite real angles"),
-        ({"eta": [0.0, float("nan"), 1.0]}, r"eta must be three finite real angles"),
+        ({"eta": [0.0, float("nan"), 1.0]}, r"eta_B=nan is out of range"),
         ({"eta": [[0.0, 1.0, 2.0]]}, r"eta must be three finite real angles"),
         ({"eta": [0.0, [1.0], 2.0]}, r"eta must be three finite real angles"),
-        ({"mode": "-+"}, r"mode='-\+' is not valid: must be one of -\+\+\+, "),
-        ({"mode": None}, r"mode=None is not valid"),
+        ({"mode": "-+"}, r"mode must be one of '-\+\+\+', "),
+        ({"mode": None}, r"mode must be one of .*got None"),
         ({"return_mask": "yes"}, r"return_mask must be True or False"),
         ({"return_mask": 1}, r"return_mask must be True or False"),
     ],
@@ -387,19 +401,19 @@ def test_keyword_parameters_are_validated(kw, match):
 @pytest.mark.parametrize(
     "kw, match",
     [
-        ({"tol": float("nan")}, r"tol=nan is out of range: must be in \[0, 0.1\]"),
+        ({"tol": float("nan")}, r"tol=nan is out of range: must be a finite number in \[0, 0.1\]"),
         ({"tol": -1e-13}, r"tol=-1e-13 is out of range"),
         ({"tol": 1.0}, r"tol=1.0 is out of range"),
         ({"tol": "1e-13"}, r"tol must be a real number"),
-        ({"max_iter": 2.5}, r"max_iter must be an integer, got 2.5; valid range \[1, 10000\]"),
-        ({"max_iter": 0}, r"max_iter=0 is out of range: must be in \[1, 10000\]"),
+        ({"max_iter": 2.5}, r"max_iter must be an integer in \[1, 10000\], got 2.5"),
+        ({"max_iter": 0}, r"max_iter=0 is out of range: must be an integer in \[1, 10000\]"),
         ({"max_iter": -1}, r"max_iter=-1 is out of range"),
         ({"max_iter": True}, r"max_iter must be an integer"),
         ({"max_iter": 10**6}, r"max_iter=1000000 is out of range"),
-        ({"max_inconsistency": float("nan")}, r"max_inconsistency=nan is out of range: must be in \[0, inf\]"),
+        ({"max_inconsistency": float("nan")}, r"max_inconsistency=nan is out of range: must be a finite number in \[0, inf\)"),
         ({"max_inconsistency": -1.0}, r"max_inconsistency=-1.0 is out of range"),
         ({"max_inconsistency": None}, r"max_inconsistency must be a real number"),
-        ({"mode": "all!"}, r"is not valid"),
+        ({"mode": "all!"}, r"mode must be one of"),
     ],
 )
 def test_fk_options_are_validated(kw, match):
@@ -515,16 +529,30 @@ def test_fk_reproduces_ik_next_to_the_flip():
         ay, az, q = ay[ok], az[ok], q[ok]
         y, z, inc, m = at.fk(q[:, 0], q[:, 4], q[:, 8], alpha=alpha, return_mask=True)
         assert m.all(), nb
-        assert np.abs(y - ay).max() < 1e-12 and np.abs(at._wrap(z - az)).max() < 1e-12 and inc.max() < 1e-12
+        assert np.abs(y - ay).max() < 1e-12 and np.abs(wrap(z - az)).max() < 1e-12 and inc.max() < 1e-12
 
 
 def _home_det(alpha, ay, az):
     """det M of the home mode's motor planes at (ay, az) (arrays), NaN outside the workspace; no guard."""
-    trig = tuple(fn(np.asarray(v, dtype=float))[..., None] for v in (ay, az) for fn in (np.cos, np.sin))
-    g = at._geometry(at.D, alpha, np.array(at.ETA))
+    q, aux = _ik_aux(ay, az, alpha)
+    inside = (aux[..., 3] > 1e-12) & np.all(1.0 - np.abs(aux[..., :3]) > 1e-12, axis=-1)
     with np.errstate(all="ignore"):
-        q1, _, c2, _, nb2, sn, cn = at._ik_eval(*trig, g, with_sc=True)
-        return q1, np.where(at._inside(c2, nb2)[..., 0], at._det_planes(sn, cn, g), np.nan)
+        q1 = _ik_eval_q1(ay, az, alpha)
+    return q1, np.where(inside, aux[..., 4], np.nan)
+
+
+def _ik_eval_q1(ay, az, alpha):
+    """q_K1 (..., 3) of eq (102) in the home mode without ik's guards (NaN outside the workspace)."""
+    from legkin.tripod.closure import _k_centre, _k_leg
+
+    G = at.Geometry(alpha=alpha)._vector
+    ay, az = np.broadcast_arrays(np.asarray(ay, dtype=float), np.asarray(az, dtype=float))
+    out = np.full(ay.shape + (3,), np.nan)
+    for idx in np.ndindex(ay.shape):
+        y, z = ay[idx], az[idx]
+        x, yy, zz, _ = _k_centre(np.cos(y), np.sin(y), np.cos(z), np.sin(z), G, True, -1.0)
+        out[idx] = [_k_leg(k, x, yy, zz, G, True, 1.0)[0] for k in range(3)]
+    return out
 
 
 def det_zero_points(alpha, az, n=601):
@@ -587,10 +615,19 @@ def _mode_of(e_side, s_legs):
     return ("-" if e_side < 0 else "+") + "".join("-" if s < 0 else "+" for s in s_legs)
 
 
+class _Consts:
+    """The constants of a geometry the tests below use (cos / sin of eta, d, k = 1 - cos alpha, -L, ...)."""
+
+    def __init__(self, geo):
+        self.d, self.ce, self.se = geo.d, np.cos(np.asarray(geo.eta)), np.sin(np.asarray(geo.eta))
+        self.ca, self.sa = math.cos(geo.alpha), math.sin(geo.alpha)
+        self.k, self.dsa, self.minus_l = 1.0 - self.ca, geo.d * self.sa, -geo.length
+
+
 def _configuration_from_motors(qa, qb, branch, s_c, alpha):
     """A closed configuration with motors q_A1 = qa, q_B1 = qb: E on both motor planes and |E| = L (the
     ``branch`` of the two line-sphere points), leg C on the side ``s_c``. Returns (u, mode, q_C1) or None."""
-    g = at._geometry(at.D, alpha, np.array(at.ETA))
+    g = _Consts(at.Geometry(alpha=alpha))
     s, c = np.sin([qa, qb]), np.cos([qa, qb])
     n = np.stack([s, -c * g.ce[:2], -c * g.se[:2]], axis=-1)
     cab, v = float(n[0] @ n[1]), np.cross(n[0], n[1])
@@ -730,17 +767,19 @@ def test_no_foreign_exception_or_warning_on_any_finite_input(u, m, mode, alpha):
 
     with warnings.catch_warnings():
         warnings.simplefilter("error")
+        geo = at.Geometry(alpha=alpha)
         calls = [
-            lambda: at.ik(*u, alpha=alpha, mode=mode),
-            lambda: at.ik(*u, alpha=alpha, mode="all"),
-            lambda: at.actuation_jacobian(*u, alpha=alpha, mode=mode),
-            lambda: at.fk(*m, alpha=alpha, mode=mode),
-            lambda: at.fk(*m, alpha=alpha, max_inconsistency=np.inf),
-            lambda: at.platform_position(*u, alpha=alpha),
+            lambda: at.ik(np.array(u), geometry=geo, mode=mode),
+            lambda: at.ik_all(np.array(u), geometry=geo),
+            lambda: at.ik_joints(np.array(u), geometry=geo, mode=mode),
+            lambda: at.jacobian(np.array(u), geometry=geo, mode=mode),
+            lambda: at.fk(np.array(m), geometry=geo, mode=mode),
+            lambda: at.fk(np.array(m), geometry=geo, max_inconsistency=np.inf),
+            lambda: at.platform_position(*u, geometry=geo),
             lambda: at.platform_rotation(*u),
             lambda: at.orientation_from_axis(m),
-            lambda: at.leg_transform(np.array([*m, u[0]]), u[1], alpha=alpha),
-            lambda: at.leg_transform_cv(m[0], m[1], m[2], alpha=alpha),
+            lambda: at.leg_transform(np.array([*m, u[0]]), "B", geometry=geo),
+            lambda: at.leg_transform_cv(np.array(m[:2]), "C", geometry=geo),
         ]
         for call in calls:
             try:
@@ -748,9 +787,8 @@ def test_no_foreign_exception_or_warning_on_any_finite_input(u, m, mode, alpha):
             except legkin.LegkinError:
                 pass
         for call in (
-            lambda: at.ik(np.array([u[0], 0.1]), np.array([u[1], 0.2]), alpha=alpha, mode=mode, return_mask=True),
-            lambda: at.fk(np.array([m[0], 0.1]), np.array([m[1], 0.2]), np.array([m[2], 0.3]), alpha=alpha,
-                          mode=mode, return_mask=True),
+            lambda: at.ik(np.array([u, (0.1, 0.2)]), geometry=geo, mode=mode, return_mask=True),
+            lambda: at.fk(np.array([m, (0.1, 0.2, 0.3)]), geometry=geo, mode=mode, return_mask=True),
         ):
             out = call()
             assert out[-1].shape == (2,)

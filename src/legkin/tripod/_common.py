@@ -82,7 +82,7 @@ def pick(pair: tuple[Callable[..., Any], Callable[..., Any]], n: int, kind: str)
 
 
 # ------------------------------------------------------------------------------------------ arguments
-def geometry_of(geometry: object, legacy: dict[str, Any] | None = None, where: str = "") -> Geometry:
+def geometry_of(geometry: object, legacy: dict[str, Any] | None = None, where: str = "", stacklevel: int = 4) -> Geometry:
     """The call's :class:`Geometry`: ``geometry`` (None: the default), or the deprecated ``d``, ``alpha``, ``eta``
     (a DeprecationWarning, mapped onto a Geometry)."""
     if legacy:
@@ -90,7 +90,7 @@ def geometry_of(geometry: object, legacy: dict[str, Any] | None = None, where: s
             raise InvalidParameterError(f"{where}: pass either geometry= or the deprecated {', '.join(legacy)}, not both")
         warnings.warn(
             f"{where}: the geometry arguments {', '.join(legacy)} are deprecated; pass geometry=tripod.Geometry(...)",
-            DeprecationWarning, stacklevel=4,
+            DeprecationWarning, stacklevel=stacklevel,
         )
         kw = dict(legacy)
         if kw.get("eta") is None:
@@ -125,9 +125,10 @@ def flag(value: object, name: str) -> bool:
     return check_flag(value, name)
 
 
-def deprecated(old: str, new: str) -> None:
-    """Warn that the call form / name ``old`` is deprecated in favour of ``new`` (stacklevel: the user's call)."""
-    warnings.warn(f"{old} is deprecated (legkin 0.2); use {new}", DeprecationWarning, stacklevel=4)
+def deprecated(old: str, new: str, stacklevel: int = 4) -> None:
+    """Warn that the call form / name ``old`` is deprecated in favour of ``new`` (``stacklevel``: of the user's call
+    as seen from here)."""
+    warnings.warn(f"{old} is deprecated (legkin 0.2); use {new}", DeprecationWarning, stacklevel=stacklevel)
 
 
 def split_legacy(kwargs: dict[str, Any], where: str, allowed: tuple[str, ...]) -> dict[str, Any]:

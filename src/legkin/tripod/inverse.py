@@ -321,7 +321,7 @@ def actuation_jacobian(target: ArrayLike, *args: Any, mode: str = HOME_MODE, geo
                        return_mask: bool = False, **legacy: Any) -> Any:
     """Deprecated alias of :func:`jacobian` (legkin 0.1, kept for one release); also in its old form
     ``actuation_jacobian(alpha_y, alpha_z, d, alpha, eta, *, mode, return_mask)``."""
-    deprecated("actuation_jacobian", "jacobian")
+    deprecated("actuation_jacobian", "jacobian", stacklevel=3)
     mode = checked_mode(mode)
     return_mask = flag(return_mask, "return_mask")
     if args or "alpha_z" in legacy:

@@ -236,7 +236,7 @@ def platform_position(alpha_y: ArrayLike, alpha_z: ArrayLike, *args: float, geom
         if len(args) > 2:
             raise TypeError(f"platform_position() takes at most 4 positional arguments ({2 + len(args)} given)")
         legacy = {**dict(zip(("d", "alpha"), args)), **_split_kw(legacy)}
-    g = geometry_of(geometry, legacy, "platform_position")
+    g = geometry_of(geometry, legacy, "platform_position", stacklevel=3)
     return _uv_closed(2, alpha_y, alpha_z, (3,), g._vector)
 
 

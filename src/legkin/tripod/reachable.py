@@ -124,7 +124,7 @@ def workspace(*args: Any, geometry: Geometry | None = None, n: int = 181, m: int
     Deprecated (legkin 0.1): ``workspace(d, alpha, eta, n, m)`` positional, or ``d=``, ``alpha=``, ``eta=``.
     """
     if args:
-        deprecated("workspace(d, alpha, eta, n, m) with positional arguments", "workspace(geometry=..., n=..., m=...)")
+        deprecated("workspace(d, alpha, eta, n, m) with positional arguments", "workspace(geometry=..., n=..., m=...)", stacklevel=3)
         if len(args) > 5:
             raise TypeError("workspace() takes at most 5 positional arguments in its deprecated form")
         legacy = {**dict(zip(("d", "alpha", "eta"), args[:3])), **legacy}
@@ -135,7 +135,7 @@ def workspace(*args: Any, geometry: Geometry | None = None, n: int = 181, m: int
     bad = set(legacy) - {"d", "alpha", "eta"}
     if bad:
         raise TypeError(f"workspace() got unexpected keyword argument(s) {', '.join(map(repr, sorted(bad)))}")
-    g = geometry_of(geometry, legacy, "workspace") if legacy else geometry_of(geometry)
+    g = geometry_of(geometry, legacy, "workspace", stacklevel=3) if legacy else geometry_of(geometry)
     if type(n) is not int or not 2 <= n <= 1001:
         n = check_integer(n, "n", 2, 1001)
     if type(m) is not int or not 2 <= m <= 100001:

@@ -24,8 +24,9 @@ def _misuse(tmp_path):
     a_file = tmp_path / "a_file"
     a_file.write_text("x")
     return [
-        (["check", "--seed", "-1"], "--seed"),
-        (["check", "--seed", "x"], "--seed"),
+        (["check", "--seed", "-1"], "--random-seed"),
+        (["check", "--random-seed", "-1"], "--random-seed"),
+        (["check", "--seed", "x"], "--random-seed"),
         (["check", "--samples", "0"], "--samples"),
         (["check", "--samples", "-5"], "--samples"),
         (["check", "--samples", "1.5"], "--samples"),
@@ -48,7 +49,7 @@ def _misuse(tmp_path):
         (["view", "quadruped", "--animate", "foot_circles", "--pose", "standing"], "--animate"),
         (["view", "quadruped", "--pose", "standing", "--q", "0"], "not allowed"),
         (["bench", "--n", "0"], "--n"),
-        (["bench", "--seed", "-1"], "--seed"),
+        (["bench", "--seed", "-1"], "--random-seed"),
         (["bench", "--json", f"{NO_DIR}/b.json"], "does not exist"),
         (["bench", "no_such_robot"], "known models"),
         (["generate", "no_such_robot"], "known models"),
@@ -58,10 +59,10 @@ def _misuse(tmp_path):
     ]
 
 
-@pytest.mark.parametrize("case", range(31))
+@pytest.mark.parametrize("case", range(32))
 def test_misuse_is_one_line_and_status_2(case, tmp_path, capsys):
     cases = _misuse(tmp_path)
-    assert len(cases) == 31
+    assert len(cases) == 32
     argv, word = cases[case]
     assert main(argv) == 2
     out, err = capsys.readouterr()

@@ -17,31 +17,30 @@ from legkin.quadruped import kinematics as aq
 from legkin.tripod import kinematics as at
 from legkin.wheel_leg import kinematics as wl
 
-P_LF = aq.foot_position([0.1, 1.0, 1.0], "LF")
+P_LF = aq.fk([0.1, 1.0, 1.0], "LF")
 T_FL = wl.fk([1.0, 0.1, 0.0], "FL")
 NAN = float("nan")
 
 #: (mechanism, call as written, thunk, expected legkin error class)
 CASES = [
     # ---- quadruped
-    ("quadruped", "foot_ik(zeros((2, 3)), 'LF', q_ref=zeros((3, 3)))",
-     lambda: aq.foot_ik(np.zeros((2, 3)), "LF", q_ref=np.zeros((3, 3))), legkin.InvalidInputError),
+    ("quadruped", "ik(zeros((2, 3)), 'LF', q_near=zeros((3, 3)))",
+     lambda: aq.ik(np.zeros((2, 3)), "LF", q_near=np.zeros((3, 3))), legkin.InvalidInputError),
     ("quadruped", "within_limits('abc')", lambda: aq.within_limits("abc"), legkin.InvalidInputError),
     ("quadruped", "within_limits(q, tol=-1e-9)", lambda: aq.within_limits(np.zeros(3), tol=-1e-9),
      legkin.InvalidParameterError),
-    ("quadruped", "foot_position(q, 'LF', foot_z=nan)", lambda: aq.foot_position(np.zeros(3), "LF", foot_z=NAN),
+    ("quadruped", "Geometry(foot_z=nan)", lambda: aq.Geometry(foot_z=NAN), legkin.InvalidParameterError),
+    ("quadruped", "Geometry(foot_z=5)", lambda: aq.Geometry(foot_z=5), legkin.InvalidParameterError),
+    ("quadruped", "Geometry(foot_z='0.01')", lambda: aq.Geometry(foot_z="0.01"), legkin.InvalidParameterError),
+    ("quadruped", "fk(q, 'LF', geometry=0.01)", lambda: aq.fk(np.zeros(3), "LF", geometry=0.01),
      legkin.InvalidParameterError),
-    ("quadruped", "foot_position(q, 'LF', foot_z=5)", lambda: aq.foot_position(np.zeros(3), "LF", foot_z=5),
+    ("quadruped", "ik(p, 'LF', return_mask='yes')", lambda: aq.ik(P_LF, "LF", return_mask="yes"),
      legkin.InvalidParameterError),
-    ("quadruped", "foot_ik(p, 'LF', foot_z='0.01')", lambda: aq.foot_ik(P_LF, "LF", foot_z="0.01"),
-     legkin.InvalidParameterError),
-    ("quadruped", "foot_ik(p, 'LF', return_mask='yes')", lambda: aq.foot_ik(P_LF, "LF", return_mask="yes"),
-     legkin.InvalidParameterError),
-    ("quadruped", "foot_ik(p + 0j, 'LF')", lambda: aq.foot_ik(P_LF + 0j, "LF"), legkin.InvalidInputError),
-    ("quadruped", "foot_ik([[0.1], [0.2, 0.3]], 'LF')", lambda: aq.foot_ik([[0.1], [0.2, 0.3]], "LF"),
+    ("quadruped", "ik(p + 0j, 'LF')", lambda: aq.ik(P_LF + 0j, "LF"), legkin.InvalidInputError),
+    ("quadruped", "ik([[0.1], [0.2, 0.3]], 'LF')", lambda: aq.ik([[0.1], [0.2, 0.3]], "LF"),
      legkin.InvalidInputError),
-    ("quadruped", "foot_ik(p, 'XX')", lambda: aq.foot_ik(P_LF, "XX"), legkin.InvalidParameterError),
-    ("quadruped", "foot_ik(full(3, 1e300), 'LF')", lambda: aq.foot_ik(np.full(3, 1e300), "LF"),
+    ("quadruped", "ik(p, 'XX')", lambda: aq.ik(P_LF, "XX"), legkin.InvalidParameterError),
+    ("quadruped", "ik(full(3, 1e300), 'LF')", lambda: aq.ik(np.full(3, 1e300), "LF"),
      legkin.UnreachableError),
     ("quadruped", "textbook_ik(p, Y12, 0, L2)", lambda: aq.textbook_ik(P_LF, aq.Y12, 0.0, 0.3),
      legkin.InvalidParameterError),

@@ -184,8 +184,8 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
         a_pin, cond[i] = _pin_actuation_jacobian(robot, qi)
         err[i] = np.abs(a_pin - a_an[i]).max() / max(1.0, np.abs(a_an[i]).max())
     well = (cond > COND_MIN) & far
-    rows.append(compare(pre + f"A_u vs Pinocchio closed-loop null space, rel. (cond > {COND_MIN:g}, far from flip)", err[well], TOL))
-    rows.append(compare(pre + f"A_u vs Pinocchio closed-loop null space, rel. (cond <= {COND_MIN:g} or near flip)", err[~well], TOL_ILL))
+    rows.append(compare(pre + f"A_u (jacobian) vs Pinocchio closed-loop null space, rel. (cond > {COND_MIN:g}, far from flip)", err[well], TOL))
+    rows.append(compare(pre + f"A_u (jacobian) vs Pinocchio closed-loop null space, rel. (cond <= {COND_MIN:g} or near flip)", err[~well], TOL_ILL))
     s2 = np.abs(np.sin(q[:, [1, 5, 9]])).min(axis=-1)
     fd_ok = (s2 > 0.1) & (np.abs(np.cos(ay)) > 0.1) & (1 + np.cos(ay) * np.cos(az) > 0.1)
     a_fd = _fd_actuation_jacobian(ay[fd_ok], az[fd_ok], alpha)

@@ -21,7 +21,7 @@ from .inverse import ik, jacobian
 #: Targets no configuration reaches in any mode (default geometry): tilts 0.3 rad beyond the boundary
 #: (:func:`legkin.tripod.workspace`, tilt_max = 2 pi / 3 in these directions), and the platform singularity.
 UNREACHABLE = np.array([[0.347, -2.465], [0.747, 3.0], [-0.347, 2.465], [0.0, np.pi]])
-#: |fk(ik(x)) - x| measured over 16 modes x 200 samples: max 4e-15 rad (see docs/tripod.md).
+#: |fk(ik(x)) - x| measured over 16 modes x 200 samples: max 2.6e-13 rad (alpha_z is ill-conditioned near c_y = 0).
 ROUND_TRIP_TOL = 1e-12
 
 

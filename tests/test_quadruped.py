@@ -215,7 +215,9 @@ def test_scalar_target_with_batch_q_near_is_a_batch():
         aq.ik(np.stack([p, p]), "LF", q_near=q_near)
 
 
-@pytest.mark.parametrize("bad", ["abc", ["a", "b", "c"], np.zeros(3) + 1j, [[0.0, 0.0, 0.0], [0.0, 0.0]], np.zeros(2), None])
+@pytest.mark.parametrize(
+    "bad", ["abc", ["a", "b", "c"], np.zeros(3) + 1j, [[0.0, 0.0, 0.0], [0.0, 0.0]], np.zeros(2), None]
+)
 def test_within_limits_refuses_non_numeric(bad):
     with pytest.raises(legkin.InvalidInputError):
         aq.within_limits(bad)
@@ -607,10 +609,12 @@ def test_configuration_helpers(quadruped, rng):
     assert full.shape == (7, quadruped.model.nq)
     np.testing.assert_array_equal(full[:, cfg.leg_slice(quadruped, "LF")], q)
     np.testing.assert_array_equal(full[:, cfg.leg_slice(quadruped, "RH")], np.broadcast_to(q[0], (7, 3)))
-    np.testing.assert_array_equal(full[:, cfg.leg_slice(quadruped, "LH")], np.broadcast_to(quadruped.q0[cfg.leg_slice(quadruped, "LH")], (7, 3)))
+    lh = cfg.leg_slice(quadruped, "LH")
+    np.testing.assert_array_equal(full[:, lh], np.broadcast_to(quadruped.q0[lh], (7, 3)))
     for leg in LEGS:
         placement = quadruped.frame_placement(full[3], f"{leg}_FOOT")
-        np.testing.assert_allclose(placement.translation, aq.fk(full[3, cfg.leg_slice(quadruped, leg)], leg), atol=1e-15)
+        foot = aq.fk(full[3, cfg.leg_slice(quadruped, leg)], leg)
+        np.testing.assert_allclose(placement.translation, foot, atol=1e-15)
     near = cfg.near_singular_joints(50, "RF", rng)
     r = cfg.rho(aq.fk(near, "RF"), "RF")
     assert aq.within_limits(near, 0.0).all() and (r < 1.1e-3).all() and (r > 0.9e-6).all()

@@ -57,7 +57,7 @@ def deprecated(old: str, new: str) -> None:
     )
 
 
-def legacy_geometry(foot_z: object, geometry: object) -> object:
+def legacy_geometry(foot_z: object, geometry: Geometry | None) -> Geometry | None:
     """The geometry of a call with the deprecated ``foot_z=`` keyword (None: not given, ``geometry`` as it is)."""
     if foot_z is None:
         return geometry

@@ -19,12 +19,12 @@ import warnings
 import numpy as np
 
 from .. import load
-from . import kinematics as aq
-from .configuration import configuration, leg_slice, sample_joints
-from ..bench import Method, MethodResult, ModelBench, Score
-from ..errors import UnreachableError
 from .._benchkit import SOLVE_TOL, missing, pinocchio_positions, quiet_stdout, sizes
 from .._single_call import SingleCall
+from ..bench import Method, MethodResult, ModelBench, Score
+from ..errors import UnreachableError
+from . import kinematics as aq
+from .configuration import configuration, leg_slice, sample_joints
 
 LEG = "LF"
 #: CLIK settings of Pinocchio's examples/inverse-kinematics.py, with the issue's tolerance 1e-10.

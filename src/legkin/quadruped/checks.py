@@ -6,8 +6,6 @@ import numpy as np
 
 from .. import load
 from .._rotations import wrap
-from . import kinematics as aq
-from .configuration import configuration, leg_slice, made_joints, near_singular_joints, random_targets, rho
 from ..validation import (
     CheckResult,
     classify_failures,
@@ -17,6 +15,8 @@ from ..validation import (
     robustness_row,
     sample_within_limits,
 )
+from . import kinematics as aq
+from .configuration import configuration, leg_slice, made_joints, near_singular_joints, random_targets, rho
 
 TOL = 1e-12
 #: Abduction-singularity band: below this distance rho (m) of the foot from the abduction cylinder

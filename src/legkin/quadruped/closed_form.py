@@ -22,8 +22,27 @@ from .._batch import check_flag
 from .._kernels import OK, SERIAL_BELOW, as_rows, batch_kernel, kernel, prange
 from ..errors import UnreachableError
 from ._common import F64, LEG_INDEX, S3, S43, foot_z_of, leg_index, raise_bad, rows
-from .constants import ALPHA, BAD_INPUT, KS, L1, PI, REACH_TOL, SU, SX, SY, TWO_PI, UNREACHABLE, X01, X34, Y01, Y12
-from .constants import X23, Y12_SQ, Z01, Z23
+from .constants import (
+    ALPHA,
+    BAD_INPUT,
+    KS,
+    L1,
+    PI,
+    REACH_TOL,
+    SU,
+    SX,
+    SY,
+    TWO_PI,
+    UNREACHABLE,
+    X01,
+    X23,
+    X34,
+    Y01,
+    Y12,
+    Y12_SQ,
+    Z01,
+    Z23,
+)
 from .forward import _finite3, hip_position
 from .geometry import Geometry
 

@@ -128,7 +128,8 @@ def random_targets(n: int, rng: np.random.Generator, legs: np.ndarray) -> np.nda
     radius = np.where(kind < 0.6, l1 + l2 + hair, np.abs(l1 - l2) + hair)
     angle = rng.uniform(-np.pi, np.pi, n)
     rh = np.where(kind < 0.6, np.abs(radius * np.sin(angle)), 10 ** rng.uniform(-12, -3, n))
-    dx = np.where(kind < 0.6, radius * np.cos(angle), np.sqrt(np.maximum(radius**2 - rh**2, 0.0)) * np.sign(np.cos(angle)))
+    inner_dx = np.sqrt(np.maximum(radius**2 - rh**2, 0.0)) * np.sign(np.cos(angle))
+    dx = np.where(kind < 0.6, radius * np.cos(angle), inner_dx)
     axis = np.sqrt(Y12**2 + rh**2)
     axis = np.where(kind < 0.45, Y12 + hair, axis)  # some straddle the cylinder itself
     tilt = rng.uniform(-np.pi, np.pi, n)

@@ -29,7 +29,7 @@ def foot_position(
 ) -> np.ndarray:
     """Deprecated alias of :func:`~legkin.quadruped.fk` (``foot_z=``: ``geometry=Geometry(foot_z=...)``)."""
     deprecated("foot_position", "fk")
-    return fk(q, leg, geometry=legacy_geometry(foot_z, geometry))  # type: ignore[arg-type]
+    return fk(q, leg, geometry=legacy_geometry(foot_z, geometry))
 
 
 def foot_jacobian(
@@ -37,7 +37,7 @@ def foot_jacobian(
 ) -> np.ndarray:
     """Deprecated alias of :func:`~legkin.quadruped.jacobian`."""
     deprecated("foot_jacobian", "jacobian")
-    return jacobian(q, leg, geometry=legacy_geometry(foot_z, geometry))  # type: ignore[arg-type]
+    return jacobian(q, leg, geometry=legacy_geometry(foot_z, geometry))
 
 
 @overload
@@ -64,7 +64,7 @@ def foot_ik(
     """Deprecated alias of :func:`~legkin.quadruped.ik` (``q_ref``: ``q_near=``)."""
     deprecated("foot_ik", "ik (q_ref -> q_near=)")
     g = legacy_geometry(foot_z, geometry)
-    return ik(p, leg, q_near=q_ref, geometry=g, return_mask=return_mask)  # type: ignore[arg-type]
+    return ik(p, leg, q_near=q_ref, geometry=g, return_mask=return_mask)
 
 
 @overload
@@ -90,4 +90,4 @@ def foot_ik_all(
 ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Deprecated alias of :func:`~legkin.quadruped.ik_all`."""
     deprecated("foot_ik_all", "ik_all")
-    return ik_all(p, leg, geometry=legacy_geometry(foot_z, geometry), return_mask=return_mask)  # type: ignore[arg-type]
+    return ik_all(p, leg, geometry=legacy_geometry(foot_z, geometry), return_mask=return_mask)

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import kinematics as aq
 from ..figures import new_figure
+from . import kinematics as aq
 
 #: Region codes of :func:`branch_regions`.
 REGIONS = (

@@ -13,10 +13,28 @@ from .._kernels import OK, SERIAL_BELOW, as_rows, batch_kernel, kernel, prange
 from .._rotations import wrap_k
 from ..errors import InvalidInputError, JointLimitError, UnreachableError
 from ._common import F64, LEG_INDEX, S3, foot_z_of, leg_index, rows
-from .closed_form import _branch_k, _ik_all_k, _knee_angle_k, _knee_branch_k, _leg_plane_k, _reach_k
-from .closed_form import unreachable_message
-from .constants import BAD_INPUT, BAD_REF, HI, JOINT_LIMIT, JOINT_LIMITS, KS, LIMIT_SLACK, LIMIT_TOL, LO, SU
-from .constants import UNREACHABLE
+from .closed_form import (
+    _branch_k,
+    _ik_all_k,
+    _knee_angle_k,
+    _knee_branch_k,
+    _leg_plane_k,
+    _reach_k,
+    unreachable_message,
+)
+from .constants import (
+    BAD_INPUT,
+    BAD_REF,
+    HI,
+    JOINT_LIMIT,
+    JOINT_LIMITS,
+    KS,
+    LIMIT_SLACK,
+    LIMIT_TOL,
+    LO,
+    SU,
+    UNREACHABLE,
+)
 from .forward import _finite3
 from .geometry import Geometry
 from .limits import _inside_by_k, _strictly_inside_k, _toward_limits_k
@@ -110,7 +128,9 @@ def _check_arrays(p_in: object, q_near_in: object) -> None:
     raise AssertionError("ik: a kernel reported a non-finite entry that as_input accepts")  # pragma: no cover
 
 
-def _ik_error(status: int, leg: str, li: int, p: np.ndarray, foot_z: float, p_in: object, q_near_in: object) -> Exception:
+def _ik_error(
+    status: int, leg: str, li: int, p: np.ndarray, foot_z: float, p_in: object, q_near_in: object
+) -> Exception:
     """The legkin error of a failed single call (the kernel's status says which)."""
     if status >= BAD_INPUT:
         _check_arrays(p_in, q_near_in)
@@ -125,7 +145,9 @@ def _ik_error(status: int, leg: str, li: int, p: np.ndarray, foot_z: float, p_in
     )
 
 
-def _broadcast_rows(arr: np.ndarray, ref: np.ndarray, p_in: object, q_near_in: object):
+def _broadcast_rows(
+    arr: np.ndarray, ref: np.ndarray, p_in: object, q_near_in: object
+) -> tuple[tuple[int, ...], np.ndarray, np.ndarray]:
     """The batch shape of ``p`` and ``q_near`` and both as C-contiguous (n, 3) rows."""
     if ref.shape == arr.shape:
         batch = arr.shape[:-1]

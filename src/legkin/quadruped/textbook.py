@@ -113,7 +113,8 @@ def textbook_ik(p: npt.ArrayLike, a: float, b: float, c: float, *, literal: bool
 
     Raises:
         InvalidInputError: ``p`` not a finite real array (..., 3).
-        InvalidParameterError: ``a`` not a finite number >= 0, ``b`` or ``c`` not finite and > 0, ``literal`` not a bool.
+        InvalidParameterError: ``a`` not a finite number >= 0, ``b`` or ``c`` not finite and > 0, ``literal``
+            not a bool.
     """
     a = check_number(a, "a", 0.0)
     b = check_number(b, "b", 0.0, low_open=True)

@@ -540,7 +540,11 @@ def test_importing_legkin_does_not_import_numba():
     import subprocess
     import sys
 
-    code = "import sys, legkin; assert 'numba' not in sys.modules, 'numba imported by import legkin'"
+    code = (
+        "import sys, legkin; assert 'numba' not in sys.modules, 'numba imported by import legkin'; "
+        "g = legkin.load('quadruped', foot_z=0.01).geometry; assert g == legkin.quadruped.Geometry(foot_z=0.01); "
+        "assert 'numba' not in sys.modules, 'numba imported by Robot.geometry'"
+    )
     subprocess.run([sys.executable, "-c", code], check=True)
 
 

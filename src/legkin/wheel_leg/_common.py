@@ -117,3 +117,25 @@ def rim_name(rim: object, stacklevel: int = 3) -> str:
                       DeprecationWarning, stacklevel=stacklevel)
         return "three_arc"
     return str(check_choice(rim, "rim", RIMS))
+
+
+def legacy_geometry(fn: str, names: tuple[str, ...], args: tuple, kwargs: dict, geometry: object,
+                    positional_geometry: bool = False) -> object:
+    """legkin 0.1's geometry arguments of ``fn`` (positional ``args`` / keywords ``kwargs`` named ``names``)
+    mapped onto a Geometry, with a DeprecationWarning; ``positional_geometry``: the one positional argument
+    is the Geometry itself."""
+    from .geometry import Geometry
+
+    if len(args) > len(names) or any(k not in names for k in kwargs):
+        bad = next((k for k in kwargs if k not in names), None)
+        raise TypeError(f"{fn}() got an unexpected argument {bad!r}" if bad else f"{fn}() got too many arguments")
+    if positional_geometry:
+        warnings.warn(f"{fn}(leg, geometry) with a positional geometry is deprecated; pass geometry=...",
+                      DeprecationWarning, stacklevel=3)
+        return args[0]
+    values = dict(zip(names, args), **kwargs)
+    warnings.warn(f"{fn}({', '.join(values)}=...) is deprecated; pass geometry=Geometry(...)",
+                  DeprecationWarning, stacklevel=3)
+    if geometry is not None:
+        raise TypeError(f"{fn}() got both geometry= and legkin 0.1's {', '.join(values)}")
+    return Geometry(**values)  # type: ignore[arg-type]

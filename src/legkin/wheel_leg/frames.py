@@ -13,7 +13,7 @@ from numpy.typing import ArrayLike
 from .._batch import as_input, check_choice, check_flag, check_number, finish
 from .._kernels import OK, as_rows, kernel, prange
 from ..errors import InvalidInputError
-from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, _loop, rim_name
+from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, _loop, legacy_geometry, rim_name
 from .geometry import _DEFAULT_GEOMETRY, FOOT_OFFSET, THETA_MAX, THETA_MIN, Geometry, _geometry, _leg
 from .linkage import _Const, _constants, _kconst
 from .rim import _k_plane, _k_select, _Sel, _select
@@ -31,12 +31,24 @@ _R_0 = {  # columns: x_M, y_M, z_M in {R} at gamma = 0
 
 
 
-def module_origin(leg, geometry: Geometry | None = None) -> np.ndarray:
-    """Origin of the module frame {M_i} in {R}: (+-L_body/2, +-W_body/2, d_abad)."""
-    geo = _geometry(geometry)
+def module_origin(leg: Leg, *args: Geometry | None, geometry: Geometry | None = None) -> np.ndarray:
+    """Origin of the module frame {M_i} in {R}: (+-L_body/2, +-W_body/2, d_abad) (a new array).
+
+    legkin 0.1's positional geometry, ``module_origin(leg, geo)``, still works for one release
+    (DeprecationWarning).
+    """
+    if args:
+        geometry = legacy_geometry("module_origin", ("geometry",), args, {}, geometry, positional_geometry=True)
+    return _origin(leg, _geometry(geometry)).copy()
+
+
+@lru_cache(maxsize=64)
+def _origin(leg, geo: Geometry) -> np.ndarray:
     _, side, sx = _leg(leg)
     sy = 1.0 if side == "L" else -1.0
-    return np.array([sx * geo.L_body / 2, sy * geo.W_body / 2, geo.d_abad])
+    o = np.array([sx * geo.L_body / 2, sy * geo.W_body / 2, geo.d_abad])
+    o.setflags(write=False)
+    return o
 
 
 @kernel
@@ -59,15 +71,19 @@ def _k_frame_batch(p, gamma, RLM, R0, dwheel, o, out):
         _k_frame(p[i], gamma[i], RLM, R0, dwheel, o, out[i])
 
 
-def leg_frame_to_robot(p_L, gamma, leg, *, geometry: Geometry | None = None) -> np.ndarray:
+def leg_frame_to_robot(p_L: ArrayLike, gamma: ArrayLike, leg: Leg, *, geometry: Geometry | None = None) -> np.ndarray:
     """Map points (..., 3) of the leg frame {L} to {R} (seed section 1.2).
 
     ``p_M = T_L^M p_L`` (the seed's matrices, offset d_wheel), ``p_R = o_i + R0_i Rz(gamma) p_M``; the
     seed does not print ``T_M^R``: this is the module placement of "Coord definitions".
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
-    _, side, _ = _leg(leg)
-    o = module_origin(leg, geo)
+    try:
+        o = _origin(leg, geo)
+    except TypeError:  # unhashable: let _leg name it
+        _leg(leg)
+        raise
+    side = "L" if o[1] > 0 else "R"
     if (type(p_L) is np.ndarray and p_L.shape == (3,) and p_L.dtype == np.float64 and type(gamma) in _SCALARS
             and math.isfinite(gamma) and np.isfinite(p_L).all()):
         out = np.empty(3)
@@ -114,7 +130,7 @@ def _context(alpha, w, leg, rim, geo, radius) -> _Ctx:
     else:
         rho = check_number(radius, "radius", 0.0, 2.0 * geo.R, low_open=True)
     sel = _select(alpha, seed, rho, geo.R)
-    return _Ctx(sel, np.asarray(w, dtype=float), _constants(geo.R), geo, module_origin(leg, geo),
+    return _Ctx(sel, np.asarray(w, dtype=float), _constants(geo.R), geo, _origin(leg, geo),
                 1.0 if side == "L" else -1.0, seed)
 
 

@@ -25,7 +25,7 @@ from . import ik_iterative
 from ._common import _LIMITS, _SCALARS, _SOLVED, Leg, Rim, _check_alpha, _check_theta, _check_w, rim_name
 from ._legacy import legacy_ik_call, method_name
 from .frames import _context, _fk, _kctx_cached
-from .geometry import _DEFAULT_GEOMETRY, ABAD_LIMIT, THETA_MAX, THETA_MIN, Geometry, _geometry, _leg
+from .geometry import _DEFAULT_GEOMETRY, _LIMIT_ROUNDING, ABAD_LIMIT, THETA_MAX, THETA_MIN, Geometry, _geometry, _leg
 from .ik_radial import _NO_Q0, _RADIAL_SOLS, _ik_radial, _k_ik_radial, _radial_table
 from .rim import _k_select
 
@@ -97,7 +97,7 @@ def _single_ctx(leg, rim, radius, geo: Geometry, method: str):
     return kc, ik_iterative.guess_table(geo.R, kc[0])
 
 
-def _single(target, alpha, w, leg, rim, radius, geo, method, opts, return_mask, return_info):
+def _single(target, alpha, w, leg, rim, radius, geo, method, opts, return_mask, return_info, limits=True):
     """One target with default keywords: the method's kernel called directly. None (the general path then
     decides, and raises) unless solved."""
     if not (abs(alpha) <= math.pi + 1e-12 and abs(w) <= geo.T / 2 + 1e-15):
@@ -115,12 +115,12 @@ def _single(target, alpha, w, leg, rim, radius, geo, method, opts, return_mask, 
         max_iter = 60 if opts.max_iter is None else opts.max_iter
         sols = np.empty((_RADIAL_SOLS, 3))
         its, err, reason, _nr, nsol = _k_ik_radial(target, upper, right, e, a, seed, K, KC, s, o0, o1, o2, *tables,
-                                                   opts.tol, max_iter, _NO_Q0[0], False, True, q, sols)
+                                                   opts.tol, max_iter, _NO_Q0[0], False, limits, q, sols)
         ev = its + 1
         if reason == _SOLVED and return_info and nsol > _RADIAL_SOLS:
             sols = np.empty((nsol, 3))
             _k_ik_radial(target, upper, right, e, a, seed, K, KC, s, o0, o1, o2, *tables, opts.tol, max_iter,
-                         _NO_Q0[0], False, True, np.empty(3), sols)
+                         _NO_Q0[0], False, limits, np.empty(3), sols)
         sols = sols[:nsol]
     else:
         max_iter = ik_iterative.DEFAULT_MAX_ITER[method] if opts.max_iter is None else opts.max_iter
@@ -315,6 +315,15 @@ def ik(target, leg=None, /, *args, alpha=0.0, w=0.0, q_near=None, q_start=None, 
     return out
 
 
+def _in_limits(sols: np.ndarray) -> np.ndarray:
+    """Mask (..., S) of solutions with gamma inside the ABAD limits (within rounding, as :func:`ik`; those are
+    clipped onto the limit in place)."""
+    with np.errstate(invalid="ignore"):
+        inside = np.abs(sols[..., 2]) <= ABAD_LIMIT + _LIMIT_ROUNDING
+    sols[..., 2] = np.where(inside, np.clip(sols[..., 2], -ABAD_LIMIT, ABAD_LIMIT), sols[..., 2])
+    return inside
+
+
 @overload
 def ik_all(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
            radius: float | None = None, limits: bool = False, options: IKOptions | None = None,
@@ -338,12 +347,21 @@ def ik_all(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike 
     opts = _options(options)
     return_mask = check_flag(return_mask, "return_mask")
     limits = check_flag(limits, "limits")
-    run, _q = _run(target, alpha, w, leg, None, None, "radial", rim_name(rim), radius, False, opts, geo, True)
+    rim = rim_name(rim)
+    if type(target) is np.ndarray and target.shape == (3,) and target.dtype == np.float64 and type(alpha) in _SCALARS \
+            and type(w) in _SCALARS:
+        out = _single(target, float(alpha), float(w), leg, rim, radius, geo, "radial", opts, False, True, False)
+        if out is not None:
+            sols = out[1].solutions
+            sols = sols[_in_limits(sols)] if limits else sols
+            if len(sols):
+                return (sols, np.array(True)) if return_mask else sols
+    run, _q = _run(target, alpha, w, leg, None, None, "radial", rim, radius, False, opts, geo, True)
     sols = run.info.solutions
     assert sols is not None
     keep = np.isfinite(sols).all(axis=-1)
     if limits:
-        keep &= np.abs(np.nan_to_num(sols[..., 2])) <= ABAD_LIMIT
+        keep &= _in_limits(sols)
     order = np.argsort(~keep, axis=-1, kind="stable")  # the kept ones first, in their order
     sols = np.take_along_axis(np.where(keep[..., None], sols, np.nan), order[..., None], axis=-2)
     count = keep.sum(axis=-1)

@@ -8,10 +8,11 @@ from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._batch import as_angles
 from .._kernels import as_rows, kernel, prange
-from ._common import _SCALARS, _check_theta, _loop
+from ._common import _SCALARS, _check_theta, _loop, legacy_geometry
 from .geometry import _ARC_BC, _ARC_HF, _DEFAULT_GEOMETRY, _J_ANGLE, FOOT_OFFSET, THETA0, THETA_MAX, THETA_MIN, Geometry, _geometry
 
 
@@ -31,13 +32,18 @@ class _Const(NamedTuple):
     ang_LFG: float
 
 
-def linkage_constants(R: float = 0.1) -> dict[str, float]:
-    """Link lengths (m) and fixed angles (rad) of the leg linkage for pitch radius ``R``.
+def linkage_constants(*args: float, geometry: Geometry | None = None, **kwargs: float) -> dict[str, float]:
+    """Link lengths (m) and fixed angles (rad) of the leg linkage for the pitch radius ``geometry.R``.
 
     ``l4 = CD`` is computed so that the rims close exactly into a circle about O at theta0 (the design
-    notes give 0.882966335 R, which this reproduces to 1e-10 R).
+    notes give 0.882966335 R, which this reproduces to 1e-10 R). legkin 0.1's ``linkage_constants(R)`` /
+    ``linkage_constants(R=...)`` still works for one release (DeprecationWarning): it means
+    ``geometry=Geometry(R=R)``.
     """
-    return _constants(float(R))._asdict()
+    if args or kwargs:
+        geometry = legacy_geometry("linkage_constants", ("R",), args, kwargs, geometry)
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    return _constants(geo.R)._asdict()
 
 
 @lru_cache(maxsize=16)
@@ -313,7 +319,8 @@ def _angle_pair(theta, beta):
     return as_rows(theta, 1)[:, 0], as_rows(beta, 1)[:, 0], theta.shape
 
 
-def linkage_points(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict[str, np.ndarray]:
+def linkage_points(theta: ArrayLike, beta: ArrayLike = 0.0, *,
+                   geometry: Geometry | None = None) -> dict[str, np.ndarray]:
     """Every hinge point and rim centre of the leg in the leg frame {L}, by the closed form.
 
     Implements the reference's closed form of the linkage (the lab's ``LegModel.calculate``):
@@ -334,11 +341,15 @@ def linkage_points(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict
     t, b, shape = _angle_pair(theta, beta)
     K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
     out = np.empty((t.shape[0], len(POINTS), 3))
+    if shape == ():
+        _k_linkage(t[0], b[0], K, KC, _PT_INDEX, _PT_CONJ, out[0])
+        return dict(zip(POINTS, out[0]))
     _k_linkage_batch(t, b, K, KC, _PT_INDEX, _PT_CONJ, out)
-    return {k: out[:, j].reshape(shape + (3,)) for j, k in enumerate(POINTS)}
+    return dict(zip(POINTS, out.transpose(1, 0, 2).reshape((len(POINTS),) + shape + (3,))))
 
 
-def passive_angles(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict[str, np.ndarray]:
+def passive_angles(theta: ArrayLike, beta: ArrayLike = 0.0, *,
+                   geometry: Geometry | None = None) -> dict[str, np.ndarray]:
     """Angles of the 10 tree joints of a leg that close its four loops, from the closed form.
 
     Every tree joint is a revolute joint about z_L whose zero is the wheel-mode configuration
@@ -360,21 +371,31 @@ def passive_angles(theta, beta=0.0, *, geometry: Geometry | None = None) -> dict
     t, b, shape = _angle_pair(theta, beta)
     K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
     out = np.empty((t.shape[0], len(PASSIVE_JOINTS)))
+    if shape == ():
+        _k_passive(t[0], b[0], K, KC, _ref_links(geo.R), out[0])
+        return {k: np.asarray(v) for k, v in zip(PASSIVE_JOINTS, out[0])}
     _k_passive_batch(t, b, K, KC, _ref_links(geo.R), out)
-    return {k: out[:, j].reshape(shape) for j, k in enumerate(PASSIVE_JOINTS)}
+    return dict(zip(PASSIVE_JOINTS, out.T.reshape((len(PASSIVE_JOINTS),) + shape)))
 
 
-def motor_angles(theta, beta) -> tuple[np.ndarray, np.ndarray]:
-    """(phi_L, phi_R) = (beta + theta - theta0, beta - theta + theta0) (reference, motor mapping)."""
+def motor_angles(theta: ArrayLike, beta: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """(phi_L, phi_R) = (beta + theta - theta0, beta - theta + theta0) (reference, motor mapping).
+
+    A linear map: numpy on the broadcast inputs (no kernel needed); two numbers give two 0-d arrays.
+    """
+    if type(theta) is float and type(beta) is float and math.isfinite(theta) and math.isfinite(beta):
+        return np.asarray(beta + (theta - THETA0)), np.asarray(beta - (theta - THETA0))
     theta, beta = as_angles(theta, beta, names=("theta", "beta"))
-    return beta + (theta - THETA0), beta - (theta - THETA0)
+    return np.asarray(beta + (theta - THETA0)), np.asarray(beta - (theta - THETA0))
 
 
-def theta_beta(phi_L, phi_R) -> tuple[np.ndarray, np.ndarray]:
+def theta_beta(phi_L: ArrayLike, phi_R: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
     """(theta, beta) = ((phi_L - phi_R)/2 + theta0, (phi_L + phi_R)/2); inverse of :func:`motor_angles`.
 
     theta is not range-checked here (the motors can be commanded anywhere; the linkage cannot).
     """
+    if type(phi_L) is float and type(phi_R) is float and math.isfinite(phi_L) and math.isfinite(phi_R):
+        return np.asarray((phi_L - phi_R) / 2 + THETA0), np.asarray((phi_L + phi_R) / 2)
     phi_L, phi_R = as_angles(phi_L, phi_R, names=("phi_L", "phi_R"))
-    return (phi_L - phi_R) / 2 + THETA0, (phi_L + phi_R) / 2
+    return np.asarray((phi_L - phi_R) / 2 + THETA0), np.asarray((phi_L + phi_R) / 2)
 

@@ -6,8 +6,9 @@ import math
 from typing import NamedTuple
 
 import numpy as np
+from numpy.typing import ArrayLike
 
-from .._batch import as_angles, as_input
+from .._batch import as_angles, as_input, check_number
 from .._kernels import as_rows, kernel, prange
 from ._common import _SCALARS, _check_alpha, _check_theta, _check_w, _loop
 from .geometry import _ARC_FG, _DEFAULT_GEOMETRY, FOOT_OFFSET, PSI_FG, THETA_MAX, THETA_MIN, Geometry, _geometry
@@ -25,12 +26,14 @@ _SEGMENTS = (
 _SEG_A0 = (-_ARC_FG, 0.0, 0.0, _ARC_FG)  # alpha at which the segment's reference point is reached
 
 
-def rim_segment(alpha) -> np.ndarray:
+def rim_segment(alpha: ArrayLike) -> np.ndarray:
     """Index (0-3) of the rim link that carries the contact point of parameter ``alpha`` in :func:`rim_point`.
 
     0: upper rim left (alpha < -50 deg), 1: lower rim left (-50 deg <= alpha < 0), 2: lower rim right
     (0 <= alpha <= 50 deg), 3: upper rim right (alpha > 50 deg).
     """
+    if type(alpha) is float:
+        return np.asarray(0 if alpha < -_ARC_FG else (1 if alpha < 0.0 else (2 if alpha <= _ARC_FG else 3)))
     a = np.asarray(alpha, dtype=float)
     return np.where(a < -_ARC_FG, 0, np.where(a < 0.0, 1, np.where(a <= _ARC_FG, 2, 3)))
 
@@ -198,7 +201,8 @@ def _rim_inputs(theta, beta, alpha, w, geo):
     return theta, beta, alpha, w
 
 
-def rim_point(theta, beta, alpha, w=0.0, *, radius: float | None = None, geometry: Geometry | None = None):
+def rim_point(theta: ArrayLike, beta: ArrayLike, alpha: ArrayLike, w: ArrayLike = 0.0, *, radius: float | None = None,
+              geometry: Geometry | None = None) -> np.ndarray:
     """Contact point on the real rims, continuous in alpha over the whole rim (leg frame, (x, y, w)).
 
     Departs from seed section 1.1 (see :func:`rim_point_seed`), whose three arcs leave the lower rims out.
@@ -228,7 +232,8 @@ def rim_point(theta, beta, alpha, w=0.0, *, radius: float | None = None, geometr
     return _rim_call(theta, beta, alpha, w, radius, geometry, False)
 
 
-def rim_point_seed(theta, beta, alpha, w=0.0, *, radius: float | None = None, geometry: Geometry | None = None):
+def rim_point_seed(theta: ArrayLike, beta: ArrayLike, alpha: ArrayLike, w: ArrayLike = 0.0, *,
+                   radius: float | None = None, geometry: Geometry | None = None) -> np.ndarray:
     """The seed's three-arc contact point (seed 001 section 1.1), exactly as printed, alpha in radians.
 
     ::
@@ -246,16 +251,18 @@ def rim_point_seed(theta, beta, alpha, w=0.0, *, radius: float | None = None, ge
     return _rim_call(theta, beta, alpha, w, radius, geometry, True)
 
 
-def rim_jump_seed(theta, *, radius: float | None = None, geometry: Geometry | None = None) -> np.ndarray:
+def rim_jump_seed(theta: ArrayLike, *, radius: float | None = None, geometry: Geometry | None = None) -> np.ndarray:
     """Size (m) of the jump of :func:`rim_point_seed` at alpha = +psi_FG (equal at -psi_FG by symmetry).
 
     The distance between the toe-arc point at alpha = psi_FG and the upper-rim point at alpha -> psi_FG+.
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    rho = geo.R + FOOT_OFFSET if radius is None else check_number(radius, "radius", 0.0, 2.0 * geo.R, low_open=True)
+    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    if type(theta) is float and THETA_MIN - 1e-12 <= theta <= THETA_MAX + 1e-12:
+        return np.asarray(_k_jump(theta, rho, K, KC))
     theta = as_input(theta, "theta")
     _check_theta(theta)
-    rho = geo.R + FOOT_OFFSET if radius is None else float(radius)
-    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
     out = np.empty(theta.size)
     _k_jump_batch(as_rows(theta, 1)[:, 0], rho, K, KC, out)
     return out.reshape(theta.shape)

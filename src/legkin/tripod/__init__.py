@@ -28,7 +28,9 @@ def __getattr__(name: str) -> Any:
     if name == "__all__":
         return ["SPEC", *kinematics.__all__]
     if name in kinematics.__all__:
-        return getattr(kinematics, name)
+        value = getattr(kinematics, name)
+        globals()[name] = value  # later look-ups skip this function
+        return value
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 

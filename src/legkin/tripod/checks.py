@@ -5,7 +5,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-import pinocchio as pin
 
 from .. import load
 from .._rotations import rotation_angle as _rot_err

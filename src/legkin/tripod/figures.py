@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import kinematics as at
 from ..figures import new_figure
+from . import kinematics as at
 
 LEG_COLOURS = {"A": "tab:red", "B": "tab:green", "C": "tab:blue"}
 

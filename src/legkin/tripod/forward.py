@@ -14,8 +14,24 @@ from .._batch import as_angles, as_input, check_integer, check_number
 from .._kernels import OK
 from ..errors import AssemblyModeError, ConvergenceError, SingularityError, UnreachableError
 from ._common import (
-    DET_GUARD, GAIN_GUARD, HOME_MODE, MODE_ARGS, MODES, ST_LEFT, ST_NONFINITE, ST_NOT_CONVERGED, ST_OUTSIDE,
-    ST_GAIN, ST_SINGULAR_PLANES, checked_mode, deprecated, flag, geometry_of, modes_sel, pick, split_legacy,
+    DET_GUARD,
+    GAIN_GUARD,
+    HOME_MODE,
+    MODE_ARGS,
+    MODES,
+    ST_GAIN,
+    ST_LEFT,
+    ST_NONFINITE,
+    ST_NOT_CONVERGED,
+    ST_OUTSIDE,
+    ST_SINGULAR_PLANES,
+    checked_mode,
+    deprecated,
+    flag,
+    geometry_of,
+    modes_sel,
+    pick,
+    split_legacy,
 )
 from .forward_kernels import FK_LOOP, _k_fk, _k_initial_guess
 from .geometry import Geometry

@@ -33,8 +33,16 @@ import numpy as np
 from .._kernels import OK, batch_kernel, kernel, prange
 from .._rotations import wrap_k
 from ._common import (
-    DET_GUARD, GAIN_GUARD, ST_GAIN, ST_INCONSISTENT, ST_LEFT, ST_NONFINITE, ST_NOT_CONVERGED, ST_OUTSIDE,
-    ST_SINGULAR_PLANES, serial,
+    DET_GUARD,
+    GAIN_GUARD,
+    ST_GAIN,
+    ST_INCONSISTENT,
+    ST_LEFT,
+    ST_NONFINITE,
+    ST_NOT_CONVERGED,
+    ST_OUTSIDE,
+    ST_SINGULAR_PLANES,
+    serial,
 )
 from .closure import _k_inside, _k_jac, _k_pose
 from .geometry import G_CE, G_K, G_SE, G_W

@@ -12,8 +12,22 @@ from .._batch import as_angles, as_input
 from .._kernels import OK
 from ..errors import SingularityError, UnreachableError
 from ._common import (
-    BOUNDARY_TOL, DET_GUARD, GAIN_GUARD, HOME_MODE, LEGS, MODE_ARGS, MODES, SINGULAR_TOL, ST_NONFINITE, checked_mode,
-    deprecated, flag, geometry_of, modes_sel, pick, split_legacy,
+    BOUNDARY_TOL,
+    DET_GUARD,
+    GAIN_GUARD,
+    HOME_MODE,
+    LEGS,
+    MODE_ARGS,
+    MODES,
+    SINGULAR_TOL,
+    ST_NONFINITE,
+    checked_mode,
+    deprecated,
+    flag,
+    geometry_of,
+    modes_sel,
+    pick,
+    split_legacy,
 )
 from .closure import IK_LOOP, JACOBIAN_LOOP, _k_actuation_jacobian, _k_ik
 from .geometry import Geometry
@@ -260,6 +274,11 @@ def ik_joints(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | 
     :func:`ik` (whose motors are columns 0, 4, 8). ``mode="all"``: (..., 16, 12)."""
     mode = checked_mode(mode, allow_all=True)
     return_mask = flag(return_mask, "return_mask")
+    if geometry is None and type(target) is np.ndarray and target.shape == (2,) and target.dtype == np.float64 and \
+            mode != "all":  # the single-call fast path
+        q, aux, st = ik_one(float(target[0]), float(target[1]), geometry_of(None)._vector, mode)
+        if st == OK:
+            return (q, np.asarray(True)) if return_mask else q
     ay, az, scalar, g, bad = _new_call("ik_joints", target, {}, geometry)
     return _solve(ay, az, scalar, g, mode, return_mask, True, bad)
 

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import math
 import warnings
+from dataclasses import dataclass
+from typing import Any, Callable
 
 import numpy as np
 
@@ -83,7 +85,7 @@ def single_calls() -> list[SingleCall]:
 _FLOOR = None
 
 
-def transcendental_floor():
+def transcendental_floor() -> Callable[[np.ndarray, np.ndarray], None]:
     """The compiled floor loop ``floor(p, out)``: per target row of ``p`` (n, 3), the transcendental calls of
     ``ik``'s closed form alone (2 sqrt, 1 acos, 2 atan2, on the target's coordinates), written to ``out``
     (n, 3); a ``prange`` loop like the batch kernels (numba's thread count), compiled on first use."""
@@ -103,28 +105,35 @@ def transcendental_floor():
     return _FLOOR
 
 
-def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
-    n_batch, n_scalar, n_iter = _sizes(n, quick)
-    robot = load("quadruped")
-    model, data = robot.model, robot.data
-    fid = robot.frame_id(f"{LEG}_FOOT")
-    cols = leg_slice(robot, LEG)
-    q0_leg = robot.q0[cols].copy()
+@dataclass
+class _Setup:
+    """What every method of the bench shares: the model, leg LF's frame and columns, the targets, the score."""
 
-    q_gen = sample_joints(rng, n_batch)
-    targets, target_rot = pinocchio_positions(model, data, fid, configuration(robot, {LEG: q_gen}))
+    robot: Any
+    fid: int
+    cols: slice
+    q0_leg: np.ndarray
+    targets: np.ndarray
+    target_rot: np.ndarray
 
-    def joints_score(p: np.ndarray, out) -> Score:
+    def joints_score(self, p: np.ndarray, out: Any) -> Score:
+        """Pinocchio's foot at the returned joints (mod 2 pi into the limits) vs the target."""
         qs, iters = out if isinstance(out, tuple) else (out, None)
         qs = np.asarray(qs, dtype=float)
         inside = np.all(np.isfinite(qs), axis=-1)
         qw = np.where(inside[:, None], _into_limits(np.nan_to_num(qs)), np.nan)
         inside &= aq.within_limits(np.nan_to_num(qw, nan=1e9))
-        pos, _ = pinocchio_positions(model, data, fid, configuration(robot, {LEG: qs}))
+        robot = self.robot
+        pos, _ = pinocchio_positions(robot.model, robot.data, self.fid, configuration(robot, {LEG: qs}))
         err = np.linalg.norm(pos - p, axis=-1)
         fk = None if iters is None else iters + 1
         reached = err <= SOLVE_TOL
         return Score(error=err, solved=reached & inside, iterations=iters, fk_evals=fk, reached=reached)
+
+
+def _legkin_methods(s: _Setup, q_gen: np.ndarray, n_batch: int, n_scalar: int) -> list[Method]:
+    """legkin's batch (numba's threads and 1 thread), batch FK, the floor and the scalar loop."""
+    targets = s.targets
 
     def fk_score(q: np.ndarray, pos: np.ndarray) -> Score:
         err = np.linalg.norm(pos - targets[: len(q)], axis=-1)
@@ -132,19 +141,18 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
 
     floor_loop = transcendental_floor()
 
-    def floor_run(p):
+    def floor_run(p: np.ndarray) -> np.ndarray:
         out = np.empty_like(p)
         floor_loop(p, out)
         return out
 
-    def floor_score(p: np.ndarray, out) -> Score:  # no answer to score: time only
+    def floor_score(p: np.ndarray, out: Any) -> Score:  # no answer to score: time only
         return Score(error=np.full(len(p), np.nan), solved=np.zeros(len(p), dtype=bool))
 
-    # ---------------------------------------------------------------- legkin
-    def batch_ik(p):
+    def batch_ik(p: np.ndarray) -> np.ndarray:
         return aq.ik(p, LEG)
 
-    def batch_ik_one_thread(p):  # the same call on one numba thread (the thread count restored after)
+    def batch_ik_one_thread(p: np.ndarray) -> np.ndarray:  # the same call on one numba thread (restored after)
         import numba
 
         before = numba.get_num_threads()
@@ -154,7 +162,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         finally:
             numba.set_num_threads(before)
 
-    def scalar_ik(p):
+    def scalar_ik(p: np.ndarray) -> np.ndarray:
         out = np.full((len(p), 3), np.nan)
         for i, pi in enumerate(p):
             try:
@@ -163,13 +171,29 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
                 pass
         return out
 
-    # ---------------------------------------------------------------- Pinocchio CLIK
+    score = s.joints_score
+    return [
+        Method(f"legkin batch closed form (ik, {n_batch} at once)", targets, batch_ik, score, repeats=7),
+        Method("legkin batch closed form, 1 thread (numba.set_num_threads(1))", targets, batch_ik_one_thread,
+               score, repeats=7),
+        Method("legkin batch FK (fk)", q_gen, lambda q: aq.fk(q, LEG), fk_score, repeats=7),
+        Method("floor: ik's transcendental calls alone (2 sqrt, acos, 2 atan2)", targets, floor_run,
+               floor_score, group="floor", repeats=7),
+        Method("legkin scalar closed form, Python loop", targets, scalar_ik, score, max_targets=n_scalar,
+               repeats=3),
+    ]
+
+
+def _clik_methods(s: _Setup, n_iter: int) -> list[Method]:
+    """Pinocchio's examples/inverse-kinematics.py on the foot position, DT = 0.1 and DT = 1."""
     import pinocchio as pin
 
+    robot = s.robot
+    model, data, fid, cols = robot.model, robot.data, s.fid, s.cols
     damp_eye = CLIK_DAMP * np.eye(3)
 
-    def clik(dt: float):
-        def run(p):
+    def clik(dt: float) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]]:
+        def run(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
             out = np.full((len(p), 3), np.nan)
             iters = np.zeros(len(p))
             for k, target in enumerate(p):
@@ -190,72 +214,63 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
 
         return run
 
-    methods = [
-        Method(f"legkin batch closed form (ik, {n_batch} at once)", targets, batch_ik, joints_score, repeats=7),
-        Method("legkin batch closed form, 1 thread (numba.set_num_threads(1))", targets, batch_ik_one_thread,
-               joints_score, repeats=7),
-        Method("legkin batch FK (fk)", q_gen, lambda q: aq.fk(q, LEG), fk_score,
-               repeats=7),
-        Method("floor: ik's transcendental calls alone (2 sqrt, acos, 2 atan2)", targets, floor_run,
-               floor_score, group="floor", repeats=7),
-        Method("legkin scalar closed form, Python loop", targets, scalar_ik, joints_score, max_targets=n_scalar,
-               repeats=3),
-        Method("pinocchio CLIK (example settings, DT=0.1)", targets, clik(CLIK_DT), joints_score,
+    return [
+        Method("pinocchio CLIK (example settings, DT=0.1)", s.targets, clik(CLIK_DT), s.joints_score,
                max_targets=n_iter, repeats=3),
-        Method("pinocchio CLIK, full Gauss-Newton step (DT=1)", targets, clik(1.0), joints_score,
+        Method("pinocchio CLIK, full Gauss-Newton step (DT=1)", s.targets, clik(1.0), s.joints_score,
                max_targets=n_iter, repeats=3),
     ]
 
-    # ---------------------------------------------------------------- ikpy
+
+def _ikpy_method(s: _Setup, n_iter: int) -> Method:
     reason = missing("ikpy")
     if reason:
-        methods.append(Method("ikpy (scipy least_squares)", skip=reason))
-    else:
-        import ikpy.chain
+        return Method("ikpy (scipy least_squares)", skip=reason)
+    import ikpy.chain
 
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            chain = ikpy.chain.Chain.from_urdf_file(str(robot.urdf_path), base_elements=["base", f"{LEG}_HAA"])
-        mask = [link.joint_type != "fixed" for link in chain.links]
-        chain = ikpy.chain.Chain.from_urdf_file(
-            str(robot.urdf_path), base_elements=["base", f"{LEG}_HAA"], active_links_mask=mask
-        )
-        active = np.flatnonzero(mask)
-        init = np.zeros(len(chain.links))
-        init[active] = q0_leg
+    urdf = str(s.robot.urdf_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        chain = ikpy.chain.Chain.from_urdf_file(urdf, base_elements=["base", f"{LEG}_HAA"])
+    mask = [link.joint_type != "fixed" for link in chain.links]
+    chain = ikpy.chain.Chain.from_urdf_file(urdf, base_elements=["base", f"{LEG}_HAA"], active_links_mask=mask)
+    active = np.flatnonzero(mask)
+    init = np.zeros(len(chain.links))
+    init[active] = s.q0_leg
 
-        def ikpy_run(p):
-            out = np.empty((len(p), 3))
-            for k, target in enumerate(p):
-                out[k] = chain.inverse_kinematics(target, initial_position=init)[active]
-            return out
+    def ikpy_run(p: np.ndarray) -> np.ndarray:
+        out = np.empty((len(p), 3))
+        for k, target in enumerate(p):
+            out[k] = chain.inverse_kinematics(target, initial_position=init)[active]
+        return out
 
-        methods.append(Method("ikpy (scipy least_squares)", targets, ikpy_run, joints_score, max_targets=n_iter,
-                              repeats=3))
+    return Method("ikpy (scipy least_squares)", s.targets, ikpy_run, s.joints_score, max_targets=n_iter, repeats=3)
 
-    # ---------------------------------------------------------------- TRAC-IK
+
+def _tracik_method(s: _Setup, n_iter: int) -> Method:
     reason = missing("pytracik", "trac_ik")
     if reason:
-        methods.append(Method("TRAC-IK (pytracik)", skip=reason))
-    else:
-        from trac_ik import TracIK
+        return Method("TRAC-IK (pytracik)", skip=reason)
+    from trac_ik import TracIK
 
-        with quiet_stdout():  # KDL prints a warning about the root link's inertia
-            tracik = TracIK("base", f"{LEG}_FOOT", str(robot.urdf_path), epsilon=TRACIK_EPS)
-        pose = np.concatenate([targets, target_rot.reshape(len(targets), 9)], axis=1)
+    with quiet_stdout():  # KDL prints a warning about the root link's inertia
+        tracik = TracIK("base", f"{LEG}_FOOT", str(s.robot.urdf_path), epsilon=TRACIK_EPS)
+    pose = np.concatenate([s.targets, s.target_rot.reshape(len(s.targets), 9)], axis=1)
 
-        def tracik_run(pr):
-            out = np.full((len(pr), 3), np.nan)
-            for k, row in enumerate(pr):
-                q = tracik.ik(row[:3], row[3:].reshape(3, 3), seed_jnt_values=q0_leg)
-                if q is not None:
-                    out[k] = q
-            return out
+    def tracik_run(pr: np.ndarray) -> np.ndarray:
+        out = np.full((len(pr), 3), np.nan)
+        for k, row in enumerate(pr):
+            q = tracik.ik(row[:3], row[3:].reshape(3, 3), seed_jnt_values=s.q0_leg)
+            if q is not None:
+                out[k] = q
+        return out
 
-        methods.append(Method("TRAC-IK (pytracik, full pose)", pose, tracik_run,
-                              lambda pr, out: joints_score(pr[:, :3], out), max_targets=n_iter, repeats=3))
+    return Method("TRAC-IK (pytracik, full pose)", pose, tracik_run,
+                  lambda pr, out: s.joints_score(pr[:, :3], out), max_targets=n_iter, repeats=3)
 
-    notes = [
+
+def _notes(n_batch: int, n_scalar: int, n_iter: int) -> list[str]:
+    return [
         f"targets: Pinocchio FK of {LEG}_FOOT for {n_batch} joint vectors of leg {LEG} uniform in its limits "
         f"(the other legs at q0); slow methods solve the first {n_scalar} (scalar loop) or {n_iter} (iterative) "
         "of the same targets",
@@ -277,31 +292,48 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         "SQP solver in two threads",
     ]
 
-    def summary(results: list[MethodResult]) -> list[str]:
-        import numba
 
-        by = {r.name: r for r in results}
-        batch = next(r for r in results if "batch closed form" in r.name)
-        fk = next(r for r in results if "batch FK" in r.name)
-        floor = next(r for r in results if r.group == "floor")
-        one = next(r for r in results if "1 thread" in r.name)
-        lines = [
-            f"batch closed form: {1.0 / batch.time_per_target_s / 1e6:.2f} M targets/s on "
-            f"{numba.get_num_threads()} thread(s); IK/floor = {batch.time_per_target_s / floor.time_per_target_s:.1f}"
-            f" (floor = its transcendental calls alone); IK/FK = {batch.time_per_target_s / fk.time_per_target_s:.1f}; "
-            f"{numba.get_num_threads()} threads vs 1: {one.time_per_target_s / batch.time_per_target_s:.2f}x faster"
-        ]
-        for r in by.values():
-            if r is batch or r is fk or r is floor or r is one:
-                continue
-            speedup = r.time_per_target_s / batch.time_per_target_s
-            lines.append(f"batch closed form is {speedup:,.0f}x faster than {r.name}")
-        return lines
+def _summary(results: list[MethodResult]) -> list[str]:
+    import numba
 
+    by = {r.name: r for r in results}
+    batch = next(r for r in results if "batch closed form" in r.name)
+    fk = next(r for r in results if "batch FK" in r.name)
+    floor = next(r for r in results if r.group == "floor")
+    one = next(r for r in results if "1 thread" in r.name)
+    lines = [
+        f"batch closed form: {1.0 / batch.time_per_target_s / 1e6:.2f} M targets/s on "
+        f"{numba.get_num_threads()} thread(s); IK/floor = {batch.time_per_target_s / floor.time_per_target_s:.1f}"
+        f" (floor = its transcendental calls alone); IK/FK = {batch.time_per_target_s / fk.time_per_target_s:.1f}; "
+        f"{numba.get_num_threads()} threads vs 1: {one.time_per_target_s / batch.time_per_target_s:.2f}x faster"
+    ]
+    for r in by.values():
+        if r is batch or r is fk or r is floor or r is one:
+            continue
+        speedup = r.time_per_target_s / batch.time_per_target_s
+        lines.append(f"batch closed form is {speedup:,.0f}x faster than {r.name}")
+    return lines
+
+
+def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
+    """The quadruped's bench rows (see the module docstring): ``n`` batch targets (None: the default sizes)."""
+    n_batch, n_scalar, n_iter = _sizes(n, quick)
+    robot = load("quadruped")
+    fid = robot.frame_id(f"{LEG}_FOOT")
+    cols = leg_slice(robot, LEG)
+    q_gen = sample_joints(rng, n_batch)
+    targets, target_rot = pinocchio_positions(robot.model, robot.data, fid, configuration(robot, {LEG: q_gen}))
+    s = _Setup(robot, fid, cols, robot.q0[cols].copy(), targets, target_rot)
+    methods = [
+        *_legkin_methods(s, q_gen, n_batch, n_scalar),
+        *_clik_methods(s, n_iter),
+        _ikpy_method(s, n_iter),
+        _tracik_method(s, n_iter),
+    ]
     return ModelBench(
         methods=methods,
         units={"ik": "m", "floor": "- (time only)"},
         tolerance=f"position error <= {SOLVE_TOL:g} m and joints inside the limits",
-        notes=notes,
-        summary=summary,
+        notes=_notes(n_batch, n_scalar, n_iter),
+        summary=_summary,
     )

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .. import load
@@ -83,7 +85,7 @@ def _geometry_rows(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     ]
 
 
-def _yourdfpy_row(robot, qs: np.ndarray, pos: np.ndarray, frames: list[str]) -> CheckResult:
+def _yourdfpy_row(robot: Any, qs: np.ndarray, pos: np.ndarray, frames: list[str]) -> CheckResult:
     """Third opinion: yourdfpy's forward kinematics of the same URDF vs Pinocchio."""
     import yourdfpy
 

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from . import kinematics as aq
 from .configuration import leg_slice
 
 
-def foot_circles(robot, frames: int = 90, radius: float = 0.06) -> list[np.ndarray]:
+def foot_circles(robot: Any, frames: int = 90, radius: float = 0.06) -> list[np.ndarray]:
     """Feet trace vertical circles (radius 6 cm) around their standing positions, legs half a turn apart."""
     t = np.linspace(0.0, 2.0 * np.pi, frames, endpoint=False)
     qs = np.tile(robot.q0, (frames, 1))

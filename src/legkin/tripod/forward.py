@@ -100,7 +100,7 @@ def _fk_error(qs: Sequence[float], out: np.ndarray, status: int, mode: str, othe
         )
     if status == ST_LEFT:  # diagnose at the planes' intersection (the start), as ik would there
         G = g._vector
-        y0, z0, _ = _k_initial_guess(*(float(v) for v in qs), G)
+        y0, z0, _ = _k_initial_guess(float(qs[0]), float(qs[1]), float(qs[2]), G)
         _, aux, st = ik_one(y0, z0, G, mode)
         if st != OK:
             exc = ik_single_error(np.float64(y0), np.float64(z0), G, mode, aux)
@@ -216,7 +216,7 @@ def fk(q: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ..., tol: f
        return_info: Literal[True]) -> tuple[np.ndarray, np.ndarray, FKInfo]: ...
 @overload
 def fk(q_A1: ArrayLike, q_B1: ArrayLike, q_C1: ArrayLike, d: float = ..., alpha: float = ...,
-       eta: Sequence[float] | None = ..., *, mode: str = ..., tol: float = ..., max_iter: int = ...,
+       eta: Sequence[float] | None = ..., /, *, mode: str = ..., tol: float = ..., max_iter: int = ...,
        max_inconsistency: float = ..., return_mask: bool = ...) -> Any: ...
 def fk(q: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | None = None, tol: float = 1e-13,
        max_iter: int = 30, max_inconsistency: float = 1e-9, return_mask: bool = False, return_info: bool = False,

@@ -191,7 +191,7 @@ def ik(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
        return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
 @overload
 def ik(alpha_y: ArrayLike, alpha_z: ArrayLike, d: float = ..., alpha: float = ..., eta: Sequence[float] | None = ...,
-       *, mode: str = ..., return_mask: bool = ...) -> Any: ...
+       /, *, mode: str = ..., return_mask: bool = ...) -> Any: ...
 def ik(target: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | None = None,
        return_mask: bool = False, **legacy: Any) -> Any:
     """The three motor angles (q_A1, q_B1, q_C1) for the platform orientation ``target = (alpha_y, alpha_z)``.
@@ -258,7 +258,7 @@ def ik_all(target: ArrayLike, *, geometry: Geometry | None = None, return_mask: 
     (mask False) where a mode does not solve it (every mode reaches the same orientations; a mode fails only on
     its own actuation singularities, :data:`DET_GUARD`, :data:`GAIN_GUARD`). A single call raises only when no
     mode solves the target. Equals :func:`ik` with ``mode="all"``."""
-    return ik(target, mode="all", geometry=geometry, return_mask=return_mask)
+    return ik(target, mode="all", geometry=geometry, return_mask=return_mask)  # type: ignore[call-overload]
 
 
 @overload
@@ -290,10 +290,10 @@ def _jacobian(ay: Any, az: Any, scalar: bool, g: Geometry, mode: str, return_mas
         shape = ay.shape
         y, z = np.ascontiguousarray(ay).reshape(-1), np.ascontiguousarray(az).reshape(-1)
         n = y.shape[0]
-        a, aux, status = np.empty((n, 3, 2)), np.empty((n, 4)), np.empty(n, dtype=np.int64)
-        pick(JACOBIAN_LOOP, n, "jac")(y, z, G, home, e, s, a, aux, status)
-        a, ok = a.reshape(shape + (3, 2)), (status == OK).reshape(shape)
-        return (a, ok) if return_mask else a
+        ab, auxb, status = np.empty((n, 3, 2)), np.empty((n, 4)), np.empty(n, dtype=np.int64)
+        pick(JACOBIAN_LOOP, n, "jac")(y, z, G, home, e, s, ab, auxb, status)
+        ab, ok = ab.reshape(shape + (3, 2)), (status == OK).reshape(shape)
+        return (ab, ok) if return_mask else ab
     a, aux = np.empty((3, 2)), np.empty(4)
     st = _k_actuation_jacobian(ay, az, G, home, e, s, a, aux)
     if st != OK:

@@ -626,3 +626,14 @@ def test_configuration_helpers(quadruped, rng):
     assert aq.within_limits(made, 0.0).all()
     legs = np.asarray(LEGS)[rng.integers(0, 4, 100)]
     assert cfg.random_targets(100, rng, legs).shape == (100, 3)
+
+
+def test_package_attributes_resolve_once():
+    """The lazy re-export keeps what it found: ``quadruped.fk`` in a loop is a plain attribute read."""
+    import legkin.quadruped as pkg
+
+    assert pkg.fk is aq.fk and pkg.Geometry is aq.Geometry
+    assert vars(pkg)["fk"] is aq.fk and vars(pkg)["Geometry"] is aq.Geometry
+    assert set(aq.__all__) <= set(dir(pkg)) and "SPEC" in pkg.__all__
+    with pytest.raises(AttributeError):
+        pkg.no_such_name  # noqa: B018

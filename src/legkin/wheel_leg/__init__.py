@@ -12,10 +12,10 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from .spec import SPEC
+from .spec import SPEC as SPEC
 
 if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they load on first use
-    from . import kinematics
+    from . import kinematics as kinematics
     from .kinematics import *  # noqa: F403
 
 _SUBMODULES = (

@@ -9,8 +9,8 @@ from typing import Literal, Union
 
 import numpy as np
 
-from .._kernels import batch_kernel, kernel
 from .._batch import check_choice
+from .._kernels import batch_kernel, kernel
 from ..errors import InvalidInputError
 from .geometry import THETA_MAX, THETA_MIN, Geometry
 

@@ -12,12 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from .. import load
-from . import kinematics as wl
-from ..bench import Method, MethodResult, ModelBench, Score
-from .configuration import SEGMENT_LINKS, configuration, ik_start, leg_joint_names, local_contact_point, sample_leg_q
-from ..errors import UnreachableError
 from .._benchkit import SOLVE_TOL, levenberg_marquardt, sizes
 from .._single_call import SingleCall
+from ..bench import Method, MethodResult, ModelBench, Score
+from ..errors import UnreachableError
+from . import kinematics as wl
+from .configuration import SEGMENT_LINKS, configuration, ik_start, leg_joint_names, local_contact_point, sample_leg_q
 
 LEG = "FL"
 #: Every iterative method is asked for the same position tolerance (m) (wl.ik's default).
@@ -197,7 +197,8 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         Method(f"legkin batch ik, analytic Jacobian (method='damped'; {n_batch} at once)", inputs, run_d, score_d,
                repeats=5),
         Method(f"legkin batch ik, radial (method='radial'; {n_batch} at once)", inputs, run_r, score_r, repeats=5),
-        Method("seed Gauss-Newton, forward differences (method='gauss_newton_fd'; batch)", inputs, run_s, score_s, repeats=5),
+        Method("seed Gauss-Newton, forward differences (method='gauss_newton_fd'; batch)", inputs, run_s, score_s,
+               repeats=5),
         Method("legkin scalar ik (damped), Python loop", inputs, run_d1, score_d1, max_targets=n_scalar, repeats=3),
         Method("legkin scalar ik (radial), Python loop", inputs, run_r1, score_r1, max_targets=n_scalar, repeats=3),
         Method("seed forward-difference Gauss-Newton, scalar calls in a loop", inputs, run_s1, score_s1,

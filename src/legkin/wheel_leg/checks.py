@@ -5,8 +5,8 @@ from __future__ import annotations
 import numpy as np
 
 from .. import load
-from . import kinematics as wl
 from ..validation import CheckResult, compare, per_sample, pinocchio_frames
+from . import kinematics as wl
 from .configuration import SEGMENT_LINKS, configuration, leg_joint_names, local_contact_point, sample_leg_q
 
 TOL = 1e-12
@@ -103,7 +103,8 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     up = np.abs(alpha) > wl.PSI_FG
     local_s, seg_s = local_contact_point(alpha[up], w[up], geo, rim="three_arc")
     idx_s = legs[up] * 4 + seg_s
-    pin_s = fpos[up][np.arange(up.sum()), idx_s] + np.einsum("nij,nj->ni", frot[up][np.arange(up.sum()), idx_s], local_s)
+    rows_s = np.arange(up.sum())
+    pin_s = fpos[up][rows_s, idx_s] + np.einsum("nij,nj->ni", frot[up][rows_s, idx_s], local_s)
     ana_s = np.empty((up.sum(), 3))
     for k, leg in enumerate(wl.LEGS):
         m = legs[up] == k
@@ -123,10 +124,11 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         for k, leg in enumerate(wl.LEGS):
             m = legs == k
             qm = q3[m]
-            plus = wl.fk(np.clip(qm + dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9]), leg, alpha=alpha[m], w=w[m], geometry=geo)
-            minus = wl.fk(np.clip(qm - dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9]), leg, alpha=alpha[m], w=w[m], geometry=geo)
-            step = np.clip(qm + dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9])[:, c] - np.clip(
-                qm - dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9])[:, c]
+            hi = np.clip(qm + dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9])
+            lo = np.clip(qm - dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9])
+            plus = wl.fk(hi, leg, alpha=alpha[m], w=w[m], geometry=geo)
+            minus = wl.fk(lo, leg, alpha=alpha[m], w=w[m], geometry=geo)
+            step = hi[:, c] - lo[:, c]
             fd[m, :, c] = (plus - minus) / step[:, None]
     rows.append(compare(f"jacobian vs central differences (h = {FD_STEP:g})",
                         np.abs(jac - fd).max(axis=(1, 2)), TOL_FD))
@@ -171,13 +173,14 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
                     target = wl.fk(q3[m], leg, alpha=alpha[m], w=w[m], rim="three_arc", geometry=geo)
                 else:
                     target = ana[m]
-                qk, ok, info = wl.ik(target, leg, alpha=alpha[m], w=w[m], method=method, rim=rim, geometry=geo,
-                                     return_mask=True, return_info=True)
+                qk, ok, ik_info = wl.ik(target, leg, alpha=alpha[m], w=w[m], method=method, rim=rim, geometry=geo,
+                                        return_mask=True, return_info=True)
                 reached = wl.fk(np.where(ok[:, None], qk, q3[m]), leg, alpha=alpha[m], w=w[m], rim=rim, geometry=geo)
                 errs[m] = np.where(ok, per_sample(reached - target), np.nan)
-                its[m], ok_all[m] = info.iterations, ok
+                its[m], ok_all[m] = ik_info.iterations, ok
                 if method == "radial":
-                    found[m] = solution_distance(info.solutions, q3[m]) * np.linalg.svd(
+                    assert ik_info.solutions is not None
+                    found[m] = solution_distance(ik_info.solutions, q3[m]) * np.linalg.svd(
                         wl.jacobian(q3[m], leg, alpha=alpha[m], w=w[m], rim=rim, geometry=geo), compute_uv=False)[:, -1]
             name = (f"ik(method='{method}', rim='{rim}') round trip: {ok_all.sum()}/{n} converged in [17, 160] deg, "
                     f"iterations mean {its.mean():.2f} max {its.max()}")
@@ -198,9 +201,10 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     q_rad = leg_q.copy()
     ok_rad = np.zeros(n, dtype=bool)
     for k, leg in enumerate(wl.LEGS):
-        m = np.flatnonzero(legs == k)
-        qk, ok_rad[m] = wl.ik(pin_p[m], leg, alpha=alpha[m], w=w[m], method="radial", geometry=geo, return_mask=True)
-        q_rad[m[ok_rad[m]], k] = qk[ok_rad[m]]
+        rows_k = np.flatnonzero(legs == k)
+        qk, ok_rad[rows_k] = wl.ik(pin_p[rows_k], leg, alpha=alpha[rows_k], w=w[rows_k], method="radial", geometry=geo,
+                                   return_mask=True)
+        q_rad[rows_k[ok_rad[rows_k]], k] = qk[ok_rad[rows_k]]
     fpos_r, frot_r = pinocchio_frames(robot, configuration(robot, q_rad), seg_frames)
     pin_r = fpos_r[np.arange(n), idx] + np.einsum("nij,nj->ni", frot_r[np.arange(n), idx], local)
     rows.append(compare(f"ik(method='radial') vs Pinocchio: target = rim link oMf * local point, answer's contact "

@@ -103,7 +103,7 @@ def sample_targets(n: int, rng: np.random.Generator, leg: str, *, geometry: Geom
     q = sample_q_in_limits(n, rng)
     alpha = rng.uniform(-np.pi, np.pi, n)
     w = rng.uniform(-geo.T / 2, geo.T / 2, n)
-    return fk(q, leg, alpha=alpha, w=w, rim=rim, geometry=geo), alpha, w, q  # type: ignore[arg-type]
+    return fk(q, leg, alpha=alpha, w=w, rim=rim, geometry=geo), alpha, w, q  # type: ignore[call-overload]
 
 
 def local_contact_point(alpha: ArrayLike, w: ArrayLike, geometry: Geometry | None = None,

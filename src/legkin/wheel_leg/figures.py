@@ -7,8 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import kinematics as wl
 from ..figures import new_figure
+from . import kinematics as wl
 
 #: Leg opening angles of the figure (deg): wheel mode, slightly open, half open, leg mode.
 THETAS_DEG = (17.0, 30.0, 90.0, 160.0)
@@ -19,7 +19,7 @@ RADIUS = 0.1
 _LINKS = (("O", "A_L"), ("O", "A_R"), ("A_L", "E"), ("A_R", "E"), ("D_L", "C_L"), ("D_R", "C_R"))
 
 
-def _seed_pieces(theta: float, alpha: np.ndarray) -> np.ndarray:
+def _seed_pieces(theta: float, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """rim_point_seed over ``alpha`` with NaN rows inserted at the jumps alpha = +-psi_FG (no false joins)."""
     p = wl.rim_point_seed(theta, 0.0, alpha, radius=RADIUS)
     # pieces: alpha < -psi_FG (upper rim, left), [-psi_FG, psi_FG] (toe arc), alpha > psi_FG (upper rim, right)
@@ -95,10 +95,10 @@ def figures(outdir: Path) -> list[Path]:
             ax.plot(deg(alpha_s), seed[:, k], color=col_k[1], lw=1.3, ls="--")
             ax.plot([40, 40], [lo[k], hi[k]], color=c_jump, lw=2.2)
             ax.plot([-40, -40], [lo[k] if k else -lo[k], hi[k] if k else -hi[k]], color=c_jump, lw=2.2)
-        for a in (-50, 50):
-            ax.axvline(a, color="0.5", lw=0.7, ls=":")
-        for a in (-40, 40):
-            ax.axvline(a, color=c_jump, lw=0.7, ls=":")
+        for a_deg in (-50, 50):
+            ax.axvline(a_deg, color="0.5", lw=0.7, ls=":")
+        for a_deg in (-40, 40):
+            ax.axvline(a_deg, color=c_jump, lw=0.7, ls=":")
         ax.set_xlim(-180, 180)
         ax.set_xticks(np.arange(-180, 181, 60))
         ax.set_ylim(-0.48, 0.2)

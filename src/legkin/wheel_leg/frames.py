@@ -18,7 +18,6 @@ from .geometry import _DEFAULT_GEOMETRY, FOOT_OFFSET, THETA_MAX, THETA_MIN, Geom
 from .linkage import _Const, _constants, _kconst
 from .rim import _k_plane, _k_select, _Sel, _select
 
-
 # ---------------------------------------------------------------- leg frame -> robot frame
 _R_LM = {  # columns: x_L, y_L, z_L in {M}
     "L": np.array([[0.0, 0.0, 1.0], [0.0, 1.0, 0.0], [-1.0, 0.0, 0.0]]),
@@ -38,7 +37,8 @@ def module_origin(leg: Leg, *args: Geometry | None, geometry: Geometry | None = 
     (DeprecationWarning).
     """
     if args:
-        geometry = legacy_geometry("module_origin", ("geometry",), args, {}, geometry, positional_geometry=True)
+        geometry = legacy_geometry(  # type: ignore[assignment]
+            "module_origin", ("geometry",), args, {}, geometry, positional_geometry=True)
     return _origin(leg, _geometry(geometry)).copy()
 
 
@@ -84,7 +84,7 @@ def leg_frame_to_robot(p_L: ArrayLike, gamma: ArrayLike, leg: Leg, *, geometry: 
         _leg(leg)
         raise
     side = "L" if o[1] > 0 else "R"
-    if (type(p_L) is np.ndarray and p_L.shape == (3,) and p_L.dtype == np.float64 and type(gamma) in _SCALARS
+    if (type(p_L) is np.ndarray and p_L.shape == (3,) and p_L.dtype == np.float64 and isinstance(gamma, (float, int))
             and math.isfinite(gamma) and np.isfinite(p_L).all()):
         out = np.empty(3)
         _k_frame(p_L, float(gamma), _R_LM[side], _R_0[side], geo.d_wheel, o, out)

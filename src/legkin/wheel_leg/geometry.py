@@ -11,7 +11,6 @@ import numpy as np
 
 from ..errors import InvalidParameterError
 
-
 LEGS = ("FL", "FR", "RR", "RL")
 THETA0 = math.radians(17.0)
 THETA_MIN = math.radians(17.0)
@@ -61,7 +60,7 @@ class Geometry:
         if params is None:
             return cls()
         names = {f.name for f in fields(cls)}
-        return cls(**{k: v for k, v in params.items() if k in names})
+        return cls(**{k: v for k, v in params.items() if k in names})  # type: ignore[arg-type]
 
 
 def _geometry(geometry) -> Geometry:

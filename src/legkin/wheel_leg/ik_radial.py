@@ -9,8 +9,8 @@ import numpy as np
 
 from .._kernels import as_rows, kernel, prange
 from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip, _k_max, _k_min, _k_phase, _loop
-from .geometry import ABAD_LIMIT, FOOT_OFFSET, THETA_MAX, THETA_MIN, _LIMIT_ROUNDING
 from .frames import _k_fk
+from .geometry import _LIMIT_ROUNDING, ABAD_LIMIT, FOOT_OFFSET, THETA_MAX, THETA_MIN
 from .linkage import _closed_form, _constants, _kconst
 from .rim import _k_plane, _Sel
 
@@ -40,6 +40,7 @@ def _arc_table(R: float, seed: bool, nodes: int) -> tuple[np.ndarray, np.ndarray
 def _arc_terms(theta: np.ndarray, R: float, seed: bool) -> np.ndarray:
     """(2 arc kinds, 8, ...): A, V, Re W, Im W and their theta-derivatives (see :func:`_arc_table`)."""
     pts, der = _closed_form(theta, _constants(R), R + FOOT_OFFSET, True, full=seed)
+    assert der is not None
     rows = []
     for ctr_name, ref_name in ((("U", "J"), ("O_r", "G")) if seed else (("U", "F"), ("L", "G"))):
         ctr, dctr = pts[ctr_name], der[ctr_name]

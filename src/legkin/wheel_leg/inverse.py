@@ -347,16 +347,16 @@ def ik_all(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike 
     opts = _options(options)
     return_mask = check_flag(return_mask, "return_mask")
     limits = check_flag(limits, "limits")
-    rim = rim_name(rim)
-    if type(target) is np.ndarray and target.shape == (3,) and target.dtype == np.float64 and type(alpha) in _SCALARS \
-            and type(w) in _SCALARS:
-        out = _single(target, float(alpha), float(w), leg, rim, radius, geo, "radial", opts, False, True, False)
+    rim_ = rim_name(rim)
+    if type(target) is np.ndarray and target.shape == (3,) and target.dtype == np.float64 and isinstance(alpha, float) \
+            and isinstance(w, float):
+        out = _single(target, alpha, w, leg, rim_, radius, geo, "radial", opts, False, True, False)
         if out is not None:
             sols = out[1].solutions
             sols = sols[_in_limits(sols)] if limits else sols
             if len(sols):
                 return (sols, np.array(True)) if return_mask else sols
-    run, _q = _run(target, alpha, w, leg, None, None, "radial", rim, radius, False, opts, geo, True)
+    run, _q = _run(target, alpha, w, leg, None, None, "radial", rim_, radius, False, opts, geo, True)
     sols = run.info.solutions
     assert sols is not None
     keep = np.isfinite(sols).all(axis=-1)

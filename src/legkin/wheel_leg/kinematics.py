@@ -19,8 +19,8 @@ Conventions (metres, radians at every API, theta included):
   alpha in [-pi, pi]; alpha = +-pi are the rim tips H_R / H_L (which meet only in wheel mode).
 
 Files: :mod:`.geometry` (constants, :class:`Geometry`), :mod:`.linkage` (closed form), :mod:`.rim` (rim
-contact points in {L}), :mod:`.frames` (frames, :func:`fk`, :func:`jacobian`), :mod:`.inverse` (:func:`ik`, :func:`ik_all`), :mod:`.ik_radial`,
-:mod:`.ik_iterative`. This module re-exports the public API.
+contact points in {L}), :mod:`.frames` (frames, :func:`fk`, :func:`jacobian`), :mod:`.inverse` (:func:`ik`,
+:func:`ik_all`), :mod:`.ik_radial`, :mod:`.ik_iterative`. This module re-exports the public API.
 
 A single input returns plain arrays and raises on failure; a batch (leading dimensions) returns NaN where
 an item fails, and ``return_mask=True`` also returns the mask of successes.

@@ -13,7 +13,18 @@ from numpy.typing import ArrayLike
 from .._batch import as_angles
 from .._kernels import as_rows, kernel, prange
 from ._common import _SCALARS, _check_theta, _loop, legacy_geometry
-from .geometry import _ARC_BC, _ARC_HF, _DEFAULT_GEOMETRY, _J_ANGLE, FOOT_OFFSET, THETA0, THETA_MAX, THETA_MIN, Geometry, _geometry
+from .geometry import (
+    _ARC_BC,
+    _ARC_HF,
+    _DEFAULT_GEOMETRY,
+    _J_ANGLE,
+    FOOT_OFFSET,
+    THETA0,
+    THETA_MAX,
+    THETA_MIN,
+    Geometry,
+    _geometry,
+)
 
 
 class _Const(NamedTuple):
@@ -41,7 +52,7 @@ def linkage_constants(*args: float, geometry: Geometry | None = None, **kwargs: 
     ``geometry=Geometry(R=R)``.
     """
     if args or kwargs:
-        geometry = legacy_geometry("linkage_constants", ("R",), args, kwargs, geometry)
+        geometry = legacy_geometry("linkage_constants", ("R",), args, kwargs, geometry)  # type: ignore[assignment]
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     return _constants(geo.R)._asdict()
 

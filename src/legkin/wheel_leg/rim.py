@@ -14,7 +14,6 @@ from ._common import _SCALARS, _check_alpha, _check_theta, _check_w, _loop
 from .geometry import _ARC_FG, _DEFAULT_GEOMETRY, FOOT_OFFSET, PSI_FG, THETA_MAX, THETA_MIN, Geometry, _geometry
 from .linkage import _IF, _IG, _IJ, _IL, _IOR, _IU, _k_closed, _kconst
 
-
 # ---------------------------------------------------------------- rim contact points
 #: Segments of the continuous rim: (name, alpha start, alpha end, link, centre point, reference point).
 _SEGMENTS = (
@@ -176,17 +175,19 @@ def _rim_call(theta, beta, alpha, w, radius, geometry, seed):
     """The wrapper of :func:`rim_point` / :func:`rim_point_seed`: checks (fast path for four numbers), then
     the batch of :func:`_k_rim`."""
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
-    rho = (geo.R + FOOT_OFFSET if seed else geo.R) if radius is None else None
+    if radius is None:
+        rho = geo.R + FOOT_OFFSET if seed else geo.R
+    else:
+        rho = check_number(radius, "radius", 0.0, 2.0 * geo.R, low_open=True)
     K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
-    if (rho is not None and type(theta) in _SCALARS and type(beta) in _SCALARS and type(alpha) in _SCALARS and type(w) in _SCALARS
+    scalars = type(theta) in _SCALARS and type(beta) in _SCALARS and type(alpha) in _SCALARS and type(w) in _SCALARS
+    if (scalars
             and THETA_MIN - 1e-12 <= theta <= THETA_MAX + 1e-12 and math.isfinite(beta)
             and abs(alpha) <= math.pi + 1e-12 and abs(w) <= geo.T / 2 + 1e-15):
         out = np.empty(3)
         _k_rim(float(theta), float(beta), float(alpha), float(w), seed, rho, K, KC, out)
         return out
     theta, beta, alpha, w = _rim_inputs(theta, beta, alpha, w, geo)
-    if rho is None:
-        rho = float(radius)
     shape = theta.shape
     out = np.empty((int(np.prod(shape, dtype=int)), 3))
     _k_rim_batch(*(as_rows(x, 1)[:, 0] for x in (theta, beta, alpha, w)), seed, rho, K, KC, out)

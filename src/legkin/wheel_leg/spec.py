@@ -26,8 +26,10 @@ SPEC = ModelSpec(
         "chassis_length": Param(0.694, "chassis box length (m)", 0.0, 5.0, low_open=True),
         "chassis_width": Param(0.352, "chassis box width (m)", 0.0, 5.0, low_open=True),
         "chassis_height": Param(0.138, "chassis box height (m)", 0.0, 5.0, low_open=True),
-        "d_abad": Param(0.057166, "height of the module (ABAD) origins above the robot frame (m)", 0.0, 1.0, low_open=True),
-        "d_wheel": Param(0.091675, "offset of the leg plane from the module origin, outward (m)", 0.0, 1.0, low_open=True),
+        "d_abad": Param(0.057166, "height of the module (ABAD) origins above the robot frame (m)", 0.0, 1.0,
+                        low_open=True),
+        "d_wheel": Param(0.091675, "offset of the leg plane from the module origin, outward (m)", 0.0, 1.0,
+                         low_open=True),
         "T": Param(0.04, "rim thickness; contact coordinate w in [-T/2, T/2] (m)", 0.0, 0.5, low_open=True),
     },
     # The two coaxial motors of each leg and its ABAD motor (all motor driven).

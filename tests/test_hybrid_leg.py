@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import warnings
 import xml.etree.ElementTree as ET
 
 import numpy as np
@@ -20,6 +21,8 @@ from legkin import (
 )
 from legkin.hybrid_leg import kinematics as ah
 from legkin.hybrid_leg import checks as ch
+from legkin.hybrid_leg import configuration as cfg
+from legkin.hybrid_leg.geometry import LL0, H
 
 DEG = math.pi / 180
 ACTUATED = ("MCS1", "MCS2", "LL")
@@ -35,10 +38,15 @@ def spherical():
     return legkin.load("hybrid_leg", center="spherical")
 
 
+def _q(theta1, theta2, theta0):
+    """Motor angles (theta1, theta2, theta0) broadcast and stacked into q (..., 3)."""
+    return np.stack(np.broadcast_arrays(*(np.asarray(v, dtype=float) for v in (theta1, theta2, theta0))), -1)
+
+
 def _in_mode(roll, pitch, sigma_min=1e-2):
     r, p = np.atleast_1d(roll), np.atleast_1d(pitch)
-    ok = ch._neutral_mode(r, p)
-    return bool(ok[0]) and float(ch._sigma_min(r, p)[0]) >= sigma_min
+    ok = cfg.neutral_mode(r, p)
+    return bool(ok[0]) and float(cfg.sigma_min(r, p)[0]) >= sigma_min
 
 
 # ------------------------------------------------------------------------------------------ model and checks
@@ -130,9 +138,9 @@ def test_neutral_motor_angles():
     th = ah.motor_angles(0.0, 0.0)
     assert th[0] == -th[1]  # mirror symmetry of the two chains
     # lever at 86.8 deg to the rod at the neutral pose
-    tip, _ = ah._lever_tips(th)
-    rod = ah._attach_world(np.eye(3)) - tip
     lever_x = np.stack([np.cos(th + ah.MOTOR_YAW), np.sin(th + ah.MOTOR_YAW), np.zeros(2)], -1)
+    tip = ah.MOTOR_POS + ah.LEVER[0] * lever_x + [0.0, 0.0, ah.LEVER[2]]
+    rod = ah.CENTER + ah.ATTACH - tip
     ang = np.arccos(np.sum(rod * lever_x, -1) / ah.ROD_LENGTH) / DEG
     assert np.allclose(ang, 86.8, atol=0.05)
 
@@ -203,11 +211,11 @@ def test_platform_orientation_near_forward_singularity(roll, log_dist):
     lo, hi = 0.0, 1.1
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ch._neutral_mode(np.array([roll]), np.array([mid]))[0] else (lo, mid)
+        lo, hi = (mid, hi) if cfg.neutral_mode(np.array([roll]), np.array([mid]))[0] else (lo, mid)
     pitch = lo - 10.0**log_dist
     th = ah.motor_angles(roll, pitch)
     back = ah.platform_orientation(th[0], th[1])
-    sigma = float(ch._sigma_min(np.array([roll]), np.array([pitch]))[0])
+    sigma = float(cfg.sigma_min(np.array([roll]), np.array([pitch]))[0])
     assert np.abs(back - [roll, pitch]).max() * sigma < ch.TOL_SCALED
 
 
@@ -240,13 +248,14 @@ def test_foot_ik_round_trip(x, tll, starting_value):
     roll, pitch = x
     assume(_in_mode(roll, pitch))
     th = ah.motor_angles(roll, pitch)
-    t0 = ah.extension_motor_angle(tll, starting_value)
-    p = ah.foot_position(th[0], th[1], t0, starting_value=starting_value)
+    geo = ah.Geometry(starting_value=starting_value)
+    t0 = ah.extension_motor_angle(tll, geometry=geo)
+    p = ah.fk(_q(th[0], th[1], t0), geometry=geo)
     assert np.abs(p - ah.foot_position_from_platform(roll, pitch, tll)).max() < 1e-12
     kappa = float(ch.foot_ik_condition(p, np.array(tll), np.array(roll), np.array(pitch)))
     llb = -1 if tll <= ah.LL_DELTA else 1
-    sol = ah.foot_ik(p, starting_value=starting_value, ll_branch=llb)
-    err = max(np.abs(sol[:2] - th).max(), abs(ah.ll_angle(sol[2], starting_value) - tll))
+    sol = ah.ik(p, geometry=geo, ll_branch=llb)
+    err = max(np.abs(sol[:2] - th).max(), abs(ah.ll_angle(sol[2], geometry=geo) - tll))
     assert err < max(1e-12, kappa * ch.TOL_KAPPA)
     # the target is reached whatever the conditioning of the angles
     plat = ah.foot_platform_ik(p, ll_branch=llb)
@@ -268,7 +277,8 @@ def test_foot_ik_near_ll_branch_merge(roll, log_alpha, side):
 
 def test_foot_ik_all_branches():
     p = ah.foot_position_from_platform(0.1, 0.2, -0.1)
-    allb, ok = ah.foot_ik(p, all_branches=True, return_mask=True)
+    every = ah.ik_all(p)
+    allb, ok = every.motors, every.mask
     assert allb.shape == (16, 3) and ok.shape == (16,)
     assert ok.sum() >= 2 and ok[0]
     assert np.all(np.isnan(allb[~ok]))
@@ -277,12 +287,12 @@ def test_foot_ik_all_branches():
             x = ah.foot_platform_ik(p, ll_branch=llb, roll_branch=rb)
             assert np.allclose(ah.motor_angles(x[1], x[2], (b1, b2)), sol[:2], atol=0)
             assert abs(ah.ll_angle(sol[2]) - x[0]) < 1e-15
-    assert np.array_equal(ah.foot_ik(p), allb[0])
+    assert np.array_equal(ah.ik(p), allb[0])
 
 
 def test_batch_shapes_and_scalar_wrapper():
     rng = np.random.default_rng(0)
-    r, p = ch.sample_workspace(12, rng)
+    r, p = cfg.sample_workspace(12, rng)
     r, p = r.reshape(3, 4), p.reshape(3, 4)
     th = ah.motor_angles(r, p)
     assert th.shape == (3, 4, 2)
@@ -290,35 +300,22 @@ def test_batch_shapes_and_scalar_wrapper():
     x = ah.platform_orientation(th[..., 0], th[..., 1])
     assert x.shape == (3, 4, 2) and np.abs(x - np.stack([r, p], -1)).max() < 1e-12
     t0 = np.zeros((3, 4))
-    foot = ah.foot_position(th[..., 0], th[..., 1], t0)
+    foot = ah.fk(_q(th[..., 0], th[..., 1], t0))
     assert foot.shape == (3, 4, 3)
-    jac = ah.foot_jacobian(th[..., 0], th[..., 1], t0)
+    jac = ah.jacobian(_q(th[..., 0], th[..., 1], t0))
     assert jac.shape == (3, 4, 3, 3)
-    assert np.array_equal(ah.foot_jacobian(th[1, 2, 0], th[1, 2, 1], 0.0), jac[1, 2])
-    sol = ah.foot_ik(foot)
+    assert np.array_equal(ah.jacobian(_q(th[1, 2, 0], th[1, 2, 1], 0.0)), jac[1, 2])
+    sol = ah.ik(foot)
     assert sol.shape == (3, 4, 3)
-    assert ah.foot_ik(foot, all_branches=True).shape == (3, 4, 16, 3)
+    assert ah.ik_all(foot).motors.shape == (3, 4, 16, 3)
     assert ah.sphere_joint_angles(ah.platform_rotation(r, p)).shape == (3, 4, 2, 3)
-
-
-def test_foot_jacobian_matches_finite_differences():
-    th = ah.motor_angles(0.1, 0.15)
-    t0 = 3.0
-    jac = ah.foot_jacobian(th[0], th[1], t0)
-    h = 1e-6
-    num = np.empty((3, 3))
-    for k in range(3):
-        e = np.zeros(3)
-        e[k] = h
-        args_p, args_m = np.array([*th, t0]) + e, np.array([*th, t0]) - e
-        num[:, k] = (ah.foot_position(*args_p) - ah.foot_position(*args_m)) / (2 * h)
-    assert np.abs(num - jac).max() < 1e-8
 
 
 def test_ll_transmission_round_trip():
     t0 = np.linspace(-50, 50, 11)
-    assert np.allclose(ah.extension_motor_angle(ah.ll_angle(t0, 0.3), 0.3), t0, atol=1e-12)
-    assert ah.ll_angle(0.0, 0.3) == 0.3
+    geo = ah.Geometry(starting_value=0.3)
+    assert np.allclose(ah.extension_motor_angle(ah.ll_angle(t0, geometry=geo), geometry=geo), t0, atol=1e-12)
+    assert ah.ll_angle(0.0, geometry=geo) == 0.3
     assert ah.ll_angle(2 * math.pi) == pytest.approx(-0.07 / 1.5, rel=1e-15)  # 70 mm of arc per turn
 
 
@@ -352,16 +349,16 @@ def test_floating_is_refused():
         lambda: ah.motor_angles_from_rotation(2 * np.eye(3)),
         lambda: ah.motor_angles_from_rotation(np.diag([1.0, 1.0, -1.0])),
         lambda: ah.platform_orientation(0.3, float("inf")),
-        lambda: ah.platform_orientation(0.3, -0.3, guess=[0.0]),
-        lambda: ah.foot_position(0.3, -0.3, float("nan")),
-        lambda: ah.foot_ik([0.4, 0.0]),
-        lambda: ah.foot_ik([0.4, float("nan"), 0.0]),
-        lambda: ah.foot_ik([0.4, 0.0, -0.2], ll_branch=0),
-        lambda: ah.foot_ik([0.4, 0.0, -0.2], starting_value=float("nan")),
+        lambda: ah.platform_orientation(0.3, -0.3, q_start=[0.0]),
+        lambda: ah.fk(_q(0.3, -0.3, float("nan"))),
+        lambda: ah.ik([0.4, 0.0]),
+        lambda: ah.ik([0.4, float("nan"), 0.0]),
+        lambda: ah.ik([0.4, 0.0, -0.2], ll_branch=0),
+        lambda: ah.ik([0.4, 0.0, -0.2], geometry=ah.Geometry(starting_value=float("nan"))),
         lambda: ah.foot_platform_ik([0.4, 0.0, -0.2], roll_branch=2),
         lambda: ah.ll_angle("x"),
         lambda: ah.sphere_joint_angles(np.ones((3, 3))),
-        lambda: ah.foot_jacobian(0.3, -0.3, [0.0, float("nan")]),
+        lambda: ah.jacobian(_q(0.3, -0.3, [0.0, float("nan")])),
     ],
 )
 def test_invalid_input_raises_value_error(call):
@@ -392,18 +389,16 @@ def test_unreachable_foot():
     near = ah.CENTER + [0.0, 0.0, -0.1]
     for p in (far, near):
         with pytest.raises(UnreachableError, match="LL arc"):
-            ah.foot_ik(p)
+            ah.ik(p)
         with pytest.raises(UnreachableError):
             ah.foot_platform_ik(p)
-        with pytest.raises(UnreachableError):
-            ah.foot_ik(p, all_branches=True)
+        assert not ah.ik_all(p).mask.any()
     # on the LL arc but beyond the motors on the extension side (ll_branch -1): needs the platform pitched
     # ~ -90 deg. (The default search also tries ll_branch +1, which reaches it in the neutral mode at pitch 0.66.)
     beyond = ah.foot_position_from_platform(0.0, -1.5, -0.2)
     with pytest.raises(UnreachableError, match="roll, pitch"):
-        ah.foot_ik(beyond, ll_branch=-1)
-    sol, ok = ah.foot_ik(np.stack([ah.foot_position_from_platform(0.0, 0.0, -0.1), far, beyond]), ll_branch=-1,
-                         return_mask=True)
+        ah.ik(beyond, ll_branch=-1)
+    sol, ok = ah.ik(np.stack([ah.foot_position_from_platform(0.0, 0.0, -0.1), far, beyond]), ll_branch=-1, return_mask=True)
     assert ok.tolist() == [True, False, False]
     assert np.all(np.isnan(sol[1:])) and np.all(np.isfinite(sol[0]))
 
@@ -413,7 +408,7 @@ def test_singular_foot_on_roll_axis():
     with pytest.raises(SingularityError, match="roll axis"):
         ah.foot_platform_ik(on_axis)
     with pytest.raises(SingularityError):
-        ah.foot_ik(on_axis)
+        ah.ik(on_axis)
     x, ok = ah.foot_platform_ik(np.stack([on_axis, on_axis + [0, 0, -0.1]]), return_mask=True)
     assert ok.tolist() == [False, True] and np.all(np.isnan(x[0]))
 
@@ -423,9 +418,9 @@ def test_forward_kinematics_does_not_assemble():
     with pytest.raises(ConvergenceError):
         ah.platform_orientation(3.0, 3.0)
     with pytest.raises(ConvergenceError):
-        ah.foot_position(3.0, 3.0, 0.0)
+        ah.fk(_q(3.0, 3.0, 0.0))
     with pytest.raises(ConvergenceError):
-        ah.foot_jacobian(3.0, 3.0, 0.0)
+        ah.jacobian(_q(3.0, 3.0, 0.0))
     x, ok = ah.platform_orientation([0.3, 3.0], [-0.3, 3.0], return_mask=True)
     assert ok.tolist() == [True, False] and np.all(np.isnan(x[1]))
 
@@ -441,7 +436,7 @@ REPRO = 1e-9
 def _aspect_box(n, rng):
     """Poses of the neutral aspect: branch (1, 1), the sign of det(dtheta/dx) of R_P = I, pitch below 1.2 rad."""
     r, p = rng.uniform(-1.3, 1.3, n), rng.uniform(-0.62, 0.98, n)
-    keep = ch._neutral_mode(r, p) & (p < 1.2)
+    keep = cfg.neutral_mode(r, p) & (p < 1.2)
     return r[keep], p[keep]
 
 
@@ -452,7 +447,7 @@ def _aspect_edge(n, rng):
     lo, hi = np.zeros(n), np.full(n, 2.0)
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        inside = ch._neutral_mode(mid * d[:, 0], mid * d[:, 1])
+        inside = cfg.neutral_mode(mid * d[:, 0], mid * d[:, 1])
         lo, hi = np.where(inside, mid, lo), np.where(inside, hi, mid)
     return lo * d[:, 0], lo * d[:, 1]
 
@@ -461,9 +456,9 @@ def test_default_answers_are_reproduced_by_foot_position():
     """Defect 1: foot_ik answered targets of the other assembly mode, foot_position put the foot cm away."""
     rng = np.random.default_rng(7)
     p = ah.CENTER + rng.uniform(-1.6, 1.6, (20000, 3))
-    sol, ok = ah.foot_ik(p, return_mask=True)
+    sol, ok = ah.ik(p, return_mask=True)
     assert ok.sum() > 1000
-    back, fk_ok = ah.foot_position(sol[ok, 0], sol[ok, 1], sol[ok, 2], return_mask=True)
+    back, fk_ok = ah.fk(_q(sol[ok, 0], sol[ok, 1], sol[ok, 2]), return_mask=True)
     assert fk_ok.all()
     assert np.linalg.norm(back - p[ok], axis=-1).max() < REPRO
 
@@ -473,11 +468,11 @@ def test_fk_made_targets_are_solved():
     rng = np.random.default_rng(8)
     th = rng.uniform(-0.6, 0.6, (4900, 2))
     t0 = rng.uniform(-20.0, 20.0, 4900)
-    p, made = ah.foot_position(th[:, 0], th[:, 1], t0, return_mask=True)
+    p, made = ah.fk(_q(th[:, 0], th[:, 1], t0), return_mask=True)
     assert made.sum() > 4500
-    sol, ok = ah.foot_ik(p[made], return_mask=True)
+    sol, ok = ah.ik(p[made], return_mask=True)
     assert ok.all()
-    back = ah.foot_position(sol[:, 0], sol[:, 1], sol[:, 2])
+    back = ah.fk(_q(sol[:, 0], sol[:, 1], sol[:, 2]))
     assert np.linalg.norm(back - p[made], axis=-1).max() < REPRO
     # every one of them is a solution of the mode foot_position was asked for
     assert np.all(ah.assembly_mode(*ah.platform_orientation(sol[:, 0], sol[:, 1]).T) == 1)
@@ -489,10 +484,10 @@ def test_reach_boundary_targets_made_by_fk_are_solved(tll):
     rng = np.random.default_rng(9)
     r, pch = _aspect_box(4000, rng)
     th = ah.motor_angles(r, pch)
-    p, made = ah.foot_position(th[:, 0], th[:, 1], ah.extension_motor_angle(np.full(len(r), tll)), return_mask=True)
-    sol, ok = ah.foot_ik(p[made], return_mask=True)
+    p, made = ah.fk(_q(th[:, 0], th[:, 1], ah.extension_motor_angle(np.full(len(r), tll))), return_mask=True)
+    sol, ok = ah.ik(p[made], return_mask=True)
     assert ok.all()
-    assert np.linalg.norm(ah.foot_position(*sol.T) - p[made], axis=-1).max() < REPRO
+    assert np.linalg.norm(ah.fk(sol) - p[made], axis=-1).max() < REPRO
 
 
 def test_motor_reach_boundary_targets_made_by_fk_are_solved():
@@ -500,11 +495,11 @@ def test_motor_reach_boundary_targets_made_by_fk_are_solved():
     rng = np.random.default_rng(10)
     r, pch = _aspect_edge(400, rng)
     th = ah.motor_angles(r, pch)
-    p, made = ah.foot_position(th[:, 0], th[:, 1], rng.uniform(-3, 3, len(r)), return_mask=True)
+    p, made = ah.fk(_q(th[:, 0], th[:, 1], rng.uniform(-3, 3, len(r))), return_mask=True)
     assert made.sum() > 100
-    sol, ok = ah.foot_ik(p[made], return_mask=True)
+    sol, ok = ah.ik(p[made], return_mask=True)
     assert ok.all()
-    assert np.linalg.norm(ah.foot_position(*sol.T) - p[made], axis=-1).max() < REPRO
+    assert np.linalg.norm(ah.fk(sol) - p[made], axis=-1).max() < REPRO
 
 
 @pytest.mark.parametrize("p", [
@@ -517,17 +512,17 @@ def test_fk_made_at_the_aspect_edge(p):
     """FK-made targets (ik_robustness, 10^5 run) whose pose lies on the neutral aspect's reach boundary: the IK's
     pose, computed from the foot, exceeded |k| = 1 by 1e-14..1e-13 and was refused."""
     p = np.array(p)
-    m = ah.foot_ik(p)
-    assert np.linalg.norm(ah.foot_position(*m) - p) < REPRO
+    m = ah.ik(p)
+    assert np.linalg.norm(ah.fk(m) - p) < REPRO
 
 
 def test_unreachable_arc_message_is_consistent():
     """Defect 2: the message said '3.14042 m from the centre; the arc reaches [0.140417, 3.14042] m'."""
-    hi = ah._LL0 + ah._H
-    for r in (hi * (1 + 1e-11), hi + 1e-9, 0.5 * (ah._LL0 - ah._H)):
+    hi = LL0 + H
+    for r in (hi * (1 + 1e-11), hi + 1e-9, 0.5 * (LL0 - H)):
         p = ah.CENTER + [r, 0.0, 1e-3]
         with pytest.raises(UnreachableError) as info:
-            ah.foot_ik(p)
+            ah.ik(p)
         msg = str(info.value)
         dist = float(msg.split(" m from the LCS centre")[0].rsplit(" ", 1)[1])
         lo_, hi_ = (float(v) for v in msg.split("reaches [")[1].split("]")[0].split(", "))
@@ -540,21 +535,21 @@ def test_other_assembly_mode_raises_and_modes_reach_it():
     and foot_ik / foot_position with those mode arguments reproduce it."""
     p = ah.foot_position_from_platform(-0.8438537262935863, 0.989660622822937, 0.15765221087324321)
     with pytest.raises(legkin.AssemblyModeError) as info:
-        ah.foot_ik(p)
+        ah.ik(p)
     err = info.value
     assert isinstance(err, UnreachableError) and err.modes
-    sol, ok = ah.foot_ik(p[None], return_mask=True)
+    sol, ok = ah.ik(p[None], return_mask=True)
     assert not ok[0] and np.all(np.isnan(sol))
     for mode in err.modes:
         assert f"branch=({mode['branch'][0]}, {mode['branch'][1]}), assembly={mode['assembly']:+d}" in str(err)
-        m = ah.foot_ik(p, **mode)
-        back = ah.foot_position(m[0], m[1], m[2], branch=mode["branch"], assembly=mode["assembly"])
+        m = ah.ik(p, **mode)
+        back = ah.fk(_q(m[0], m[1], m[2]), branch=mode["branch"], assembly=mode["assembly"])
         assert np.linalg.norm(back - p) < REPRO
         # and foot_position with the default mode does not put the foot there
-        fk, fk_ok = ah.foot_position(m[:1], m[1:2], m[2:], return_mask=True)
+        fk, fk_ok = ah.fk(_q(m[:1], m[1:2], m[2:]), return_mask=True)
         assert not fk_ok[0] or np.linalg.norm(fk[0] - p) > 1e-6
     # all modes on request
-    every = ah.foot_ik_solutions(p)
+    every = ah.ik_all(p)
     assert every.valid.sum() == len(err.modes) and not (every.valid & (every.assembly == 1))[[0, 4, 8, 12]].any()
 
 
@@ -562,10 +557,10 @@ def test_joint_limit_error():
     """Reachable only with |roll| > pi/2 (LCS_x limit): JointLimitError, mask False; no answer outside the limits."""
     p = ah.foot_position_from_platform(-0.06284610557749781, -1.0207832560887642, 0.23457715140921453)
     with pytest.raises(legkin.JointLimitError, match="outside the joint limits"):
-        ah.foot_ik(p)
-    every = ah.foot_ik_solutions(p)
+        ah.ik(p)
+    every = ah.ik_all(p)
     assert every.mask.any() and not every.within_limits[every.mask].any()
-    assert not ah.foot_ik(p[None], return_mask=True)[1][0]
+    assert not ah.ik(p[None], return_mask=True)[1][0]
 
 
 def test_fk_mode_arguments_and_all_poses():
@@ -581,18 +576,18 @@ def test_fk_mode_arguments_and_all_poses():
             continue
         got = ah.platform_orientation(th[0], th[1], tuple(b), assembly=int(a))
         assert np.linalg.norm(got) <= np.linalg.norm(x) + 1e-12  # the mode's pose nearest R_P = I
-        foot = ah.foot_position(th[0], th[1], 0.0, branch=tuple(b), assembly=int(a), return_mask=True)
+        foot = ah.fk(_q(th[0], th[1], 0.0), branch=tuple(b), assembly=int(a), return_mask=True)
         if foot[1]:
-            m = ah.foot_ik(foot[0], branch=tuple(b), assembly=int(a))
-            back = ah.foot_position(m[0], m[1], m[2], branch=tuple(b), assembly=int(a))
+            m = ah.ik(foot[0], branch=tuple(b), assembly=int(a))
+            back = ah.fk(_q(m[0], m[1], m[2]), branch=tuple(b), assembly=int(a))
             assert np.linalg.norm(back - foot[0]) < REPRO
     # R_P = I on the other motor branches: the default mode does not assemble, the message says where it does
     th = ah.motor_angles(0.0, 0.0, (-1, -1))
     with pytest.raises(ConvergenceError, match=r"it does at \(roll, pitch\) = \(0, 0\) on branch \(-1, -1\)"):
         ah.platform_orientation(th[0], th[1])
     assert np.abs(ah.platform_orientation(th[0], th[1], (-1, -1))).max() < 1e-12
-    foot = ah.foot_position(th[0], th[1], 0.0, branch=(-1, -1))
-    m = ah.foot_ik(foot, branch=(-1, -1))
+    foot = ah.fk(_q(th[0], th[1], 0.0), branch=(-1, -1))
+    m = ah.ik(foot, branch=(-1, -1))
     assert np.allclose(m[:2], th, atol=1e-12)
 
 
@@ -603,40 +598,40 @@ def test_forward_singularity_band():
     lo, hi = 0.0, 1.1
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ch._neutral_mode(np.array([roll]), np.array([mid]))[0] else (lo, mid)
+        lo, hi = (mid, hi) if cfg.neutral_mode(np.array([roll]), np.array([mid]))[0] else (lo, mid)
     for dist, refused in ((1e-9, True), (1e-2, False)):
         th = ah.motor_angles(roll, lo - dist)
-        foot, ok = ah.foot_position([th[0]], [th[1]], [0.0], return_mask=True)
+        foot, ok = ah.fk(_q([th[0]], [th[1]], [0.0]), return_mask=True)
         assert ok[0] != refused
         p = ah.foot_position_from_platform(roll, lo - dist, 0.0)
         if refused:
             with pytest.raises(SingularityError, match="forward singularity"):
-                ah.foot_position(th[0], th[1], 0.0)
+                ah.fk(_q(th[0], th[1], 0.0))
             with pytest.raises(SingularityError, match="forward singularity"):
-                ah.foot_ik(p, ll_branch=-1)
+                ah.ik(p, ll_branch=-1)
         else:
-            m = ah.foot_ik(p)
-            assert np.linalg.norm(ah.foot_position(*m) - p) < REPRO
+            m = ah.ik(p)
+            assert np.linalg.norm(ah.fk(m) - p) < REPRO
 
 
 _BAD_KEYWORDS = [
-    ("foot_ik", {"ll_branch": np.array([1, -1])}, "ll_branch"),
-    ("foot_ik", {"ll_branch": True}, "ll_branch"),
-    ("foot_ik", {"ll_branch": 0.5}, "ll_branch"),
-    ("foot_ik", {"roll_branch": "1"}, "roll_branch"),
-    ("foot_ik", {"roll_branch": float("nan")}, "roll_branch"),
-    ("foot_ik", {"branch": np.array([[1, 1]])}, "branch"),
-    ("foot_ik", {"branch": "11"}, "branch"),
-    ("foot_ik", {"branch": (1, 1j)}, "branch"),
-    ("foot_ik", {"assembly": 0}, "assembly"),
-    ("foot_ik", {"assembly": "all"}, "assembly"),
+    ("ik", {"ll_branch": np.array([1, -1])}, "ll_branch"),
+    ("ik", {"ll_branch": True}, "ll_branch"),
+    ("ik", {"ll_branch": 0.5}, "ll_branch"),
+    ("ik", {"roll_branch": "1"}, "roll_branch"),
+    ("ik", {"roll_branch": float("nan")}, "roll_branch"),
+    ("ik", {"branch": np.array([[1, 1]])}, "branch"),
+    ("ik", {"branch": "11"}, "branch"),
+    ("ik", {"branch": (1, 1j)}, "branch"),
+    ("ik", {"assembly": 0}, "assembly"),
+    ("ik", {"assembly": "all"}, "assembly"),
     ("foot_ik", {"starting_value": float("inf")}, "starting_value"),
     ("foot_ik", {"starting_value": 4.0}, "starting_value"),
     ("foot_ik", {"starting_value": np.array([0.1, 0.2])}, "starting_value"),
     ("foot_ik", {"starting_value": 1j}, "starting_value"),
     ("foot_ik", {"starting_value": 10**400}, "starting_value"),
     ("foot_ik", {"all_branches": 1}, "all_branches"),
-    ("foot_ik", {"return_mask": "yes"}, "return_mask"),
+    ("ik", {"return_mask": "yes"}, "return_mask"),
     ("foot_platform_ik", {"ll_branch": np.array([1])}, "ll_branch"),
     ("foot_platform_ik", {"assembly": 2}, "assembly"),
     ("foot_ik_solutions", {"starting_value": None}, "starting_value"),
@@ -646,7 +641,8 @@ _BAD_KEYWORDS = [
 @pytest.mark.parametrize("func, kwargs, name", _BAD_KEYWORDS, ids=[f"{f}-{n}-{i}" for i, (f, _, n) in enumerate(_BAD_KEYWORDS)])
 def test_bad_keyword_arguments(func, kwargs, name):
     """Defect 3: every keyword validated, a legkin error naming it and its valid values (never a numpy error)."""
-    with pytest.raises(InvalidParameterError) as info:
+    with pytest.raises(InvalidParameterError) as info, warnings.catch_warnings():
+        warnings.simplefilter("ignore", DeprecationWarning)  # foot_ik, foot_ik_solutions: the deprecated aliases
         getattr(ah, func)([0.4, 0.0, -0.2], **kwargs)
     assert isinstance(info.value, InvalidInputError)
     assert name in str(info.value) and repr(kwargs[name])[:20] in str(info.value)
@@ -666,12 +662,12 @@ def test_bad_keyword_arguments(func, kwargs, name):
         lambda: ah.platform_orientation(0.3, -0.3, assembly=-2),
         lambda: ah.platform_orientation(0.3, -0.3, branch=[1, 1, 1]),
         lambda: ah.platform_poses(0.3, -0.3, tol=-1.0),
-        lambda: ah.foot_position(0.3, -0.3, 0.0, assembly=None),
-        lambda: ah.foot_position(0.3, -0.3, 0.0, starting_value=True),
-        lambda: ah.foot_jacobian(0.3, -0.3, 0.0, branch=np.array([1.0, -1.0, 1.0])),
+        lambda: ah.fk(_q(0.3, -0.3, 0.0), assembly=None),
+        lambda: ah.fk(_q(0.3, -0.3, 0.0), geometry=ah.Geometry(starting_value=True)),
+        lambda: ah.jacobian(_q(0.3, -0.3, 0.0), branch=np.array([1.0, -1.0, 1.0])),
         lambda: ah.motor_angles(0.0, 0.0, branch=np.array([1, 1]) * 1j),
         lambda: ah.assembly_mode(0.0, 0.0, return_mask=None),
-        lambda: ah.ll_angle(0.0, starting_value=np.nan),
+        lambda: ah.ll_angle(0.0, geometry=ah.Geometry(starting_value=np.nan)),
     ],
 )
 def test_bad_parameters_of_other_functions(call):
@@ -682,17 +678,17 @@ def test_bad_parameters_of_other_functions(call):
 @pytest.mark.parametrize(
     "call",
     [
-        lambda: ah.foot_ik([0.4, 0.0, -0.2j]),
-        lambda: ah.foot_ik([[0.4, 0.0, -0.2], [0.4, 0.0]]),
-        lambda: ah.foot_ik(["0.4", "0", "-0.2"]),
-        lambda: ah.foot_ik(np.zeros((2, 4))),
-        lambda: ah.foot_ik([0.4, float("inf"), 0.0]),
-        lambda: ah.foot_ik_solutions([0.4, 0.0, float("nan")]),
+        lambda: ah.ik([0.4, 0.0, -0.2j]),
+        lambda: ah.ik([[0.4, 0.0, -0.2], [0.4, 0.0]]),
+        lambda: ah.ik(["0.4", "0", "-0.2"]),
+        lambda: ah.ik(np.zeros((2, 4))),
+        lambda: ah.ik([0.4, float("inf"), 0.0]),
+        lambda: ah.ik_all([0.4, 0.0, float("nan")]),
         lambda: ah.foot_platform_ik(np.zeros(2)),
-        lambda: ah.foot_position(0.3 + 0j, -0.3, 0.0),
+        lambda: ah.fk(np.array([0.3 + 0j, -0.3, 0.0])),
         lambda: ah.platform_poses([0.3, 0.2], [0.1, 0.2, 0.3]),
-        lambda: ah.platform_orientation(0.3, -0.3, guess=[0.0, float("nan")]),
-        lambda: ah.platform_orientation([0.3, 0.3], [-0.3, 0.3], guess=np.zeros((3, 2))),
+        lambda: ah.platform_orientation(0.3, -0.3, q_start=[0.0, float("nan")]),
+        lambda: ah.platform_orientation([0.3, 0.3], [-0.3, 0.3], q_start=np.zeros((3, 2))),
         lambda: ah.assembly_mode(float("nan"), 0.0),
     ],
 )
@@ -705,25 +701,25 @@ def test_extreme_inputs_give_nan_and_mask_or_legkin_errors():
     """No numpy exception escapes: huge, tiny and empty inputs; a batch gives NaN + mask, a single call a legkin
     error."""
     big = np.array([[1e308, 1e308, 1e308], [-1e300, 0.0, 1e-300], [5e-324, 0.0, 0.0], ah.CENTER, [0.4, 0.0, -0.2]])
-    for f in (ah.foot_ik, ah.foot_platform_ik):
+    for f in (ah.ik, ah.foot_platform_ik):
         out, ok = f(big, return_mask=True)
         assert ok.tolist()[:4] == [False, False, False, False] and np.all(np.isnan(out[:4]))
         for p in big[:4]:
             with pytest.raises(legkin.LegkinError):
                 f(p)
-    every = ah.foot_ik_solutions(big)
+    every = ah.ik_all(big)
     assert not every.mask[[0, 1, 3]].any()
-    assert ah.foot_ik(np.zeros((0, 3))).shape == (0, 3)
-    assert ah.foot_ik(np.zeros((0, 3)), all_branches=True).shape == (0, 16, 3)
-    assert ah.foot_position(np.zeros(0), np.zeros(0), np.zeros(0)).shape == (0, 3)
+    assert ah.ik(np.zeros((0, 3))).shape == (0, 3)
+    assert ah.ik_all(np.zeros((0, 3))).motors.shape == (0, 16, 3)
+    assert ah.fk(_q(np.zeros(0), np.zeros(0), np.zeros(0))).shape == (0, 3)
     assert ah.platform_orientation(np.zeros((2, 0)), np.zeros((2, 0))).shape == (2, 0, 2)
     assert ah.platform_poses(np.zeros(0), np.zeros(0)).x.shape == (0, 8, 2)
     th, ok = ah.platform_orientation([1e300, -1e300, 0.3], [1e300, 0.0, -0.3], return_mask=True)
     assert ok.tolist() == [False, False, True]
-    foot, ok = ah.foot_position([1e300, 0.3], [0.0, -0.3], [1e300, 1e300], return_mask=True)
+    foot, ok = ah.fk(_q([1e300, 0.3], [0.0, -0.3], [1e300, 1e300]), return_mask=True)
     assert not ok[0] and np.all(np.isnan(foot[0]))
     with pytest.raises(legkin.LegkinError):
-        ah.foot_position(1e300, 0.0, 0.0)
+        ah.fk(_q(1e300, 0.0, 0.0))
 
 
 def test_roll_axis_targets_made_by_fk():
@@ -734,10 +730,10 @@ def test_roll_axis_targets_made_by_fk():
     for roll, pitch, tll in ((-0.29684081726065514, 0.3928812109894282, 0.06424568367655326),
                              (-0.15205468195581676, -0.45561409836429995, -0.021177949055006404)):
         th = ah.motor_angles(roll, pitch)
-        p = ah.foot_position(th[0], th[1], ah.extension_motor_angle(tll))
+        p = ah.fk(_q(th[0], th[1], ah.extension_motor_angle(tll)))
         assert p[1] == 0.0 and p[2] == ah.CENTER[2]
-        m = ah.foot_ik(p)
-        assert np.linalg.norm(ah.foot_position(*m) - p) < REPRO
+        m = ah.ik(p)
+        assert np.linalg.norm(ah.fk(m) - p) < REPRO
 
 
 def test_ik_robustness_row():
@@ -750,7 +746,7 @@ def _fold_pitch(roll):
     lo, hi = 0.0, 1.1
     for _ in range(60):
         mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ch._neutral_mode(np.array([roll]), np.array([mid]))[0] else (lo, mid)
+        lo, hi = (mid, hi) if cfg.neutral_mode(np.array([roll]), np.array([mid]))[0] else (lo, mid)
     return lo
 
 
@@ -795,7 +791,7 @@ def _build(case):
         return ah.CENTER + np.array([a, b, c]), False
     th, ok = ah.motor_angles([roll], [pitch], return_mask=True)
     if ok[0] and abs(tll) <= math.pi:
-        foot, made = ah.foot_position(th[:, 0], th[:, 1], [ah.extension_motor_angle(tll)], return_mask=True)
+        foot, made = ah.fk(_q(th[:, 0], th[:, 1], [ah.extension_motor_angle(tll)]), return_mask=True)
         if made[0]:
             return foot[0], True
     return ah.foot_position_from_platform(roll, pitch, tll), False
@@ -816,30 +812,30 @@ def _build(case):
 def test_ik_contract_property(case):
     p, made = _build(case)
     try:
-        m = ah.foot_ik(p)
+        m = ah.ik(p)
         err = None
     except (UnreachableError, SingularityError) as exc:
         m, err = None, exc
-    sol, ok = ah.foot_ik(p[None], return_mask=True)
+    sol, ok = ah.ik(p[None], return_mask=True)
     assert bool(ok[0]) == (err is None)  # batch and single call agree
     if made:
         assert err is None, (case, err)  # (b)
     if err is None:
         assert np.array_equal(sol[0], m)
-        assert np.linalg.norm(ah.foot_position(*m) - p) < REPRO  # (a)
+        assert np.linalg.norm(ah.fk(m) - p) < REPRO  # (a)
         assert np.all(np.abs(m[:2]) <= ah.MOTOR_LIMIT) and abs(ah.ll_angle(m[2])) <= ah.LL_LIMIT  # (c)
         x = ah.platform_orientation(m[0], m[1])
         assert np.all(np.abs(x) <= ah.PLATFORM_LIMIT)
         assert ah.assembly_mode(x[0], x[1]) == 1  # (d) the default mode
         return
     assert np.all(np.isnan(sol[0]))
-    every = ah.foot_ik_solutions(p)
+    every = ah.ik_all(p)
     if isinstance(err, legkin.AssemblyModeError):
         assert not (every.valid & (every.assembly == 1))[[0, 4, 8, 12]].any()  # no default-mode answer ...
         for mode in err.modes[:3]:  # ... but each named mode reaches it
             assert f"assembly={mode['assembly']:+d}" in str(err)
-            m2 = ah.foot_ik(p, **mode)
-            back = ah.foot_position(m2[0], m2[1], m2[2], branch=mode["branch"], assembly=mode["assembly"])
+            m2 = ah.ik(p, **mode)
+            back = ah.fk(_q(m2[0], m2[1], m2[2]), branch=mode["branch"], assembly=mode["assembly"])
             assert np.linalg.norm(back - p) < REPRO
     elif isinstance(err, legkin.JointLimitError):
         assert every.mask.any() and not every.within_limits.any()

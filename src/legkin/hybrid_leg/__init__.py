@@ -2,7 +2,9 @@
 
 The package is the mechanism: its registry entry (``spec``), its kinematics (re-exported here, imported on first use so that
 ``import legkin`` stays light), its
-checks against Pinocchio (``checks``), bench (``bench``), figures (``figures``) and clips (``clips``).
+checks against Pinocchio (``checks``), bench (``bench``), figures (``figures``) and clips (``clips``); its
+geometry (``geometry.Geometry``), configurations and samplers (``configuration``) and its kinematic contract
+(``contract``).
 """
 
 from __future__ import annotations
@@ -16,12 +18,14 @@ if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they l
     from . import kinematics
     from .kinematics import *  # noqa: F403
 
-_SUBMODULES = ("kinematics", "checks", "bench", "figures", "clips")
+_SUBMODULES = ("kinematics", "geometry", "configuration", "contract", "checks", "bench", "figures", "clips")
 
 
 def __getattr__(name: str) -> Any:
     if name in _SUBMODULES:
         return importlib.import_module(f"{__name__}.{name}")
+    if name == "Geometry":  # light: no numba
+        return importlib.import_module(f"{__name__}.geometry").Geometry
     kinematics = importlib.import_module(f"{__name__}.kinematics")
     if name == "__all__":
         return ["SPEC", *kinematics.__all__]

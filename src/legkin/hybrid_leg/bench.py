@@ -1,10 +1,10 @@
-"""Hybrid leg: closed-form ``foot_ik`` (batch and scalar) vs a Pinocchio closed-loop iterative IK, same targets.
+"""Hybrid leg: closed-form ``ik`` (batch and scalar) vs a Pinocchio closed-loop iterative IK, same targets.
 
-Targets: Pinocchio's ``FCS`` frame at closed configurations (``checks.hybrid_leg.closed_configuration``) of
-random platform poses of the neutral assembly mode (``checks.hybrid_leg.sample_workspace``, motor Jacobian
-sigma_min >= 1e-2) and theta_LL uniform on the extension side [-0.3, delta] (the ``ll_branch`` foot_ik tries first).
+Targets: Pinocchio's ``FCS`` frame at closed configurations (``configuration.closed_configuration``) of
+random platform poses of the neutral assembly mode (``configuration.sample_workspace``, motor Jacobian
+sigma_min >= 1e-2) and theta_LL uniform on the extension side [-0.3, delta] (the ``ll_branch`` ik tries first).
 Every answer (three motor angles) is scored the same way: the foot that those motors give in the neutral
-assembly mode (:func:`legkin.hybrid_leg.foot_position`, validated against Pinocchio) vs the target.
+assembly mode (:func:`legkin.hybrid_leg.fk`, validated against Pinocchio) vs the target.
 """
 
 from __future__ import annotations
@@ -14,7 +14,7 @@ import numpy as np
 from .. import load
 from . import kinematics as ah
 from ..bench import Method, MethodResult, ModelBench, Score
-from .checks import LL_RANGE, closed_configuration, sample_workspace
+from .configuration import LL_RANGE, closed_configuration, sample_workspace
 from ..errors import LegkinError
 from .._benchkit import SOLVE_TOL, levenberg_marquardt, pinocchio_positions, sizes
 from .._single_call import SingleCall
@@ -40,15 +40,16 @@ def single_calls() -> list[SingleCall]:
     :data:`SINGLE_THETA0`, the foot they give as the IK target. Yardsticks: Pinocchio ``forwardKinematics`` +
     ``updateFramePlacement`` on the quadruped (``quadruped_fk``) for the closed forms; ``Robot.solve_loops`` on
     the hybrid leg (``solve_loops``, ``iterative=True``) for the functions that solve the closed sub-chain's
-    forward kinematics (the degree-8 polynomial and Newton): platform_orientation, platform_poses, foot_position,
-    foot_jacobian and foot_ik_solutions (which runs the forward kinematics of every branch).
+    forward kinematics (the degree-8 polynomial and Newton): platform_orientation, platform_poses, fk,
+    jacobian and ik_all (which runs the forward kinematics of every branch).
     """
     roll, pitch = SINGLE_POSE
     t0 = SINGLE_THETA0
     rot = ah.platform_rotation(roll, pitch)
     t1, t2 = (float(v) for v in ah.motor_angles(roll, pitch))
     tll = float(ah.ll_angle(t0))
-    p = ah.foot_position(t1, t2, t0)
+    q = np.array([t1, t2, t0])
+    p = ah.fk(q)
     cf, it = "quadruped_fk", "solve_loops"
     return [
         SingleCall("ll_angle", lambda: ah.ll_angle(t0), cf),
@@ -63,12 +64,12 @@ def single_calls() -> list[SingleCall]:
         SingleCall("assembly_mode", lambda: ah.assembly_mode(roll, pitch), cf),
         SingleCall("foot_position_from_platform", lambda: ah.foot_position_from_platform(roll, pitch, tll), cf),
         SingleCall("foot_platform_ik", lambda: ah.foot_platform_ik(p), cf),
-        SingleCall("foot_ik", lambda: ah.foot_ik(p), cf),
+        SingleCall("ik", lambda: ah.ik(p), cf),
         SingleCall("platform_orientation", lambda: ah.platform_orientation(t1, t2), it, iterative=True),
         SingleCall("platform_poses", lambda: ah.platform_poses(t1, t2), it, iterative=True),
-        SingleCall("foot_position", lambda: ah.foot_position(t1, t2, t0), it, iterative=True),
-        SingleCall("foot_jacobian", lambda: ah.foot_jacobian(t1, t2, t0), it, iterative=True),
-        SingleCall("foot_ik_solutions", lambda: ah.foot_ik_solutions(p), it, iterative=True),
+        SingleCall("fk", lambda: ah.fk(q), it, iterative=True),
+        SingleCall("jacobian", lambda: ah.jacobian(q), it, iterative=True),
+        SingleCall("ik_all", lambda: ah.ik_all(p), it, iterative=True),
     ]
 
 
@@ -90,7 +91,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         ok_in = np.all(np.isfinite(motors), axis=-1)
         foot = np.full((len(p), 3), np.nan)
         if ok_in.any():
-            foot[ok_in] = ah.foot_position(motors[ok_in, 0], motors[ok_in, 1], motors[ok_in, 2])
+            foot[ok_in] = ah.fk(motors[ok_in])
         err = np.linalg.norm(foot - p, axis=-1)
         solved = err <= SOLVE_TOL
         if residual is not None:
@@ -98,13 +99,13 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         return Score(error=err, solved=solved, orientation=residual, iterations=iters, fk_evals=evals)
 
     def batch_ik(p):
-        return ah.foot_ik(p)
+        return ah.ik(p)
 
     def scalar_ik(p):
         out = np.full((len(p), 3), np.nan)
         for i, pi in enumerate(p):
             try:
-                out[i] = ah.foot_ik(pi)
+                out[i] = ah.ik(pi)
             except LegkinError:
                 pass
         return out
@@ -138,7 +139,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         return score_motors(p, motors, res, iters, evals)
 
     methods = [
-        Method(f"legkin batch closed form (foot_ik; {n_batch} at once)", targets, batch_ik,
+        Method(f"legkin batch closed form (ik; {n_batch} at once)", targets, batch_ik,
                lambda p, m: score_motors(p, m), repeats=5),
         Method("legkin scalar closed form, Python loop", targets, scalar_ik, lambda p, m: score_motors(p, m),
                max_targets=n_scalar, repeats=3),
@@ -147,9 +148,9 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
     ]
     notes = [
         f"targets: Pinocchio FCS of {n_batch} closed configurations, platform poses of the neutral assembly mode "
-        "(sigma_min(dtheta/dx) >= 1e-2), theta_LL uniform in [-0.3, delta] (the ll_branch foot_ik tries first); the "
+        "(sigma_min(dtheta/dx) >= 1e-2), theta_LL uniform in [-0.3, delta] (the ll_branch ik tries first); the "
         f"scalar loop solves the first {n_scalar}, Pinocchio the first {n_iter}",
-        "err = foot of the answer's motors (theta1, theta2, theta0) in the neutral assembly mode (foot_position) vs "
+        "err = foot of the answer's motors (theta1, theta2, theta0) in the neutral assembly mode (fk) vs "
         "target (m); loop |r| = Pinocchio loop residual of the Pinocchio answer; a Pinocchio answer closing the "
         "loops in another assembly mode lands elsewhere and counts as not solved",
         f"pinocchio closed-loop IK: the Levenberg-Marquardt of Robot.solve_loops on [2 rod closures; FCS - target] "
@@ -162,7 +163,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         s = next(r for r in results if "scalar" in r.name)
         p = next(r for r in results if "pinocchio" in r.name)
         return [
-            f"batch foot_ik is {p.time_per_target_s / b.time_per_target_s:,.0f}x and the scalar call "
+            f"batch ik is {p.time_per_target_s / b.time_per_target_s:,.0f}x and the scalar call "
             f"{p.time_per_target_s / s.time_per_target_s:,.1f}x faster than the Pinocchio closed-loop IK"
         ]
 

@@ -6,128 +6,36 @@ import numpy as np
 import pinocchio as pin
 
 from .. import load
+from .._rotations import rot_x, rot_y, rot_z
 from . import kinematics as ah
+from .geometry import LL0, H
 from ..validation import CheckResult, compare, per_sample, pinocchio_frames
+from .configuration import (
+    ACTUATED, LL_RANGE, PASSIVE_U, SIGMA_MIN, closed_configuration, sample_near_forward_singularity, sample_workspace,
+)
+from .configuration import sigma_min as _sigma_min
 
 TOL = 1e-12
 #: Samples for the iterative Pinocchio loop solver and the mobility SVDs (costly per sample).
 SOLVE_SAMPLES = 200
-#: Well-conditioned workspace: sigma_min(dtheta/d(roll, pitch)) at least this (rad/rad).
-SIGMA_MIN = 1e-2
 #: Near the forward singularity the FK error scales as eps / sigma_min: that row reports
 #: error * sigma_min, measured <= 6.0e-15 over 140,000 samples; tolerance:
 TOL_SCALED = 1e-13
-#: LL samples: theta_LL uniform in this range (rad), i.e. theta0 from -16.8 to +40 motor radians (-2.7 to
-#: +6.4 revolutions with starting_value 0).
-LL_RANGE = (-0.3, 0.125)
-#: foot_ik: condition number (see :func:`foot_ik_condition`) above which a sample is near-singular.
+#: ik: condition number (see :func:`foot_ik_condition`) above which a sample is near-singular.
 KAPPA_NEAR = 100.0
 #: Tolerance of error / kappa for those (measured <= 1.7e-15 over 20,000 samples placed near alpha = 0).
 TOL_KAPPA = 1e-14
-#: foot_jacobian: sigma_min(dtheta/dx) at least this for the 1e-12 row.
+#: jacobian: sigma_min(dtheta/dx) at least this for the 1e-12 row.
 SIGMA_JAC = 0.3
 #: Tolerance of error x sigma_min^3 below SIGMA_JAC (measured <= 3.1e-15 at 10,000 samples).
 TOL_SIGMA3 = 1e-14
 #: Samples of the foot-Jacobian rows (one pseudo-inverse per sample).
 JAC_SAMPLES = 10_000
-PASSIVE_U = ("LCS_x", "LCS_y", "Sph_1_1_z", "Sph_1_1_y", "Sph_1_1_x", "Sph_2_1_z", "Sph_2_1_y", "Sph_2_1_x")
-ACTUATED = ("MCS1", "MCS2", "LL")
 
-
-def _sigma_min(roll: np.ndarray, pitch: np.ndarray, branch=(1, 1)) -> np.ndarray:
-    jac, ok = ah.motor_jacobian(roll, pitch, branch, return_mask=True)
-    s = np.full(roll.shape, np.nan)
-    s[ok] = np.linalg.svd(jac[ok], compute_uv=False)[..., -1]
-    return s
-
-
-def _neutral_mode(roll: np.ndarray, pitch: np.ndarray, branch=(1, 1)) -> np.ndarray:
-    """Reachable, and same sign of det dtheta/dx as at R_P = I (the neutral assembly mode)."""
-    jac, ok = ah.motor_jacobian(roll, pitch, branch, return_mask=True)
-    j0 = ah.motor_jacobian(0.0, 0.0, branch)
-    det = np.linalg.det(np.where(ok[..., None, None], jac, np.eye(2)))
-    return ok & (np.sign(det) == np.sign(np.linalg.det(j0)))
-
-
-def sample_workspace(n: int, rng: np.random.Generator, sigma_min: float = SIGMA_MIN) -> tuple[np.ndarray, np.ndarray]:
-    """``n`` (roll, pitch) pairs of the neutral assembly mode with sigma_min(dtheta/dx) >= ``sigma_min``.
-
-    Rejection sampling in |roll| <= 1, pitch in [-1, 1.1] rad (the neutral mode's component lies inside it:
-    pitch from about -34 to +55 deg, roll up to about +-57 deg).
-    """
-    out_r, out_p, got = [], [], 0
-    while got < n:
-        r = rng.uniform(-1.0, 1.0, 4 * n)
-        p = rng.uniform(-1.0, 1.1, 4 * n)
-        keep = _neutral_mode(r, p)
-        keep[keep] &= _sigma_min(r[keep], p[keep]) >= sigma_min
-        out_r.append(r[keep])
-        out_p.append(p[keep])
-        got += int(keep.sum())
-    return np.concatenate(out_r)[:n], np.concatenate(out_p)[:n]
-
-
-def sample_near_forward_singularity(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    """(roll, pitch) just inside the forward-singularity curve (det N = 0) bounding the neutral mode.
-
-    For roll in [-0.9, 0.9], the pitch where det dtheta/dx changes sign between 0 and 1.1 rad is found by
-    bisection; samples sit 10^U(-7, -2) rad inside it.
-    """
-    roll = rng.uniform(-0.9, 0.9, n)
-    lo, hi = np.zeros(n), np.full(n, 1.1)
-    for _ in range(60):
-        mid = 0.5 * (lo + hi)
-        inside = _neutral_mode(roll, mid)
-        lo = np.where(inside, mid, lo)
-        hi = np.where(inside, hi, mid)
-    return roll, lo - 10.0 ** rng.uniform(-7, -2, n)
-
-
-def _rx(a):
-    c, s = np.cos(a), np.sin(a)
-    o, z = np.ones_like(a), np.zeros_like(a)
-    return np.stack([np.stack([o, z, z], -1), np.stack([z, c, -s], -1), np.stack([z, s, c], -1)], -2)
-
-
-def _ry(a):
-    c, s = np.cos(a), np.sin(a)
-    o, z = np.ones_like(a), np.zeros_like(a)
-    return np.stack([np.stack([c, z, s], -1), np.stack([z, o, z], -1), np.stack([-s, z, c], -1)], -2)
-
-
-def _rz(a):
-    c, s = np.cos(a), np.sin(a)
-    o, z = np.ones_like(a), np.zeros_like(a)
-    return np.stack([np.stack([c, -s, z], -1), np.stack([s, c, z], -1), np.stack([z, z, o], -1)], -2)
-
-
-def closed_configuration(robot, angles: np.ndarray, theta_ll: np.ndarray, branch=(1, 1)) -> np.ndarray:
-    """Analytic configurations (n, nq) closing both loops.
-
-    Args:
-        robot: a loaded ``hybrid_leg`` (either centre).
-        angles: centre joint angles (n, 2) (roll, pitch) for the universal centre, (n, 3) (x, y, z) for the
-            spherical one (R_P = Rx Ry Rz).
-        theta_ll: LL angles (n,).
-    """
-    rot = _rx(angles[:, 0]) @ _ry(angles[:, 1])
-    if angles.shape[1] == 3:
-        rot = rot @ _rz(angles[:, 2])
-    theta = ah.motor_angles_from_rotation(rot, branch)
-    sph = ah.sphere_joint_angles(rot, branch)
-    qs = np.tile(robot.q0, (len(angles), 1))
-    for k, axis in enumerate("xyz"[: angles.shape[1]]):
-        qs[:, robot.idx_q(f"LCS_{axis}")] = angles[:, k]
-    for i in (1, 2):
-        qs[:, robot.idx_q(f"MCS{i}")] = theta[:, i - 1]
-        for k, axis in enumerate("zyx"):
-            qs[:, robot.idx_q(f"Sph_{i}_1_{axis}")] = sph[:, i - 1, k]
-    qs[:, robot.idx_q("LL")] = theta_ll
-    return qs
 
 
 def foot_ik_condition(pos: np.ndarray, theta_ll: np.ndarray, roll: np.ndarray, pitch: np.ndarray) -> np.ndarray:
-    """Condition number of foot_ik at a sample: ``max(1, sigma_max(dtheta/dx)) * max(1 / alpha, |u| / rho)``.
+    """Condition number of ik at a sample: ``max(1, sigma_max(dtheta/dx)) * max(1 / alpha, |u| / rho)``.
 
     ``alpha = |theta_LL - LL_DELTA|`` (the LL branches merge at 0), ``u = p - CENTER``, ``rho`` = distance of
     the foot from the roll axis (x through the LCS centre; roll is undetermined at 0), and
@@ -243,10 +151,10 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     theta0 = ah.extension_motor_angle(tll)
     rows.append(compare("foot_position_from_platform vs Pinocchio FCS (m)",
                         per_sample(ah.foot_position_from_platform(roll, pitch, tll) - pos), TOL))
-    rows.append(compare("foot_position(theta1, theta2, theta0) vs Pinocchio FCS (m)",
-                        per_sample(ah.foot_position(th[:, 0], th[:, 1], theta0) - pos), TOL))
+    rows.append(compare("fk(theta1, theta2, theta0) vs Pinocchio FCS (m)",
+                        per_sample(ah.fk(np.column_stack([th, theta0])) - pos), TOL))
 
-    # -- foot_ik: default branch round trip, and every branch closes in Pinocchio at the target.
+    # -- ik: default branch round trip, and every branch closes in Pinocchio at the target.
     # Its conditioning: kappa = max(1, sigma_max(dtheta/dx)) * max(1 / alpha, |u| / rho), alpha = |theta_LL -
     # LL_DELTA| (the two LL branches merge at alpha = 0: acos near 1) and rho = distance of the foot from the
     # roll axis (roll undetermined at rho = 0): error ~ eps * kappa. Samples with kappa > KAPPA_NEAR are in
@@ -254,19 +162,20 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     kappa = foot_ik_condition(pos, tll, roll, pitch)
     well = kappa <= KAPPA_NEAR
     default = tll <= ah.LL_DELTA  # samples on the default LL branch (the others are in the all-branch rows)
-    sol = ah.foot_ik(pos[default])
+    sol = ah.ik(pos[default])
     jerr = np.maximum(np.abs(sol[:, :2] - th[default]).max(-1), np.abs(ah.ll_angle(sol[:, 2]) - tll[default]))
     wd = well[default]
-    rows.append(compare(f"foot_ik round trip (default branch, kappa <= {KAPPA_NEAR:g}): theta1, theta2, theta_LL",
+    rows.append(compare(f"ik round trip (default branch, kappa <= {KAPPA_NEAR:g}): theta1, theta2, theta_LL",
                         jerr[wd], TOL))
-    rows.append(compare(f"foot_ik round trip (default branch, kappa > {KAPPA_NEAR:g}): error / kappa",
+    rows.append(compare(f"ik round trip (default branch, kappa > {KAPPA_NEAR:g}): error / kappa",
                         jerr[~wd] / kappa[default][~wd], TOL_KAPPA))
-    allb, okb = ah.foot_ik(pos[:ns], all_branches=True, return_mask=True)
+    every = ah.ik_all(pos[:ns])
+    allb, okb = every.motors, every.mask
     truth = np.concatenate([th[:ns], theta0[:ns, None]], -1)[:, None, :]
     # theta0 compared as theta_LL (x RATIO): one LL radian is 134.6 motor radians
     diff = (np.abs(allb - truth) * np.array([1.0, 1.0, ah.RATIO])).max(-1)
     found = np.min(np.where(okb, diff, np.inf), axis=-1) / np.maximum(kappa[:ns] / KAPPA_NEAR, 1.0)
-    rows.append(compare(f"foot_ik all branches contain the sample ({ns} samples; / (kappa/{KAPPA_NEAR:g}) if larger)",
+    rows.append(compare(f"ik_all: the branches contain the sample ({ns} samples; / (kappa/{KAPPA_NEAR:g}) if larger)",
                         found, TOL))
     res_b, foot_b = [], []
     for j, (llb, rb, b1, b2) in enumerate(ah.FOOT_IK_BRANCHES):
@@ -278,13 +187,13 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         mot = np.stack([qb[:, robot.idx_q("MCS1")], qb[:, robot.idx_q("MCS2")]], -1)
         res_b.append(np.maximum(_residuals(robot, qb), np.abs(mot - allb[idx, j, :2]).max(-1)))
         foot_b.append(per_sample(pinocchio_frames(robot, qb, ["FCS"])[0][:, 0] - pos[idx]))
-    rows.append(compare("foot_ik every branch -> Pinocchio loop residual (m)", np.concatenate(res_b), TOL))
-    rows.append(compare("foot_ik every branch -> Pinocchio FCS at the target (m)", np.concatenate(foot_b), TOL))
+    rows.append(compare("ik_all every branch -> Pinocchio loop residual (m)", np.concatenate(res_b), TOL))
+    rows.append(compare("ik_all every branch -> Pinocchio FCS at the target (m)", np.concatenate(foot_b), TOL))
 
     # -- foot Jacobian vs Pinocchio's closed-loop Jacobian. Given motor angles, the platform comes from the
     # FK (error ~ eps / sigma_min) and the Jacobian's sensitivity grows as 1 / sigma_min^2: error ~ 1 / sigma^3.
     nj = min(n, JAC_SAMPLES)
-    ja = ah.foot_jacobian(th[:nj, 0], th[:nj, 1], theta0[:nj])
+    ja = ah.jacobian(np.column_stack([th[:nj], theta0[:nj]]))
     jerr = np.empty(nj)
     for k in range(nj):
         jp = _closed_loop_jacobian(robot, qs[k], "FCS")
@@ -292,9 +201,9 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         jerr[k] = np.abs(ja[k] - jp).max()
     smin = _sigma_min(roll[:nj], pitch[:nj])
     wj = smin >= SIGMA_JAC
-    rows.append(compare(f"foot_jacobian vs Pinocchio closed-loop Jacobian, sigma_min >= {SIGMA_JAC:g} (m/rad)",
+    rows.append(compare(f"jacobian vs Pinocchio closed-loop Jacobian, sigma_min >= {SIGMA_JAC:g} (m/rad)",
                         jerr[wj], TOL))
-    rows.append(compare(f"foot_jacobian vs Pinocchio closed-loop Jacobian, sigma_min < {SIGMA_JAC:g}: error x sigma_min^3",
+    rows.append(compare(f"jacobian vs Pinocchio closed-loop Jacobian, sigma_min < {SIGMA_JAC:g}: error x sigma_min^3",
                         jerr[~wj] * smin[~wj] ** 3, TOL_SIGMA3))
 
     rows += _mobility_rows(robot, roll[:ns], pitch[:ns], rng)
@@ -317,7 +226,7 @@ def _mobility_rows(robot, roll, pitch, rng) -> list[CheckResult]:
 
     sph = load("hybrid_leg", center="spherical")
     ang = np.stack([roll, pitch, rng.uniform(-0.2, 0.2, ns)], -1)
-    rot = _rx(ang[:, 0]) @ _ry(ang[:, 1]) @ _rz(ang[:, 2])
+    rot = rot_x(ang[:, 0]) @ rot_y(ang[:, 1]) @ rot_z(ang[:, 2])
     ok = ah.motor_angles_from_rotation(rot, return_mask=True)[1]
     ang, rot = ang[ok], rot[ok]
     qs = closed_configuration(sph, ang, np.zeros(len(ang)))
@@ -365,11 +274,11 @@ def _aspect_boundary(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.n
 
 
 def _fk_made(roll, pitch, tll):
-    """Foot targets made by the default ``foot_position`` from the in-limit joints of poses (roll, pitch, theta_LL)
+    """Foot targets made by the default ``fk`` from the in-limit joints of poses (roll, pitch, theta_LL)
     of the neutral mode; returns the targets and the mask of those the FK produced."""
     th, ok = ah.motor_angles(roll, pitch, return_mask=True)
     th = np.where(ok[:, None], th, 0.0)
-    p, made = ah.foot_position(th[:, 0], th[:, 1], ah.extension_motor_angle(tll), return_mask=True)
+    p, made = ah.fk(np.column_stack([th, ah.extension_motor_angle(tll)]), return_mask=True)
     return p, made & ok
 
 
@@ -414,7 +323,7 @@ def ik_robustness_targets(n: int, rng: np.random.Generator) -> tuple[np.ndarray,
     # random motor angles over the motor range of the neutral aspect (most assemble there)
     th = rng.uniform([-1.6, -2.7], [2.7, 1.6], (3 * k[5] + 16, 2))
     t0 = ah.extension_motor_angle(rng.uniform(-ah.LL_LIMIT, ah.LL_LIMIT, len(th)))
-    p, made = ah.foot_position(th[:, 0], th[:, 1], t0, return_mask=True)
+    p, made = ah.fk(np.column_stack([th, t0]), return_mask=True)
     sel = np.flatnonzero(made)[: k[5]]
     add(p[sel], made[sel])
 
@@ -436,7 +345,7 @@ def ik_robustness_targets(n: int, rng: np.random.Generator) -> tuple[np.ndarray,
     out.append(base + v)
     out.append(ah.CENTER + np.stack([rng.uniform(-3.3, 3.3, k[2]), np.zeros(k[2]), np.zeros(k[2])], -1))
     v = rng.normal(size=(k[3], 3))
-    radius = np.where(rng.uniform(size=k[3]) < 0.5, ah._LL0 + ah._H, ah._LL0 - ah._H)
+    radius = np.where(rng.uniform(size=k[3]) < 0.5, LL0 + H, LL0 - H)
     radius *= 1.0 + rng.choice([-1.0, 1.0], k[3]) * 10.0 ** rng.uniform(-15, -9, k[3])
     out.append(ah.CENTER + v * (radius / np.linalg.norm(v, axis=-1))[:, None])
     out.append(np.tile(ah.CENTER, (k[4], 1)))
@@ -447,32 +356,32 @@ def ik_robustness_targets(n: int, rng: np.random.Generator) -> tuple[np.ndarray,
 
 
 def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 2000) -> CheckResult:
-    """The IK contract row of the hybrid leg: default ``foot_ik`` on ``n`` targets in and around the workspace.
+    """The IK contract row of the hybrid leg: default ``ik`` on ``n`` targets in and around the workspace.
 
-    Targets from :func:`ik_robustness_targets` (about half made by the default ``foot_position`` from in-limit
-    joints). The default batch IK runs on all; each solved answer is scored by ``|foot_position(IK(x)) - x|``
+    Targets from :func:`ik_robustness_targets` (about half made by the default ``fk`` from in-limit
+    joints). The default batch IK runs on all; each solved answer is scored by ``|fk(ik(x)) - x|``
     (default options); up to ``classify`` unsolved targets (None: all; FK-made ones first) are classified by the
-    error a single ``foot_ik`` call raises (:func:`legkin.validation.classify_failures`).
+    error a single ``ik`` call raises (:func:`legkin.validation.classify_failures`).
     """
     from ..validation import classify_failures, robustness_row
 
     targets, made = ik_robustness_targets(n, rng)
     exceptions = 0
     try:
-        sol, solved = ah.foot_ik(targets, return_mask=True)
+        sol, solved = ah.ik(targets, return_mask=True)
     except Exception:  # noqa: BLE001 - a foreign exception from the batch call is a defect, counted
         exceptions += 1
         sol, solved = np.full(targets.shape, np.nan), np.zeros(len(targets), dtype=bool)
     error = np.full(len(targets), np.inf)
     if solved.any():
         try:
-            back, ok = ah.foot_position(sol[solved, 0], sol[solved, 1], sol[solved, 2], return_mask=True)
+            back, ok = ah.fk(sol[solved], return_mask=True)
             error[solved] = np.where(ok, np.linalg.norm(back - targets[solved], axis=-1), np.inf)
         except Exception:  # noqa: BLE001
             exceptions += 1
     unsolved = np.flatnonzero(~solved)
     order = np.concatenate([unsolved[made[unsolved]], rng.permutation(unsolved[~made[unsolved]])])
     idx = order if classify is None else order[: int(classify)]
-    reasons, exc = classify_failures(lambda i: ah.foot_ik(targets[i]), idx)
+    reasons, exc = classify_failures(lambda i: ah.ik(targets[i]), idx)
     return robustness_row("hybrid_leg", made=made, solved=solved, error=error, reasons=reasons,
                           classified=len(idx), exceptions=exceptions + exc)

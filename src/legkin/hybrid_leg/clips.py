@@ -7,6 +7,8 @@ import math
 import numpy as np
 
 from . import kinematics as ah
+from .configuration import closed_configuration
+from .geometry import Geometry
 
 #: Roll and pitch amplitudes of the clip (rad): inside the reachable set and clear of the parallel
 #: singularity of motor branch (+1, +1) (see ``hybrid_leg_workspace.png``).
@@ -26,11 +28,9 @@ def tilt_path(frames: int = 400) -> tuple[np.ndarray, np.ndarray]:
 def configurations(robot, roll, pitch, theta_ll, branch=BRANCH) -> np.ndarray:
     """Configurations (n, nq) closing both loops: universal centre at (roll, pitch), LL at ``theta_ll``.
 
-    Built by :func:`legkin.hybrid_leg.checks.closed_configuration` (motors and lever-tip spherical joints in
+    Built by :func:`legkin.hybrid_leg.configuration.closed_configuration` (motors and lever-tip spherical joints in
     closed form). For the spherical-centre model, its third centre joint ``LCS_z`` keeps its ``q0`` value.
     """
-    from .checks import closed_configuration
-
     angles = [np.ravel(roll), np.ravel(pitch)]
     if robot.model.existJointName("LCS_z"):
         angles.append(np.full(angles[0].shape, robot.q0[robot.idx_q("LCS_z")]))
@@ -50,7 +50,7 @@ def extend_and_tilt(robot, frames: int = 120) -> list[np.ndarray]:
     roll, pitch = roll[:-1], pitch[:-1]
     t = np.arange(frames) / frames
     theta0 = EXTENSION * 0.5 * (1.0 - np.cos(2.0 * math.pi * t))
-    theta_ll = ah.ll_angle(theta0, float(robot.params.get("starting_value", 0.0)))
+    theta_ll = ah.ll_angle(theta0, geometry=Geometry.from_params(robot.params))
     return list(configurations(robot, roll, pitch, theta_ll))
 
 

@@ -1,0 +1,189 @@
+"""Option checks, fast-path tests, status codes and the geometry resolution shared by the hybrid leg's modules.
+
+Every option error is an :class:`~legkin.errors.InvalidArgumentError` (both an InvalidParameterError and an
+InvalidInputError, hence a ValueError) naming the option and the value given.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import replace
+from typing import Callable, Final
+
+import numpy as np
+
+from .._batch import check_flag, check_integer, check_number
+from ..errors import InvalidArgumentError, InvalidParameterError, UnreachableError
+from .geometry import DEFAULT, K_TOL, MOTOR_BRANCHES, Geometry
+
+# Status codes of the kernels (OK = legkin._kernels.OK = 0).
+ST_INPUT: Final = 1  # a non-finite input (or not a rotation): the wrapper's checks raise the InvalidInputError
+ST_REACH: Final = 2  # a chain out of the motors' reach (|k| > 1 + tol)
+ST_ASSEMBLE: Final = 3  # the closed sub-chain does not assemble in the mode asked for
+ST_BAND: Final = 4  # the forward-singularity band (foot gain >= FK_GAIN_MAX)
+ST_SINGULAR: Final = 5  # N singular / reach boundary
+
+#: Scalar types a single-call fast path passes straight to a kernel (anything else takes the checked path).
+SCALARS = (float, np.float64)
+#: Batches smaller than this run the serial loop: starting numba's threads costs more than they save.
+PARALLEL_MIN = 64
+
+
+class Unset:
+    """The type of :data:`UNSET`, the default of a deprecated keyword (tells "not given" from any value)."""
+
+    def __repr__(self) -> str:
+        return "UNSET"
+
+
+UNSET: Final = Unset()
+
+
+def loop(parallel: Callable[..., object], serial: Callable[..., object], n: int) -> Callable[..., object]:
+    """The compiled batch loop to run for n items: the prange one (parallel) or the plain one (serial)."""
+    return parallel if n >= PARALLEL_MIN else serial
+
+
+def flat(a: np.ndarray) -> np.ndarray:
+    """A checked input as a fresh, writeable, C-contiguous float64 vector (for a kernel)."""
+    return np.array(a, dtype=np.float64).reshape(-1)
+
+
+def _is_real(value: object) -> bool:
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def check_branch(branch: object) -> np.ndarray:
+    """Motor branch pair (b1, b2), each +1 or -1, as a float array."""
+    b = None
+    if not isinstance(branch, (str, bytes)):
+        try:
+            raw = np.asarray(branch)
+        except (TypeError, ValueError):
+            raw = None
+        if raw is not None and raw.dtype.kind in "iuf" and raw.shape == (2,) and np.all(np.abs(raw) == 1):
+            b = raw.astype(float)
+    if b is None:
+        raise InvalidArgumentError(
+            f"branch must be one of {', '.join(map(str, MOTOR_BRANCHES))} (b1, b2: the motor branch of each chain), "
+            f"got {branch!r}"
+        )
+    return b
+
+
+def check_sign(value: object, name: str, allow_none: bool = False) -> float | None:
+    """+1 or -1 (as float), or None if allowed."""
+    if value is None and allow_none:
+        return None
+    if _is_real(value) and value in (1, -1):
+        return float(value)  # type: ignore[arg-type]
+    valid = "+1 or -1" + (" (or None: try both, see FOOT_IK_ORDER)" if allow_none else "")
+    raise InvalidArgumentError(f"{name} must be {valid}, got {value!r}")
+
+
+def check_assembly(value: object) -> float:
+    if _is_real(value) and value in (1, -1):
+        return float(value)  # type: ignore[arg-type]
+    raise InvalidArgumentError(
+        f"assembly must be +1 (the assembly mode of the neutral pose, R_P = I, on the given branch) or -1 (the other "
+        f"sign of det(dtheta/d(roll, pitch))), got {value!r}"
+    )
+
+
+def flag(value: object, name: str) -> bool:
+    """:func:`legkin._batch.check_flag`, raising an InvalidArgumentError."""
+    try:
+        return check_flag(value, name)
+    except InvalidParameterError as exc:
+        raise InvalidArgumentError(str(exc)) from None
+
+
+def real(value: object, name: str, lo: float, hi: float, what: str) -> float:
+    """A real number in (lo, hi] (:func:`legkin._batch.check_number`), raising an InvalidArgumentError."""
+    try:
+        return check_number(value, name, lo, hi, low_open=True)
+    except (InvalidParameterError, OverflowError):
+        raise InvalidArgumentError(f"{name} must be a finite real number in ({lo:g}, {hi:g}] ({what}), "
+                                   f"got {value!r}") from None
+
+
+def count(value: object, name: str, lo: int, hi: int, what: str) -> int:
+    """An integer in [lo, hi] (:func:`legkin._batch.check_integer`), raising an InvalidArgumentError."""
+    try:
+        return check_integer(value, name, lo, hi)
+    except InvalidParameterError:
+        raise InvalidArgumentError(f"{name} must be an integer in [{lo}, {hi}] ({what}), got {value!r}") from None
+
+
+def fast_branch(branch: object) -> tuple[float, float] | None:
+    """(b1, b2) as floats for a plain tuple of two ints +-1, else None (the checked path then)."""
+    if type(branch) is tuple and len(branch) == 2:
+        b1, b2 = branch
+        if type(b1) is int and type(b2) is int and (b1 == 1 or b1 == -1) and (b2 == 1 or b2 == -1):
+            return float(b1), float(b2)
+    return None
+
+
+def fast_sign(value: object) -> float | None:
+    """+-1.0 for a plain int +-1, else None."""
+    if type(value) is int and (value == 1 or value == -1):
+        return float(value)
+    return None
+
+
+def fast_geometry(geometry: object) -> Geometry | None:
+    """The geometry for a fast path: the default for None, a Geometry as is, else None (the checked path)."""
+    if geometry is None:
+        return DEFAULT
+    if type(geometry) is Geometry:
+        return geometry
+    return None
+
+
+def resolve(geometry: object, starting_value: object = UNSET, *, universal: str = "") -> Geometry:
+    """The checked geometry of a call, with the deprecated ``starting_value=`` keyword mapped onto it.
+
+    ``universal``: the function's name when it needs the universal centre (refuses ``center="spherical"``).
+    """
+    if geometry is None:
+        g = DEFAULT
+    elif isinstance(geometry, Geometry):
+        g = geometry
+    else:
+        raise InvalidArgumentError(f"geometry must be a legkin.hybrid_leg.Geometry or None, got {geometry!r}")
+    if starting_value is not UNSET:
+        warnings.warn("the starting_value= keyword is deprecated; pass geometry=Geometry(starting_value=...)",
+                      DeprecationWarning, stacklevel=3)
+        g = replace(g, starting_value=starting_value)  # type: ignore[arg-type]
+    if universal and g.center != "universal":
+        raise InvalidArgumentError(
+            f"{universal} needs the universal centre (geometry.center='universal'), got center={g.center!r}: with the "
+            "spherical centre one platform rotation is free with the motors locked (spherical_free_axis), so the "
+            "motors do not fix the platform"
+        )
+    return g
+
+
+def deprecated(old: str, new: str) -> None:
+    """Warn that ``old`` is deprecated in favour of ``new`` (at the caller's caller)."""
+    warnings.warn(f"{old} is deprecated; use {new}", DeprecationWarning, stacklevel=3)
+
+
+def unreachable(what: str, k: np.ndarray) -> UnreachableError:
+    """The error of a rotation or pose out of the motors' reach, naming the chain(s) and their |k|."""
+    bad = [f"chain {i + 1} (|k| = {abs(float(k[i])):.15g})" for i in range(2) if not abs(float(k[i])) <= 1.0 + K_TOL]
+    return UnreachableError(
+        f"{what} is out of the motors' reach: the rod-length equation A cos(theta) + B sin(theta) = C has no "
+        f"solution for {', '.join(bad) or 'a chain (|k| not finite)'}; it needs |k| = |C| / sqrt(A^2 + B^2) <= 1 "
+        f"(+ {K_TOL:g} for rounding)",
+        target=None,
+    )
+
+
+def fmt(p: object) -> str:
+    return "[" + ", ".join(f"{float(v):.17g}" for v in np.ravel(p)) + "]"
+
+
+def mode_text(b: np.ndarray, s: float) -> str:
+    return f"branch=({int(b[0])}, {int(b[1])}), assembly={int(s):+d}"
+

@@ -1,0 +1,259 @@
+"""The foot IK in closed form (seed 003): the platform pose of a foot target (:func:`foot_platform_ik`), the motor
+angles in the mode asked for (:func:`ik`), and every closed-form branch with its mode (:func:`ik_all`)."""
+
+from __future__ import annotations
+
+from typing import Literal, NamedTuple, Sequence, overload
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._batch import as_input, finish
+from .._kernels import OK
+from ..errors import InvalidInputError, UnreachableError
+from ._ik_errors import arc_error, axis_error, ik_error, platform_pose
+from ._ik_kernels import foot_ik_b, foot_ik_k, foot_ik_s, ik_all_b, ik_all_s, platform_pose_b, platform_pose_s
+from ._options import (
+    UNSET, Unset, check_assembly, check_branch, check_sign, deprecated, fast_branch, fast_geometry, fast_sign, flag,
+    fmt, loop, resolve,
+)
+from .chains import CX, CY, CZ
+from .geometry import CENTER, FK_GAIN_MAX, FOOT_IK_ORDER, Geometry
+
+__all__ = ["foot_platform_ik", "ik", "ik_all", "FootIKSolutions", "foot_ik", "foot_ik_solutions"]
+
+Branch = Sequence[int]
+_COMBOS = np.array(FOOT_IK_ORDER, dtype=np.float64)
+_NO_NEAR = np.full(3, np.nan)
+
+
+def _combos(llb: float | None, rb: float | None) -> list:
+    return [(l, r) for l, r in FOOT_IK_ORDER if (llb is None or l == llb) and (rb is None or r == rb)]
+
+
+def _search(u: np.ndarray, sv: float, combos: list, b: np.ndarray, s: float, limits_only: bool = False,
+            axis_ok: bool = True, near: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """First accepted candidate per target u (n, 3), in the order ``combos`` (or the nearest ``near`` (n, 3)):
+    motors, pose, ok (the batch kernel :func:`foot_ik_b`)."""
+    n = len(u)
+    motors, pose, ok = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.bool_)
+    nr = np.broadcast_to(_NO_NEAR, (n, 3)) if near is None else near
+    loop(foot_ik_b, foot_ik_s, n)(np.ascontiguousarray(u, dtype=np.float64), float(sv),
+                                  np.array(combos, dtype=np.float64).reshape(-1, 2), float(b[0]), float(b[1]),
+                                  float(s), bool(limits_only), bool(axis_ok), np.ascontiguousarray(nr), motors, pose, ok)
+    return motors, pose, ok
+
+
+def _targets(p: ArrayLike) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
+    pp = as_input(p, "p", (3,))
+    return pp, (pp - CENTER).reshape(-1, 3), pp.shape[:-1]
+
+
+@overload
+def foot_platform_ik(p: ArrayLike, *, ll_branch: int | None = ..., roll_branch: int | None = ...,
+                     branch: Branch | None = ..., assembly: int | None = ..., geometry: Geometry | None = ...,
+                     return_mask: Literal[False] = ...) -> np.ndarray: ...
+@overload
+def foot_platform_ik(p: ArrayLike, *, ll_branch: int | None = ..., roll_branch: int | None = ...,
+                     branch: Branch | None = ..., assembly: int | None = ..., geometry: Geometry | None = ...,
+                     return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+def foot_platform_ik(p: ArrayLike, *, ll_branch: int | None = None, roll_branch: int | None = None,
+                     branch: Branch | None = None, assembly: int | None = None, geometry: Geometry | None = None,
+                     return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """(theta_LL, roll, pitch) (..., 3) placing the foot at ``p`` (CCS), in closed form.
+
+    Inverts :func:`foot_position_from_platform`:
+
+    1. the distance from the LCS centre depends on theta_LL alone:
+       ``|p - c|^2 = |o|^2 + h^2 - 2 h |o| cos(theta_LL - delta)`` with ``o = (1.640, -0.037)``,
+       ``h = 1.5``, ``delta = atan2(0.037, 1.640)``; ``theta_LL = delta + ll_branch acos(...)``
+       (``ll_branch = -1``: theta_LL <= delta, the extension side). Unreachable unless
+       ``|o| - h <= |p - c| <= |o| + h`` (0.14042 to 3.14042 m, :data:`LL_TOL` of rounding allowed).
+    2. ``u = p - c = Rx(roll) v``, ``v = Ry(pitch) f`` with ``f`` the foot in P: ``v_y = 0`` gives
+       ``v_z = +-sqrt(u_y^2 + u_z^2)``, ``roll = atan2(-u_y / v_z, u_z / v_z)`` (``roll_branch = +1``:
+       |roll| <= pi/2), and ``pitch = atan2(f_z, f_x) - atan2(v_z, u_x)``.
+
+    Branches: with neither ``ll_branch`` nor ``roll_branch`` given (default) the branches are tried in the order
+    :data:`FOOT_IK_ORDER` and the first inside the joint limits (|roll|, |pitch| <= pi/2) is returned; with
+    ``branch`` / ``assembly`` given (either; the other defaults to (1, 1) / +1), also in that assembly mode, as
+    :func:`ik` (the foot's forward map from the pose has no assembly mode, hence no mode check by default).
+    Giving ``ll_branch`` or ``roll_branch`` alone returns that closed-form branch as is (the other defaulting to
+    -1 / +1), unchecked.
+
+    Singular exactly on the roll axis (``u_y = u_z = 0``: roll undetermined, SingularityError; with ``branch`` /
+    ``assembly`` given, as :func:`ik`, roll 0 or pi is tried there); within :data:`RHO_TOL` of it roll is
+    taken as 0 (roll_branch +1) or pi (-1).
+
+    Raises:
+        UnreachableError: single target out of reach (JointLimitError: only outside the limits;
+            AssemblyModeError: only in another mode).
+        SingularityError: single target exactly on the roll axis.
+    """
+    if (ll_branch is None and roll_branch is None and branch is None and assembly is None and return_mask is False
+            and geometry is None and type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64):
+        motors, pose = np.empty(3), np.empty(3)
+        if foot_ik_k(p[0] - CX, p[1] - CY, p[2] - CZ, 0.0, _COMBOS, 1.0, 1.0, 1.0, True, False, _NO_NEAR, motors,
+                     pose) == OK:
+            return pose
+    resolve(geometry)
+    pp, u, shape = _targets(p)
+    llb = check_sign(ll_branch, "ll_branch", allow_none=True)
+    rb = check_sign(roll_branch, "roll_branch", allow_none=True)
+    moded = branch is not None or assembly is not None
+    b = check_branch((1, 1) if branch is None else branch)
+    s = check_assembly(1 if assembly is None else assembly)
+    flag(return_mask, "return_mask")
+    if (llb is not None or rb is not None) and not moded:
+        n = len(u)
+        out, info = np.empty((n, 3)), np.empty((n, 3))
+        loop(platform_pose_b, platform_pose_s, n)(np.ascontiguousarray(u), -1.0 if llb is None else llb,
+                                                  1.0 if rb is None else rb, out, info)
+        ok = (info[:, 1] == 1.0) & (info[:, 2] > 0.0)
+        out = np.where(ok[:, None], out, np.nan)
+
+        def error() -> Exception:
+            return arc_error(pp) if info[0, 1] != 1.0 else axis_error(pp)
+
+        return finish(out.reshape(shape + (3,)), ok.reshape(shape), pp.ndim == 1, return_mask, error)
+    combos = _combos(llb, rb)
+    _, pose, ok = _search(u, 0.0, combos, b, s, limits_only=not moded, axis_ok=moded)
+    return finish(pose.reshape(shape + (3,)), ok.reshape(shape), pp.ndim == 1, return_mask,
+                  lambda: ik_error(pp, 0.0, combos, b, s, limits_only=not moded))
+
+
+@overload
+def ik(p: ArrayLike, *, branch: Branch = ..., assembly: int = ..., ll_branch: int | None = ...,
+       roll_branch: int | None = ..., q_near: ArrayLike | None = ..., geometry: Geometry | None = ...,
+       return_mask: Literal[False] = ...) -> np.ndarray: ...
+@overload
+def ik(p: ArrayLike, *, branch: Branch = ..., assembly: int = ..., ll_branch: int | None = ...,
+       roll_branch: int | None = ..., q_near: ArrayLike | None = ..., geometry: Geometry | None = ...,
+       return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+def ik(p: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, ll_branch: int | None = None,
+       roll_branch: int | None = None, q_near: ArrayLike | None = None, geometry: Geometry | None = None,
+       return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """Motor angles ``q = (theta1, theta2, theta0)`` (..., 3) placing the foot at ``p`` (..., 3) (CCS), in closed
+    form: :func:`foot_platform_ik` (target -> theta_LL -> roll, pitch), :func:`motor_angles` (eqs 3-16 per chain)
+    and :func:`extension_motor_angle` (eq 19 inverted).
+
+    The IK contract: the answer is in the mode ``branch`` (motor branches), ``assembly`` (:func:`assembly_mode`)
+    that :func:`fk` uses with the same arguments (defaults: the mode of the SRDF reference pose ``neutral``),
+    inside the URDF joint limits, and :func:`fk` of it is the target. The IK-only branches ``ll_branch`` (LL side)
+    and ``roll_branch`` are tried in the order :data:`FOOT_IK_ORDER` ((-1, +1), (+1, +1), (-1, -1), (+1, -1));
+    giving one restricts the search to it. The first candidate kept is inside the limits, in the mode, outside the
+    forward-singularity band (:data:`FK_GAIN_MAX`) and the pose the forward kinematics returns for its motor angles.
+
+    Args:
+        p: foot targets (..., 3) in CCS.
+        branch, assembly: the assembly mode (default (1, 1), +1), as in :func:`fk`.
+        ll_branch, roll_branch: None (search both, default) or +1 / -1.
+        q_near: motor angles (theta1, theta2, theta0) (3,) or (..., 3): of the candidates kept, return the one
+            nearest them in the joints (MCS1, MCS2 wrapped, LL = RATIO theta0) instead of the first.
+        geometry: the geometry (universal centre; ``starting_value`` of eq 19); None = the default.
+        return_mask: also return the mask of successes.
+
+    Raises:
+        UnreachableError: single target out of reach (of the LL arc or of the motors);
+            JointLimitError: reachable only outside the joint limits;
+            AssemblyModeError: reachable only in other modes (``.modes`` lists the arguments that reach it).
+        SingularityError: single target in the forward-singularity band, or exactly on the roll axis (where roll
+            is undetermined and ik tries roll = 0 and pi) with neither roll reaching it in the mode.
+    """
+    if (ll_branch is None and roll_branch is None and q_near is None and return_mask is False
+            and type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64):
+        fb, fs, g = fast_branch(branch), fast_sign(assembly), fast_geometry(geometry)
+        if fb is not None and fs is not None and g is not None and g.center == "universal":
+            motors, pose = np.empty(3), np.empty(3)
+            if foot_ik_k(p[0] - CX, p[1] - CY, p[2] - CZ, g.starting_value, _COMBOS, fb[0], fb[1], fs, False, True,
+                         _NO_NEAR, motors, pose) == OK:
+                return motors
+    g = resolve(geometry, universal="ik")
+    pp, u, shape = _targets(p)
+    llb = check_sign(ll_branch, "ll_branch", allow_none=True)
+    rb = check_sign(roll_branch, "roll_branch", allow_none=True)
+    b = check_branch(branch)
+    s = check_assembly(assembly)
+    flag(return_mask, "return_mask")
+    near = None
+    if q_near is not None:
+        qn = as_input(q_near, "q_near", (3,))
+        try:
+            near = np.ascontiguousarray(np.broadcast_to(qn, shape + (3,)).reshape(-1, 3))
+        except ValueError:
+            raise InvalidInputError(f"q_near must broadcast to shape {shape + (3,)}, got shape {qn.shape}") from None
+    combos = _combos(llb, rb)
+    motors, _, ok = _search(u, g.starting_value, combos, b, s, near=near)
+    return finish(motors.reshape(shape + (3,)), ok.reshape(shape), pp.ndim == 1, return_mask,
+                  lambda: ik_error(pp, g.starting_value, combos, b, s))
+
+
+class FootIKSolutions(NamedTuple):
+    """Every closed-form foot IK branch of :func:`ik_all`, in :data:`FOOT_IK_BRANCHES` order."""
+
+    #: (..., 16, 3) motor angles (theta1, theta2, theta0), NaN where the branch does not exist.
+    motors: np.ndarray
+    #: (..., 16, 3) (theta_LL, roll, pitch) of each branch.
+    pose: np.ndarray
+    #: (..., 16) the branch exists (LL arc and motors reach, target off the roll axis).
+    mask: np.ndarray
+    #: (..., 16) assembly mode of the branch's pose on its motor branch (+1 / -1, 0 where it does not exist).
+    assembly: np.ndarray
+    #: (..., 16) the branch's pose is inside the joint limits.
+    within_limits: np.ndarray
+    #: (..., 16) what :func:`ik` returns with these mode arguments: inside the limits, off the
+    #: forward-singularity band, reproduced by :func:`fk` in that mode.
+    valid: np.ndarray
+
+
+def ik_all(p: ArrayLike, *, geometry: Geometry | None = None) -> FootIKSolutions:
+    """Every foot IK solution with its mode: the 16 closed-form branches ((ll_branch, roll_branch, b1, b2) in
+    :data:`FOOT_IK_BRANCHES` order) with their assembly mode, joint-limit and validity flags (the compiled
+    :func:`._ik_kernels.ik_all_k` per target). Never raises for valid input."""
+    g = resolve(geometry, universal="ik_all")
+    pp, u, shape = _targets(p)
+    n = len(u)
+    motors, pose, info, fk = np.empty((n, 16, 3)), np.empty((n, 16, 3)), np.empty((n, 16, 7)), \
+        np.empty((n, 16), dtype=np.bool_)
+    loop(ik_all_b, ik_all_s, n)(np.ascontiguousarray(u), g.starting_value, False, motors, pose, info, fk)
+    exists = info[..., 0] == 1.0
+    return FootIKSolutions(
+        motors.reshape(shape + (16, 3)), np.where(exists[..., None], pose, np.nan).reshape(shape + (16, 3)),
+        exists.reshape(shape + (16,)), info[..., 2].astype(int).reshape(shape + (16,)),
+        ((info[..., 1] == 1.0) & exists).reshape(shape + (16,)),
+        (fk & (info[..., 3] < FK_GAIN_MAX)).reshape(shape + (16,)),
+    )
+
+
+def foot_ik(p: ArrayLike, *, starting_value: float | Unset = UNSET, ll_branch: int | None = None,
+            roll_branch: int | None = None, branch: Branch = (1, 1), assembly: int = 1, all_branches: bool = False,
+            geometry: Geometry | None = None, return_mask: bool = False
+            ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """Deprecated: :func:`ik` (``all_branches=True``: ``ik_all(p).motors`` and ``.mask``; ``starting_value`` ->
+    ``geometry``)."""
+    deprecated("foot_ik", "ik (all_branches=True: ik_all)")
+    g = resolve(geometry, starting_value)
+    if not flag(all_branches, "all_branches"):
+        return ik(p, branch=branch, assembly=assembly, ll_branch=ll_branch, roll_branch=roll_branch,  # type: ignore
+                  geometry=g, return_mask=return_mask)
+    for v, name in ((ll_branch, "ll_branch"), (roll_branch, "roll_branch")):
+        check_sign(v, name, allow_none=True)
+    check_branch(branch)
+    check_assembly(assembly)
+    flag(return_mask, "return_mask")
+    sol = ik_all(p, geometry=g)
+    pp = np.asarray(p, dtype=float)
+    if pp.ndim == 1 and not bool(np.any(sol.mask)):
+        _, arc = platform_pose(pp, -1.0, 1.0)
+        if arc[1] != 1.0:
+            raise arc_error(pp)
+        if not arc[2] > 0.0:
+            raise axis_error(pp, False)
+        raise UnreachableError(f"foot target {fmt(pp)} is out of the motors' reach on every branch", target=pp)
+    return (sol.motors, sol.mask) if return_mask else sol.motors
+
+
+def foot_ik_solutions(p: ArrayLike, *, starting_value: float | Unset = UNSET,
+                      geometry: Geometry | None = None) -> FootIKSolutions:
+    """Deprecated: :func:`ik_all` (``starting_value`` -> ``geometry``)."""
+    deprecated("foot_ik_solutions", "ik_all")
+    return ik_all(p, geometry=resolve(geometry, starting_value))

@@ -75,7 +75,7 @@ REACH_TOL = 1e-12
 #: at most LIMIT_TOL x the leg's reach, < 1e-10 m).
 LIMIT_TOL = 1e-10
 #: Damped Newton steps (at most) polishing each closed-form branch on the exact forward map (see _polish_k).
-POLISH_STEPS = 3
+POLISH_STEPS = 8
 #: Damping (m) of the polishing steps: bounds a step to ~|e| / (2 lambda) rad near a singularity.
 POLISH_DAMPING = 1e-7
 #: Foot error (m) below which a branch is not polished (a few ulps of a 1 m reach).
@@ -94,7 +94,8 @@ _KN, _LN, _PK, _PL = 20, 21, 22, 23  # |k|, |l|, phi_k, phi_l
 _LO, _HI = 24, 27  # lower, upper limits (3 each)
 _A1, _A2, _A3 = 30, 33, 36  # the measured unit axes a1, a2, a3 (exact forward map)
 _V21, _V32, _V3F = 39, 42, 45  # o2 - o1, o3 - o2, f - o3
-_NPARAMS = 48
+_SLACK = 48  # reach slack of the ideal structure: REACH_TOL + its deviation bound (see Leg.from_geometry)
+_NPARAMS = 49
 
 _TWO_PI = 2.0 * math.pi
 _NAN = math.nan
@@ -190,13 +191,14 @@ def _jacobian_k(q, g, out) -> int:
 
 
 @kernel
-def _polish_k(p, g, q, jac) -> None:
+def _polish_k(p, g, q, jac) -> float:
     """At most :data:`POLISH_STEPS` damped Newton steps on the exact forward map while the foot error exceeds
     :data:`POLISH_BELOW`, each kept only if it reduces the error: ``e = p - fk(q)``, ``dq = J^T (J J^T + lambda^2 I)^-1 e`` (``lambda`` = :data:`POLISH_DAMPING`).
 
     The closed form is exact for the ideal structure (a1 perpendicular to a2 = +-a3); URDF angles written
     with 11 digits (``rpy="0 1.57079632679 0"``) leave axes ~5e-12 off, i.e. ~1e-12 m at the foot, and near the
     fold of the knee (|w| -> 0 when |k| = |l|) the law of cosines loses digits: the steps remove both.
+    Returns the final foot error ``|e|`` (m).
     """
     fx, fy, fz = _fk3_k(q[0], q[1], q[2], g)
     ex, ey, ez = p[0] - fx, p[1] - fy, p[2] - fz
@@ -204,7 +206,7 @@ def _polish_k(p, g, q, jac) -> None:
     lam2 = POLISH_DAMPING * POLISH_DAMPING
     for _ in range(POLISH_STEPS):
         if err <= _POLISH_DONE:
-            return
+            break
         _jac3_k(q[0], q[1], q[2], g, jac)
         # A = J J^T + lam^2 I (symmetric positive definite), solve A y = e by the adjugate, dq = J^T y
         a00 = jac[0, 0] ** 2 + jac[0, 1] ** 2 + jac[0, 2] ** 2 + lam2
@@ -217,7 +219,7 @@ def _polish_k(p, g, q, jac) -> None:
         c01, c02, c12 = a02 * a12 - a01 * a22, a01 * a12 - a02 * a11, a01 * a02 - a00 * a12
         det = a00 * c00 + a01 * c01 + a02 * c02
         if not det > 0.0:
-            return
+            break
         yx = (c00 * ex + c01 * ey + c02 * ez) / det
         yy = (c01 * ex + c11 * ey + c12 * ez) / det
         yz = (c02 * ex + c12 * ey + c22 * ez) / det
@@ -228,9 +230,17 @@ def _polish_k(p, g, q, jac) -> None:
         nx, ny, nz = p[0] - fx, p[1] - fy, p[2] - fz
         new = nx * nx + ny * ny + nz * nz
         if not new < err:
-            return
+            break
         q[0], q[1], q[2] = n0, n1, n2
         ex, ey, ez, err = nx, ny, nz, new
+    return math.sqrt(err)
+
+
+@kernel
+def _residual_k(p, g, q) -> float:
+    """``|p - fk(q)|`` on the exact forward map."""
+    fx, fy, fz = _fk3_k(q[0], q[1], q[2], g)
+    return math.sqrt((p[0] - fx) ** 2 + (p[1] - fy) ** 2 + (p[2] - fz) ** 2)
 
 
 @kernel
@@ -261,8 +271,10 @@ def _ik_all_k(p, g, ref, out, info) -> int:
     d = g[_D]
     ad = abs(d)
     r = math.hypot(y, z)
-    if ad - r > REACH_TOL:
-        info[0], info[1] = ad - r, _IN_CYLINDER
+    slack = g[_SLACK]
+    cyl = ad - r
+    if cyl > slack:
+        info[0], info[1] = cyl, _IN_CYLINDER
         return _UNREACHABLE
     disc = (r - ad) * (r + ad)
     t = math.sqrt(disc) if disc > 0.0 else 0.0
@@ -270,8 +282,11 @@ def _ik_all_k(p, g, ref, out, info) -> int:
     kn, ln = g[_KN], g[_LN]
     s3 = g[_S3]
     best, why = math.inf, 0.0
+    if cyl > REACH_TOL:
+        best, why = cyl, _IN_CYLINDER
     found = 0
     qb = np.empty(3)
+    qt = np.empty(3)
     jac = np.empty((3, 3))
     for ia in range(2):
         u3 = t if ia == 1 else -t
@@ -280,11 +295,13 @@ def _ik_all_k(p, g, ref, out, info) -> int:
         wn = math.hypot(wx, wy)
         far = wn - (kn + ln)
         near = abs(kn - ln) - wn
-        if far > REACH_TOL or near > REACH_TOL:
-            miss = far if far > near else near
+        miss = far if far > near else near
+        if miss > slack:
             if miss < best:
                 best, why = miss, (_TOO_FAR if far > near else _TOO_NEAR)
             continue
+        # within the slack of the ideal structure's boundary: kept only if the exact foot error is <= REACH_TOL
+        check = cyl > REACH_TOL or miss > REACH_TOL
         c = (wn * wn - kn * kn - ln * ln) / (2.0 * kn * ln)
         c = 1.0 if c > 1.0 else (-1.0 if c < -1.0 else c)
         acb = math.acos(c)
@@ -297,7 +314,24 @@ def _ik_all_k(p, g, ref, out, info) -> int:
             q2 = math.atan2(wy, wx) - math.atan2(vy, vx)
             b = 2 * ia + ik
             qb[0], qb[1], qb[2] = q1, q2, s3 * a
-            _polish_k(p, g, qb, jac)
+            res = _polish_k(p, g, qb, jac)
+            if res > REACH_TOL:  # near a fold of the ideal structure: restart off it (Newton stalls on a fold)
+                eta = 4.0 * math.sqrt(res / min(kn, ln))
+                q0, q1b, q2b = qb[0], qb[1], qb[2]
+                for jr in range(6):
+                    qt[0], qt[1], qt[2] = q0, q1b, q2b
+                    qt[jr // 2] += eta if jr % 2 == 0 else -eta
+                    rt = _polish_k(p, g, qt, jac)
+                    if rt < res:
+                        res = rt
+                        qb[0], qb[1], qb[2] = qt[0], qt[1], qt[2]
+                    if res <= REACH_TOL:
+                        break
+            # a branch clamped onto the ideal structure's boundary is kept only if it reaches the target
+            if check and res > REACH_TOL:
+                if cyl <= REACH_TOL and res < best:
+                    best, why = res, (_TOO_FAR if far > near else _TOO_NEAR)
+                continue
             out[b, 0] = _near_k(qb[0], ref[0])
             out[b, 1] = _near_k(qb[1], ref[1])
             out[b, 2] = _near_k(qb[2], ref[2])
@@ -562,6 +596,10 @@ class Leg:
         g[_LO:_LO + 3], g[_HI:_HI + 3] = lo, hi
         g[_A1:_A1 + 3], g[_A2:_A2 + 3], g[_A3:_A3 + 3] = a1, a2, a3
         g[_V21:_V21 + 3], g[_V32:_V32 + 3], g[_V3F:_V3F + 3] = o[1] - o[0], o[2] - o[1], f - o[2]
+        # The ideal structure (e1 perpendicular to e2 = +-a3) differs from the measured one by at most the axis
+        # deviations (rad) times the lever arms: its reach boundaries get that much slack (then exact check).
+        lever = float(np.linalg.norm(o[1] - o[0]) + np.linalg.norm(o[2] - o[1]) + np.linalg.norm(f - o[2]))
+        g[_SLACK] = REACH_TOL + 4.0 * (abs(dot12) + cross23 + 1e-15) * lever
         return cls(
             name=str(name), joint_names=(str(j1), str(j2), str(j3)), foot_frame=str(foot_frame),
             lower=_frozen(lo), upper=_frozen(hi), origin=_frozen(o[0]), axes=_frozen(np.stack([a1, a2, a3])),

@@ -609,7 +609,7 @@ def test_configuration_helpers(quadruped, rng):
         cfg.joint_names("XX")
     q = cfg.sample_joints(rng, 7)
     assert aq.within_limits(q).all()
-    full = cfg.configuration(quadruped, {"LF": q, "RH": q[0]})
+    full = cfg.pinocchio_configuration(quadruped, {"LF": q, "RH": q[0]})
     assert full.shape == (7, quadruped.model.nq)
     np.testing.assert_array_equal(full[:, cfg.leg_slice(quadruped, "LF")], q)
     np.testing.assert_array_equal(full[:, cfg.leg_slice(quadruped, "RH")], np.broadcast_to(q[0], (7, 3)))

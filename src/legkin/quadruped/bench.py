@@ -26,7 +26,7 @@ from .._single_call import SingleCall
 from ..bench import Method, MethodResult, ModelBench, Score
 from ..errors import UnreachableError
 from . import kinematics as aq
-from .configuration import configuration, leg_slice, sample_joints
+from .configuration import leg_slice, pinocchio_configuration, sample_joints
 
 LEG = "LF"
 #: CLIK settings of Pinocchio's examples/inverse-kinematics.py, with the issue's tolerance 1e-10.
@@ -124,7 +124,7 @@ class _Setup:
         qw = np.where(inside[:, None], _into_limits(np.nan_to_num(qs)), np.nan)
         inside &= aq.within_limits(np.nan_to_num(qw, nan=1e9))
         robot = self.robot
-        pos, _ = pinocchio_positions(robot.model, robot.data, self.fid, configuration(robot, {LEG: qs}))
+        pos, _ = pinocchio_positions(robot.model, robot.data, self.fid, pinocchio_configuration(robot, {LEG: qs}))
         err = np.linalg.norm(pos - p, axis=-1)
         fk = None if iters is None else iters + 1
         reached = err <= SOLVE_TOL
@@ -322,7 +322,8 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
     fid = robot.frame_id(f"{LEG}_FOOT")
     cols = leg_slice(robot, LEG)
     q_gen = sample_joints(rng, n_batch)
-    targets, target_rot = pinocchio_positions(robot.model, robot.data, fid, configuration(robot, {LEG: q_gen}))
+    full = pinocchio_configuration(robot, {LEG: q_gen})
+    targets, target_rot = pinocchio_positions(robot.model, robot.data, fid, full)
     s = _Setup(robot, fid, cols, robot.q0[cols].copy(), targets, target_rot)
     methods = [
         *_legkin_methods(s, q_gen, n_batch, n_scalar),

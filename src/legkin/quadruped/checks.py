@@ -18,7 +18,7 @@ from ..validation import (
     sample_within_limits,
 )
 from . import kinematics as aq
-from .configuration import configuration, leg_slice, made_joints, near_singular_joints, random_targets, rho
+from .configuration import leg_slice, made_joints, near_singular_joints, pinocchio_configuration, random_targets, rho
 
 TOL = 1e-12
 #: Abduction-singularity band: below this distance rho (m) of the foot from the abduction cylinder
@@ -43,7 +43,7 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         rows.append(compare(f"{leg} foot Jacobian vs getFrameJacobian", jerr, TOL))
         # IK round trip: q in limits -> Pinocchio FK -> ik (branch nearest the sample).
         q_sing = near_singular_joints(max(samples // 20, 50), leg, rng)
-        pos_n = pinocchio_frames(robot, configuration(robot, {leg: q_sing}), [f"{leg}_FOOT"])[0][:, 0]
+        pos_n = pinocchio_frames(robot, pinocchio_configuration(robot, {leg: q_sing}), [f"{leg}_FOOT"])[0][:, 0]
         q_all = np.concatenate([q, q_sing])
         p_all = np.concatenate([pos[:, k], pos_n])
         q_ik = aq.ik(p_all, leg, q_near=q_all)

@@ -22,7 +22,7 @@ __all__ = [
     "JOINTS",
     "joint_names",
     "leg_slice",
-    "configuration",
+    "pinocchio_configuration",
     "sample_joints",
     "near_singular_joints",
     "made_joints",
@@ -46,7 +46,9 @@ def leg_slice(robot: Any, leg: str) -> slice:
     return slice(iq, iq + 3)
 
 
-def configuration(robot: Any, legs: Mapping[str, npt.ArrayLike], base: npt.ArrayLike | None = None) -> np.ndarray:
+def pinocchio_configuration(
+    robot: Any, legs: Mapping[str, npt.ArrayLike], base: npt.ArrayLike | None = None
+) -> np.ndarray:
     """A Pinocchio configuration (..., nq) of ``robot`` with the legs' angles ``{leg: q (..., 3)}`` set.
 
     The other coordinates are ``base`` (default ``robot.q0``, the SRDF ``standing`` pose); the leading shapes

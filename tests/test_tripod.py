@@ -14,8 +14,8 @@ from hypothesis import strategies as st
 import legkin
 from legkin import InvalidInputError, InvalidParameterError, SingularityError, UnreachableError
 from legkin._rotations import wrap
-from legkin.tripod import kinematics as at
 from legkin.tripod import checks as ct
+from legkin.tripod import kinematics as at
 from legkin.tripod.forward_kernels import STEP_RCOND, _k_gn_step, _k_initial_guess
 from legkin.tripod.inverse import _run
 
@@ -410,7 +410,8 @@ def test_keyword_parameters_are_validated(kw, match):
         ({"max_iter": -1}, r"max_iter=-1 is out of range"),
         ({"max_iter": True}, r"max_iter must be an integer"),
         ({"max_iter": 10**6}, r"max_iter=1000000 is out of range"),
-        ({"max_inconsistency": float("nan")}, r"max_inconsistency=nan is out of range: must be a finite number in \[0, inf\)"),
+        ({"max_inconsistency": float("nan")},
+         r"max_inconsistency=nan is out of range: must be a finite number in \[0, inf\)"),
         ({"max_inconsistency": -1.0}, r"max_inconsistency=-1.0 is out of range"),
         ({"max_inconsistency": None}, r"max_inconsistency must be a real number"),
         ({"mode": "all!"}, r"mode must be one of"),
@@ -494,7 +495,8 @@ def test_fk_mode_is_explicit():
         q = at.ik(*u, mode=m)
         y, z, inc = at.fk(q[0], q[4], q[8], mode=m)
         assert np.abs(at.platform_rotation(y, z) - at.platform_rotation(*u)).max() < 1e-12 and inc < 1e-12
-        with pytest.raises(legkin.AssemblyModeError, match=f"mode\\(s\\) {re.escape(m)}, not in mode -\\+\\+\\+") as exc:
+        pattern = f"mode\\(s\\) {re.escape(m)}, not in mode -\\+\\+\\+"
+        with pytest.raises(legkin.AssemblyModeError, match=pattern) as exc:
             at.fk(q[0], q[4], q[8])
         assert exc.value.modes == [{"mode": m}]
         assert isinstance(exc.value, UnreachableError)
@@ -607,7 +609,7 @@ def test_fk_near_boundary_and_near_singular_planes():
     assert abs(y - ay) < 1e-12 and abs(z - az) < 1e-12 and inc < 1e-12
 
 
-# ------------------------------------------------------------------------------------------ the IK contract (property tests)
+# ------------------------------------------------------------------------------------- the IK contract (property tests)
 CONTRACT_TOL = 1e-9
 
 
@@ -666,7 +668,8 @@ motor = st.one_of(st.floats(-math.pi, math.pi), st.sampled_from([-math.pi, math.
 @example(qa=1e-06, qb=1e-06, branch=1.0, s_c=-1.0, alpha=math.pi / 3)  # where the boundary meets the flip
 @example(qa=0.0, qb=1e-06, branch=1.0, s_c=-1.0, alpha=math.pi / 3)
 @example(qa=0.0, qb=-4.5661120220129836e-07, branch=-1.0, s_c=-1.0, alpha=math.pi / 3)
-@given(qa=motor, qb=motor, branch=st.sampled_from([-1.0, 1.0]), s_c=st.sampled_from([-1.0, 1.0]), alpha=st.sampled_from(ALPHAS))
+@given(qa=motor, qb=motor, branch=st.sampled_from([-1.0, 1.0]), s_c=st.sampled_from([-1.0, 1.0]),
+       alpha=st.sampled_from(ALPHAS))
 def test_contract_fk_from_in_limit_motors(qa, qb, branch, s_c, alpha):
     """(b) and (d): fk of the motors of a closed configuration in the joint limits, in its mode, is a pose that ik
     solves in that mode and whose motors it gives back; the default fk refuses motors of another mode with

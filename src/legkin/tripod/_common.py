@@ -82,12 +82,16 @@ def pick(pair: tuple[Callable[..., Any], Callable[..., Any]], n: int, kind: str)
 
 
 # ------------------------------------------------------------------------------------------ arguments
-def geometry_of(geometry: object, legacy: dict[str, Any] | None = None, where: str = "", stacklevel: int = 4) -> Geometry:
+def geometry_of(
+    geometry: object, legacy: dict[str, Any] | None = None, where: str = "", stacklevel: int = 4
+) -> Geometry:
     """The call's :class:`Geometry`: ``geometry`` (None: the default), or the deprecated ``d``, ``alpha``, ``eta``
     (a DeprecationWarning, mapped onto a Geometry)."""
     if legacy:
         if geometry is not None:
-            raise InvalidParameterError(f"{where}: pass either geometry= or the deprecated {', '.join(legacy)}, not both")
+            raise InvalidParameterError(
+                f"{where}: pass either geometry= or the deprecated {', '.join(legacy)}, not both"
+            )
         warnings.warn(
             f"{where}: the geometry arguments {', '.join(legacy)} are deprecated; pass geometry=tripod.Geometry(...)",
             DeprecationWarning, stacklevel=stacklevel,
@@ -101,7 +105,9 @@ def geometry_of(geometry: object, legacy: dict[str, Any] | None = None, where: s
             except (TypeError, ValueError):
                 eta = None
             if eta is None or eta.dtype.kind not in "biuf" or eta.shape != (3,):
-                raise InvalidParameterError(f"eta must be three finite real angles (eta_A, eta_B, eta_C), got {kw['eta']!r}")
+                raise InvalidParameterError(
+                    f"eta must be three finite real angles (eta_A, eta_B, eta_C), got {kw['eta']!r}"
+                )
             kw["eta"] = tuple(float(v) for v in eta)
         return Geometry(**kw)
     if geometry is None:

@@ -32,26 +32,27 @@ H = 1e-4
 TOL_FD = 1e-9
 #: fk vs solve_loops: the configuration solve_loops closes (residual ~1e-15, A_q1 and B_q1 held) is only as
 #: accurate as 1e-15 x gain, gain = 1 / sigma_min(constraint Jacobian on the free joints), which is large near
-#: bifurcations of the legs' branches (measured: 1.75e-12 rad at gain 3.9e4, alpha = pi/4, seed 2; error / gain <= 1.4e-16 over seeds 0, 2, 5, 7). Samples with
-#: gain > GAIN_MAX report error / gain against TOL_GAIN.
+#: bifurcations of the legs' branches (measured: 1.75e-12 rad at gain 3.9e4, alpha = pi/4, seed 2; error / gain
+#: <= 1.4e-16 over seeds 0, 2, 5, 7). Samples with gain > GAIN_MAX report error / gain against TOL_GAIN.
 GAIN_MAX = 1e3
 TOL_GAIN = 1e-15
 #: fk vs solve_loops: samples (loop solving is slower) and the solver tolerance (tighter than the default
 #: 1e-12, which would limit the comparison to ~1e-12 x conditioning).
 SOLVE_SAMPLES = 200
 #: Near the platform singularity 1 + c_y c_z = 0 (tilt -> pi) fk and ik are ill-conditioned: the orientation
-#: error of fk(ik(u)) grows like 1e-16 / (1 + c_y c_z) (measured 3.8e-10 at 1 + c_y c_z = 7e-7, alpha = pi/4); samples with
-#: 1 + c_y c_z <= NEAR_FLIP get rows of their own with TOL_FLIP, valid down to 1 + c_y c_z ~ 1e-7.
+#: error of fk(ik(u)) grows like 1e-16 / (1 + c_y c_z) (measured 3.8e-10 at 1 + c_y c_z = 7e-7, alpha = pi/4);
+#: samples with 1 + c_y c_z <= NEAR_FLIP get rows of their own with TOL_FLIP, valid down to 1 + c_y c_z ~ 1e-7.
 NEAR_FLIP = 1e-2
 TOL_FLIP = 1e-8
 SOLVE_TOL = 1e-14
 
 
-def sample_near_boundary(n: int, rng: np.random.Generator, alpha: float):
+def sample_near_boundary(n: int, rng: np.random.Generator, alpha: float) -> tuple[np.ndarray, np.ndarray]:
     """Orientations with some leg at 1 - |cos q_K2| in [1e-10, 1e-3] (close to the workspace boundary)."""
     ch = math.cos(alpha / 2)
-    ays, azs = [], []
-    while sum(len(a) for a in ays) < n:
+    ays: list[np.ndarray] = []
+    azs: list[np.ndarray] = []
+    while sum(a.shape[0] for a in ays) < n:
         phi = rng.uniform(-np.pi, np.pi, 2 * n)
         k = rng.integers(0, 3, 2 * n)
         s = np.abs(np.sin(phi - np.asarray(at.ETA)[k]))
@@ -161,7 +162,8 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
     pos, rot = pinocchio_frames(robot, q, ["platform"])
     rot_e = _rot_err(at.platform_rotation(ay, az), rot[:, 0])
     pos_e = per_sample(at.platform_position(ay, az, geometry=geo) - pos[:, 0])
-    for sel, tag_, tol in ((far, f"1 + c_y c_z > {NEAR_FLIP:g}", TOL), (~far, f"1 + c_y c_z <= {NEAR_FLIP:g}", TOL_FLIP)):
+    flip_tags = (f"1 + c_y c_z > {NEAR_FLIP:g}", f"1 + c_y c_z <= {NEAR_FLIP:g}")
+    for sel, tag_, tol in ((far, flip_tags[0], TOL), (~far, flip_tags[1], TOL_FLIP)):
         if not sel.any():
             continue
         rows.append(compare(pre + f"ik -> loop residual |r| (Pinocchio) ({tag_})", res[sel], tol))
@@ -171,7 +173,7 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
     qb = at.ik_joints(np.stack([by, bz], axis=-1), geometry=geo)
     resb = np.array([np.linalg.norm(robot.constraint_residual(qi)) for qi in qb])
     farb = 1 + np.cos(by) * np.cos(bz) > NEAR_FLIP  # boundary samples can be near the flip too
-    for sel, tag_, tol in ((farb, f"1 + c_y c_z > {NEAR_FLIP:g}", TOL), (~farb, f"1 + c_y c_z <= {NEAR_FLIP:g}", TOL_FLIP)):
+    for sel, tag_, tol in ((farb, flip_tags[0], TOL), (~farb, flip_tags[1], TOL_FLIP)):
         if sel.any():
             rows.append(compare(pre + f"ik -> loop residual, near boundary (1-|cos q2| in [1e-10, 1e-3]) ({tag_})",
                                 resb[sel], tol))
@@ -183,8 +185,9 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
         a_pin, cond[i] = _pin_actuation_jacobian(robot, qi)
         err[i] = np.abs(a_pin - a_an[i]).max() / max(1.0, np.abs(a_an[i]).max())
     well = (cond > COND_MIN) & far
-    rows.append(compare(pre + f"A_u (jacobian) vs Pinocchio closed-loop null space, rel. (cond > {COND_MIN:g}, far from flip)", err[well], TOL))
-    rows.append(compare(pre + f"A_u (jacobian) vs Pinocchio closed-loop null space, rel. (cond <= {COND_MIN:g} or near flip)", err[~well], TOL_ILL))
+    head_a = pre + "A_u (jacobian) vs Pinocchio closed-loop null space, rel."
+    rows.append(compare(head_a + f" (cond > {COND_MIN:g}, far from flip)", err[well], TOL))
+    rows.append(compare(head_a + f" (cond <= {COND_MIN:g} or near flip)", err[~well], TOL_ILL))
     s2 = np.abs(np.sin(q[:, [1, 5, 9]])).min(axis=-1)
     fd_ok = (s2 > 0.1) & (np.abs(np.cos(ay)) > 0.1) & (1 + np.cos(ay) * np.cos(az) > 0.1)
     a_fd = _fd_actuation_jacobian(ay[fd_ok], az[fd_ok], alpha)
@@ -199,7 +202,8 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
                             max_inconsistency=1e-6)
     inconsistency = u_info.inconsistency
     u_ok[far & (inconsistency > 1e-9)] = False
-    fk_rot = _rot_err(at.platform_rotation(np.nan_to_num(u[:, 0]), np.nan_to_num(u[:, 1])), at.platform_rotation(ay, az))
+    fk_rot = _rot_err(at.platform_rotation(np.nan_to_num(u[:, 0]), np.nan_to_num(u[:, 1])),
+                      at.platform_rotation(ay, az))
     fk_rot[~u_ok] = np.nan  # a failure counts against the row
     far = 1 + np.cos(ay) * np.cos(az) > NEAR_FLIP
     rows.append(compare(pre + f"fk(ik(u)) round trip, platform rotation (rad) (1 + c_y c_z > {NEAR_FLIP:g})",
@@ -214,10 +218,12 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
     delta = rng.normal(0.0, 0.15, (m, 2))
     q_start, ok = at.ik_joints(np.stack([ay[:m] + delta[:, 0], az[:m] + delta[:, 1]], axis=-1), geometry=geo,
                                return_mask=True)
-    errs, gain, other, failed = [], [], 0, 0
+    err_list: list[float] = []
+    gain_list: list[float] = []
+    other, failed = 0, 0
     held_free = np.ones(robot.model.nv, dtype=bool)
     held_free[[robot.idx_v("A_q1"), robot.idx_v("B_q1")]] = False
-    for i in np.nonzero(ok)[0]:
+    for i in np.flatnonzero(ok).tolist():
         try:
             qs_i = robot.solve_loops(q_start[i], {"A_q1": q[i, 0], "B_q1": q[i, 4]}, tol=SOLVE_TOL)
         except LoopClosureError:
@@ -227,12 +233,13 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
             other += 1  # another assembly mode of the legs: outside fk's model (q3=q2, q4=q1, q2 in (0, pi))
             continue
         uf = at.fk(qs_i[list(MOTOR_COLUMNS)], geometry=geo)
-        errs.append(_rot_err(at.platform_rotation(uf[0], uf[1]), robot.frame_placement(qs_i, "platform").rotation))
+        rot_pin = robot.frame_placement(qs_i, "platform").rotation
+        err_list.append(float(_rot_err(at.platform_rotation(uf[0], uf[1]), rot_pin)))
         # The closed configuration's own error (its residual <= SOLVE_TOL) is amplified by 1 / sigma_min of the
         # constraint Jacobian on the free joints: near a bifurcation of the legs' branches it is large
         jac_free = robot.constraint_jacobian(qs_i)[:, held_free]
-        gain.append(1.0 / np.linalg.svd(jac_free, compute_uv=False)[-1])
-    errs, gain = np.asarray(errs), np.asarray(gain)
+        gain_list.append(float(1.0 / np.linalg.svd(jac_free, compute_uv=False)[-1]))
+    errs, gain = np.asarray(err_list, dtype=float), np.asarray(gain_list, dtype=float)
     well = gain <= GAIN_MAX
     head = pre + f"fk vs solve_loops (A_q1, B_q1 held, start 0.15 rad away; {other} of {int(ok.sum())} " \
         f"landed on another assembly mode, {failed} did not close; both skipped)"
@@ -328,7 +335,8 @@ def _det_curve_points(rng: np.random.Generator, alpha: float, grid: int = 121) -
     G = at.Geometry(alpha=alpha)._vector
 
     def det_of(y, z):  # det M of the home mode's motor planes (ik's kernel, also where its guards refuse the pose)
-        aux = _run(*np.broadcast_arrays(np.asarray(y, dtype=float), np.asarray(z, dtype=float)), G, HOME_MODE)[1][..., 0, :]
+        yz = np.broadcast_arrays(np.asarray(y, dtype=float), np.asarray(z, dtype=float))
+        aux = _run(*yz, G, HOME_MODE)[1][..., 0, :]
         inside = (aux[..., 3] > SINGULAR_TOL) & np.all(1.0 - np.abs(aux[..., :3]) > BOUNDARY_TOL, axis=-1)
         return np.where(inside, aux[..., 4], np.nan)
 

@@ -160,7 +160,9 @@ def _single(qs: tuple[float, float, float], g: Geometry, mode: str, tol: float, 
     return out, np.asarray(True)
 
 
-def _batch(qm: np.ndarray, g: Geometry, mode: str, tol: float, max_iter: int, max_inc: float) -> tuple[np.ndarray, np.ndarray]:
+def _batch(
+    qm: np.ndarray, g: Geometry, mode: str, tol: float, max_iter: int, max_inc: float
+) -> tuple[np.ndarray, np.ndarray]:
     """A batch fk call on motors (..., 3): out (..., [16,] 3) NaN where an item fails, ok (..., [16])."""
     shape = qm.shape[:-1]
     rows = np.ascontiguousarray(qm.reshape(-1, 3), dtype=np.float64)
@@ -201,7 +203,8 @@ def _finish(out: np.ndarray, ok: np.ndarray, return_mask: bool, return_info: boo
 
 @overload
 def fk(q: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ..., tol: float = ..., max_iter: int = ...,
-       max_inconsistency: float = ..., return_mask: Literal[False] = ..., return_info: Literal[False] = ...) -> np.ndarray: ...
+       max_inconsistency: float = ..., return_mask: Literal[False] = ...,
+       return_info: Literal[False] = ...) -> np.ndarray: ...
 @overload
 def fk(q: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ..., tol: float = ..., max_iter: int = ...,
        max_inconsistency: float = ..., return_mask: Literal[True],

@@ -113,7 +113,8 @@ def _k_gn_step(a1, a2, r):  # type: ignore[no-untyped-def]
 
 @kernel
 def _k_normal_residual(a1, a2, r):  # type: ignore[no-untyped-def]
-    """|r - A A^+ r| and |A|_F for A = [a1 a2] (the part of r off the range of A: rank 2 ``|r . n| / |n|``, n = a1 x a2; rank-1 projection where ``sigma_2 <= STEP_RCOND sigma_1``)."""
+    """|r - A A^+ r| and |A|_F for A = [a1 a2] (the part of r off the range of A: rank 2 ``|r . n| / |n|``,
+    n = a1 x a2; rank-1 projection where ``sigma_2 <= STEP_RCOND sigma_1``)."""
     nn = 0.0
     f = 0.0
     rn = 0.0
@@ -172,10 +173,12 @@ def _k_fk_report(ay, az, qm, G, home, e, s, a1, a2, q1, c2, s2, sn, cn, r, last)
 @kernel
 def _k_fk(qa, qb, qc, G, home, e, s, tol, max_iter, max_inc, out):  # type: ignore[no-untyped-def]
     """fk of one motor triple in one assembly mode: writes (alpha_y, alpha_z, inconsistency) into ``out`` (3,)
-    and returns the status (0 ok, else the ST_ codes of :mod:`legkin.tripod._common`; :data:`ST_NONFINITE` for NaN / inf motors).
+    and returns the status (0 ok, else the ST_ codes of :mod:`legkin.tripod._common`; :data:`ST_NONFINITE` for
+    NaN / inf motors).
 
     Gauss-Newton from the motor planes' intersection, kept inside the workspace (a step that
-    lands outside is halved, a start outside is pulled in towards home); early exit per target. See :func:`legkin.tripod.fk`.
+    lands outside is halved, a start outside is pulled in towards home); early exit per target.
+    See :func:`legkin.tripod.fk`.
     """
     if not (np.isfinite(qa) and np.isfinite(qb) and np.isfinite(qc)):
         out[0] = out[1] = out[2] = np.nan

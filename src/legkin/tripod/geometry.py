@@ -67,7 +67,8 @@ class Geometry:
 
     @property
     def length(self) -> float:
-        """``L = |OE| = d sqrt(2 (1 - cos alpha))`` (eq 18): the distance of the platform centre from the base centre."""
+        """``L = |OE| = d sqrt(2 (1 - cos alpha))`` (eq 18): the distance of the platform centre from the base
+        centre."""
         return self.d * math.sqrt(2.0 * (1.0 - math.cos(self.alpha)))
 
 

@@ -109,7 +109,8 @@ def ik_single_error(ay: float, az: float, G: np.ndarray, mode: str, aux: np.ndar
 def _run(ay: np.ndarray, az: np.ndarray, G: np.ndarray, mode: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The ik batch loop on broadcast orientations: q (shape, m, 12), aux (shape, m, 6), status (shape, m)."""
     shape = ay.shape
-    y, z = np.ascontiguousarray(ay, dtype=np.float64).reshape(-1), np.ascontiguousarray(az, dtype=np.float64).reshape(-1)
+    y = np.ascontiguousarray(ay, dtype=np.float64).reshape(-1)
+    z = np.ascontiguousarray(az, dtype=np.float64).reshape(-1)
     homes, es, ss = modes_sel(mode)
     n, m = y.shape[0], homes.shape[0]
     q, aux, status = np.empty((n, m, 12)), np.empty((n, m, 6)), np.empty((n, m), dtype=np.int64)

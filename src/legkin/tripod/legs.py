@@ -38,7 +38,8 @@ def _k_matmul3(A, B):  # type: ignore[no-untyped-def]
 
 @kernel
 def _k_leg_position(q1, q2, eta, G, T):  # type: ignore[no-untyped-def]
-    """Eqs (10) last column and (12): T[:3, 3] = d (-h1, -(c_eta h2 + s_eta h3), c_eta h3 - s_eta h2), T[3] = (0 0 0 1)."""
+    """Eqs (10) last column and (12): T[:3, 3] = d (-h1, -(c_eta h2 + s_eta h3), c_eta h3 - s_eta h2),
+    T[3] = (0 0 0 1)."""
     c1, s1, c2, s2 = np.cos(q1), np.sin(q1), np.cos(q2), np.sin(q2)
     ca, sa, d = G[G_CA], G[G_SA], G[G_D]
     ce, se = np.cos(eta), np.sin(eta)
@@ -54,7 +55,8 @@ def _k_leg_transform(q1, q2, q3, q4, eta, alpha, G, T):  # type: ignore[no-untyp
     """:func:`leg_transform` of one joint vector into T (4, 4); returns OK or ST_NONFINITE (T not written)."""
     if not (np.isfinite(q1) and np.isfinite(q2) and np.isfinite(q3) and np.isfinite(q4)):
         return ST_NONFINITE
-    R = _k_matmul3(rot_k(0, eta), rot_k(2, math.pi))  # Rx(eta) Rz(pi) Rz(q1) Ry(q2) Rx(-alpha) Ry(q3) Rz(-q4) Rx(pi - eta)
+    # Rx(eta) Rz(pi) Rz(q1) Ry(q2) Rx(-alpha) Ry(q3) Rz(-q4) Rx(pi - eta)
+    R = _k_matmul3(rot_k(0, eta), rot_k(2, math.pi))
     R = _k_matmul3(R, rot_k(2, q1))
     R = _k_matmul3(R, rot_k(1, q2))
     R = _k_matmul3(R, rot_k(0, -alpha))
@@ -137,7 +139,9 @@ def _legacy_kw(fn: str, kw: dict[str, Any]) -> dict[str, Any]:
 
 
 # ------------------------------------------------------------------------------------------ public
-def leg_transform(q: ArrayLike, leg: str, *args: float, geometry: Geometry | None = None, **legacy: float) -> np.ndarray:
+def leg_transform(
+    q: ArrayLike, leg: str, *args: float, geometry: Geometry | None = None, **legacy: float
+) -> np.ndarray:
     """Placement of K_ee in the base frame for any four joint values of leg K (open chain).
 
     Math (the chain of the URDF, checked against Pinocchio):

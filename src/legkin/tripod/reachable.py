@@ -124,7 +124,8 @@ def workspace(*args: Any, geometry: Geometry | None = None, n: int = 181, m: int
     Deprecated (legkin 0.1): ``workspace(d, alpha, eta, n, m)`` positional, or ``d=``, ``alpha=``, ``eta=``.
     """
     if args:
-        deprecated("workspace(d, alpha, eta, n, m) with positional arguments", "workspace(geometry=..., n=..., m=...)", stacklevel=3)
+        deprecated("workspace(d, alpha, eta, n, m) with positional arguments", "workspace(geometry=..., n=..., m=...)",
+                   stacklevel=3)
         if len(args) > 5:
             raise TypeError("workspace() takes at most 5 positional arguments in its deprecated form")
         legacy = {**dict(zip(("d", "alpha", "eta"), args[:3])), **legacy}

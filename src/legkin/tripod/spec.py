@@ -9,7 +9,9 @@ SPEC = ModelSpec(
     title="2-DOF parallel tripod (double-spherical CV wrist), 3 legs x 4 revolute, closed loops",
     seed="000",
     params={
-        "d": Param(0.05, "distance |OD| = |DE| from the leg's middle joint point D to O and to E (m)", 0.0, None, low_open=True),
+        "d": Param(
+            0.05, "distance |OD| = |DE| from the leg's middle joint point D to O and to E (m)", 0.0, None, low_open=True
+        ),
         "alpha": Param(
             1.0471975511965976, "angle between the axes of joints 2 and 3 of each leg (rad)", 0.0, 3.141592653589793,
             low_open=True, high_open=True,

@@ -639,6 +639,12 @@ class Leg:
         return thigh_zero, _signed_angle(k, l, self.axes[2])
 
     @property
+    def axis_deviation(self) -> tuple[float, float]:
+        """``(|a1 . a2|, |a2 x a3|)``: how far (rad) the measured axes are from perpendicular / parallel."""
+        a1, a2, a3 = self.axes
+        return abs(float(a1 @ a2)), float(np.linalg.norm(np.cross(a2, a3)))
+
+    @property
     def reach(self) -> tuple[float, float]:
         """``(| |k| - |l| |, |k| + |l|)``: the knee's inner and outer reach (m) in the pitch plane."""
         return abs(self.thigh_length - self.shank_length), self.thigh_length + self.shank_length

@@ -107,10 +107,12 @@ def closed_configuration(robot: Any, angles: np.ndarray, theta_ll: np.ndarray,
     return qs
 
 
-def sample_joints(rng: np.random.Generator, n: int, *, geometry: Geometry | None = None) -> np.ndarray:
+def sample_joints(rng: np.random.Generator, n: int, *, sigma: float = SIGMA_MIN,
+                  geometry: Geometry | None = None) -> np.ndarray:
     """``n`` motor angle triples q = (theta1, theta2, theta0) (n, 3) inside the URDF limits whose :func:`fk` (default
-    mode) is defined: platform poses from :func:`sample_workspace`, theta_LL uniform in :data:`LL_RANGE`."""
-    roll, pitch = sample_workspace(n, rng)
+    mode) is defined: platform poses from :func:`sample_workspace` (sigma_min(dtheta/dx) >= ``sigma``), theta_LL
+    uniform in :data:`LL_RANGE`."""
+    roll, pitch = sample_workspace(n, rng, sigma)
     th = motor_angles(roll, pitch)
     t0 = extension_motor_angle(rng.uniform(*LL_RANGE, n), geometry=geometry)
     return np.column_stack([th, t0])
@@ -124,6 +126,7 @@ def within_limits(q: np.ndarray, *, geometry: Geometry | None = None, tol: float
             & (np.abs(tll) <= LL_LIMIT + tol))
 
 
-def sample_targets(rng: np.random.Generator, n: int, *, geometry: Geometry | None = None) -> np.ndarray:
+def sample_targets(rng: np.random.Generator, n: int, *, sigma: float = SIGMA_MIN,
+                   geometry: Geometry | None = None) -> np.ndarray:
     """``n`` foot targets (n, 3) made by the default :func:`fk` from :func:`sample_joints`."""
-    return fk(sample_joints(rng, n, geometry=geometry), geometry=geometry)  # type: ignore[no-any-return]
+    return fk(sample_joints(rng, n, sigma=sigma, geometry=geometry), geometry=geometry)  # type: ignore[no-any-return]

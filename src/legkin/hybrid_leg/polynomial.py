@@ -36,13 +36,14 @@ FOLD_OFFSETS = (1e-9, 1e-7, 1e-5, 1e-3)
 
 
 @kernel
-def pmul_k(a, b, out):
-    """out = a * b (ascending polynomial coefficients; len(out) = len(a) + len(b) - 1)."""
-    for j in range(out.shape[0]):
-        out[j] = 0.0
+def pconv_k(a, b, k):
+    """Coefficient k of the product of the polynomials a, b (ascending coefficients), summed over ascending i."""
+    s = 0.0
     for i in range(a.shape[0]):
-        for j in range(b.shape[0]):
-            out[i + j] += a[i] * b[j]
+        j = k - i
+        if 0 <= j < b.shape[0]:
+            s += a[i] * b[j]
+    return s
 
 
 @kernel
@@ -66,27 +67,14 @@ def roll_poly_k(tip, poly, al, be, ga):
         ga[i, 0] = ay * qy0 - kap
         ga[i, 1] = ay * qy1
         ga[i, 2] = ay * qy2 - kap
-    t1 = np.empty(5)
-    t2 = np.empty(5)
-    det = np.empty(5)
-    cc = np.empty(5)
-    ss = np.empty(5)
-    pmul_k(al[0], be[1], t1)
-    pmul_k(al[1], be[0], t2)
-    det[:] = t1 - t2
-    pmul_k(be[0], ga[1], t1)
-    pmul_k(be[1], ga[0], t2)
-    cc[:] = t1 - t2
-    pmul_k(al[1], ga[0], t1)
-    pmul_k(al[0], ga[1], t2)
-    ss[:] = t1 - t2
-    p1 = np.empty(9)
-    p2 = np.empty(9)
-    p3 = np.empty(9)
-    pmul_k(cc, cc, p1)
-    pmul_k(ss, ss, p2)
-    pmul_k(det, det, p3)
-    poly[:] = p1 + p2 - p3
+    # det = al0 be1 - al1 be0, cc = be0 ga1 - be1 ga0, ss = al1 ga0 - al0 ga1 (degree 4); poly = cc^2 + ss^2 - det^2
+    w = np.empty((3, 5))
+    for k in range(5):
+        w[0, k] = pconv_k(al[0], be[1], k) - pconv_k(al[1], be[0], k)
+        w[1, k] = pconv_k(be[0], ga[1], k) - pconv_k(be[1], ga[0], k)
+        w[2, k] = pconv_k(al[1], ga[0], k) - pconv_k(al[0], ga[1], k)
+    for k in range(9):
+        poly[k] = pconv_k(w[1], w[1], k) + pconv_k(w[2], w[2], k) - pconv_k(w[0], w[0], k)
 
 
 @kernel

@@ -662,10 +662,20 @@ def test_legkin_01_calls_warn_and_agree():
         np.testing.assert_array_equal(wl.contact_jacobian(q, 0.5, 0.01, "FL"), wl.jacobian(q, "FL", alpha=0.5, w=0.01))
     new = wl.ik(target, "FL", alpha=0.5, w=0.01)
     for call in (lambda: wl.ik(target, 0.5, 0.01, "FL"), lambda: wl.ik(target, 0.5, 0.01, leg="FL"),
-                 lambda: wl.ik(target, alpha=0.5, w=0.01), lambda: wl.ik(target, "FL", alpha=0.5, w=0.01, tol=1e-12),
-                 lambda: wl.ik(target, 0.5, 0.01, "FL", q0=q + 0.01)):
+                 lambda: wl.ik(target, alpha=0.5, w=0.01), lambda: wl.ik(target, "FL", alpha=0.5, w=0.01, tol=1e-12)):
         with pytest.warns(DeprecationWarning, match="legkin 0.1"):
             np.testing.assert_array_equal(call(), new)
+    with pytest.warns(DeprecationWarning, match="q_near"):
+        np.testing.assert_array_equal(wl.ik(target, 0.5, 0.01, "FL", q0=q + 0.01),
+                                      wl.ik(target, "FL", alpha=0.5, w=0.01, q_near=q + 0.01))
+    with pytest.warns(DeprecationWarning, match="q_start"):
+        np.testing.assert_array_equal(wl.ik(target, 0.5, 0.01, "FL", q0=q + 0.01, method="damped"),
+                                      wl.ik(target, "FL", alpha=0.5, w=0.01, q_start=q + 0.01, method="damped"))
+    with pytest.warns(DeprecationWarning, match="geometry"):
+        assert wl.linkage_constants(0.12) == wl.linkage_constants(geometry=wl.Geometry(R=0.12))
+    with pytest.warns(DeprecationWarning, match="geometry"):
+        np.testing.assert_array_equal(wl.module_origin("RR", wl.Geometry(W_body=0.3)),
+                                      wl.module_origin("RR", geometry=wl.Geometry(W_body=0.3)))
     with pytest.warns(DeprecationWarning, match="gauss_newton_fd"):
         old = wl.ik(target, "FL", alpha=0.5, w=0.01, method="seed")
     np.testing.assert_array_equal(old, wl.ik(target, "FL", alpha=0.5, w=0.01, method="gauss_newton_fd"))

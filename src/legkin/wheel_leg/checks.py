@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import load
+from .._rotations import wrap
 from ..validation import CheckResult, compare, per_sample, pinocchio_frames
 from . import kinematics as wl
 from .configuration import SEGMENT_LINKS, configuration, leg_joint_names, local_contact_point, sample_leg_q
@@ -64,7 +65,7 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         q_init[ip] += rng.uniform(-0.05, 0.05, ip.size)
         q_sol, info = robot.solve_loops(q_init, fixed, tol=SOLVE_TOL, return_info=True)
         iters[i] = info.iterations
-        ang_err[i] = np.abs(np.angle(np.exp(1j * (q_sol[ip] - qs[i][ip])))).max()
+        ang_err[i] = np.abs(wrap(q_sol[ip] - qs[i][ip])).max()
         p_sol = pinocchio_frames(robot, q_sol[None], frames)[0].reshape(4, len(FRAME_POINTS), 3)
         frame_err[i] = per_sample(p_sol - pos[i]).max()
     rows.append(compare(f"solve_loops from motors (passive +-0.05 rad off) vs passive_angles, "
@@ -216,7 +217,7 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
 def solution_distance(solutions: np.ndarray, q: np.ndarray) -> np.ndarray:
     """Distance (max-norm, angles wrapped) from each q (n, 3) to the nearest of its solutions (n, S, 3)."""
     d = solutions - q[:, None, :]
-    d[..., 1:] = np.angle(np.exp(1j * d[..., 1:]))
+    d[..., 1:] = wrap(d[..., 1:])
     d = np.abs(d).max(axis=-1)
     return np.min(np.where(np.isnan(d), np.inf, d), axis=1)
 

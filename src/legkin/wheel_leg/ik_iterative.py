@@ -16,6 +16,7 @@ import math
 import numpy as np
 
 from .._kernels import as_rows, kernel, prange
+from .._rotations import wrap_k
 from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip, _loop
 from .frames import _Ctx, _k_fk
 from .geometry import _LIMIT_ROUNDING, ABAD_LIMIT, FOOT_OFFSET, THETA_MAX, THETA_MIN
@@ -54,8 +55,7 @@ def _k_starts(tgt, upper, right, e, a, seed, K, KC, o0, o1, o2, s, grid, table, 
     m = complex(s * d1, d2)
     yabs = math.sqrt(max(m.real * m.real + m.imag * m.imag - a * a, 0.0))
     y = branch * yabs
-    g0 = math.atan2(m.imag, m.real) - math.atan2(y, a)
-    gamma = math.atan2(math.sin(g0), math.cos(g0))
+    gamma = wrap_k(math.atan2(m.imag, m.real) - math.atan2(y, a))
     t = complex(-d0, y)
     r = abs(t)
     nodes = grid.shape[0]

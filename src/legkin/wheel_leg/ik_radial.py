@@ -8,10 +8,12 @@ from functools import lru_cache
 import numpy as np
 
 from .._kernels import as_rows, kernel, prange
+from .._rotations import wrap_k
 from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip, _k_max, _k_min, _k_phase, _loop
 from .frames import _k_fk
 from .geometry import _LIMIT_ROUNDING, ABAD_LIMIT, FOOT_OFFSET, THETA_MAX, THETA_MIN
 from .linkage import _closed_form, _constants, _kconst
+from .radial_roots import _k_lower_bound, _k_radial_extremum, _k_radial_newton
 from .rim import _k_plane, _Sel
 
 
@@ -77,7 +79,6 @@ def _arc_coefficients(sel: _Sel, r2) -> np.ndarray:
 _RADIAL_NODES = 17
 #: Sub-cells per cell of the fine coefficient table that refines the Newton start (0.14 deg).
 _RADIAL_SUB = 64
-_EPS = float(np.finfo(float).eps)
 
 
 @lru_cache(maxsize=16)
@@ -106,192 +107,6 @@ def _radial_table(R: float, seed: bool):
     return grid, table, m2, fine, fine_rows
 
 
-@kernel
-def _k_f_and_slope(theta, upper, right, e, seed, K, KC, r2):
-    """``f = |c(theta)|^2 - r2`` and ``f' = 2 Re(conj(c) dc/dtheta)``, ``c`` the contact point in the leg plane
-    (right halves unconjugated: same modulus), and ``c, dc``: the radial IK's only linkage evaluation."""
-    y, dy = _k_plane(theta, upper, right, e, seed, K, KC, True, False)
-    return y.real * y.real + y.imag * y.imag - r2, 2.0 * (y.real * dy.real + y.imag * dy.imag), y, dy
-
-
-
-
-@kernel
-def _k_lower_bound(Fa, Fb, Ga, Gb, h, M):
-    """Lower bound of f on a cell of width h from its ends (f oriented positive there: Fa, Fb > 0; slopes
-    Ga, Gb) and a bound M of |f''|: the larger of the Taylor bounds from the two ends,
-    ``Fa + Ga t - M t^2/2`` and ``Fb - Gb (h - t) - M (h - t)^2/2``, at the t where they cross."""
-    tc = _k_clip((Fa - Fb + Gb * h + M * h * h / 2) / (Gb - Ga + M * h), 0.0, h)
-    if not math.isfinite(tc):
-        tc = 0.5 * h
-    return _k_max(Fa + Ga * tc - M * tc * tc / 2, Fb - Gb * (h - tc) - M * (h - tc) ** 2 / 2)
-
-
-@kernel
-def _k_hermite_root(h, flo, fhi, glo, ghi):
-    """Root (offset from the lower end, in [0, h]) of the cubic Hermite model of f on a bracket of width h
-    (values flo, fhi of opposite signs, slopes glo, ghi): four Newton steps on the cubic from the regula
-    falsi point, clipped to the bracket."""
-    df = fhi - flo
-    c2 = (3 * df / h - 2 * glo - ghi) / h
-    c3 = (glo + ghi - 2 * df / h) / (h * h)
-    t = _k_clip(-flo / df, 0.0, 1.0) * h
-    for _ in range(4):
-        t = _k_clip(t - (flo + t * (glo + t * (c2 + t * c3))) / (glo + t * (2 * c2 + 3 * t * c3)), 0.0, h)
-    return t
-
-
-@kernel
-def _k_radial_extremum(lo, hi, flo, fhi, glo, ghi, M, upper, right, e, seed, K, KC, r2, ftol, max_iter):
-    """Decide whether f (of one sign at both ends of [lo, hi]) reaches 0 near the extremum inside.
-
-    Regula falsi (Illinois) on f' from the extremum of the cubic Hermite model, until: f changes sign at
-    the new point (two roots: split the bracket there), ``|f| <= 4 eps r^2`` (a double root at rounding
-    level), :func:`_k_lower_bound` on the shrunk bracket is above ftol (no root), or the bracket is 1e-11
-    wide (the extremum: a double root if ``|f| <= ftol`` there, else none). Returns (theta, f and f'
-    there, status: 1 split / 2 double root / 0 none, f'' estimated by the secant of f' over the last
-    bracket, iterations).
-    """
-    sig = 1.0 if flo > 0 else -1.0
-    Fa, Fb, Ga, Gb = sig * flo, sig * fhi, sig * glo, sig * ghi  # oriented: Fa, Fb > 0, Ga < 0 < Gb
-    h = hi - lo
-    c2 = (3 * (Fb - Fa) / h - 2 * Ga - Gb) / h  # extremum of the cubic model p'(t) = 0
-    c3 = (Ga + Gb - 2 * (Fb - Fa) / h) / (h * h)
-    disc = math.sqrt(_k_max(c2 * c2 - 3 * c3 * Ga, 0.0))
-    t0 = -Ga / (c2 + disc)  # the root of Ga + 2 c2 t + 3 c3 t^2 between the slopes' sign change
-    th = lo + t0 if (t0 > 0 and t0 < h) else lo - Ga * h / (Gb - Ga)
-    ga, gb = Ga, Gb  # Illinois-modified slopes
-    f_out, g_out = math.nan, math.nan
-    status = 0
-    its = 0
-    kept = 0  # +1: the upper end was kept last time, -1: the lower end
-    for _ in range(max_iter):
-        t = th
-        f, g, _y, _dy = _k_f_and_slope(t, upper, right, e, seed, K, KC, r2)
-        its += 1
-        F, G = sig * f, sig * g
-        f_out, g_out = f, g
-        split = F < 0
-        double = (not split) and F <= 4 * _EPS * r2  # at rounding level: a double root
-        if G < 0:  # t replaces the lower end
-            lo, Fa, Ga = t, F, G
-            ga = G
-            if kept == 1:
-                gb = 0.5 * gb
-            kept = 1
-        else:
-            hi, Fb, Gb = t, F, G
-            if kept == -1:
-                ga = 0.5 * ga
-            gb = G
-            kept = -1
-        none = _k_lower_bound(Fa, Fb, Ga, Gb, hi - lo, M) > ftol
-        narrow = (hi - lo <= 1e-11) or G == 0  # the extremum found: a double root if within tolerance
-        if (not split) and narrow and F <= ftol:
-            double = True
-        status = 1 if split else (2 if double else 0)
-        if split or double or none or narrow:
-            th = t
-            break
-        nxt = (lo * gb - hi * ga) / (gb - ga)
-        th = nxt if (nxt > lo and nxt < hi) else 0.5 * (lo + hi)
-    curv = sig * (Gb - Ga) / (hi - lo)
-    return th, f_out, g_out, status, curv, its
-
-
-@kernel
-def _k_fine_f(fine_rows, i, coef):
-    """f (f' for rows kf + i) from the fine table at node i: ``fine_rows[i] . coef``."""
-    acc = 0.0
-    for j in range(9):
-        acc += fine_rows[i, j] * coef[j]
-    return acc
-
-
-@kernel
-def _k_radial_newton(lo, hi, flo, fhi, glo, ghi, guess, coef, fine, fine_rows, upper, right, e, seed, K, KC, r2,
-                     mb, max_iter):
-    """Safeguarded Newton on ``f(theta) = |c(theta)|^2 - r2`` in a bracket [lo, hi] where f changes sign.
-
-    Start (no linkage evaluation): the root of the cubic Hermite model of f on the bracket
-    (:func:`_k_hermite_root`) picks a sub-cell of the fine table (0.14 deg); if f (from the table and
-    ``coef`` (9,), the target's :func:`_arc_coefficients`) does not change sign there, bisection on the
-    table's nodes inside the bracket finds one; the start is then the root of the cubic model on that
-    sub-cell, which becomes the bracket (if the table's signs do not bracket the root, e.g. a root at a
-    node, the start on the whole bracket is kept). ``guess`` (NaN: none) overrides the start (the
-    parabola start of the brackets split at an extremum). Each step ``-f/f'`` stays inside the
-    (shrinking) bracket, else bisects. Stops when the predicted radius error after the step,
-    ``|f''| step^2 / (4 r)`` with ``mb`` bounding ``|f''|``, is below one ulp of r, when
-    ``|f| <= 4 eps r^2``, or when the bracket is ~eps wide.
-
-    Returns (theta, c(theta) (complex, conjugated on right halves: the contact point before the beta
-    rotation, from the last evaluation's Taylor step ``c + (theta - t) dc``, at rounding level since
-    the last step is), iterations, converged).
-    """
-    kf = fine.shape[0]
-    hf = fine[1] - fine[0]
-    start = lo + _k_hermite_root(hi - lo, flo, fhi, glo, ghi)
-    x = (start - THETA_MIN) / hf
-    i_lo = int(x) if math.isfinite(x) else 0
-    i_lo = min(max(i_lo, 0), kf - 2)
-    i_hi = i_lo + 1
-    f_lo, f_hi = _k_fine_f(fine_rows, i_lo, coef), _k_fine_f(fine_rows, i_hi, coef)
-    ok = ((f_lo > 0) != (f_hi > 0)) and fine[i_lo] >= lo and fine[i_hi] <= hi
-    if not ok and guess != guess:  # bisection on the table's nodes inside the bracket
-        b_lo = min(max(int(math.ceil((lo - THETA_MIN) / hf - 1e-6)), 0), kf - 1)
-        b_hi = min(max(int(math.floor((hi - THETA_MIN) / hf + 1e-6)), 0), kf - 1)
-        b_p = _k_fine_f(fine_rows, b_lo, coef) > 0
-        ok = (b_p != (_k_fine_f(fine_rows, b_hi, coef) > 0)) and b_lo < b_hi
-        if ok:
-            while b_hi - b_lo > 1:
-                mid = (b_lo + b_hi) // 2
-                if (_k_fine_f(fine_rows, mid, coef) > 0) == b_p:
-                    b_lo = mid
-                else:
-                    b_hi = mid
-        i_lo, i_hi = b_lo, b_hi
-        f_lo, f_hi = _k_fine_f(fine_rows, b_lo, coef), _k_fine_f(fine_rows, b_hi, coef)
-    if ok:  # the cubic model on the sub-cell
-        lo, hi, flo, fhi = fine[i_lo], fine[i_hi], f_lo, f_hi
-        glo, ghi = _k_fine_f(fine_rows, kf + i_lo, coef), _k_fine_f(fine_rows, kf + i_hi, coef)
-        start = lo + _k_hermite_root(hi - lo, flo, fhi, glo, ghi)
-    if guess == guess:
-        start = guess
-    th = start if (start > lo and start < hi) else 0.5 * (lo + hi)
-    root = math.nan
-    z = complex(math.nan, math.nan)
-    its = 0
-    conv = False
-    pos_lo = flo > 0
-    tol_step = 4 * _EPS * r2 / mb  # step^2 below this: the Newton update is at rounding level
-    tol_f = 4 * _EPS * r2
-    for _ in range(max_iter):
-        t = th
-        f, g, y, dy = _k_f_and_slope(t, upper, right, e, seed, K, KC, r2)
-        its += 1
-        if (f > 0) == pos_lo:
-            lo = t
-        else:
-            hi = t
-        step = f / g
-        new = t - step
-        newton = new > lo and new < hi
-        if not newton:
-            new = 0.5 * (lo + hi)
-        small = abs(f) <= tol_f
-        done = small or (newton and step * step <= tol_step) or (hi - lo <= 4 * _EPS * hi)
-        if small:
-            new = t
-        root, z = new, y + (new - t) * dy
-        conv = done
-        th = new
-        if done:
-            break
-    if right:
-        z = z.conjugate()
-    return root, z, its, conv
-
-
 #: Most roots of one target kept by the radial kernel (16 cells, two per split cell, the ends, doubles).
 _RADIAL_CAP = 64
 
@@ -299,38 +114,16 @@ _RADIAL_CAP = 64
 
 
 @kernel
-def _k_ik_radial(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, table, m2, fine, fine_rows, tol,
-                 max_iter, q0, use_q0, limits, q, sols):
-    """The radial IK for one target (:func:`_ik_radial` states the math) into ``q`` (3,) and ``sols``
-    (S, 3) (NaN-padded, as many as fit). Returns (iterations, error, reason, roots, solutions)."""
+def _k_radial_brackets(grid, f, g, m2, kind, ee, ea, ftol, upper, right, e, seed, K, KC, r2, max_iter, jobs, xth):
+    """The roots' brackets on the grid for one target (``f``, ``g``: f and f' at the nodes).
+
+    Into ``jobs`` (rows ``(lo, hi, flo, fhi, glo, ghi, curvature bound, start guess)``): every cell where f
+    changes sign, then the two halves of every cell split at an extremum where f reaches 0
+    (:func:`_k_radial_extremum`); into ``xth``: the roots found without Newton (an end of [17, 160] deg with
+    ``|f| <= ftol``, double roots at an extremum). Returns (brackets, roots without Newton, split cells,
+    iterations)."""
     K_ = grid.shape[0]
-    d0, d1, d2 = tgt[0] - o0, tgt[1] - o1, tgt[2] - o2
-    x_L = -d0
-    m = complex(s * d1, d2)
-    yabs = math.sqrt(_k_max(m.real * m.real + m.imag * m.imag - a * a, 0.0))
-    r2 = x_L * x_L + yabs * yabs
-    ftol = 2.0 * math.sqrt(r2) * tol
-    coef = np.zeros(9)
-    base = 0 if upper else 4
-    ee = e.real * e.real + e.imag * e.imag
-    coef[base] = 1.0
-    coef[base + 1] = ee
-    coef[base + 2] = 2.0 * e.real
-    coef[base + 3] = -2.0 * e.imag
-    coef[8] = -r2
-    kind = 0 if upper else 1
-    ea = math.sqrt(ee)
-    f = np.empty(K_)
-    g = np.empty(K_)
-    for k in range(K_):
-        fk, gk = 0.0, 0.0
-        for j in range(9):
-            fk += coef[j] * table[j, k]
-            gk += coef[j] * table[j, K_ + k]
-        f[k], g[k] = fk, gk
     h = grid[1] - grid[0]
-    # brackets: (lo, hi, flo, fhi, glo, ghi, curvature bound, start guess)
-    jobs = np.empty((3 * K_, 8))
     nj = 0
     for k in range(K_ - 1):
         if (f[k] > 0) != (f[k + 1] > 0):
@@ -339,10 +132,7 @@ def _k_ik_radial(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, tabl
             jobs[nj, 4], jobs[nj, 5], jobs[nj, 6], jobs[nj, 7] = g[k], g[k + 1], M, math.nan
             nj += 1
     its = 0
-    rth = np.empty(_RADIAL_CAP)
-    rz = np.empty(_RADIAL_CAP, dtype=np.complex128)
-    nx = 0  # roots found without Newton (ends of the range, double roots)
-    xth = np.empty(K_ + 2)
+    nx = 0
     for end in range(2):
         col, inward, cell = (0, 1.0, 0) if end == 0 else (K_ - 1, -1.0, K_ - 2)
         # An end of [17, 160] deg with |f| <= ftol is a root within rounding (issue 15; see _ik_radial).
@@ -386,6 +176,17 @@ def _k_ik_radial(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, tabl
     for i in range(ns):
         jobs[nj] = split_hi[i]
         nj += 1
+    return nj, nx, ns, its
+
+
+@kernel
+def _k_radial_roots(jobs, nj, xth, nx, ns, coef, fine, fine_rows, upper, right, e, seed, K, KC, r2, max_iter, rth,
+                    rz):
+    """The roots of one target into ``rth`` (theta) and ``rz`` (its contact point before the beta rotation):
+    :func:`_k_radial_newton` on every bracket of :func:`_k_radial_brackets`, then the roots found without
+    Newton (contact point from the closed form); sorted by theta and deduplicated (1e-10 rad) when there are
+    such roots or split cells. Returns (roots, iterations)."""
+    its = 0
     nr = 0
     for j in range(nj):
         root, zr, its_n, conv = _k_radial_newton(jobs[j, 0], jobs[j, 1], jobs[j, 2], jobs[j, 3], jobs[j, 4],
@@ -417,18 +218,27 @@ def _k_ik_radial(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, tabl
                 keep += 1
             prev = cur
         nr = keep
-    # solutions: branch y_L <= 0 by increasing theta, then branch y_L > 0
-    tau = complex(x_L, -yabs)  # exp(i (beta + pi/2)) c = tau on the branch y_L <= 0
-    gamma1 = _k_phase(m * complex(a, yabs))
-    gamma2 = _k_phase(m * complex(a, -yabs))
-    nsol = nr * (2 if yabs > 0 else 1)
+    return nr, its
+
+
+@kernel
+def _k_radial_pick(rth, rz, nr, tau, gamma1, gamma2, two, q0, use_q0, limits, q, sols):
+    """The solutions of one target into ``sols`` (S, 3) (NaN-padded, as many as fit) and the answer into ``q``.
+
+    Each root gives ``(theta, arg(tau conj(i c)), gamma1)`` on the branch ``y_L <= 0`` and, if ``two``,
+    ``(theta, arg(conj(tau) conj(i c)), gamma2)`` on ``y_L > 0``, listed in that order. The answer: the
+    first usable one (finite; with ``limits`` gamma inside the ABAD limits within rounding, clipped onto
+    them), or with ``use_q0`` the usable one nearest ``q0`` (wrapped angle differences), its beta (and,
+    without limits, gamma) shifted by multiples of 2 pi to lie within pi of ``q0``'s. Without a usable one
+    ``q`` is the first solution. Returns (answer index or -1, solutions).
+    """
+    nsol = nr * (2 if two else 1)
     S = sols.shape[0]
     for i in range(S):
         sols[i, 0], sols[i, 1], sols[i, 2] = math.nan, math.nan, math.nan
     best = -1
     best_d2 = math.inf
     sq0 = np.empty(3)
-    sel = np.empty(3)
     for i in range(nsol):
         r = i if i < nr else i - nr
         ccz = rz[r].conjugate() * -1j
@@ -444,25 +254,70 @@ def _k_ik_radial(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, tabl
                 sq0[2] = _k_clip(sq0[2], -ABAD_LIMIT, ABAD_LIMIT)
         if i < S:
             sols[i, 0], sols[i, 1], sols[i, 2] = sq0[0], sq0[1], sq0[2]
-        if i == 0:
-            sel[0], sel[1], sel[2] = sq0[0], sq0[1], sq0[2]  # kept for the out-of-limits answer
+        if i == 0 or (usable and not use_q0 and best < 0):
+            q[0], q[1], q[2] = sq0[0], sq0[1], sq0[2]  # the first: kept for the out-of-limits answer
         if usable:
             if not use_q0:
                 if best < 0:
                     best = i
-                    q[0], q[1], q[2] = sq0[0], sq0[1], sq0[2]
             else:
                 dist = (sq0[0] - q0[0]) ** 2
-                w1 = _k_phase(complex(math.cos(sq0[1] - q0[1]), math.sin(sq0[1] - q0[1])))
-                w2 = _k_phase(complex(math.cos(sq0[2] - q0[2]), math.sin(sq0[2] - q0[2])))
+                w1 = wrap_k(sq0[1] - q0[1])
+                w2 = wrap_k(sq0[2] - q0[2])
                 dist += w1 * w1 + w2 * w2
                 if dist < best_d2 or best < 0:
                     best, best_d2 = i, dist
                     q[0], q[1], q[2] = sq0[0], q0[1] + w1, (q0[2] + w2 if not limits else sq0[2])
+    return best, nsol
+
+
+@kernel
+def _k_ik_radial(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, table, m2, fine, fine_rows, tol,
+                 max_iter, q0, use_q0, limits, q, sols):
+    """The radial IK for one target (:func:`_ik_radial` states the math) into ``q`` (3,) and ``sols``
+    (S, 3) (NaN-padded, as many as fit): the out-of-plane part in closed form, f and f' on the grid from the
+    table, :func:`_k_radial_brackets`, :func:`_k_radial_roots`, :func:`_k_radial_pick`; the answer checked
+    by the FK. Returns (iterations, error, reason, roots, solutions)."""
+    K_ = grid.shape[0]
+    d0, d1, d2 = tgt[0] - o0, tgt[1] - o1, tgt[2] - o2
+    x_L = -d0
+    m = complex(s * d1, d2)
+    yabs = math.sqrt(_k_max(m.real * m.real + m.imag * m.imag - a * a, 0.0))
+    r2 = x_L * x_L + yabs * yabs
+    ftol = 2.0 * math.sqrt(r2) * tol
+    coef = np.zeros(9)
+    base = 0 if upper else 4
+    ee = e.real * e.real + e.imag * e.imag
+    coef[base] = 1.0
+    coef[base + 1] = ee
+    coef[base + 2] = 2.0 * e.real
+    coef[base + 3] = -2.0 * e.imag
+    coef[8] = -r2
+    f = np.empty(K_)
+    g = np.empty(K_)
+    for k in range(K_):
+        fk, gk = 0.0, 0.0
+        for j in range(9):
+            fk += coef[j] * table[j, k]
+            gk += coef[j] * table[j, K_ + k]
+        f[k], g[k] = fk, gk
+    jobs = np.empty((3 * K_, 8))
+    xth = np.empty(K_ + 2)
+    nj, nx, ns, its = _k_radial_brackets(grid, f, g, m2, 0 if upper else 1, ee, math.sqrt(ee), ftol, upper, right,
+                                         e, seed, K, KC, r2, max_iter, jobs, xth)
+    rth = np.empty(_RADIAL_CAP)
+    rz = np.empty(_RADIAL_CAP, dtype=np.complex128)
+    nr, its_r = _k_radial_roots(jobs, nj, xth, nx, ns, coef, fine, fine_rows, upper, right, e, seed, K, KC, r2,
+                                max_iter, rth, rz)
+    its += its_r
+    # solutions: branch y_L <= 0 by increasing theta, then branch y_L > 0
+    tau = complex(x_L, -yabs)  # exp(i (beta + pi/2)) c = tau on the branch y_L <= 0
+    gamma1 = _k_phase(m * complex(a, yabs))
+    gamma2 = _k_phase(m * complex(a, -yabs))
+    best, nsol = _k_radial_pick(rth, rz, nr, tau, gamma1, gamma2, yabs > 0, q0, use_q0, limits, q, sols)
     if best >= 0:
         reason = _SOLVED
-    elif nr > 0:  # reachable only outside the ABAD limits: the first solution, for the error message
-        q[0], q[1], q[2] = sel[0], sel[1], sel[2]
+    elif nr > 0:  # reachable only outside the ABAD limits: q is the first solution, for the error message
         reason = _LIMITS
     else:  # no root: the grid node of smallest |f|, as the point reached
         kb = 0

@@ -110,14 +110,26 @@ def _knee_branch_k(kk, sk, k, co, so, foot_z):
 
 
 @kernel
-def _branch_k(dx, dy, dz, rho, s_u, vx, vz, li):
-    """Steps 2 and 4: q1 and q2 of abduction branch ``s_u`` for a knee vector ``v``; angle differences in one
-    atan2 (``atan2(a) - atan2(b) = atan2(a x b, a . b)``, wrapped to (-pi, pi] already)."""
+def _abduction_k(dy, dz, rho, s_u, li):
+    """Step 2: q1 of abduction branch ``s_u``, ``s_y [atan2(d_z, d_y) - atan2(u_z, s_y y12)]`` in one atan2
+    (``atan2(a) - atan2(b) = atan2(a x b, a . b)``, wrapped to (-pi, pi] already)."""
     sy = SY[li]
     uz = s_u * rho
-    q1 = sy * np.arctan2(sy * Y12 * dz - dy * uz, sy * Y12 * dy + dz * uz)
-    q2 = np.arctan2(uz * vx - dx * vz, dx * vx + uz * vz)
-    return q1, q2
+    return sy * np.arctan2(sy * Y12 * dz - dy * uz, sy * Y12 * dy + dz * uz)
+
+
+@kernel
+def _hip_k(dx, rho, s_u, vx, vz):
+    """Step 4: q2 = atan2(u_z, u_x) - atan2(v_z, v_x) of abduction branch ``s_u`` for a knee vector ``v``, in
+    one atan2 like :func:`_abduction_k`."""
+    uz = s_u * rho
+    return np.arctan2(uz * vx - dx * vz, dx * vx + uz * vz)
+
+
+@kernel
+def _branch_k(dx, dy, dz, rho, s_u, vx, vz, li):
+    """Steps 2 and 4: q1 and q2 of abduction branch ``s_u`` for a knee vector ``v``."""
+    return _abduction_k(dy, dz, rho, s_u, li), _hip_k(dx, rho, s_u, vx, vz)
 
 
 @kernel

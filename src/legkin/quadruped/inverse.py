@@ -14,7 +14,8 @@ from .._rotations import wrap_k
 from ..errors import InvalidInputError, JointLimitError, UnreachableError
 from ._common import F64, LEG_INDEX, S3, foot_z_of, leg_index, rows
 from .closed_form import (
-    _branch_k,
+    _abduction_k,
+    _hip_k,
     _ik_all_k,
     _knee_angle_k,
     _knee_branch_k,
@@ -49,7 +50,7 @@ def _ik_core(p, li, foot_z, l2, offset, co, so, has_ref, q_near, out) -> int:
     when ``has_ref``), or NaN and the failure code (unreachable, or only outside the limits).
 
     A knee branch is computed only if its q3 is inside the limits (q3 depends on the knee sign alone): inside
-    POPI's limits the k = +1 branch never is, which halves the work.
+    POPI's limits the k = +1 branch never is, which halves the work; and q1 (one atan2) only if q2 is.
     """
     if not _finite3(p):
         return BAD_INPUT
@@ -66,8 +67,10 @@ def _ik_core(p, li, foot_z, l2, offset, co, so, has_ref, q_near, out) -> int:
         if not (q3 >= LO[2] - LIMIT_TOL and q3 <= HI[2] + LIMIT_TOL):
             continue
         vx, vz = _knee_branch_k(kk, sk, k, co, so, foot_z)
-        q1, q2 = _branch_k(dx, dy, dz, rho, SU[b], vx, vz, li)
-        q2 = _toward_limits_k(q2, 1)  # q1 and q3 limits are far from +-pi
+        q2 = _toward_limits_k(_hip_k(dx, rho, SU[b], vx, vz), 1)  # q1 and q3 limits are far from +-pi
+        if not (q2 >= LO[1] - LIMIT_SLACK and q2 <= HI[1] + LIMIT_SLACK):
+            continue  # (q1 is computed only for a branch whose q2 may be inside the limits)
+        q1 = _abduction_k(dy, dz, rho, SU[b], li)
         if not _inside_by_k(q1, q2, q3, LIMIT_SLACK):
             continue
         if not _strictly_inside_k(q1, q2, q3):  # a hair outside the limits: clip, re-solve the other joints

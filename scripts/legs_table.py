@@ -48,7 +48,7 @@ def geometry_table() -> str:
 
 def error_table(samples: int, seed: int) -> str:
     lines = [
-        f"| robot | samples x legs | FK vs oMf (m) | Jacobian vs getFrameJacobian | IK round trip (m) | solved in limits | "
+        "| robot | samples x legs | FK vs oMf (m) | Jacobian vs getFrameJacobian | IK round trip (m) | solved in limits | "
         "all branches (m) | branches | time (s) |",
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]

@@ -13,7 +13,14 @@ from hypothesis import assume, example, given
 from hypothesis import strategies as st
 
 from legkin import legs
-from legkin.errors import InvalidInputError, InvalidParameterError, JointLimitError, LegkinError, UnknownModelError, UnreachableError
+from legkin.errors import (
+    InvalidInputError,
+    InvalidParameterError,
+    JointLimitError,
+    LegkinError,
+    UnknownModelError,
+    UnreachableError,
+)
 from legkin.legs import LegStructureError
 
 ROBOTS = tuple(legs.ERD_ROBOTS)

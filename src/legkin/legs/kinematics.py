@@ -30,6 +30,9 @@ Inverse kinematics, with ``p' = p - o1`` and ``(x1, y, z) = (p'.e1, p'.e2, p'.e3
    ``beta = s3 q3 + phi_l - phi_k`` so ``q3 = s3 (beta - phi_l + phi_k)``;
 3. hip pitch: ``v = k + Rot(s3 q3) l``; ``q2 = atan2(w_Y, w_X) - atan2(v_Y, v_X)``.
 
+The forward map and Jacobian kernels use the measured axes exactly (the product of exponentials above, as
+Pinocchio); each closed-form branch is polished by at most :data:`POLISH_STEPS` damped Newton steps on it when
+its foot error exceeds :data:`POLISH_BELOW` (axes a few 1e-12 rad off the ideal structure, the knee's fold).
 Each angle is then moved by a multiple of 2 pi: in :meth:`Leg.ik_all` to the representative nearest the
 reference configuration, in :meth:`Leg.ik` to the representative inside the URDF limits nearest ``q_near``.
 
@@ -46,9 +49,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
 from .._batch import as_input, check_flag, finish
 from .._kernels import OK, SERIAL_BELOW, as_rows, batch_kernel, kernel, prange
+from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
 
 __all__ = [
     "Leg",

@@ -1,4 +1,6 @@
-"""Tests of the tripod: model, loops, analytic kinematics (legkin.analytic.tripod) and its checks."""
+"""Tests of the tripod's own facts: model, loops, the seed's corrections, assembly modes, guards and the IK contract
+near the flip / the boundary / the actuation singularities. The generic kinematic contract (round trips, Jacobian
+vs differences, single == batch, NaN + mask, bad arrays) is tests/test_contract.py's, over legkin.tripod.contract."""
 
 from __future__ import annotations
 
@@ -19,8 +21,18 @@ from legkin.tripod import kinematics as at
 from legkin.tripod.forward_kernels import STEP_RCOND, _k_gn_step, _k_initial_guess
 from legkin.tripod.inverse import _run
 
-# Many tests below call the deprecated 0.1 forms on purpose (they must keep working for one release).
-pytestmark = pytest.mark.filterwarnings("ignore::DeprecationWarning")
+ALPHAS = (math.pi / 4, math.pi / 3, math.pi / 2)
+MOTORS = [0, 4, 8]  # the motor columns of ik_joints
+
+
+def _u(ay, az):
+    """Targets (..., 2) = (alpha_y, alpha_z) as float arrays."""
+    ay, az = np.broadcast_arrays(np.asarray(ay, dtype=float), np.asarray(az, dtype=float))
+    return np.stack([ay, az], axis=-1)
+
+
+def _geo(alpha):
+    return at.Geometry(alpha=alpha)
 
 
 def _ik_aux(ay, az, alpha=at.ALPHA):
@@ -29,8 +41,6 @@ def _ik_aux(ay, az, alpha=at.ALPHA):
     ay, az = np.broadcast_arrays(np.asarray(ay, dtype=float), np.asarray(az, dtype=float))
     q, aux, _ = _run(ay, az, at.Geometry(alpha=alpha)._vector, at.HOME_MODE)
     return q[..., 0, :], aux[..., 0, :]
-
-ALPHAS = (math.pi / 4, math.pi / 3, math.pi / 2)
 
 
 @pytest.fixture(scope="module")
@@ -43,14 +53,7 @@ def _tilt_u(theta, phi):
     return at.orientation_from_axis(r)
 
 
-# ------------------------------------------------------------------------------------------ model and checks
-def test_check_rows_pass():
-    rows = ct.run(150, np.random.default_rng(1))
-    assert len(rows) >= 45
-    failed = [r for r in rows if not r.passed]
-    assert not failed, failed
-
-
+# ------------------------------------------------------------------------------------------ model
 def test_committed_urdf_matches_xacro():
     from legkin._generate import check_all
 
@@ -74,6 +77,8 @@ def test_model_structure(robot):
 @pytest.mark.parametrize("alpha", [math.pi / 3, math.pi / 2, 2.5])
 def test_srdf_poses_close_loops_and_match_orientation(alpha):
     robot = legkin.load("tripod") if alpha == math.pi / 3 else legkin.load("tripod", alpha=alpha, d=0.08)
+    geo = at.Geometry.from_params(robot.params)
+    assert geo.alpha == alpha
     theta = 2 * math.asin(0.6 * math.cos(alpha / 2))
     phis = {"home": None, "tilt_y": -math.pi / 2, "tilt_z": 0.0, "tilt_diag": 3 * math.pi / 4}
     for name, phi in phis.items():
@@ -83,7 +88,7 @@ def test_srdf_poses_close_loops_and_match_orientation(alpha):
         ay, az = (0.0, 0.0) if phi is None else _tilt_u(theta, phi)
         rot = robot.frame_placement(q, "platform").rotation
         assert np.abs(rot - at.platform_rotation(ay, az)).max() < 1e-12, name
-        assert np.abs(q - at.ik(ay, az, d=robot.params["d"], alpha=alpha)).max() < 1e-12, name
+        assert np.abs(q - at.ik_joints(_u(ay, az), geometry=geo)).max() < 1e-12, name
 
 
 def test_point_closures_would_not_suffice(robot):
@@ -107,55 +112,63 @@ def test_solve_loops_from_home_reaches_tilted_pose(robot):
     assert np.abs(q - qt).max() < 1e-10
 
 
+# ------------------------------------------------------------------------------------------ the deprecated forms
+def test_deprecated_forms_still_work_and_warn():
+    """The 0.1 call forms (one release): same answers as the 0.2 API, each with a DeprecationWarning."""
+    u = np.array([0.3, -0.4])
+    q = at.ik_joints(u)
+    with pytest.warns(DeprecationWarning, match="deprecated"):
+        assert np.array_equal(at.ik(0.3, -0.4, alpha=at.ALPHA), q)
+    with pytest.warns(DeprecationWarning, match="deprecated"):
+        y, z, inc = at.fk(q[0], q[4], q[8])
+    assert np.array_equal([y, z], at.fk(q[MOTORS])) and inc < 1e-12
+    with pytest.warns(DeprecationWarning, match="deprecated"):
+        assert np.array_equal(at.actuation_jacobian(u), at.jacobian(u))
+    with pytest.warns(DeprecationWarning, match="deprecated"):
+        assert np.array_equal(at.leg_transform(q[:4], at.ETA[0]), at.leg_transform(q[:4], "A"))
+    with pytest.warns(DeprecationWarning, match="legkin.analytic"):
+        from legkin.analytic import tripod as old
+
+        assert old.ik is at.ik
+
+
 # ------------------------------------------------------------------------------------------ properties
-@settings(max_examples=60, deadline=None)
-@given(
-    st.floats(-math.pi / 2 + 1e-3, math.pi / 2 - 1e-3),
-    st.floats(-math.pi, math.pi),
-    st.sampled_from(ALPHAS),
-)
-def test_ik_fk_round_trip(ay, az, alpha):
-    q, ok = at.ik(np.array([ay]), np.array([az]), alpha=alpha, return_mask=True)
-    if not ok[0] or 1 + math.cos(ay) * math.cos(az) < 1e-2:
-        return
-    y, z, inc = at.fk(q[0, 0], q[0, 4], q[0, 8], alpha=alpha)
-    assert inc < 1e-11
-    assert np.abs(at.platform_rotation(y, z) - at.platform_rotation(ay, az)).max() < 1e-11
-    assert -math.pi / 2 <= y <= math.pi / 2
-
-
 @settings(max_examples=60, deadline=None)
 @given(st.floats(-math.pi, math.pi), st.floats(-10, -3), st.sampled_from(ALPHAS), st.integers(0, 2))
 def test_round_trip_near_boundary(phi, log_gap, alpha, k):
-    """Tilts where leg k has 1 - |cos q_k2| = 10**log_gap (just inside the workspace)."""
+    """Tilts where leg k has 1 - |cos q_k2| = 10**log_gap (just inside the workspace: the boundary formula of
+    docs/tripod.md); fk reports alpha_y in [-pi/2, pi/2]."""
     s = abs(math.sin(phi - at.ETA[k]))
     arg = (1 - 10**log_gap) * math.cos(alpha / 2) / max(s, 1e-300)
     if arg >= 1 or arg < 0.05:
         return
     ay, az = _tilt_u(2 * math.asin(arg), phi)
-    q, ok = at.ik(np.array([ay]), np.array([az]), alpha=alpha, return_mask=True)
+    geo = _geo(alpha)
+    q, ok = at.ik_joints(_u([ay], [az]), geometry=geo, return_mask=True)
     if not ok[0] or 1 + math.cos(ay) * math.cos(az) < 1e-2:
         return
     assert 1 - abs(math.cos(q[0, 4 * k + 1])) == pytest.approx(10**log_gap, rel=1e-3)
-    y, z, inc = at.fk(q[0, 0], q[0, 4], q[0, 8], alpha=alpha, max_inconsistency=1e-8)
+    y, z = at.fk(q[0, MOTORS], geometry=geo, max_inconsistency=1e-8)
     assert np.abs(at.platform_rotation(y, z) - at.platform_rotation(ay, az)).max() < 1e-9
+    assert -math.pi / 2 <= y <= math.pi / 2
 
 
 @settings(max_examples=40, deadline=None)
-@given(st.lists(st.floats(-math.pi, math.pi), min_size=4, max_size=4), st.sampled_from(range(3)))
-def test_leg_transform_is_eq10_on_cv_branch_and_general_position(q, k):
+@given(st.lists(st.floats(-math.pi, math.pi), min_size=4, max_size=4), st.sampled_from(at.LEGS))
+def test_leg_transform_is_eq10_on_cv_branch_and_general_position(q, leg):
     q = np.array(q)
-    t = at.leg_transform(q, at.ETA[k])
+    t = at.leg_transform(q, leg)
+    cv = at.leg_transform_cv(q[:2], leg)
     assert np.allclose(t[:3, :3] @ t[:3, :3].T, np.eye(3), atol=1e-14)
-    assert np.allclose(t[:3, 3], at.leg_transform_cv(q[0], q[1], at.ETA[k])[:3, 3], atol=1e-16)
+    assert np.allclose(t[:3, 3], cv[:3, 3], atol=1e-16)
     qcv = np.array([q[0], q[1], q[1], q[0]])
-    assert np.abs(at.leg_transform(qcv, at.ETA[k]) - at.leg_transform_cv(q[0], q[1], at.ETA[k])).max() < 1e-15
+    assert np.abs(at.leg_transform(qcv, leg) - cv).max() < 1e-15
 
 
 def test_seed_t33_sign_and_eq15_atan_are_wrong():
     """The corrections are needed: the printed forms disagree with the mechanism."""
     q1, q2, eta = 0.3, 1.1, at.ETA[1]
-    t = at.leg_transform_cv(q1, q2, eta)
+    t = at.leg_transform_cv(np.array([q1, q2]), "B")
     c1, s1, c2, s2 = math.cos(q1), math.sin(q1), math.cos(q2), math.sin(q2)
     ca, sa, ce, se = math.cos(at.ALPHA), math.sin(at.ALPHA), math.cos(eta), math.sin(eta)
     g4 = c2 * (c1 * sa + s1 * s2 * (1 + ca))
@@ -164,34 +177,25 @@ def test_seed_t33_sign_and_eq15_atan_are_wrong():
     ay, az = 1.2, 2.0  # c_y + c_z < 0: one-argument atan lands on the wrong branch
     wrong = math.atan(math.sin(ay) * math.sin(az) / (math.cos(ay) + math.cos(az)))
     assert abs(wrong - float(at.alpha_x(ay, az))) == pytest.approx(math.pi, abs=1e-12)
-    q = at.ik(ay, az)
+    q = at.ik_joints(np.array([ay, az]))
     robot = legkin.load("tripod")
     rot = robot.frame_placement(q, "platform").rotation
     assert np.abs(rot - at.platform_rotation(ay, az)).max() < 1e-13
 
 
-def test_batch_shapes_and_scalar_wrapper():
-    ay = np.linspace(-0.5, 0.5, 6).reshape(2, 3)
-    q = at.ik(ay, 0.2)
-    assert q.shape == (2, 3, 12)
-    assert np.array_equal(at.ik(float(ay[1, 2]), 0.2), q[1, 2])
-    assert at.actuation_jacobian(ay, 0.2).shape == (2, 3, 3, 2)
-    y, z, inc = at.fk(q[..., 0], q[..., 4], q[..., 8])
-    assert y.shape == (2, 3) and np.allclose(y, ay, atol=1e-12)
-
-
 def test_workspace_matches_ik():
     for alpha in ALPHAS:
-        ws = at.workspace(alpha=alpha, n=61)
+        ws = at.workspace(geometry=_geo(alpha), n=61)
         gy, gz = np.meshgrid(ws.alpha_y, ws.alpha_z, indexing="ij")
-        _, ok = at.ik(gy, gz, alpha=alpha, return_mask=True)
+        _, ok = at.ik(_u(gy, gz), geometry=_geo(alpha), return_mask=True)
         assert np.array_equal(ok, ws.reachable)
         b = ws.boundary[np.all(np.isfinite(ws.boundary), axis=1)]
         if len(b):
             c2 = _ik_aux(b[:, 0], b[:, 1], alpha)[1][:, :3]
             c2 = c2[np.all(np.isfinite(c2), axis=-1)]  # points at the flip (tilt pi) have no E
             assert len(c2) > 100 and np.allclose(np.abs(c2).max(axis=-1), 1.0, atol=1e-9)
-    assert at.workspace(alpha=math.pi / 2).reachable.mean() < at.workspace(alpha=math.pi / 4).reachable.mean()
+    small, large = at.workspace(geometry=_geo(math.pi / 2)), at.workspace(geometry=_geo(math.pi / 4))
+    assert small.reachable.mean() < large.reachable.mean()
 
 
 # ------------------------------------------------------------------------------------------ error paths
@@ -216,55 +220,33 @@ def test_xacro_refuses_bad_alpha_directly():
         render(spec, {**args, "d": -1.0})
 
 
-@pytest.mark.parametrize("kw", [{"d": 0}, {"alpha": -1}, {"alpha": math.pi}, {"eta": (0.0, 1.0)}])
-def test_analytic_bad_params(kw):
-    with pytest.raises(InvalidParameterError):
-        at.ik(0.1, 0.2, **kw)
-
-
-def test_bad_inputs():
-    with pytest.raises(InvalidInputError):
-        at.ik(float("nan"), 0.2)
-    with pytest.raises(ValueError):
-        at.ik(np.zeros(3), np.zeros(2))
-    with pytest.raises(InvalidInputError):
-        at.leg_transform(np.zeros(3), 0.0)
-    with pytest.raises(InvalidInputError):
-        at.fk(0.1, np.inf, 0.2)
-    with pytest.raises(InvalidInputError):
-        at.platform_rotation("a", 1.0)
-
-
-def test_unreachable_and_singular():
-    alpha = math.pi / 2  # workspace: tilt <= 2 asin(cos(pi/4) / max |sin(phi - eta)|)
-    ay, az = _tilt_u(2.6, 0.0)  # tilt 2.6 rad towards +y: beyond legs B and C
+def test_unreachable_and_singular_name_the_leg():
+    geo = _geo(math.pi / 2)  # workspace: tilt <= 2 asin(cos(pi/4) / max |sin(phi - eta)|)
+    u = _u(*_tilt_u(2.6, 0.0))  # tilt 2.6 rad towards +y: beyond legs B and C
+    with pytest.raises(UnreachableError, match="leg B would need cos q_B2"):
+        at.ik(u, geometry=geo)
     with pytest.raises(UnreachableError, match="leg B"):
-        at.ik(ay, az, alpha=alpha)
-    q, ok = at.ik(np.array([ay, 0.1]), np.array([az, 0.1]), alpha=alpha, return_mask=True)
-    assert ok.tolist() == [False, True] and np.isnan(q[0]).all() and np.isfinite(q[1]).all()
-    with pytest.raises(UnreachableError):
-        at.actuation_jacobian(ay, az, alpha=alpha)
+        at.jacobian(u, geometry=geo)
     with pytest.raises(SingularityError, match="1 \\+ cos"):
-        at.ik(0.0, math.pi)
+        at.ik(np.array([0.0, math.pi]))
     # exactly on the boundary of leg A: sin q_A2 = 0
-    phi = math.pi / 2
-    ay, az = _tilt_u(2 * math.asin(math.cos(alpha / 2)), phi)
-    with pytest.raises(SingularityError, match="leg A"):
-        at.ik(ay, az, alpha=alpha)
-    a, m = at.actuation_jacobian(np.array([ay]), np.array([az]), alpha=alpha, return_mask=True)
+    u = _u(*_tilt_u(2 * math.asin(math.cos(math.pi / 4)), math.pi / 2))
+    with pytest.raises(SingularityError, match="leg A has sin q_A2 = 0"):
+        at.ik(u, geometry=geo)
+    a, m = at.jacobian(u[None], geometry=geo, return_mask=True)
     assert not m[0] and np.isnan(a).all()
 
 
 def test_fk_reports_inconsistent_motors():
-    q = at.ik(0.3, -0.4)
+    q = at.ik(np.array([0.3, -0.4]))
+    bad = q + np.array([0.0, 0.0, 1e-3])
     with pytest.raises(UnreachableError, match="inconsistent") as exc:
-        at.fk(q[0], q[4], q[8] + 1e-3)
+        at.fk(bad)
     assert exc.value.closest is not None
-    y, z, inc = at.fk(q[0], q[4], q[8] + 1e-3, max_inconsistency=np.inf)
-    assert 1e-5 < inc < 1e-3
-    ys, zs, incs, mask = at.fk(np.array([q[0], q[0]]), np.array([q[4], q[4]]), np.array([q[8], q[8] + 1e-3]),
-                               return_mask=True)
-    assert mask.tolist() == [True, False] and np.isnan(ys[1]) and incs[0] < 1e-12
+    _, info = at.fk(bad, max_inconsistency=np.inf, return_info=True)
+    assert 1e-5 < info.inconsistency < 1e-3
+    u, ok, info = at.fk(np.stack([q, bad]), return_mask=True, return_info=True)
+    assert ok.tolist() == [True, False] and np.isnan(u[1]).all() and info.inconsistency[0] < 1e-12
 
 
 # ------------------------------------------------------------------------------------------ fk internals (closed forms)
@@ -345,18 +327,11 @@ def test_initial_guess_is_the_planes_intersection():
         assert np.abs(at.platform_rotation(ay, az) - at.platform_rotation(*row)).max() < 1e-13
 
 
-def test_fk_scalar_is_a_batch_of_one():
-    u = [(0.3, -0.4), (math.pi / 2, 0.3), (-1.2, 2.9)]  # alpha_y = pi/2: A_u has rank 1 (rank-1 step)
-    for ay, az in u:
-        q = at.ik(ay, az)
-        single = at.fk(q[0], q[4], q[8])
-        batch = at.fk(q[[0]], q[[4]], q[[8]])
-        assert all(np.array_equal(np.asarray(s), b[0]) for s, b in zip(single, batch))
-        assert np.abs(at.platform_rotation(*single[:2]) - at.platform_rotation(ay, az)).max() < 1e-13
-        assert np.array_equal(at.actuation_jacobian(ay, az), at.actuation_jacobian([ay], [az])[0])
-    q = at.ik(0.3, -0.4)
-    y, z, inc, ok = at.fk(q[[0]], q[[4]], q[[8]] + 1e-3, return_mask=True)
-    assert not ok[0] and np.isnan(y[0]) and np.isnan(inc[0])
+def test_fk_rank_one_step():
+    """alpha_y = pi/2 makes A_u's second column vanish (rank-1 Gauss-Newton step): fk still reproduces the pose."""
+    for ay, az in [(0.3, -0.4), (math.pi / 2, 0.3), (-1.2, 2.9)]:
+        y, z = at.fk(at.ik(np.array([ay, az])))
+        assert np.abs(at.platform_rotation(y, z) - at.platform_rotation(ay, az)).max() < 1e-13
 
 
 # ------------------------------------------------------------------------------------------ parameter validation
@@ -366,33 +341,46 @@ def test_fk_scalar_is_a_batch_of_one():
         ({"d": float("nan")}, r"d=nan is out of range: must be in \(0, inf\)"),
         ({"d": float("inf")}, r"d=inf is out of range"),
         ({"d": -0.1}, r"d=-0.1 is out of range"),
+        ({"d": 0}, r"d=0(\.0)? is out of range"),
         ({"d": True}, r"d must be a real number, got True"),
         ({"d": "0.05"}, r"d must be a real number, got '0.05'; valid range \(0, inf\)"),
         ({"d": 0.05 + 0j}, r"d must be a real number"),
         ({"d": [0.05]}, r"d must be a real number"),
         ({"alpha": 0.0}, r"alpha=0.0 is out of range: must be in \(0, 3.14159\)"),
+        ({"alpha": -1}, r"alpha=-1(\.0)? is out of range"),
+        ({"alpha": math.pi}, r"alpha=3.14159\d* is out of range"),
         ({"alpha": float("nan")}, r"alpha=nan is out of range"),
         ({"alpha": "pi"}, r"alpha must be a real number"),
         ({"eta": "abc"}, r"eta must be three finite real angles"),
-        ({"eta": [0.0, 1.0, 2.0j]}, r"eta must be three finite real angles"),
+        ({"eta": (0.0, 1.0)}, r"eta must be three finite real angles"),
+        ({"eta": [0.0, 1.0, 2.0j]}, r"eta_C must be a real number"),
         ({"eta": [0.0, float("nan"), 1.0]}, r"eta_B=nan is out of range"),
         ({"eta": [[0.0, 1.0, 2.0]]}, r"eta must be three finite real angles"),
-        ({"eta": [0.0, [1.0], 2.0]}, r"eta must be three finite real angles"),
+        ({"eta": [0.0, [1.0], 2.0]}, r"eta_B must be a real number"),
+    ],
+)
+def test_geometry_is_validated(kw, match):
+    with pytest.raises(InvalidParameterError, match=match):
+        at.Geometry(**kw)
+
+
+@pytest.mark.parametrize(
+    "kw, match",
+    [
         ({"mode": "-+"}, r"mode must be one of '-\+\+\+', "),
         ({"mode": None}, r"mode must be one of .*got None"),
         ({"return_mask": "yes"}, r"return_mask must be True or False"),
         ({"return_mask": 1}, r"return_mask must be True or False"),
+        ({"geometry": {"d": 0.05}}, r"geometry must be a legkin.tripod.Geometry or None"),
     ],
 )
 def test_keyword_parameters_are_validated(kw, match):
-    q = at.ik(0.1, 0.2)
-    calls = [lambda: at.ik(0.1, 0.2, **kw), lambda: at.fk(q[0], q[4], q[8], **kw)]
-    if "mode" not in kw or kw["mode"] != "all":
-        calls.append(lambda: at.actuation_jacobian(0.1, 0.2, **kw))
-    if set(kw) <= {"d", "alpha", "eta"}:
-        calls.append(lambda: at.workspace(n=5, m=5, **kw))
-        if "eta" not in kw:
-            calls += [lambda: at.platform_position(0.1, 0.2, **kw), lambda: at.leg_transform(np.zeros(4), 0.0, **kw)]
+    u = np.array([0.1, 0.2])
+    q = at.ik(u)
+    calls = [lambda: at.ik(u, **kw), lambda: at.ik_joints(u, **kw), lambda: at.jacobian(u, **kw),
+             lambda: at.fk(q, **kw)]
+    if "mode" not in kw:
+        calls.append(lambda: at.ik_all(u, **kw))
     for call in calls:
         with pytest.raises(InvalidParameterError, match=match):
             call()
@@ -415,12 +403,13 @@ def test_keyword_parameters_are_validated(kw, match):
         ({"max_inconsistency": -1.0}, r"max_inconsistency=-1.0 is out of range"),
         ({"max_inconsistency": None}, r"max_inconsistency must be a real number"),
         ({"mode": "all!"}, r"mode must be one of"),
+        ({"return_info": "no"}, r"return_info must be True or False"),
     ],
 )
 def test_fk_options_are_validated(kw, match):
-    q = at.ik(0.1, 0.2)
+    q = at.ik(np.array([0.1, 0.2]))
     with pytest.raises(InvalidParameterError, match=match):
-        at.fk(q[0], q[4], q[8], **kw)
+        at.fk(q, **kw)
 
 
 @pytest.mark.parametrize(
@@ -430,11 +419,12 @@ def test_fk_options_are_validated(kw, match):
         lambda: at.workspace(n=2.5),
         lambda: at.workspace(n=10**6),
         lambda: at.workspace(m="10"),
-        lambda: at.leg_transform(np.zeros(4), [0.0, 1.0]),
+        lambda: at.workspace(geometry=(0.05, 1.0)),
+        lambda: at.leg_transform(np.zeros(4), "D"),
         lambda: at.leg_transform(np.zeros(4), "a"),
-        lambda: at.leg_transform(np.zeros(4), float("nan")),
-        lambda: at.leg_transform_cv(0.1, 0.2, 1j),
-        lambda: at.actuation_jacobian(0.1, 0.2, mode="all"),
+        lambda: at.leg_transform_cv(np.zeros(2), "AB"),
+        lambda: at.platform_position(0.1, 0.2, geometry="default"),
+        lambda: at.jacobian(np.array([0.1, 0.2]), mode="all"),
     ],
 )
 def test_other_parameters_are_validated(call):
@@ -445,11 +435,11 @@ def test_other_parameters_are_validated(call):
 @pytest.mark.parametrize(
     "call",
     [
-        lambda: at.ik(0.1 + 1j, 0.2),
-        lambda: at.ik([[0.1], [0.2, 0.3]], 0.2),
-        lambda: at.fk(0.1, 0.2, np.array([0.3]) + 0j),
-        lambda: at.fk("a", 0.2, 0.3),
-        lambda: at.leg_transform(np.zeros(4) + 0j, 0.0),
+        lambda: at.leg_transform(np.zeros(3), "A"),
+        lambda: at.leg_transform(np.zeros(4) + 0j, "A"),
+        lambda: at.leg_transform_cv(np.array([0.1, np.nan]), "B"),
+        lambda: at.platform_rotation("a", 1.0),
+        lambda: at.platform_position(np.inf, 0.0),
         lambda: at.orientation_from_axis(np.zeros(3)),
         lambda: at.orientation_from_axis([[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]),
         lambda: at.orientation_from_axis([1.0, 0.0, 0.0, 0.0]),
@@ -457,6 +447,7 @@ def test_other_parameters_are_validated(call):
     ],
 )
 def test_bad_arrays_raise_invalid_input(call):
+    """The functions outside the contract (fk / ik / jacobian are tests/test_contract.py's)."""
     with pytest.raises(InvalidInputError):
         call()
 
@@ -468,15 +459,18 @@ def test_modes_and_home_mode(robot):
     q0 = robot.q0
     assert np.all(np.sin(q0[[1, 5, 9]]) > 0)
     assert robot.frame_placement(q0, "platform").translation[0] < 0
-    np.testing.assert_allclose(at.ik(0.0, 0.0), q0, atol=1e-15)
+    np.testing.assert_allclose(at.ik_joints(np.zeros(2)), q0, atol=1e-15)
 
 
 @pytest.mark.parametrize("alpha", ALPHAS)
 def test_every_mode_closes_the_loops_with_the_same_rotation(alpha):
     robot = legkin.load("tripod") if alpha == math.pi / 3 else legkin.load("tripod", alpha=alpha)
-    u = (0.4, -0.7)
-    q_all, ok = at.ik(*u, alpha=alpha, mode="all", return_mask=True)
+    geo = _geo(alpha)
+    u = np.array([0.4, -0.7])
+    q_all, ok = at.ik_joints(u, geometry=geo, mode="all", return_mask=True)
     assert q_all.shape == (16, 12) and ok.all()
+    m_all, ok_all = at.ik_all(u, geometry=geo, return_mask=True)
+    assert np.array_equal(m_all, q_all[:, MOTORS]) and np.array_equal(ok_all, ok)
     rot = at.platform_rotation(*u)
     for m, q in zip(at.MODES, q_all):
         assert np.linalg.norm(robot.constraint_residual(q)) < 1e-12, m
@@ -484,54 +478,45 @@ def test_every_mode_closes_the_loops_with_the_same_rotation(alpha):
         assert np.abs(placement.rotation - rot).max() < 1e-12, m
         assert np.sign(placement.translation[0]) == (-1 if m[0] == "-" else 1), m
         assert [np.sign(np.sin(q[4 * k + 1])) for k in range(3)] == [(-1 if c == "-" else 1) for c in m[1:]], m
-        np.testing.assert_array_equal(at.ik(*u, alpha=alpha, mode=m), q)
+        np.testing.assert_array_equal(at.ik_joints(u, geometry=geo, mode=m), q)
+        np.testing.assert_array_equal(at.ik(u, geometry=geo, mode=m), q[MOTORS])
 
 
 def test_fk_mode_is_explicit():
     """fk solves motors in the mode asked for; motors of another mode: AssemblyModeError naming it (single),
     mask False (batch); mode="all" finds it."""
-    u = (0.3, -0.4)
+    u = np.array([0.3, -0.4])
     for m in at.MODES[1:]:
-        q = at.ik(*u, mode=m)
-        y, z, inc = at.fk(q[0], q[4], q[8], mode=m)
-        assert np.abs(at.platform_rotation(y, z) - at.platform_rotation(*u)).max() < 1e-12 and inc < 1e-12
+        q = at.ik(u, mode=m)
+        y, z = at.fk(q, mode=m)
+        assert np.abs(at.platform_rotation(y, z) - at.platform_rotation(*u)).max() < 1e-12
         pattern = f"mode\\(s\\) {re.escape(m)}, not in mode -\\+\\+\\+"
         with pytest.raises(legkin.AssemblyModeError, match=pattern) as exc:
-            at.fk(q[0], q[4], q[8])
+            at.fk(q)
         assert exc.value.modes == [{"mode": m}]
         assert isinstance(exc.value, UnreachableError)
-        _, _, _, ok = at.fk(q[[0]], q[[4]], q[[8]], return_mask=True)
+        _, ok = at.fk(q[None], return_mask=True)
         assert not ok[0]
-        ys, _, _, oks = at.fk(q[0], q[4], q[8], mode="all", return_mask=True)
-        assert ys.shape == (16,) and oks.tolist() == [mm == m for mm in at.MODES]
-        assert np.isnan(ys[~oks]).all() and np.isfinite(ys[oks]).all()
-
-
-@pytest.mark.parametrize("mode", ["-+-+", "+++-", "+---"])
-def test_actuation_jacobian_in_other_modes_matches_differences(mode):
-    u, h = np.array([0.3, -0.4]), 1e-6
-    a = at.actuation_jacobian(*u, mode=mode)
-    for j in range(2):
-        du = np.zeros(2)
-        du[j] = h
-        fd = (at.ik(*(u + du), mode=mode) - at.ik(*(u - du), mode=mode))[[0, 4, 8]] / (2 * h)
-        np.testing.assert_allclose(a[:, j], fd, atol=1e-8)
+        us, oks = at.fk(q, mode="all", return_mask=True)
+        assert us.shape == (16, 2) and oks.tolist() == [mm == m for mm in at.MODES]
+        assert np.isnan(us[~oks]).all() and np.isfinite(us[oks]).all()
 
 
 # ------------------------------------------------------------------------------------------ the guards
 def test_fk_reproduces_ik_next_to_the_flip():
     """With 1 + c_y c_z computed without cancellation and the inconsistency measured off the range of A_u,
     fk(ik(u)) reproduces u down to the singular tolerance (before: default fk failed below ~1e-6)."""
-    alpha = math.pi / 4
+    geo = _geo(math.pi / 4)
     phi = np.linspace(-3, 3, 200)
     for nb in (1e-11, 1e-9, 1e-7, 1e-5):
         ay, az = _tilt_u(np.full_like(phi, np.arccos(nb - 1.0)), phi)
-        q, ok = at.ik(ay, az, alpha=alpha, return_mask=True)
+        q, ok = at.ik(_u(ay, az), geometry=geo, return_mask=True)
         assert ok.sum() > 20
         ay, az, q = ay[ok], az[ok], q[ok]
-        y, z, inc, m = at.fk(q[:, 0], q[:, 4], q[:, 8], alpha=alpha, return_mask=True)
+        u, m, info = at.fk(q, geometry=geo, return_mask=True, return_info=True)
         assert m.all(), nb
-        assert np.abs(y - ay).max() < 1e-12 and np.abs(wrap(z - az)).max() < 1e-12 and inc.max() < 1e-12
+        assert np.abs(u[:, 0] - ay).max() < 1e-12 and np.abs(wrap(u[:, 1] - az)).max() < 1e-12
+        assert info.inconsistency.max() < 1e-12
 
 
 def _home_det(alpha, ay, az):
@@ -584,29 +569,28 @@ def test_actuation_singularity_guard():
     """On det M = 0 the motors fit two poses: ik and fk refuse them (SingularityError) instead of fk returning
     the other pose (before: fk failed or returned the other pose); away from the guard fk(ik(u)) reproduces u."""
     alpha, az = math.pi / 3, -2.5
+    geo = _geo(alpha)
     y0 = det_zero_points(alpha, az)[0]
     with pytest.raises(SingularityError, match="actuation singularity"):
-        at.ik(y0, az, alpha=alpha)
-    _, ok = at.ik(np.array([y0, y0 + 0.01]), np.array([az, az]), alpha=alpha, return_mask=True)
+        at.ik(_u(y0, az), geometry=geo)
+    _, ok = at.ik(_u([y0, y0 + 0.01], az), geometry=geo, return_mask=True)
     assert ok.tolist() == [False, True]
     qm = _home_det(alpha, y0, az)[0]  # the motors, from an unguarded evaluation
     with pytest.raises(SingularityError, match="actuation singularity"):
-        at.fk(*qm, alpha=alpha)
-    _, _, _, ok = at.fk(qm[[0]], qm[[1]], qm[[2]], alpha=alpha, return_mask=True)
+        at.fk(qm, geometry=geo)
+    _, ok = at.fk(qm[None], geometry=geo, return_mask=True)
     assert not ok[0]
     for off in (1e-3, -1e-4):
-        q = at.ik(y0 + off, az, alpha=alpha)
-        y, z, _ = at.fk(q[0], q[4], q[8], alpha=alpha)
+        y, z = at.fk(at.ik(_u(y0 + off, az), geometry=geo), geometry=geo)
         assert abs(y - (y0 + off)) < 1e-10 and abs(z - az) < 1e-10
 
 
 def test_fk_near_boundary_and_near_singular_planes():
     """A start a rounding error outside the workspace (planes nearly dependent, a hair from a leg's boundary)
     is pulled in; before, fk reported "the solver left the workspace"."""
-    alpha, ay, az = math.pi / 2, -0.5236046131772432, -1.570796326775148
-    q = at.ik(ay, az, alpha=alpha)
-    y, z, inc = at.fk(q[0], q[4], q[8], alpha=alpha)
-    assert abs(y - ay) < 1e-12 and abs(z - az) < 1e-12 and inc < 1e-12
+    geo, ay, az = _geo(math.pi / 2), -0.5236046131772432, -1.570796326775148
+    u, info = at.fk(at.ik(_u(ay, az), geometry=geo), geometry=geo, return_info=True)
+    assert abs(u[0] - ay) < 1e-12 and abs(u[1] - az) < 1e-12 and info.inconsistency < 1e-12
 
 
 # ------------------------------------------------------------------------------------- the IK contract (property tests)
@@ -678,24 +662,25 @@ def test_contract_fk_from_in_limit_motors(qa, qb, branch, s_c, alpha):
     if made is None:
         return
     u, mode, qc = made
+    geo, qm = _geo(alpha), np.array([qa, qb, qc])
     try:
-        y, z, _ = at.fk(qa, qb, qc, alpha=alpha, mode=mode)
+        y, z = at.fk(qm, geometry=geo, mode=mode)
     except (SingularityError, UnreachableError) as exc:  # the guards, the flip, a boundary: refused by ik as well
         assert not isinstance(exc, legkin.AssemblyModeError)
-        _, ok = at.ik(np.array([u[0]]), np.array([u[1]]), alpha=alpha, mode=mode, return_mask=True)
+        _, ok = at.ik(_u([u[0]], [u[1]]), geometry=geo, mode=mode, return_mask=True)
         assert not ok[0], exc
         return
     assert ct.pose_error(u[0], u[1], y, z) <= CONTRACT_TOL
-    q = at.ik(y, z, alpha=alpha, mode=mode)  # (b): solved (its motors may differ from qa, qb, qc by more than
-    # 1e-9 where a leg is near its boundary: the motors are ill-conditioned functions of the pose there), and (a):
-    assert ct.pose_error(y, z, *at.fk(q[0], q[4], q[8], alpha=alpha, mode=mode)[:2]) <= CONTRACT_TOL
-    _, _, _, ok = at.fk(np.array([qa]), np.array([qb]), np.array([qc]), alpha=alpha, return_mask=True)
+    q = at.ik(_u(y, z), geometry=geo, mode=mode)  # (b): solved (its motors may differ from qa, qb, qc by more
+    # than 1e-9 where a leg is near its boundary: the motors are ill-conditioned functions of the pose there), (a):
+    assert ct.pose_error(y, z, *at.fk(q, geometry=geo, mode=mode)) <= CONTRACT_TOL
+    _, ok = at.fk(qm[None], geometry=geo, return_mask=True)
     if mode == at.HOME_MODE:
-        assert ok[0] and np.array_equal(at.fk(qa, qb, qc, alpha=alpha)[0], y)
+        assert ok[0] and np.array_equal(at.fk(qm, geometry=geo)[0], y)
     else:
         assert not ok[0]
         with pytest.raises(legkin.AssemblyModeError) as exc:
-            at.fk(qa, qb, qc, alpha=alpha)
+            at.fk(qm, geometry=geo)
         assert {"mode": mode} in exc.value.modes
 
 
@@ -740,22 +725,17 @@ def _orientation(kind, alpha, a, b, phi, log_small, sign, index):
 def test_contract_random_orientations(kind, alpha, a, b, phi, log_small, sign, index, mode):
     """(a), (c): whatever the orientation (in and around the workspace, near the flip, a hair from a leg's
     boundary, on and next to the actuation-singular curves), ik either raises a legkin error or returns joints in
-    the limits whose motors fk (same mode, default options) maps back to the orientation within 1e-9 rad; the
-    batch call agrees item by item."""
+    the limits whose motors fk (same mode, default options) maps back to the orientation within 1e-9 rad."""
     ay, az = _orientation(kind, alpha, a, b, phi, log_small, sign, index)
+    geo = _geo(alpha)
     try:
-        q = at.ik(ay, az, alpha=alpha, mode=mode)
+        q = at.ik_joints(_u(ay, az), geometry=geo, mode=mode)
     except (UnreachableError, SingularityError):
-        q = None
-    qb, ok = at.ik(np.array([ay, ay]), np.array([az, az]), alpha=alpha, mode=mode, return_mask=True)
-    if q is None:
-        assert not ok.any() and np.isnan(qb).all()
         return
-    assert ok.all() and np.array_equal(qb[0], q)
     assert np.all(np.abs(q) <= math.pi)  # the URDF limits of every joint
-    y, z, _ = at.fk(q[0], q[4], q[8], alpha=alpha, mode=mode)
+    y, z = at.fk(q[MOTORS], geometry=geo, mode=mode)
     assert ct.pose_error(ay, az, y, z) <= CONTRACT_TOL
-    at.ik(y, z, alpha=alpha, mode=mode)  # and fk's answer is solved by ik (b)
+    at.ik(_u(y, z), geometry=geo, mode=mode)  # and fk's answer is solved by ik (b)
 
 
 finite = st.floats(allow_nan=False, allow_infinity=False)

@@ -19,9 +19,9 @@ from legkin import (
     SingularityError,
     UnreachableError,
 )
-from legkin.hybrid_leg import kinematics as ah
 from legkin.hybrid_leg import checks as ch
 from legkin.hybrid_leg import configuration as cfg
+from legkin.hybrid_leg import kinematics as ah
 from legkin.hybrid_leg.geometry import LL0, H
 
 DEG = math.pi / 180
@@ -398,7 +398,8 @@ def test_unreachable_foot():
     beyond = ah.foot_position_from_platform(0.0, -1.5, -0.2)
     with pytest.raises(UnreachableError, match="roll, pitch"):
         ah.ik(beyond, ll_branch=-1)
-    sol, ok = ah.ik(np.stack([ah.foot_position_from_platform(0.0, 0.0, -0.1), far, beyond]), ll_branch=-1, return_mask=True)
+    sol, ok = ah.ik(np.stack([ah.foot_position_from_platform(0.0, 0.0, -0.1), far, beyond]), ll_branch=-1,
+                    return_mask=True)
     assert ok.tolist() == [True, False, False]
     assert np.all(np.isnan(sol[1:])) and np.all(np.isfinite(sol[0]))
 
@@ -478,7 +479,8 @@ def test_fk_made_targets_are_solved():
     assert np.all(ah.assembly_mode(*ah.platform_orientation(sol[:, 0], sol[:, 1]).T) == 1)
 
 
-@pytest.mark.parametrize("tll", [ah.LL_DELTA - math.pi, ah.LL_DELTA, math.pi, -math.pi], ids=["outer", "inner", "+pi", "-pi"])
+@pytest.mark.parametrize("tll", [ah.LL_DELTA - math.pi, ah.LL_DELTA, math.pi, -math.pi],
+                         ids=["outer", "inner", "+pi", "-pi"])
 def test_reach_boundary_targets_made_by_fk_are_solved(tll):
     """Defect 2: 262 of 10,000 FK-made targets at the outer reach (3.14042 m) were rejected."""
     rng = np.random.default_rng(9)
@@ -638,7 +640,8 @@ _BAD_KEYWORDS = [
 ]
 
 
-@pytest.mark.parametrize("func, kwargs, name", _BAD_KEYWORDS, ids=[f"{f}-{n}-{i}" for i, (f, _, n) in enumerate(_BAD_KEYWORDS)])
+@pytest.mark.parametrize("func, kwargs, name", _BAD_KEYWORDS,
+                         ids=[f"{f}-{n}-{i}" for i, (f, _, n) in enumerate(_BAD_KEYWORDS)])
 def test_bad_keyword_arguments(func, kwargs, name):
     """Defect 3: every keyword validated, a legkin error naming it and its valid values (never a numpy error)."""
     with pytest.raises(InvalidParameterError) as info, warnings.catch_warnings():
@@ -841,3 +844,99 @@ def test_ik_contract_property(case):
         assert every.mask.any() and not every.within_limits.any()
     elif isinstance(err, UnreachableError):
         assert not every.valid.any()
+
+
+# ------------------------------------------------------------------------------------------ API 0.2 (issue 11)
+def test_geometry_defaults_range_and_from_params(robot):
+    assert ah.Geometry() == ah.Geometry("universal", 0.0) == ah.Geometry.from_params(robot.params)
+    assert ah.Geometry.from_params(None) == ah.Geometry()
+    shifted = legkin.load("hybrid_leg", starting_value=0.25, center="spherical")
+    assert ah.Geometry.from_params(shifted.params) == ah.Geometry(center="spherical", starting_value=0.25)
+    assert ah.Geometry.from_params({"starting_value": 0.1, "unrelated": 3}) == ah.Geometry(starting_value=0.1)
+    for bad in ({"starting_value": 3.5}, {"starting_value": float("nan")}, {"center": "ball"}):
+        with pytest.raises(InvalidParameterError, match=list(bad)[0]):
+            ah.Geometry(**bad)
+    with pytest.raises(InvalidParameterError, match="geometry"):
+        ah.ik(np.array([0.4, 0.0, -0.2]), geometry={"starting_value": 0.1})
+    # the universal-centre forward kinematics refuses the spherical centre (the motors do not fix the platform)
+    sph = ah.Geometry(center="spherical")
+    q = np.array([0.3, -0.3, 0.0])
+    for call in (lambda: ah.fk(q, geometry=sph), lambda: ah.jacobian(q, geometry=sph),
+                 lambda: ah.platform_orientation(0.3, -0.3, geometry=sph), lambda: ah.ik(ah.fk(q), geometry=sph)):
+        with pytest.raises(InvalidParameterError, match="universal centre"):
+            call()
+    # but the closed forms of a platform rotation hold for either centre
+    assert np.array_equal(ah.motor_angles_from_rotation(np.eye(3), geometry=sph), ah.motor_angles(0.0, 0.0))
+
+
+def test_starting_value_shifts_ll_only():
+    geo = ah.Geometry(starting_value=0.2)
+    q = np.array([*ah.motor_angles(0.1, 0.2), 3.0])
+    assert ah.ll_angle(3.0, geometry=geo) == pytest.approx(ah.ll_angle(3.0) + 0.2, abs=1e-16)
+    p = ah.fk(q, geometry=geo)
+    assert np.abs(p - ah.foot_position_from_platform(0.1, 0.2, ah.ll_angle(3.0, geometry=geo))).max() < 1e-12
+    sol = ah.ik(p, geometry=geo)
+    assert np.linalg.norm(ah.fk(sol, geometry=geo) - p) < 1e-12
+    assert not np.allclose(ah.fk(sol), p)
+
+
+def test_deprecated_names_warn_and_agree():
+    q = np.array([*ah.motor_angles(0.1, 0.2), 1.0])
+    p = ah.fk(q)
+    geo = ah.Geometry(starting_value=0.1)
+    with pytest.warns(DeprecationWarning, match="foot_position"):
+        assert np.array_equal(ah.foot_position(q[0], q[1], q[2]), p)
+    with pytest.warns(DeprecationWarning, match="starting_value"), pytest.warns(DeprecationWarning, match="foot_pos"):
+        assert np.array_equal(ah.foot_position(q[0], q[1], q[2], starting_value=0.1), ah.fk(q, geometry=geo))
+    with pytest.warns(DeprecationWarning, match="foot_jacobian"):
+        assert np.array_equal(ah.foot_jacobian(*q), ah.jacobian(q))
+    with pytest.warns(DeprecationWarning, match="foot_ik"):
+        assert np.array_equal(ah.foot_ik(p), ah.ik(p))
+    with pytest.warns(DeprecationWarning, match="foot_ik"):
+        allb, ok = ah.foot_ik(p, all_branches=True, return_mask=True)
+    every = ah.ik_all(p)
+    assert np.array_equal(allb, every.motors, equal_nan=True) and np.array_equal(ok, every.mask)
+    with pytest.warns(DeprecationWarning, match="foot_ik_solutions"):
+        old = ah.foot_ik_solutions(p)
+    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(old, every))
+    with pytest.warns(DeprecationWarning, match="starting_value"):
+        assert ah.ll_angle(1.0, 0.1) == ah.ll_angle(1.0, geometry=geo)
+    with pytest.warns(DeprecationWarning, match="starting_value"):
+        assert ah.extension_motor_angle(0.0, 0.1) == ah.extension_motor_angle(0.0, geometry=geo)
+    with pytest.warns(DeprecationWarning, match="guess"):
+        assert np.array_equal(ah.platform_orientation(q[0], q[1], guess=[0.0, 0.0]),
+                              ah.platform_orientation(q[0], q[1], q_start=[0.0, 0.0]))
+    with pytest.warns(DeprecationWarning, match="legkin.analytic.hybrid_leg"):
+        import importlib
+        import sys
+
+        sys.modules.pop("legkin.analytic.hybrid_leg", None)
+        shim = importlib.import_module("legkin.analytic.hybrid_leg")
+    assert shim.fk is ah.fk and shim.foot_ik is ah.foot_ik
+
+
+def test_new_api_does_not_warn():
+    q = np.array([*ah.motor_angles(0.1, 0.2), 1.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        p = ah.fk(q)
+        ah.jacobian(q[None])
+        ah.ik(p, q_near=q)
+        ah.ik_all(p)
+        ah.platform_orientation(q[0], q[1], q_start=[0.0, 0.0])
+        ah.ll_angle(np.zeros(2), geometry=ah.Geometry())
+
+
+def test_q_near_picks_the_nearest_valid_branch():
+    """Of the candidates the default IK keeps (in the mode, in the limits), q_near selects the nearest in the joints."""
+    p = ah.fk(np.array([*ah.motor_angles(0.1, 0.2), 1.0]))  # both LL sides reach it in the mode, in the limits
+    every = ah.ik_all(p)
+    keep = every.valid & (every.assembly == 1) & np.array([b[2:] == (1, 1) for b in ah.FOOT_IK_BRANCHES])
+    assert keep.sum() >= 2
+    first = ah.ik(p)
+    assert np.array_equal(first, every.motors[keep][0]) or np.array_equal(first, every.motors[keep][1])
+    for target in every.motors[keep]:
+        got = ah.ik(p, q_near=target + 1e-3)
+        assert np.array_equal(got, target)
+    both = ah.ik(np.stack([p, p]), q_near=every.motors[keep][:2])
+    assert np.array_equal(both, every.motors[keep][:2])

@@ -1,10 +1,9 @@
 """The 2-RSS hybrid leg with an extension joint (seed 003).
 
-The package is the mechanism: its registry entry (``spec``), its kinematics (re-exported here, imported on first use so that
-``import legkin`` stays light), its
-checks against Pinocchio (``checks``), bench (``bench``), figures (``figures``) and clips (``clips``); its
-geometry (``geometry.Geometry``), configurations and samplers (``configuration``) and its kinematic contract
-(``contract``).
+The package is the mechanism: its registry entry (``spec``), its kinematics (re-exported here, imported on first use
+so that ``import legkin`` stays light), its checks against Pinocchio (``checks``), bench (``bench``), figures
+(``figures``) and clips (``clips``); its geometry (``geometry.Geometry``), configurations and samplers
+(``configuration``) and its kinematic contract (``contract``).
 """
 
 from __future__ import annotations
@@ -12,10 +11,10 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-from .spec import SPEC
+from .spec import SPEC as SPEC
 
 if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they load on first use
-    from . import kinematics
+    from . import kinematics as kinematics
     from .kinematics import *  # noqa: F403
 
 _SUBMODULES = ("kinematics", "geometry", "configuration", "contract", "checks", "bench", "figures", "clips")

@@ -12,7 +12,7 @@ from ._ik_kernels import ik_all_k, platform_pose_k
 from ._options import fmt, mode_text, unreachable
 from .chains import chains_k, rot_k
 from .foot import band_message
-from .geometry import CENTER, FK_GAIN_MAX, FOOT_IK_BRANCHES, FOOT_IK_ORDER, H, K_TOL, LL0, LL_TOL, MOTOR_BRANCHES
+from .geometry import CENTER, FK_GAIN_MAX, FOOT_IK_BRANCHES, FOOT_IK_ORDER, K_TOL, LL0, LL_TOL, MOTOR_BRANCHES, H
 
 #: The 16 branches in the order the errors report them (FOOT_IK_ORDER x MOTOR_BRANCHES), as indices of
 #: FOOT_IK_BRANCHES.
@@ -111,8 +111,9 @@ def ik_error(p: np.ndarray, sv: float, combos: list, b: np.ndarray, s: float, li
         c = inl[0]
         return AssemblyModeError(
             f"foot target {fmt(p)} needs (roll, pitch) = ({c['pose'][1]:.6g}, {c['pose'][2]:.6g}) (branch "
-            f"({int(c['b'][0])}, {int(c['b'][1])})), a pose the forward kinematics of its motor angles does not return "
-            f"(another pose of the same mode is nearer R_P = I, or it is in the forward-singularity band); asked: {asked}",
+            f"({int(c['b'][0])}, {int(c['b'][1])})), a pose the forward kinematics of its motor angles does not "
+            "return (another pose of the same mode is nearer R_P = I, or it is in the forward-singularity band); "
+            f"asked: {asked}",
             target=p, modes=[],
         )
     out = [c for c in cands if c["exists"]]

@@ -18,11 +18,23 @@ from .._rotations import wrap_k
 from ._options import ST_ASSEMBLE, ST_INPUT, ST_REACH
 from .chains import OX, OZ, chain_k, ref_of, rod_system_k, rot_k, sgn_k, tips_k
 from .extension import theta0_k
-from .forward import fk_select_k
 from .foot import gain_k
+from .forward import fk_select_k
 from .geometry import (
-    CLIP_FOOT_TOL, FK_GAIN_MAX, FOOT_IK_BRANCHES, FOOT_X, H, IK_K_TOL, LIMIT_TOL, LL0, LL_DELTA, LL_TOL,
-    PITCH_SPLIT, PLATFORM_LIMIT, RATIO, RHO_TOL,
+    CLIP_FOOT_TOL,
+    FK_GAIN_MAX,
+    FOOT_IK_BRANCHES,
+    FOOT_X,
+    IK_K_TOL,
+    LIMIT_TOL,
+    LL0,
+    LL_DELTA,
+    LL_TOL,
+    PITCH_SPLIT,
+    PLATFORM_LIMIT,
+    RATIO,
+    RHO_TOL,
+    H,
 )
 
 #: FOOT_IK_BRANCHES as a (16, 4) float array (ll_branch, roll_branch, b1, b2), for the kernels.

@@ -180,7 +180,7 @@ def unreachable(what: str, k: np.ndarray) -> UnreachableError:
     )
 
 
-def fmt(p: object) -> str:
+def fmt(p: np.ndarray) -> str:
     return "[" + ", ".join(f"{float(v):.17g}" for v in np.ravel(p)) + "]"
 
 

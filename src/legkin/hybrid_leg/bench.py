@@ -12,12 +12,12 @@ from __future__ import annotations
 import numpy as np
 
 from .. import load
-from . import kinematics as ah
-from ..bench import Method, MethodResult, ModelBench, Score
-from .configuration import LL_RANGE, closed_configuration, sample_workspace
-from ..errors import LegkinError
 from .._benchkit import SOLVE_TOL, levenberg_marquardt, pinocchio_positions, sizes
 from .._single_call import SingleCall
+from ..bench import Method, MethodResult, ModelBench, Score
+from ..errors import LegkinError
+from . import kinematics as ah
+from .configuration import LL_RANGE, closed_configuration, sample_workspace
 
 TOL = 1e-12
 MAX_ITER = 100

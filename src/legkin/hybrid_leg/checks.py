@@ -3,17 +3,22 @@
 from __future__ import annotations
 
 import numpy as np
-import pinocchio as pin
 
 from .. import load
 from .._rotations import rot_x, rot_y, rot_z
-from . import kinematics as ah
-from .geometry import LL0, H
 from ..validation import CheckResult, compare, per_sample, pinocchio_frames
+from . import kinematics as ah
 from .configuration import (
-    ACTUATED, LL_RANGE, PASSIVE_U, SIGMA_MIN, closed_configuration, sample_near_forward_singularity, sample_workspace,
+    ACTUATED,
+    LL_RANGE,
+    PASSIVE_U,
+    SIGMA_MIN,
+    closed_configuration,
+    sample_near_forward_singularity,
+    sample_workspace,
 )
 from .configuration import sigma_min as _sigma_min
+from .geometry import LL0, H
 
 TOL = 1e-12
 #: Samples for the iterative Pinocchio loop solver and the mobility SVDs (costly per sample).
@@ -148,7 +153,7 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
 
     # -- foot position (Newton FK + eq 19 + eqs 17-20) vs Pinocchio FCS
     pos = pinocchio_frames(robot, qs, ["FCS"])[0][:, 0]
-    theta0 = ah.extension_motor_angle(tll)
+    theta0 = np.asarray(ah.extension_motor_angle(tll))
     rows.append(compare("foot_position_from_platform vs Pinocchio FCS (m)",
                         per_sample(ah.foot_position_from_platform(roll, pitch, tll) - pos), TOL))
     rows.append(compare("fk(theta1, theta2, theta0) vs Pinocchio FCS (m)",
@@ -230,7 +235,8 @@ def _mobility_rows(robot, roll, pitch, rng) -> list[CheckResult]:
     ok = ah.motor_angles_from_rotation(rot, return_mask=True)[1]
     ang, rot = ang[ok], rot[ok]
     qs = closed_configuration(sph, ang, np.zeros(len(ang)))
-    rows.append(compare("spherical: motor_angles_from_rotation -> Pinocchio loop residual (m)", _residuals(sph, qs), TOL))
+    rows.append(compare("spherical: motor_angles_from_rotation -> Pinocchio loop residual (m)", _residuals(sph, qs),
+                        TOL))
     mob = np.array([sph.mobility(q, locked=ACTUATED) for q in qs])
     meas = [platform_dof(sph, q) for q in qs]
     dof = np.array([m[0] for m in meas])

@@ -13,8 +13,23 @@ from .._batch import as_angles, as_input, finish
 from .._kernels import OK, batch_kernel, kernel, prange
 from ..errors import ConvergenceError, SingularityError
 from ._options import (
-    SCALARS, ST_ASSEMBLE, ST_BAND, ST_INPUT, ST_SINGULAR, UNSET, Unset, check_assembly, check_branch, deprecated,
-    fast_branch, fast_geometry, fast_sign, flag, flat, loop, resolve,
+    SCALARS,
+    ST_ASSEMBLE,
+    ST_BAND,
+    ST_INPUT,
+    ST_SINGULAR,
+    UNSET,
+    Unset,
+    check_assembly,
+    check_branch,
+    deprecated,
+    fast_branch,
+    fast_geometry,
+    fast_sign,
+    flag,
+    flat,
+    loop,
+    resolve,
 )
 from .chains import CX, CY, CZ, OX, OZ, rod_rates_k, tips_k
 from .extension import ll_k

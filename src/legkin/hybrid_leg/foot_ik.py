@@ -14,8 +14,19 @@ from ..errors import InvalidInputError, UnreachableError
 from ._ik_errors import arc_error, axis_error, ik_error, platform_pose
 from ._ik_kernels import foot_ik_b, foot_ik_k, foot_ik_s, ik_all_b, ik_all_s, platform_pose_b, platform_pose_s
 from ._options import (
-    UNSET, Unset, check_assembly, check_branch, check_sign, deprecated, fast_branch, fast_geometry, fast_sign, flag,
-    fmt, loop, resolve,
+    UNSET,
+    Unset,
+    check_assembly,
+    check_branch,
+    check_sign,
+    deprecated,
+    fast_branch,
+    fast_geometry,
+    fast_sign,
+    flag,
+    fmt,
+    loop,
+    resolve,
 )
 from .chains import CX, CY, CZ
 from .geometry import CENTER, FK_GAIN_MAX, FOOT_IK_ORDER, Geometry
@@ -40,7 +51,8 @@ def _search(u: np.ndarray, sv: float, combos: list, b: np.ndarray, s: float, lim
     nr = np.broadcast_to(_NO_NEAR, (n, 3)) if near is None else near
     loop(foot_ik_b, foot_ik_s, n)(np.ascontiguousarray(u, dtype=np.float64), float(sv),
                                   np.array(combos, dtype=np.float64).reshape(-1, 2), float(b[0]), float(b[1]),
-                                  float(s), bool(limits_only), bool(axis_ok), np.ascontiguousarray(nr), motors, pose, ok)
+                                  float(s), bool(limits_only), bool(axis_ok), np.ascontiguousarray(nr), motors, pose,
+                                  ok)
     return motors, pose, ok
 
 

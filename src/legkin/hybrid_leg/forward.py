@@ -14,8 +14,23 @@ from .._kernels import OK, batch_kernel, kernel, prange
 from .._rotations import wrap_k
 from ..errors import ConvergenceError, InvalidInputError
 from ._options import (
-    SCALARS, ST_ASSEMBLE, ST_INPUT, UNSET, Unset, check_assembly, check_branch, count, deprecated, fast_branch,
-    fast_sign, flag, flat, loop, mode_text, real, resolve,
+    SCALARS,
+    ST_ASSEMBLE,
+    ST_INPUT,
+    UNSET,
+    Unset,
+    check_assembly,
+    check_branch,
+    count,
+    deprecated,
+    fast_branch,
+    fast_sign,
+    flag,
+    flat,
+    loop,
+    mode_text,
+    real,
+    resolve,
 )
 from .chains import chains_k, ref_of, rot_k, tips_k
 from .geometry import K_TOL, Geometry
@@ -298,8 +313,6 @@ def platform_orientation(
     else:
         b1, b2, ss = np.full(n, b[0]), np.full(n, b[1]), np.full(n, s)
         loop(_fk_select_b, _fk_select_s, n)(flat(t1), flat(t2), b1, b2, ss, tol, max_iter, x, ok)
-    x = np.where(ok[:, None], x, np.nan).reshape(shape + (2,))
-    ok = ok.reshape(shape)
     guessed = q_start is not None
-    return finish(x, ok, t1.ndim == 0, return_mask,
+    return finish(np.where(ok[:, None], x, np.nan).reshape(shape + (2,)), ok.reshape(shape), t1.ndim == 0, return_mask,
                   lambda: ConvergenceError(fk_failure(float(t1), float(t2), b, s, guessed)))

@@ -42,7 +42,8 @@ CENTER = np.array([0.265, 0.0, 0.014])
 #: (atan2(0.0549998406976098, 0.139807669447128)); eqs 5 and 12 print its cosine/sine rounded to 4 digits.
 BETA = math.radians(21.4745)
 #: Motor base origins in CCS (eqs 5, 12), chain 1 then chain 2.
-MOTOR_POS = np.array([[0.139807669447128, 0.0549998406976098, -0.051], [0.139807669447128, -0.0549998406976098, -0.051]])
+MOTOR_POS = np.array([[0.139807669447128, 0.0549998406976098, -0.051],
+                      [0.139807669447128, -0.0549998406976098, -0.051]])
 #: Base yaw of each motor: Rz(+BETA) for MCS1, Rz(-BETA) for MCS2.
 MOTOR_YAW = np.array([BETA, -BETA])
 #: Lever from the motor axis to the first spherical joint, in the motor frame (eqs 7, 14).

@@ -18,11 +18,38 @@ from .._batch import as_angles, as_input, finish
 from .._kernels import OK, batch_kernel, kernel, prange
 from ..errors import InvalidInputError, SingularityError
 from ._options import (
-    SCALARS, ST_INPUT, ST_REACH, ST_SINGULAR, fast_branch, flag, flat, loop, resolve, unreachable, check_branch,
+    SCALARS,
+    ST_INPUT,
+    ST_REACH,
+    ST_SINGULAR,
+    check_branch,
+    fast_branch,
+    flag,
+    flat,
+    loop,
+    resolve,
+    unreachable,
 )
 from .chains import (
-    AX0, AX1, AY0, AY1, AZ0, AZ1, CX, CY, CZ, L, chains_k, is_rotation_k, motor_angles_k, ref_of, rod_rates_k,
-    rot_k, rotation_error_k, sgn_k, tips_k,
+    AX0,
+    AX1,
+    AY0,
+    AY1,
+    AZ0,
+    AZ1,
+    CX,
+    CY,
+    CZ,
+    L,
+    chains_k,
+    is_rotation_k,
+    motor_angles_k,
+    ref_of,
+    rod_rates_k,
+    rot_k,
+    rotation_error_k,
+    sgn_k,
+    tips_k,
 )
 from .geometry import BETA, K_TOL, Geometry
 
@@ -261,7 +288,7 @@ def rod_spans(theta1: ArrayLike, theta2: ArrayLike, roll: ArrayLike = 0.0, pitch
     eqs 9, 16. At zero motors and R_P = I the span is 0.0839 m, not 0.11: that pose does not close.
     """
     if (type(theta1) in SCALARS and type(theta2) in SCALARS and type(roll) in SCALARS and type(pitch) in SCALARS
-            and geometry is None and math.isfinite(theta1 + theta2 + roll + pitch)):  # type: ignore[operator]
+            and geometry is None and math.isfinite(theta1 + theta2 + roll + pitch)):  # type: ignore[operator, arg-type]
         out = np.empty(2)
         spans_k(theta1, theta2, roll, pitch, out)
         return out
@@ -302,8 +329,8 @@ def motor_angles(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *, 
     n = r.size
     theta, k, ok = np.empty((n, 2)), np.empty((n, 2)), np.empty(n, dtype=np.bool_)
     loop(_motor_angles_b, _motor_angles_s, n)(flat(r), flat(p), float(b[0]), float(b[1]), theta, k, ok)
-    theta, k, ok = theta.reshape(r.shape + (2,)), k.reshape(r.shape + (2,)), ok.reshape(r.shape)
-    return finish(theta, ok, r.ndim == 0, return_mask, lambda: unreachable(_pose_text(r, p), k))
+    return finish(theta.reshape(r.shape + (2,)), ok.reshape(r.shape), r.ndim == 0, return_mask,
+                  lambda: unreachable(_pose_text(r, p), k[0]))
 
 
 def _rotation_call(kernels: tuple[Callable[..., object], Callable[..., object]], core: tuple[int, ...],

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import numpy as np
 
-from . import kinematics as ah
 from ..figures import new_figure
+from . import kinematics as ah
 
 
 def figures(outdir: Path) -> list[Path]:

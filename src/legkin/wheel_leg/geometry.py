@@ -53,6 +53,11 @@ class Geometry:
 
         for f in fields(self):
             object.__setattr__(self, f.name, float(SPEC.params[f.name].check(f.name, getattr(self, f.name))))
+        # the kernels' constants are cached per geometry: hash once (a dataclass hashes its fields every time)
+        object.__setattr__(self, "_hash", hash(tuple(getattr(self, f.name) for f in fields(self))))
+
+    def __hash__(self) -> int:
+        return self._hash  # type: ignore[attr-defined, no-any-return]
 
     @classmethod
     def from_params(cls, params: Mapping[str, object] | None) -> "Geometry":

@@ -34,7 +34,7 @@ def _replace_section(text: str, name: str, body: str) -> str:
 
 def model_table() -> str:
     lines = ["| name | DOF | loops | actuated joints | source seed |", "| --- | --- | --- | --- | --- |"]
-    for name in legkin.list_models():
+    for name in legkin.list_models("legkin"):
         spec = get_spec(name)
         robot = legkin.load(name)
         mobility = robot.mobility(robot.q0)
@@ -52,12 +52,12 @@ def pictures() -> str:
     IMG.mkdir(parents=True, exist_ok=True)
     cells = []
     with tempfile.TemporaryDirectory() as tmp:
-        for name in legkin.list_models():
+        for name in legkin.list_models("legkin"):
             robot = legkin.load(name)
             page = write_html(robot, robot.q0, Path(tmp) / f"{name}.html")
             screenshot(page, IMG / f"{name}.png", size=(480, 360))
             cells.append(f'<img src="docs/img/{name}.png" width="240" alt="{name}"/>')
-    names = " | ".join(f"`{n}`" for n in legkin.list_models())
+    names = " | ".join(f"`{n}`" for n in legkin.list_models("legkin"))
     return f"| {names} |\n|{' --- |' * len(cells)}\n| {' | '.join(cells)} |\n"
 
 

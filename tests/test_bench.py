@@ -63,7 +63,7 @@ def test_quick_quadruped_cli_and_json(tmp_path, capsys):
 def test_quick_all_models_covers_the_registry(tmp_path):
     code, doc = _run(tmp_path)
     assert code == 0
-    assert set(doc["models"]) | set(doc["skipped"]) == set(legkin.list_models())
+    assert set(doc["models"]) | set(doc["skipped"]) == set(legkin.list_models("legkin"))
     for name in doc["models"]:
         _check_schema(doc, name)
 
@@ -136,7 +136,7 @@ def test_run_model_statistics_and_ratio():
 
 # ------------------------------------------------------------------------------------------- single calls
 def _bench_modules():
-    return {name: bench._load_bench_module(name) for name in legkin.list_models()}
+    return {name: bench._load_bench_module(name) for name in legkin.list_models("legkin")}
 
 
 def test_single_call_entries_run_and_name_known_yardsticks():
@@ -156,7 +156,7 @@ def test_single_call_entries_run_and_name_known_yardsticks():
 def test_yardstick_calls_every_key_every_model():
     from legkin._single_call import YARDSTICKS
 
-    for name in legkin.list_models():
+    for name in legkin.list_models("legkin"):
         calls = bench.yardstick_calls(name, list(YARDSTICKS))
         assert set(calls) == set(YARDSTICKS)
         for call, label in calls.values():

@@ -30,7 +30,7 @@ def _contract(model: str) -> Contract:
 
 def _cases() -> list:
     out = []
-    for model in legkin.list_models():
+    for model in legkin.list_models("legkin"):
         try:
             cases = importlib.import_module(f"legkin.{model}.contract").contract().cases
         except ModuleNotFoundError:
@@ -42,7 +42,7 @@ def _cases() -> list:
 CASES = _cases()
 
 
-@pytest.mark.parametrize("model", legkin.list_models())
+@pytest.mark.parametrize("model", legkin.list_models("legkin"))
 def test_every_mechanism_signs_the_contract(model):
     _contract(model)
 
@@ -134,7 +134,7 @@ def test_bad_inputs_raise_invalid_input(model, case, which):
         assert str(exc.value), label
 
 
-@pytest.mark.parametrize("model", legkin.list_models())
+@pytest.mark.parametrize("model", legkin.list_models("legkin"))
 def test_check_rows_pass_and_include_a_jacobian_against_pinocchio(model):
     checks = importlib.import_module(f"legkin.{model}.checks")
     rows = checks.run(100, np.random.default_rng(0))

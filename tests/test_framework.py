@@ -12,15 +12,15 @@ import pytest
 import legkin
 from legkin import _generate
 from legkin.__main__ import main
-from legkin._registry import MODELS, get_spec
+from legkin._registry import get_spec
 
 ROOT = Path(__file__).resolve().parents[1]
-MODEL_NAMES = sorted(MODELS)
+MODEL_NAMES = legkin.list_models("legkin")
 
 
 def test_list_models_matches_xacro_sources():
     sources = sorted(p.name[: -len(".urdf.xacro")] for p in (ROOT / "xacro").glob("*.urdf.xacro"))
-    assert legkin.list_models() == sources
+    assert legkin.list_models("legkin") == sources
 
 
 def test_unknown_model_lists_known_names():
@@ -372,3 +372,29 @@ def test_no_foreign_exception_from_robot_methods(tripod):
             call()
         except legkin.LegkinError:
             pass
+
+
+# ---------------------------------------------------------------------- external robots (legkin.legs)
+def test_the_nine_example_robot_data_quadrupeds_are_registered_and_load():
+    from legkin.legs import ERD_ROBOTS
+
+    assert legkin.list_models("example-robot-data") == sorted(ERD_ROBOTS)
+    assert len(ERD_ROBOTS) == 9
+    assert set(legkin.list_models()) == set(ERD_ROBOTS) | set(legkin.list_models("legkin"))
+    with pytest.raises(legkin.InvalidParameterError, match="source"):
+        legkin.list_models("ros")
+    for name in ERD_ROBOTS:
+        robot = legkin.load(name)
+        assert robot.model.nq == 12 and len(robot.actuated_joints) == 12, name
+        assert "site-packages" in str(robot.urdf_path) or "dist-packages" in str(robot.urdf_path), robot.urdf_path
+        legs = robot.geometry  # the legs measured from the model
+        assert len(legs) == 4, (name, list(legs))
+        floating = legkin.load(name, floating=True)
+        assert floating.model.nq == 19 and floating.q0.shape == (19,)
+
+
+def test_generate_refuses_an_external_robot():
+    from legkin._generate import check_all
+
+    with pytest.raises(legkin.LegkinError, match="example-robot-data"):
+        check_all(["go2"])

@@ -8,7 +8,6 @@ import pytest
 import legkin
 from legkin import clips as animations
 from legkin.__main__ import main
-from legkin._registry import MODELS
 
 
 def test_check_plots_written(tmp_path):
@@ -24,7 +23,7 @@ def test_check_plots_written(tmp_path):
         assert img.std() > 5, p
 
 
-@pytest.mark.parametrize("name", sorted(MODELS))
+@pytest.mark.parametrize("name", legkin.list_models("legkin"))
 def test_animation_clips_are_valid_configurations(name):
     robot = legkin.load(name)
     for clip in animations.available(name):

@@ -10,7 +10,6 @@ import pytest
 from conftest import shot
 
 import legkin
-from legkin._registry import MODELS
 from legkin.viewer import chromium_path, write_html
 
 CHROMIUM = chromium_path()
@@ -29,7 +28,7 @@ def assert_shows_something(img: np.ndarray, empty: np.ndarray) -> None:
 
 
 @needs_chromium
-@pytest.mark.parametrize("name", sorted(MODELS))
+@pytest.mark.parametrize("name", [*legkin.list_models("legkin"), "go2"])
 def test_model_page_renders(name, tmp_path, empty_scene):
     robot = legkin.load(name)
     page = write_html(robot, robot.q0, tmp_path / f"{name}.html")

@@ -115,7 +115,8 @@ def _cmd_list(args) -> int:
 
     for name in sorted(MODELS):
         spec = MODELS[name]
-        print(f"{name:<12} seed {spec.seed:<10} {spec.title}")
+        origin = f"from {spec.source}" if spec.external else f"seed {spec.seed}"
+        print(f"{name:<12} {origin:<24} {spec.title}")
     return 0
 
 

@@ -10,7 +10,7 @@ import re
 from pathlib import Path
 from typing import Mapping
 
-from ._registry import MODELS, ModelSpec, get_spec
+from ._registry import ModelSpec, get_spec, list_models
 from .errors import LegkinError
 
 __all__ = ["root_dir", "installed_from_source", "render", "generate_all", "check_all", "model_files", "GeneratedFiles"]
@@ -109,8 +109,8 @@ def generate_all(names: list[str] | None = None, out_dir: str | Path | None = No
         if base.exists() and not base.is_dir():
             raise LegkinError(f"--out {str(base)!r} exists and is not a directory")
     out = []
-    for name in names or sorted(MODELS):
-        spec = get_spec(name)
+    for name in names or list_models("legkin"):
+        spec = _generated_spec(name)
         try:
             out += _write(base, render(spec, _default_args(spec)))
         except OSError as exc:
@@ -118,11 +118,19 @@ def generate_all(names: list[str] | None = None, out_dir: str | Path | None = No
     return out
 
 
+def _generated_spec(name: str) -> ModelSpec:
+    """The registry entry of a model legkin generates (an external robot's URDF is its distribution's)."""
+    spec = get_spec(name)
+    if spec.external:
+        raise LegkinError(f"model {name!r} comes from {spec.source}: legkin does not generate its URDF")
+    return spec
+
+
 def check_all(names: list[str] | None = None) -> list[str]:
     """Relative paths of committed files that differ from (or are missing for) what xacro produces."""
     stale = []
-    for name in names or sorted(MODELS):
-        spec = get_spec(name)
+    for name in names or list_models("legkin"):
+        spec = _generated_spec(name)
         for rel, content in render(spec, _default_args(spec)).items():
             path = root_dir() / "urdf" / rel
             if not path.exists() or path.read_bytes() != content:

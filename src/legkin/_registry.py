@@ -75,6 +75,8 @@ class ModelSpec:
         actuated_joints: names of the actuated joints.
         floating: whether ``load(..., floating=True)`` makes sense (a walking robot).
         reference_pose: the SRDF pose used as ``Robot.q0``.
+        source: ``"legkin"`` (the model is generated from ``xacro/``) or the distribution whose installed URDF
+            it is (``"example-robot-data"``: the nine quadrupeds whose leg IK :mod:`legkin.legs` derives).
 
     The mechanism itself is the package ``legkin.<name>`` (:attr:`package`), found by one rule: every
     sub-package of :mod:`legkin` with a ``spec`` module defining ``SPEC``. Its modules are found by name:
@@ -90,11 +92,17 @@ class ModelSpec:
     actuated_joints: tuple[str, ...] = ()
     floating: bool = False
     reference_pose: str = "standing"
+    source: str = "legkin"
+
+    @property
+    def external(self) -> bool:
+        """A robot whose URDF comes from another distribution (example-robot-data), not from legkin's xacro."""
+        return self.source != "legkin"
 
     @property
     def package(self) -> str:
-        """Dotted name of the mechanism's package."""
-        return f"legkin.{self.name}"
+        """Dotted name of the mechanism's package (``legkin.legs`` for the external quadrupeds)."""
+        return "legkin.legs" if self.external else f"legkin.{self.name}"
 
     @property
     def xacro_file(self) -> str:
@@ -132,7 +140,24 @@ def _discover() -> dict[str, ModelSpec]:
     return found
 
 
-MODELS: Mapping[str, ModelSpec] = _discover()
+def _external() -> dict[str, ModelSpec]:
+    """The quadrupeds of example-robot-data (:data:`legkin.legs.ERD_ROBOTS`; their files are found when loaded)."""
+    from .legs.erd import ERD_ROBOTS
+
+    return {
+        r.name: ModelSpec(
+            name=r.name,
+            title=f"{r.title}: closed-form leg IK measured from its URDF (legkin.legs)",
+            seed="",
+            floating=True,
+            reference_pose=r.reference_pose or "",
+            source="example-robot-data",
+        )
+        for r in ERD_ROBOTS.values()
+    }
+
+
+MODELS: Mapping[str, ModelSpec] = {**_discover(), **_external()}
 
 
 def get_spec(name: str) -> ModelSpec:
@@ -149,6 +174,17 @@ def get_spec(name: str) -> ModelSpec:
         ) from None
 
 
-def list_models() -> list[str]:
-    """Names of the registered models, sorted."""
-    return sorted(MODELS)
+def list_models(source: str | None = None) -> list[str]:
+    """Names of the registered models, sorted.
+
+    Args:
+        source: only the models of this source: ``"legkin"`` (the mechanisms generated from legkin's xacro,
+            with their analytic kinematics) or ``"example-robot-data"`` (the external quadrupeds of
+            :mod:`legkin.legs`); None (default): all.
+    """
+    if source is None:
+        return sorted(MODELS)
+    sources = sorted({s.source for s in MODELS.values()})
+    if source not in sources:
+        raise InvalidParameterError(f"source={source!r} is not valid: must be one of {', '.join(map(repr, sources))}")
+    return sorted(n for n, s in MODELS.items() if s.source == source)

@@ -320,7 +320,7 @@ def run_bench(
         ``{"models": {name: (ModelBench, [MethodResult])}, "single": {name: single_call_table(...)},
         "skipped": {name: reason}}``.
     """
-    names = models or list_models()
+    names = models or list_models("legkin")
     for name in names:
         get_spec(name)  # unknown names raise UnknownModelError
     out: dict = {"models": {}, "single": {}, "skipped": {}}

@@ -69,13 +69,18 @@ class Robot:
         self.name = name
         self.params = dict(params)
         self.floating = floating
-        self.urdf_path, self.srdf_path = model_files(spec, self.params)
+        if spec.external:
+            from .legs.erd import erd_files
+
+            self.urdf_path, self.srdf_path, pkg = erd_files(name)
+        else:
+            self.urdf_path, self.srdf_path = model_files(spec, self.params)
+            pkg = [str(self.urdf_path.parent)]
         if floating:
             self.model = pin.buildModelFromUrdf(str(self.urdf_path), pin.JointModelFreeFlyer())
         else:
             self.model = pin.buildModelFromUrdf(str(self.urdf_path))
         self.data = self.model.createData()
-        pkg = [str(self.urdf_path.parent)]
         self.visual_model = pin.buildGeomFromUrdf(self.model, str(self.urdf_path), pin.VISUAL, package_dirs=pkg)
         self.collision_model = pin.buildGeomFromUrdf(
             self.model, str(self.urdf_path), pin.COLLISION, package_dirs=pkg
@@ -87,6 +92,10 @@ class Robot:
         for j in spec.actuated_joints:
             self.joint_id(j)  # raises if the URDF and the registry disagree
         self.actuated_joints = spec.actuated_joints
+        if spec.external:  # an open tree: every one-coordinate joint is driven
+            self.actuated_joints = tuple(
+                n for n, j in zip(self.model.names[1:], self.model.joints[1:]) if j.nq == 1 and j.nv == 1
+            )
         if self.srdf_path is not None:
             pin.loadReferenceConfigurations(self.model, str(self.srdf_path), False)
         self.poses = {e.key(): np.array(e.data()) for e in self.model.referenceConfigurations}
@@ -99,7 +108,13 @@ class Robot:
 
     @property
     def geometry(self) -> Any:
-        """``legkin.<name>.Geometry.from_params(self.params)``: the geometry this model was generated with."""
+        """``legkin.<name>.Geometry.from_params(self.params)``: the geometry this model was generated with.
+
+        For an external quadruped (example-robot-data), the legs measured from its model:
+        ``legkin.legs.from_model(self.model)``, a dict ``{leg name: Leg}``.
+        """
+        if self.spec.external:
+            return self.kinematics.from_model(self.model)
         return self.kinematics.Geometry.from_params(self.params)
 
     def __repr__(self) -> str:

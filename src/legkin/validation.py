@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import contextlib
+import functools
 import importlib
 import json
 import sys
 import time
+import types
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -105,6 +108,15 @@ def progress_bar(total: int, desc: str, enabled: bool = True):
         bar.close()
 
 
+def _checks_module(spec) -> Any:
+    """The module whose ``run(samples, rng)`` checks ``spec``: ``legkin.<name>.checks``, or for an external
+    quadruped :mod:`legkin.legs.checks` bound to its name."""
+    module = importlib.import_module(f"{spec.package}.checks")
+    if spec.external:
+        return types.SimpleNamespace(run=functools.partial(module.run, spec.name))
+    return module
+
+
 def run_checks(
     models: list[str] | None = None,
     samples: int = 10_000,
@@ -123,7 +135,7 @@ def run_checks(
     """
     names = list(models or list_models())
     specs = [get_spec(name) for name in names]  # every unknown name raises before any work
-    modules = [importlib.import_module(f"{spec.package}.checks") for spec in specs]
+    modules = [_checks_module(spec) for spec in specs]
     steps = sum(2 if hasattr(m, "ik_robustness") else 1 for m in modules)
     out = {}
     with progress_bar(steps, "legkin check", enabled=progress) as bar:
@@ -148,8 +160,8 @@ def _mujoco_rows(name: str, samples: int, seed: int) -> list[CheckResult]:
     says so: :func:`mujoco_note`). At most 20 samples: each is a loop solve, the simulation rows need no more."""
     from .mjcf import check_rows, unavailable_reason
 
-    if unavailable_reason() is not None:
-        return []
+    if get_spec(name).external or unavailable_reason() is not None:
+        return []  # the export covers legkin's own models (their loops); the external robots have .dae meshes
     return list(check_rows(name, samples=min(samples, 20), rng=np.random.default_rng(seed + 2)))
 
 

@@ -10,10 +10,22 @@ legs in a Pinocchio model), :mod:`.erd` (the nine quadrupeds of example-robot-da
 :mod:`.checks` (rows of ``legkin check``), :mod:`.bench`.
 """
 
-from .erd import ERD_ROBOTS, ErdRobot, erd_files, external_models, load_erd, reference_configuration
-from .extract import find_chains, from_model, from_urdf
-from .kinematics import BRANCHES, Leg, LegStructureError
-from .registry import erd_spec
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # at run time the names load on first use: `import legkin` (its registry) imports no numba
+    from .erd import ERD_ROBOTS, ErdRobot, erd_files, external_models, load_erd, reference_configuration
+    from .extract import find_chains, from_model, from_urdf
+    from .kinematics import BRANCHES, Leg, LegStructureError
+    from .registry import erd_spec
+
+_WHERE = {
+    "ERD_ROBOTS": "erd", "ErdRobot": "erd", "erd_files": "erd", "external_models": "erd", "load_erd": "erd",
+    "reference_configuration": "erd", "find_chains": "extract", "from_model": "extract", "from_urdf": "extract",
+    "BRANCHES": "kinematics", "Leg": "kinematics", "LegStructureError": "kinematics", "erd_spec": "registry",
+}
 
 __all__ = [
     "Leg",
@@ -30,3 +42,13 @@ __all__ = [
     "external_models",
     "erd_spec",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _WHERE:
+        return getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

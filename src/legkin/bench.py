@@ -16,6 +16,7 @@ same model. For the quadruped the bench also runs the peer IK libraries of :mod:
 
 from __future__ import annotations
 
+import functools
 import importlib
 import json
 import os
@@ -29,7 +30,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ._registry import get_spec, list_models
+from ._registry import MODELS, get_spec, list_models
 
 __all__ = [
     "Method",
@@ -301,7 +302,16 @@ def _run_methods(bench: ModelBench, runnable: list[Method], progress: _Progress)
 
 
 def _load_bench_module(name: str):
-    """The bench module of ``name``, or None if there is none."""
+    """The bench module of ``name``, or None if there is none (an external quadruped: :mod:`legkin.legs.bench`,
+    its ``build(name, n, rng, quick)`` bound to the name)."""
+    spec = MODELS.get(name)
+    if spec is not None and spec.external:
+        import types
+
+        module = importlib.import_module("legkin.legs.bench")
+        if not hasattr(module, "build"):
+            return None
+        return types.SimpleNamespace(build=functools.partial(module.build, name))
     modname = f"legkin.{name}.bench"
     try:
         return importlib.import_module(modname)

@@ -1,6 +1,7 @@
 """Animation clips for ``legkin view MODEL --animate NAME``.
 
-A model's clips live in ``legkin.<model>.clips`` as ``ANIMATIONS = {name: function(robot) -> list of q}``.
+A model's clips live in ``legkin.<model>.clips`` (the external quadrupeds': ``legkin.legs.clips``) as
+``ANIMATIONS = {name: function(robot) -> list of q}``.
 """
 
 from __future__ import annotations
@@ -14,8 +15,12 @@ __all__ = ["available", "frames"]
 
 def available(model: str) -> dict:
     """The clips of ``model`` (name -> function(robot) -> configurations)."""
+    from ._registry import MODELS
+
+    spec = MODELS.get(model)
+    package = spec.package if spec is not None else f"legkin.{model}"  # legkin.legs for the external robots
     try:
-        mod = importlib.import_module(f"legkin.{model}.clips")
+        mod = importlib.import_module(f"{package}.clips")
     except ModuleNotFoundError:
         return {}
     return dict(mod.ANIMATIONS)

@@ -482,6 +482,34 @@ def test_every_mode_closes_the_loops_with_the_same_rotation(alpha):
         np.testing.assert_array_equal(at.ik(u, geometry=geo, mode=m), q[MOTORS])
 
 
+def test_ik_all_is_ik_in_every_mode_bit_for_bit():
+    """ik_all's shared kernel (each leg solved once per side of E and sign of sin q_K2) gives every mode's ik
+    exactly, guards included: random orientations in and around the workspace, near the flip and on the
+    actuation-singular curves; the single call is the batch row."""
+    rng = np.random.default_rng(11)
+    for alpha in ALPHAS:
+        geo = _geo(alpha)
+        box = _u(rng.uniform(-2.0, 2.0, 1500), rng.uniform(-3.5, 3.5, 1500))
+        flip = _u(*_tilt_u(np.arccos(10.0 ** rng.uniform(-13, -2, 300) - 1.0), rng.uniform(-3, 3, 300)))
+        det = np.array(det_curves(alpha)[:200]) + 10.0 ** rng.uniform(-9, -5, (min(200, len(det_curves(alpha))), 2))
+        u = np.concatenate([box, flip, det])
+        q_all, ok_all = at.ik_all(u, geometry=geo, return_mask=True)
+        j_all, jok_all = at.ik_joints(u, geometry=geo, mode="all", return_mask=True)
+        assert np.array_equal(j_all[..., MOTORS], q_all, equal_nan=True) and np.array_equal(jok_all, ok_all)
+        assert 0 < ok_all.mean() < 1
+        for j, m in enumerate(at.MODES):
+            q, ok = at.ik(u, geometry=geo, mode=m, return_mask=True)
+            assert np.array_equal(ok, ok_all[:, j]), m
+            assert np.array_equal(q, q_all[:, j], equal_nan=True), m
+        for i in np.flatnonzero(ok_all.any(axis=-1))[::50]:
+            single, mask = at.ik_all(u[i], geometry=geo, return_mask=True)
+            assert np.array_equal(single, q_all[i], equal_nan=True) and np.array_equal(mask, ok_all[i])
+    with pytest.raises(UnreachableError, match="leg B"):
+        at.ik_all(_u(*_tilt_u(2.6, 0.0)), geometry=_geo(math.pi / 2))
+    with pytest.raises(InvalidInputError):
+        at.ik_all(np.array([np.nan, 0.0]))
+
+
 def test_fk_mode_is_explicit():
     """fk solves motors in the mode asked for; motors of another mode: AssemblyModeError naming it (single),
     mask False (batch); mode="all" finds it."""

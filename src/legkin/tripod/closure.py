@@ -192,12 +192,84 @@ def _k_ik(ay, az, G, home, e, s, q, aux):  # type: ignore[no-untyped-def]
         gain = np.sqrt(tot)
     aux[0], aux[1], aux[2], aux[3], aux[4], aux[5] = c2a, c2b, c2c, nb2, det, gain
     if inside and abs(det) >= DET_GUARD and gain <= GAIN_GUARD:
-        q[0], q[1], q[2], q[3] = q1a, q2a, q2a, q1a
-        q[4], q[5], q[6], q[7] = q1b, q2b, q2b, q1b
-        q[8], q[9], q[10], q[11] = q1c, q2c, q2c, q1c
+        _k_write(q, q1a, q2a, q1b, q2b, q1c, q2c)
         return OK
     q[:] = np.nan
     return ST_FAIL
+
+
+@kernel
+def _k_write(q, q1a, q2a, q1b, q2b, q1c, q2c):  # type: ignore[no-untyped-def]
+    """The solution into ``q``: every joint (12,) (q_K3 = q_K2, q_K4 = q_K1) or the motors (3,)."""
+    if q.shape[0] == 12:
+        q[0], q[1], q[2], q[3] = q1a, q2a, q2a, q1a
+        q[4], q[5], q[6], q[7] = q1b, q2b, q2b, q1b
+        q[8], q[9], q[10], q[11] = q1c, q2c, q2c, q1c
+    else:
+        q[0], q[1], q[2] = q1a, q1b, q1c
+
+
+@kernel
+def _k_ik_all(ay, az, G, q, ok):  # type: ignore[no-untyped-def]
+    """ik of one orientation in every assembly mode at once (:data:`legkin.tripod.MODES` order): writes each
+    mode's joints into ``q[j]`` ((16, 12) every joint or (16, 3) the motors; NaN unless ok) and its success
+    into ``ok[j]``; returns OK if some mode solves it, else ST_FAIL (ST_NONFINITE for NaN / inf).
+
+    The 16 modes share their work: the platform centre once per side of E (``E = -+L b / |b|``), seed eqs (98),
+    (102) once per (side, leg, sign of sin q_K2) -- 12 leg solutions instead of 48 -- and each mode combines
+    three of them with its own det M, gain and guards. Every step is :func:`_k_ik`'s, in the same order, so mode
+    j's answer is bit-identical to ``_k_ik`` in that mode (the home mode ``j = 0`` uses eqs (103)-(105) for
+    the exact gain, as there).
+    """
+    if not (np.isfinite(ay) and np.isfinite(az)):
+        q[:, :] = np.nan
+        ok[:] = False
+        return ST_NONFINITE
+    cy, sy, cz, sz = np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
+    # legs[side, K, i] = (q1, q2, c2, s2, sn, cn) with side 0: E_x < 0 (e = -1), i = 0: sin q_K2 > 0
+    legs = np.empty((2, 3, 2, 6))
+    nbs = np.empty(2)
+    for side in range(2):
+        e = -1.0 if side == 0 else 1.0
+        x, y, z, nb2 = _k_centre(cy, sy, cz, sz, G, False, e)
+        nbs[side] = nb2
+        for K in range(3):
+            for i in range(2):
+                sg = 1.0 if i == 0 else -1.0
+                (legs[side, K, i, 0], legs[side, K, i, 1], legs[side, K, i, 2], legs[side, K, i, 3],
+                 legs[side, K, i, 4], legs[side, K, i, 5]) = _k_leg(K, x, y, z, G, False, sg)
+    found = False
+    for j in range(16):
+        side, ia, ib, ic = j // 8, (j // 4) % 2, (j // 2) % 2, j % 2
+        la, lb, lc = legs[side, 0, ia], legs[side, 1, ib], legs[side, 2, ic]
+        nb2 = nbs[side]
+        det = _k_det_planes(la[4], lb[4], lc[4], la[5], lb[5], lc[5], G)
+        inside = _k_inside(la[2], lb[2], lc[2], nb2)
+        n = nb2 if inside else 1.0
+        m = abs(la[3])
+        for v in (abs(lb[3]), abs(lc[3])):
+            if not v >= m:  # NaN propagates, as np.minimum
+                m = v
+        gain = 1.3 / (m * np.sqrt(n))
+        if gain > GAIN_GUARD:
+            e = -1.0 if side == 0 else 1.0
+            tot = 0.0
+            for K in range(3):
+                lk = la if K == 0 else (lb if K == 1 else lc)
+                if j == 0:
+                    j1, j2 = _k_jac_home(K, cy, sy, cz, sz, lk[3], n, G)
+                else:
+                    j1, j2 = _k_jac_general(K, cy, sy, cz, sz, lk[2], lk[3], n, G, e)
+                tot += j1 * j1 + j2 * j2
+            gain = np.sqrt(tot)
+        if inside and abs(det) >= DET_GUARD and gain <= GAIN_GUARD:
+            _k_write(q[j], la[0], la[1], lb[0], lb[1], lc[0], lc[1])
+            ok[j] = True
+            found = True
+        else:
+            q[j, :] = np.nan
+            ok[j] = False
+    return OK if found else ST_FAIL
 
 
 @kernel
@@ -233,6 +305,12 @@ def _ik_loop(ay, az, G, homes, es, ss, q, aux, status):  # type: ignore[no-untyp
             status[i, j] = _k_ik(ay[i], az[i], G, homes[j], es[j], ss[j], q[i, j], aux[i, j])
 
 
+def _ik_all_loop(ay, az, G, q, ok, status):  # type: ignore[no-untyped-def]
+    """ik in every mode over orientations (n,): q (n, 16, 12 or 3), ok (n, 16), status (n,)."""
+    for i in prange(ay.shape[0]):
+        status[i] = _k_ik_all(ay[i], az[i], G, q[i], ok[i])
+
+
 def _jacobian_loop(ay, az, G, home, e, s, a, aux, status):  # type: ignore[no-untyped-def]
     """A_u over orientations (n,): a (n, 3, 2), aux (n, 4), status (n,)."""
     for i in prange(ay.shape[0]):
@@ -240,4 +318,5 @@ def _jacobian_loop(ay, az, G, home, e, s, a, aux, status):  # type: ignore[no-un
 
 
 IK_LOOP = (batch_kernel(_ik_loop), serial(_ik_loop))
+IK_ALL_LOOP = (batch_kernel(_ik_all_loop), serial(_ik_all_loop))
 JACOBIAN_LOOP = (batch_kernel(_jacobian_loop), serial(_jacobian_loop))

@@ -29,12 +29,13 @@ from ._common import (
     pick,
     split_legacy,
 )
-from .closure import IK_LOOP, JACOBIAN_LOOP, _k_actuation_jacobian, _k_ik
-from .geometry import Geometry
+from .closure import IK_ALL_LOOP, IK_LOOP, JACOBIAN_LOOP, _k_actuation_jacobian, _k_ik, _k_ik_all
+from .geometry import DEFAULT, Geometry
 
 __all__ = ["ik", "ik_all", "ik_joints", "jacobian", "actuation_jacobian"]
 
 _GEOMETRY_KW = ("d", "alpha", "eta")
+_G_DEFAULT = DEFAULT._vector
 
 
 # ------------------------------------------------------------------------------------------ diagnosis
@@ -106,16 +107,49 @@ def ik_single_error(ay: float, az: float, G: np.ndarray, mode: str, aux: np.ndar
 
 
 # ------------------------------------------------------------------------------------------ the solve
-def _run(ay: np.ndarray, az: np.ndarray, G: np.ndarray, mode: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The ik batch loop on broadcast orientations: q (shape, m, 12), aux (shape, m, 6), status (shape, m)."""
+def _run(ay: np.ndarray, az: np.ndarray, G: np.ndarray, mode: str,
+         width: int = 12) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The ik batch loop on broadcast orientations: q (shape, m, width) (every joint, 12, or the motors, 3),
+    aux (shape, m, 6), status (shape, m)."""
     shape = ay.shape
     y = np.ascontiguousarray(ay, dtype=np.float64).reshape(-1)
     z = np.ascontiguousarray(az, dtype=np.float64).reshape(-1)
     homes, es, ss = modes_sel(mode)
     n, m = y.shape[0], homes.shape[0]
-    q, aux, status = np.empty((n, m, 12)), np.empty((n, m, 6)), np.empty((n, m), dtype=np.int64)
+    q, aux, status = np.empty((n, m, width)), np.empty((n, m, 6)), np.empty((n, m), dtype=np.int64)
     pick(IK_LOOP, n * m, "ik")(y, z, G, homes, es, ss, q, aux, status)
-    return q.reshape(shape + (m, 12)), aux.reshape(shape + (m, 6)), status.reshape(shape + (m,))
+    return q.reshape(shape + (m, width)), aux.reshape(shape + (m, 6)), status.reshape(shape + (m,))
+
+
+def _fast_g(geometry: object) -> np.ndarray | None:
+    """The kernels' geometry vector for the single-call fast paths (None: not a plain geometry argument)."""
+    if geometry is None:
+        return _G_DEFAULT
+    return geometry._vector if type(geometry) is Geometry else None
+
+
+def _all_modes(ay: Any, az: Any, scalar: bool, G: np.ndarray, return_mask: bool, joints: bool,
+               bad_input: Any) -> Any:
+    """ik in every mode (:func:`legkin.tripod.closure._k_ik_all`): (..., 16, 12) joints or (..., 16, 3) motors,
+    per the single/batch rule (a single call raises only when no mode solves the target)."""
+    w = 12 if joints else 3
+    if scalar:
+        q, ok = np.empty((16, w)), np.empty(16, dtype=np.bool_)
+        st = _k_ik_all(ay, az, G, q, ok)
+        if st != OK:
+            if st == ST_NONFINITE:
+                bad_input()
+            aux = ik_one(ay, az, G, HOME_MODE)[1]
+            raise ik_single_error(np.float64(ay), np.float64(az), G, HOME_MODE, aux)
+        return (q, ok) if return_mask else q
+    shape = ay.shape
+    y = np.ascontiguousarray(ay, dtype=np.float64).reshape(-1)
+    z = np.ascontiguousarray(az, dtype=np.float64).reshape(-1)
+    n = y.shape[0]
+    q, ok, status = np.empty((n, 16, w)), np.empty((n, 16), dtype=np.bool_), np.empty(n, dtype=np.int64)
+    pick(IK_ALL_LOOP, n * 16, "ik")(y, z, G, q, ok, status)
+    q, ok = q.reshape(shape + (16, w)), ok.reshape(shape + (16,))
+    return (q, ok) if return_mask else q
 
 
 def _solve(ay: Any, az: Any, scalar: bool, g: Geometry, mode: str, return_mask: bool, joints: bool,
@@ -124,22 +158,20 @@ def _solve(ay: Any, az: Any, scalar: bool, g: Geometry, mode: str, return_mask: 
     motors (``joints=False``), per the single/batch rule. ``bad_input()`` raises the InvalidInputError of a
     non-finite scalar input."""
     G = g._vector
-    if scalar and mode != "all":
-        q, aux, st = ik_one(ay, az, G, mode)
+    if mode == "all":
+        return _all_modes(ay, az, scalar, G, return_mask, joints, bad_input)
+    if scalar:
+        home, e, s = MODE_ARGS[mode]
+        q, aux = np.empty(12 if joints else 3), np.empty(6)
+        st = _k_ik(ay, az, G, home, e, s, q, aux)
         if st != OK:
             if st == ST_NONFINITE:
                 bad_input()
             raise ik_single_error(np.float64(ay), np.float64(az), G, mode, aux)
-        out = q if joints else q[0::4].copy()
-        return (out, np.asarray(True)) if return_mask else out
-    q, aux, status = _run(np.asarray(ay, dtype=np.float64), np.asarray(az, dtype=np.float64), G, mode)
-    ok = status == OK
-    if scalar and not ok.any():
-        raise ik_single_error(np.float64(ay), np.float64(az), G, HOME_MODE, aux[0])
-    if mode != "all":
-        q, ok = q[..., 0, :], ok[..., 0]
-    if not joints:
-        q = np.ascontiguousarray(q[..., 0::4])
+        return (q, np.asarray(True)) if return_mask else q
+    q, aux, status = _run(np.asarray(ay, dtype=np.float64), np.asarray(az, dtype=np.float64), G, mode,
+                          12 if joints else 3)
+    q, ok = q[..., 0, :], status[..., 0] == OK
     return (q, ok) if return_mask else q
 
 
@@ -233,18 +265,19 @@ def ik(target: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry 
     Deprecated form (legkin 0.1, one release): ``ik(alpha_y, alpha_z, d, alpha, eta, *, mode, return_mask)``
     returns every joint (..., 12), as :func:`ik_joints` does.
     """
-    old = bool(args) or "alpha_z" in legacy
+    if type(target) is np.ndarray and target.shape == (2,) and target.dtype == np.float64 and not args and \
+            not legacy and type(mode) is str and (return_mask is False or return_mask is True):
+        G = _fast_g(geometry)  # the single-call fast path: straight to the kernel, the motors only
+        args_m = MODE_ARGS.get(mode)
+        if G is not None and args_m is not None:
+            out, aux = np.empty(3), np.empty(6)
+            if _k_ik(target[0], target[1], G, args_m[0], args_m[1], args_m[2], out, aux) == OK:
+                return (out, np.asarray(True)) if return_mask else out
     mode = checked_mode(mode, allow_all=True)
     return_mask = flag(return_mask, "return_mask")
-    if old:
+    if args or "alpha_z" in legacy:
         ay, az, scalar, g, bad = _legacy_call("ik", target, args, legacy, geometry)
         return _solve(ay, az, scalar, g, mode, return_mask, True, bad)
-    if geometry is None and not legacy and type(target) is np.ndarray and target.shape == (2,) and \
-            target.dtype == np.float64 and mode != "all":  # the single-call fast path
-        q, aux, st = ik_one(float(target[0]), float(target[1]), geometry_of(None)._vector, mode)
-        if st == OK:
-            out = q[0::4].copy()
-            return (out, np.asarray(True)) if return_mask else out
     ay, az, scalar, g, bad = _new_call("ik", target, legacy, geometry)
     return _solve(ay, az, scalar, g, mode, return_mask, False, bad)
 
@@ -258,8 +291,19 @@ def ik_all(target: ArrayLike, *, geometry: Geometry | None = None, return_mask: 
     """The motors of every assembly mode for ``target`` (..., 2): shape (..., 16, 3) in :data:`MODES` order, NaN
     (mask False) where a mode does not solve it (every mode reaches the same orientations; a mode fails only on
     its own actuation singularities, :data:`DET_GUARD`, :data:`GAIN_GUARD`). A single call raises only when no
-    mode solves the target. Equals :func:`ik` with ``mode="all"``."""
-    return ik(target, mode="all", geometry=geometry, return_mask=return_mask)  # type: ignore[call-overload]
+    mode solves the target. Equals :func:`ik` with ``mode="all"``, and row j equals ``ik(target, mode=MODES[j])``
+    bit for bit: one kernel (:func:`legkin.tripod.closure._k_ik_all`) solves each leg once per side of E and sign
+    of sin q_K2 and combines the 12 leg solutions into the 16 modes; the batch is a compiled loop over it."""
+    if type(target) is np.ndarray and target.shape == (2,) and target.dtype == np.float64 and \
+            (return_mask is False or return_mask is True):
+        G = _fast_g(geometry)  # the single-call fast path
+        if G is not None:
+            q, ok = np.empty((16, 3)), np.empty(16, dtype=np.bool_)
+            if _k_ik_all(target[0], target[1], G, q, ok) == OK:
+                return (q, ok) if return_mask else q
+    return_mask = flag(return_mask, "return_mask")
+    ay, az, scalar, g, bad = _new_call("ik_all", target, {}, geometry)
+    return _all_modes(ay, az, scalar, g._vector, return_mask, False, bad)
 
 
 @overload
@@ -273,13 +317,16 @@ def ik_joints(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | 
     """Every joint for ``target`` (..., 2): (..., 12) ordered A_q1..A_q4, B_q1..B_q4, C_q1..C_q4 (the Pinocchio
     order: a closed configuration of ``legkin.load("tripod")``), ``q_K3 = q_K2``, ``q_K4 = q_K1``; otherwise as
     :func:`ik` (whose motors are columns 0, 4, 8). ``mode="all"``: (..., 16, 12)."""
+    if type(target) is np.ndarray and target.shape == (2,) and target.dtype == np.float64 and \
+            type(mode) is str and (return_mask is False or return_mask is True):
+        G = _fast_g(geometry)  # the single-call fast path
+        args_m = MODE_ARGS.get(mode)
+        if G is not None and args_m is not None:
+            q, aux = np.empty(12), np.empty(6)
+            if _k_ik(target[0], target[1], G, args_m[0], args_m[1], args_m[2], q, aux) == OK:
+                return (q, np.asarray(True)) if return_mask else q
     mode = checked_mode(mode, allow_all=True)
     return_mask = flag(return_mask, "return_mask")
-    if geometry is None and type(target) is np.ndarray and target.shape == (2,) and target.dtype == np.float64 and \
-            mode != "all":  # the single-call fast path
-        q, aux, st = ik_one(float(target[0]), float(target[1]), geometry_of(None)._vector, mode)
-        if st == OK:
-            return (q, np.asarray(True)) if return_mask else q
     ay, az, scalar, g, bad = _new_call("ik_joints", target, {}, geometry)
     return _solve(ay, az, scalar, g, mode, return_mask, True, bad)
 

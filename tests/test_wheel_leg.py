@@ -705,3 +705,17 @@ def test_kinematics_module_reexports_the_public_api():
     for name in kinematics.__all__:
         assert getattr(wheel_leg, name) is getattr(kinematics, name)
     assert {"fk", "ik", "ik_all", "jacobian", "Geometry", "IKOptions", "contact_point"} <= set(kinematics.__all__)
+
+
+def test_docs_examples_run():
+    import pathlib
+    import re
+    import warnings
+
+    text = (pathlib.Path(__file__).parents[1] / "docs" / "wheel_leg.md").read_text()
+    blocks = re.findall(r"```python\n(.*?)```", text, flags=re.S)
+    assert blocks
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)  # the docs show the 0.2 API
+        for code in blocks:
+            exec(compile(code, "docs/wheel_leg.md", "exec"), {})

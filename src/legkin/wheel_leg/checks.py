@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any, NamedTuple
+
 import numpy as np
 
 from .. import load
@@ -32,18 +34,32 @@ FRAME_POINTS = {
     "U_L": "U_L", "U_R": "U_R", "L_L": "L_L", "L_R": "L_R", "leg": "O",
 }  # fmt: skip
 
-def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
-    robot = load("wheel_leg")
-    geo = wl.Geometry.from_params(robot.params)
-    rows: list[CheckResult] = []
-    n = samples
 
-    # ---------------------------------------------------------------- closed-form assembly
-    leg_q = sample_leg_q(4 * n, rng).reshape(n, 4, 3)
-    qs = configuration(robot, leg_q)
+class _Samples(NamedTuple):
+    """The configurations and contact points every section of :func:`run` compares."""
+
+    robot: Any
+    geo: wl.Geometry
+    n: int
+    leg_q: np.ndarray  # (n, 4, 3) (theta, beta, gamma) per leg
+    qs: np.ndarray  # (n, nq) closed configurations
+    legs: np.ndarray  # (n,) the leg of each contact sample
+    alpha: np.ndarray
+    w: np.ndarray
+    q3: np.ndarray  # (n, 3) that leg's joints
+    local: np.ndarray  # (n, 3) contact point in its rim link
+    seg: np.ndarray  # (n,) its rim segment
+    seg_frames: list[str]
+    idx: np.ndarray  # (n,) index into seg_frames
+    pin_p: np.ndarray  # (n, 3) Pinocchio's contact point
+    ana: np.ndarray  # (n, 3) fk's
+
+
+def _assembly_rows(robot, geo, leg_q, qs) -> tuple[list[CheckResult], np.ndarray, list[str]]:
+    """Loop residual of the closed-form configurations; linkage_points vs the hinge frames."""
+    n = len(qs)
     res = np.array([np.abs(robot.constraint_residual(q)).max() for q in qs])
-    rows.append(compare("closed-form configuration: loop residual (16 loops, theta 17-160 deg)", res, TOL))
-
+    rows = [compare("closed-form configuration: loop residual (16 loops, theta 17-160 deg)", res, TOL)]
     frames = [f"{leg}_{f}" for leg in wl.LEGS for f in FRAME_POINTS]
     pos = pinocchio_frames(robot, qs, frames)[0].reshape(n, 4, len(FRAME_POINTS), 3)
     err = np.zeros((n, 4, len(FRAME_POINTS)))
@@ -53,9 +69,12 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
             ana = wl.leg_frame_to_robot(pts[pt], leg_q[:, k, 2], leg, geometry=geo)
             err[:, k, m] = per_sample(ana - pos[:, k, m])
     rows.append(compare("linkage_points vs hinge frames oMf (23 frames x 4 legs)", err.max(axis=(1, 2)), TOL))
+    return rows, pos, frames
 
-    # ---------------------------------------------------------------- loop solver from the motors alone
-    ns = min(n, SOLVE_SAMPLES)
+
+def _loop_solver_rows(robot, qs, pos, frames, rng) -> list[CheckResult]:
+    """solve_loops from the motors alone (passive joints perturbed) against the closed form."""
+    ns = min(len(qs), SOLVE_SAMPLES)
     fixed = [f"{leg}_{j}" for leg in wl.LEGS for j in ("abad", "phi_L", "phi_R")]
     passive = [f"{leg}_hinge_{h}_{s}" for leg in wl.LEGS for h in "ABDF" for s in "LR"]
     ip = np.array([robot.idx_q(j) for j in passive])
@@ -68,12 +87,15 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         ang_err[i] = np.abs(wrap(q_sol[ip] - qs[i][ip])).max()
         p_sol = pinocchio_frames(robot, q_sol[None], frames)[0].reshape(4, len(FRAME_POINTS), 3)
         frame_err[i] = per_sample(p_sol - pos[i]).max()
-    rows.append(compare(f"solve_loops from motors (passive +-0.05 rad off) vs passive_angles, "
-                        f"{ns} samples, tol {SOLVE_TOL:g}, <= {iters.max()} iterations", ang_err, TOL_SOLVE))
-    rows.append(compare(f"solve_loops: hinge frames vs linkage_points, {ns} samples", frame_err, TOL))
+    return [
+        compare(f"solve_loops from motors (passive +-0.05 rad off) vs passive_angles, "
+                f"{ns} samples, tol {SOLVE_TOL:g}, <= {iters.max()} iterations", ang_err, TOL_SOLVE),
+        compare(f"solve_loops: hinge frames vs linkage_points, {ns} samples", frame_err, TOL),
+    ]
 
-    # ---------------------------------------------------------------- mobility
-    nm = min(n, MOBILITY_SAMPLES)
+
+def _mobility_rows(robot, qs) -> list[CheckResult]:
+    nm = min(len(qs), MOBILITY_SAMPLES)
     mob_err = np.zeros(nm)
     for i in range(nm):
         k = i % 4
@@ -81,9 +103,13 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         m_leg = robot.mobility(qs[i], locked=others + [f"{wl.LEGS[k]}_abad"])
         m_all = robot.mobility(qs[i])
         mob_err[i] = abs(m_leg - 2) + abs(m_all - 12)
-    rows.append(compare(f"mobility: 2 per leg linkage (ABAD locked), 12 for the robot, {nm} samples", mob_err, 0.0))
+    return [compare(f"mobility: 2 per leg linkage (ABAD locked), 12 for the robot, {nm} samples", mob_err, 0.0)]
 
-    # ---------------------------------------------------------------- contact point vs rim link placement
+
+def _contact_samples(robot, geo, leg_q, qs, rng) -> tuple[_Samples, np.ndarray, np.ndarray]:
+    """Random contact points (leg, alpha, w) of the sampled configurations: Pinocchio's (rim link placement
+    times the constant local point) and fk's. Also returns the rim frames' placements (fpos, frot)."""
+    n = len(qs)
     legs = rng.integers(0, 4, n)
     alpha = rng.uniform(-np.pi, np.pi, n)
     w = rng.uniform(-geo.T / 2, geo.T / 2, n)
@@ -97,120 +123,148 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     for k, leg in enumerate(wl.LEGS):
         m = legs == k
         ana[m] = wl.fk(q3[m], leg, alpha=alpha[m], w=w[m], geometry=geo)
-    rows.append(compare("fk (contact point) vs rim link oMf * local point (alpha over the whole rim)",
-                        per_sample(ana - pin_p), TOL))
+    s = _Samples(robot, geo, n, leg_q, qs, legs, alpha, w, q3, local, seg, seg_frames, idx, pin_p, ana)
+    return s, fpos, frot
 
-    # seed rim: its upper-rim arcs are fixed in the upper rims (the toe arc about O_r is in no link)
-    up = np.abs(alpha) > wl.PSI_FG
-    local_s, seg_s = local_contact_point(alpha[up], w[up], geo, rim="three_arc")
-    idx_s = legs[up] * 4 + seg_s
+
+def _contact_rows(s: _Samples, fpos, frot) -> list[CheckResult]:
+    rows = [compare("fk (contact point) vs rim link oMf * local point (alpha over the whole rim)",
+                    per_sample(s.ana - s.pin_p), TOL)]
+    # three-arc rim: its upper-rim arcs are fixed in the upper rims (the toe arc about O_r is in no link)
+    up = np.abs(s.alpha) > wl.PSI_FG
+    local_s, seg_s = local_contact_point(s.alpha[up], s.w[up], s.geo, rim="three_arc")
+    idx_s = s.legs[up] * 4 + seg_s
     rows_s = np.arange(up.sum())
     pin_s = fpos[up][rows_s, idx_s] + np.einsum("nij,nj->ni", frot[up][rows_s, idx_s], local_s)
     ana_s = np.empty((up.sum(), 3))
     for k, leg in enumerate(wl.LEGS):
-        m = legs[up] == k
-        ana_s[m] = wl.fk(q3[up][m], leg, alpha=alpha[up][m], w=w[up][m], rim="three_arc", geometry=geo)
+        m = s.legs[up] == k
+        ana_s[m] = wl.fk(s.q3[up][m], leg, alpha=s.alpha[up][m], w=s.w[up][m], rim="three_arc", geometry=s.geo)
     rows.append(compare("fk(rim='three_arc'), upper-rim arcs |alpha| > psi_FG vs upper rim oMf",
                         per_sample(ana_s - pin_s), TOL))
+    return rows
 
-    # ---------------------------------------------------------------- contact Jacobian
-    jac = np.empty((n, 3, 3))
+
+def _jacobian_rows(s: _Samples) -> list[CheckResult]:
+    """jacobian against central differences of fk, and against Pinocchio's closed-loop Jacobian."""
+    jac = np.empty((s.n, 3, 3))
     for k, leg in enumerate(wl.LEGS):
-        m = legs == k
-        jac[m] = wl.jacobian(q3[m], leg, alpha=alpha[m], w=w[m], geometry=geo)
+        m = s.legs == k
+        jac[m] = wl.jacobian(s.q3[m], leg, alpha=s.alpha[m], w=s.w[m], geometry=s.geo)
     fd = np.empty_like(jac)
     for c in range(3):
         dq = np.zeros(3)
         dq[c] = FD_STEP
         for k, leg in enumerate(wl.LEGS):
-            m = legs == k
-            qm = q3[m]
+            m = s.legs == k
+            qm = s.q3[m]
             hi = np.clip(qm + dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9])
             lo = np.clip(qm - dq, [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9])
-            plus = wl.fk(hi, leg, alpha=alpha[m], w=w[m], geometry=geo)
-            minus = wl.fk(lo, leg, alpha=alpha[m], w=w[m], geometry=geo)
+            plus = wl.fk(hi, leg, alpha=s.alpha[m], w=s.w[m], geometry=s.geo)
+            minus = wl.fk(lo, leg, alpha=s.alpha[m], w=s.w[m], geometry=s.geo)
             step = hi[:, c] - lo[:, c]
             fd[m, :, c] = (plus - minus) / step[:, None]
-    rows.append(compare(f"jacobian vs central differences (h = {FD_STEP:g})",
-                        np.abs(jac - fd).max(axis=(1, 2)), TOL_FD))
-
-    nj = min(n, JACOBIAN_SAMPLES)
-    jerr = np.zeros(nj)
-    import pinocchio as pin
-
-    model, data = robot.model, robot.data
-    for i in range(nj):
-        leg = wl.LEGS[legs[i]]
-        q = qs[i]
-        lk = f"{leg}_{SEGMENT_LINKS[seg[i]][0]}"
-        fid = robot.frame_id(lk)
-        pin.computeJointJacobians(model, data, q)
-        pin.updateFramePlacements(model, data)
-        J6 = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
-        M = data.oMf[fid]
-        r = M.rotation @ local[i]
-        Jp = J6[:3] - np.cross(r, J6[3:].T).T  # velocity of the point: v + w x r
-        Jc = robot.constraint_jacobian(q)
-        iv = [robot.idx_v(f"{leg}_{j}") for j in ("phi_L", "phi_R", "abad")]
-        pv = [robot.idx_v(f"{leg}_hinge_{h}_{s}") for h in "ABDF" for s in "LR"]
-        # independent velocities (phi_L, phi_R, abad) per unit (theta, beta, gamma) rates
-        S_ind = np.array([[1.0, 1.0, 0.0], [-1.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
-        S_pas = -np.linalg.pinv(Jc[:, pv], rcond=1e-10) @ (Jc[:, iv] @ S_ind)
-        J_pin = Jp[:, iv] @ S_ind + Jp[:, pv] @ S_pas
-        jerr[i] = np.abs(J_pin - jac[i]).max()
+    rows = [compare(f"jacobian vs central differences (h = {FD_STEP:g})", np.abs(jac - fd).max(axis=(1, 2)), TOL_FD)]
+    nj = min(s.n, JACOBIAN_SAMPLES)
+    jerr = np.array([np.abs(_pinocchio_jacobian(s, i) - jac[i]).max() for i in range(nj)])
     rows.append(compare(f"jacobian vs Pinocchio closed-loop Jacobian (constraint null space), {nj} samples",
                         jerr, TOL))
+    return rows
 
-    # ---------------------------------------------------------------- IK round trips
-    for method in ("damped", "gauss_newton_fd", "radial"):
-        for rim in ("continuous", "three_arc"):
-            errs = np.full(n, np.nan)
-            its = np.zeros(n, dtype=int)
-            ok_all = np.zeros(n, dtype=bool)
-            found = np.full(n, np.nan)
-            for k, leg in enumerate(wl.LEGS):
-                m = legs == k
-                if rim == "three_arc":
-                    target = wl.fk(q3[m], leg, alpha=alpha[m], w=w[m], rim="three_arc", geometry=geo)
-                else:
-                    target = ana[m]
-                qk, ok, ik_info = wl.ik(target, leg, alpha=alpha[m], w=w[m], method=method, rim=rim, geometry=geo,
-                                        return_mask=True, return_info=True)
-                reached = wl.fk(np.where(ok[:, None], qk, q3[m]), leg, alpha=alpha[m], w=w[m], rim=rim, geometry=geo)
-                errs[m] = np.where(ok, per_sample(reached - target), np.nan)
-                its[m], ok_all[m] = ik_info.iterations, ok
-                if method == "radial":
-                    assert ik_info.solutions is not None
-                    found[m] = solution_distance(ik_info.solutions, q3[m]) * np.linalg.svd(
-                        wl.jacobian(q3[m], leg, alpha=alpha[m], w=w[m], rim=rim, geometry=geo), compute_uv=False)[:, -1]
-            name = (f"ik(method='{method}', rim='{rim}') round trip: {ok_all.sum()}/{n} converged in [17, 160] deg, "
-                    f"iterations mean {its.mean():.2f} max {its.max()}")
-            if method == "gauss_newton_fd":
-                # The baseline is measured, not required to succeed: the row covers the converged targets.
-                rows.append(compare(name + " (converged targets)", errs[ok_all], TOL))
-            else:
-                rows.append(compare(name, errs, TOL))
-            if method == "radial":
-                # Every root found: the sampled q is one of info.solutions. Its distance in q is scaled by the
-                # smallest singular value of the contact Jacobian at the sample (near folds theta is
-                # ill-conditioned: a position error e moves the root by ~e / sigma_min), giving metres.
-                rows.append(compare(f"ik(method='radial', rim='{rim}'): sampled q among info.solutions "
-                                    "(q distance x sigma_min(J), m)", found, TOL))
 
-    # radial IK against Pinocchio: targets are the rim link placements oMf times the local contact point,
-    # the answers are scored by Pinocchio on the configuration closing every loop
-    q_rad = leg_q.copy()
+def _pinocchio_jacobian(s: _Samples, i: int) -> np.ndarray:
+    """d(contact point) / d(theta, beta, gamma) of sample i by Pinocchio: the rim link's frame Jacobian at the
+    point, the passive joint rates from the constraint Jacobian's null space."""
+    import pinocchio as pin
+
+    robot = s.robot
+    model, data = robot.model, robot.data
+    leg = wl.LEGS[s.legs[i]]
+    q = s.qs[i]
+    fid = robot.frame_id(f"{leg}_{SEGMENT_LINKS[s.seg[i]][0]}")
+    pin.computeJointJacobians(model, data, q)
+    pin.updateFramePlacements(model, data)
+    J6 = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+    r = data.oMf[fid].rotation @ s.local[i]
+    Jp = J6[:3] - np.cross(r, J6[3:].T).T  # velocity of the point: v + w x r
+    Jc = robot.constraint_jacobian(q)
+    iv = [robot.idx_v(f"{leg}_{j}") for j in ("phi_L", "phi_R", "abad")]
+    pv = [robot.idx_v(f"{leg}_hinge_{h}_{side}") for h in "ABDF" for side in "LR"]
+    # independent velocities (phi_L, phi_R, abad) per unit (theta, beta, gamma) rates
+    S_ind = np.array([[1.0, 1.0, 0.0], [-1.0, 1.0, 0.0], [0.0, 0.0, 1.0]])
+    S_pas = -np.linalg.pinv(Jc[:, pv], rcond=1e-10) @ (Jc[:, iv] @ S_ind)
+    return Jp[:, iv] @ S_ind + Jp[:, pv] @ S_pas
+
+
+def _ik_round_trip_rows(s: _Samples, method: str, rim: str) -> list[CheckResult]:
+    """ik on fk-made targets: the answer reproduces the target; radial: the sampled q is among the solutions."""
+    n = s.n
+    errs = np.full(n, np.nan)
+    its = np.zeros(n, dtype=int)
+    ok_all = np.zeros(n, dtype=bool)
+    found = np.full(n, np.nan)
+    for k, leg in enumerate(wl.LEGS):
+        m = s.legs == k
+        kw = {"alpha": s.alpha[m], "w": s.w[m], "rim": rim, "geometry": s.geo}
+        target = wl.fk(s.q3[m], leg, **kw) if rim == "three_arc" else s.ana[m]
+        qk, ok, ik_info = wl.ik(target, leg, method=method, return_mask=True, return_info=True,  # type: ignore[call-overload]
+                                **kw)  # (method, rim: names of the Literal types, as str)
+        reached = wl.fk(np.where(ok[:, None], qk, s.q3[m]), leg, **kw)
+        errs[m] = np.where(ok, per_sample(reached - target), np.nan)
+        its[m], ok_all[m] = ik_info.iterations, ok
+        if method == "radial":
+            assert ik_info.solutions is not None
+            sigma = np.linalg.svd(wl.jacobian(s.q3[m], leg, **kw), compute_uv=False)[:, -1]
+            found[m] = solution_distance(ik_info.solutions, s.q3[m]) * sigma
+    name = (f"ik(method='{method}', rim='{rim}') round trip: {ok_all.sum()}/{n} converged in [17, 160] deg, "
+            f"iterations mean {its.mean():.2f} max {its.max()}")
+    if method == "gauss_newton_fd":
+        # The baseline is measured, not required to succeed: the row covers the converged targets.
+        return [compare(name + " (converged targets)", errs[ok_all], TOL)]
+    rows = [compare(name, errs, TOL)]
+    if method == "radial":
+        # Every root found: the sampled q is one of info.solutions. Its distance in q is scaled by the
+        # smallest singular value of the contact Jacobian at the sample (near folds theta is
+        # ill-conditioned: a position error e moves the root by ~e / sigma_min), giving metres.
+        rows.append(compare(f"ik(method='radial', rim='{rim}'): sampled q among info.solutions "
+                            "(q distance x sigma_min(J), m)", found, TOL))
+    return rows
+
+
+def _ik_vs_pinocchio_row(s: _Samples) -> CheckResult:
+    """Radial IK on Pinocchio's contact points (rim link oMf times the local point), the answers scored by
+    Pinocchio on the configuration closing every loop."""
+    n = s.n
+    q_rad = s.leg_q.copy()
     ok_rad = np.zeros(n, dtype=bool)
     for k, leg in enumerate(wl.LEGS):
-        rows_k = np.flatnonzero(legs == k)
-        qk, ok_rad[rows_k] = wl.ik(pin_p[rows_k], leg, alpha=alpha[rows_k], w=w[rows_k], method="radial", geometry=geo,
-                                   return_mask=True)
+        rows_k = np.flatnonzero(s.legs == k)
+        qk, ok_rad[rows_k] = wl.ik(s.pin_p[rows_k], leg, alpha=s.alpha[rows_k], w=s.w[rows_k], method="radial",
+                                   geometry=s.geo, return_mask=True)
         q_rad[rows_k[ok_rad[rows_k]], k] = qk[ok_rad[rows_k]]
-    fpos_r, frot_r = pinocchio_frames(robot, configuration(robot, q_rad), seg_frames)
-    pin_r = fpos_r[np.arange(n), idx] + np.einsum("nij,nj->ni", frot_r[np.arange(n), idx], local)
-    rows.append(compare(f"ik(method='radial') vs Pinocchio: target = rim link oMf * local point, answer's contact "
-                        f"point by Pinocchio (closed configuration), {ok_rad.sum()}/{n} solved",
-                        np.where(ok_rad, per_sample(pin_r - pin_p), np.nan), TOL))
+    fpos_r, frot_r = pinocchio_frames(s.robot, configuration(s.robot, q_rad), s.seg_frames)
+    pin_r = fpos_r[np.arange(n), s.idx] + np.einsum("nij,nj->ni", frot_r[np.arange(n), s.idx], s.local)
+    return compare(f"ik(method='radial') vs Pinocchio: target = rim link oMf * local point, answer's contact "
+                   f"point by Pinocchio (closed configuration), {ok_rad.sum()}/{n} solved",
+                   np.where(ok_rad, per_sample(pin_r - s.pin_p), np.nan), TOL)
+
+
+def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
+    """The check rows: closed form, loop solver, mobility, contact point, Jacobian and IK against Pinocchio."""
+    robot = load("wheel_leg")
+    geo = wl.Geometry.from_params(robot.params)
+    leg_q = sample_leg_q(4 * samples, rng).reshape(samples, 4, 3)
+    qs = configuration(robot, leg_q)
+    rows, pos, frames = _assembly_rows(robot, geo, leg_q, qs)
+    rows += _loop_solver_rows(robot, qs, pos, frames, rng)
+    rows += _mobility_rows(robot, qs)
+    s, fpos, frot = _contact_samples(robot, geo, leg_q, qs, rng)
+    rows += _contact_rows(s, fpos, frot)
+    rows += _jacobian_rows(s)
+    for method in ("damped", "gauss_newton_fd", "radial"):
+        for rim in ("continuous", "three_arc"):
+            rows += _ik_round_trip_rows(s, method, rim)
+    rows.append(_ik_vs_pinocchio_row(s))
     return rows
 
 

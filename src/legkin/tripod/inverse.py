@@ -378,6 +378,14 @@ def jacobian(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | N
     pose is outside the workspace or singular (NaN / the exceptions of :func:`ik`); the actuation-singularity
     guard of :func:`ik` (:data:`DET_GUARD`) does not apply: A_u is defined there.
     """
+    if type(target) is np.ndarray and target.shape == (2,) and target.dtype == np.float64 and \
+            type(mode) is str and (return_mask is False or return_mask is True):
+        G = _fast_g(geometry)  # the single-call fast path
+        args_m = MODE_ARGS.get(mode)
+        if G is not None and args_m is not None:
+            a, aux = np.empty((3, 2)), np.empty(4)
+            if _k_actuation_jacobian(target[0], target[1], G, args_m[0], args_m[1], args_m[2], a, aux) == OK:
+                return (a, np.asarray(True)) if return_mask else a
     mode = checked_mode(mode)
     return_mask = flag(return_mask, "return_mask")
     ay, az, scalar, g, bad = _new_call("jacobian", target, {}, geometry)

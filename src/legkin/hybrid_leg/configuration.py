@@ -12,7 +12,8 @@ from .._rotations import rot_x, rot_y, rot_z
 from .extension import extension_motor_angle, ll_angle
 from .foot import fk
 from .geometry import LL_LIMIT, MOTOR_LIMIT, Geometry
-from .platform import motor_angles, motor_angles_from_rotation, motor_jacobian, sphere_joint_angles
+from .platform import motor_angles, motor_jacobian
+from .rotation import motor_angles_from_rotation, sphere_joint_angles
 
 __all__ = [
     "ACTUATED", "PASSIVE_U", "LL_RANGE", "SIGMA_MIN", "sigma_min", "neutral_mode", "sample_workspace",

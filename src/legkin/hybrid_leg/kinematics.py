@@ -5,7 +5,8 @@ The public API, re-exported from the modules that implement it (each kernel besi
 * :mod:`.geometry`: :class:`Geometry` (``center``, ``starting_value``), the fixed constants, tolerances, limits;
 * :mod:`.extension`: eq 19 (:func:`ll_angle`, :func:`extension_motor_angle`);
 * :mod:`.platform`: the motor chains of a platform pose (eqs 2-16): :func:`motor_angles`, their Jacobian, the
-  assembly mode, rod spans, spherical joints, the spherical centre's free axis;
+  assembly mode, rod spans; :mod:`.rotation`: the closed forms of a rotation matrix (either centre): motor angles,
+  spherical joints, the spherical centre's free axis;
 * :mod:`.forward`: the closed sub-chain's forward kinematics (:func:`platform_orientation`, :func:`platform_poses`;
   the degree-8 polynomial of :mod:`.polynomial`);
 * :mod:`.foot`: the foot (eqs 17, 18, 20), the leg's forward kinematics :func:`fk` and :func:`jacobian`;
@@ -58,16 +59,8 @@ from .geometry import (
     SCREW_LEAD,
     Geometry,
 )
-from .platform import (
-    assembly_mode,
-    motor_angles,
-    motor_angles_from_rotation,
-    motor_jacobian,
-    platform_rotation,
-    rod_spans,
-    sphere_joint_angles,
-    spherical_free_axis,
-)
+from .platform import assembly_mode, motor_angles, motor_jacobian, platform_rotation, rod_spans
+from .rotation import motor_angles_from_rotation, sphere_joint_angles, spherical_free_axis
 
 __all__ = [
     # the API of docs/api.md

@@ -473,12 +473,30 @@ def test_checks_run_rows_pass():
     assert "1200/1200 solved" in rows[2].name
 
 
-def test_bench_go2_rows():
-    from legkin.legs.bench import bench_go2
+def test_bench_build_quick_rows():
+    from legkin import bench
+    from legkin.legs.bench import build
 
-    rows = bench_go2(40)
-    names = [r["method"] for r in rows]
-    assert names[:3] == ["legkin Leg.ik (batch)", "legkin Leg.ik (single calls)",
-                         "Pinocchio CLIK (damped Newton, 3 leg joints)"]
-    assert rows[0]["success_rate"] == 1.0 and rows[1]["success_rate"] == 1.0
-    assert all({"method", "targets", "solved", "success_rate", "us_per_target", "max_error", "note"} <= set(r) for r in rows)
+    mb = build("go2", None, np.random.default_rng(0), True)
+    results = {r.name: r for r in bench.run_model(mb, quiet=True)}
+    names = [m.name for m in mb.methods]
+    assert names[:3] == ["legkin Leg.ik batch (closed form; 1000 at once)", "legkin Leg.ik single calls (Python loop)",
+                         "pinocchio CLIK (damped Newton, 3 leg joints)"]
+    assert any("ikpy" in nm for nm in names) and any("ik_LM" in nm for nm in names)
+    for nm in names[:2]:
+        assert results[nm].solved == 100.0 and results[nm].max_error < 1e-12
+    assert results[names[0]].targets == 1000 and results[names[2]].targets == 100
+    for m in mb.methods:  # a peer is timed or skipped with its reason
+        assert (m.name in results) != (m.skip is not None)
+        if m.name in results:
+            assert results[m.name].targets >= 1 and results[m.name].time_per_target_s > 0
+    text = bench.format_table("go2", mb, list(results.values()))
+    assert "time/target" in text and "FL_foot" in text
+
+
+def test_bench_cli_external_robot(capsys):
+    from legkin.__main__ import main
+
+    assert main(["bench", "solo12", "--quick", "--n", "50", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "solo12" in out and "legkin Leg.ik batch" in out and "FL_FOOT" in out

@@ -1,37 +1,49 @@
-"""Foot IK on go2's FL leg (measured from example-robot-data): legkin's closed form vs Pinocchio CLIK and peers.
+"""``legkin bench ROBOT`` for an external quadruped: one leg's closed-form IK vs Pinocchio CLIK and peers.
 
-Targets: Pinocchio's ``FL_foot`` for FL joint values drawn uniformly inside the URDF limits (the base at its
-neutral pose, the other legs at zero), so every target is reachable inside the limits. Every method's answer
-is scored the same way: Pinocchio's foot at the returned joints against the target; solved = error
-<= :data:`SOLVE_TOL` and the joints inside the URDF limits. Peers (ikpy, roboticstoolbox ``ik_LM``) are
-optional: a row says why it is skipped when one is not installed or cannot be set up. Their URDF is go2's with
-the visual/collision/gazebo elements removed (their loaders try to resolve the ``package://`` meshes).
+:func:`build` (found by :mod:`legkin.bench` for every robot of :data:`legkin.legs.ERD_ROBOTS`) benches the leg
+:data:`LEG` (else the robot's first leg) of ``legkin.load(name)`` (fixed base: world = root frame).
+
+Targets: Pinocchio's foot frame for the leg's three joints drawn uniformly inside the URDF limits (the other
+joints at the standing pose ``robot.q0``), so every target is reachable inside the limits. Every method's
+answer is scored the same way: Pinocchio's foot at the returned joints against the target; solved = error
+<= :data:`legkin._benchkit.SOLVE_TOL` and the joints inside the limits; reached = the error alone. Peers
+(ikpy, roboticstoolbox ``ik_LM``) are optional: a row says why it is skipped when one is not installed or
+cannot be set up. They read the robot's URDF without its visual/collision/gazebo elements (their loaders try
+to resolve the ``package://`` meshes), with the chain from the URDF's root link to the foot link.
 """
 
 from __future__ import annotations
 
 import os
 import tempfile
-import time
 import warnings
 import xml.etree.ElementTree as ET
+from typing import Any, Callable
 
 import numpy as np
 
-__all__ = ["bench_go2", "SOLVE_TOL", "CLIK_MAX_ITER", "CLIK_DAMPING", "PEER_TARGETS"]
+from .._benchkit import SOLVE_TOL, missing, sizes
+from ..bench import Method, MethodResult, ModelBench, Score
 
-#: A target is solved when the foot at the answer is within this distance (m) of it, inside the limits.
-SOLVE_TOL = 1e-10
-#: Pinocchio CLIK: iteration cap and damping (m^2) of the damped Newton steps.
+__all__ = ["build", "LEG", "CLIK_MAX_ITER", "CLIK_DAMPING", "PEER_TOL", "stripped_urdf", "urdf_chain"]
+
+#: The benched leg when the robot has one of this name (else its first leg).
+LEG = "FL"
+#: Pinocchio CLIK: iteration cap, damping (m^2) of the damped Newton steps and stopping error (m).
 CLIK_MAX_ITER = 100
 CLIK_DAMPING = 1e-12
-#: At most this many targets go to the iterative methods (CLIK gets 10x as many).
-PEER_TARGETS = 200
-LEG = "FL"
+#: The stopping error (m) given to the iterative methods: a tenth of the solved tolerance.
+PEER_TOL = 0.1 * SOLVE_TOL
 
 
-def _stripped_urdf(urdf) -> str:
-    """A temporary copy of ``urdf`` without visual, collision and gazebo elements; returns its path."""
+def _sizes(n: int | None, quick: bool) -> tuple[int, int, int]:
+    """(batch targets, single-call targets, iterative-solver targets); CLIK gets 10x the iterative count."""
+    return sizes(n, quick, full=(20_000, 5_000, 200), small=(1_000, 200, 10))
+
+
+def stripped_urdf(urdf) -> str:
+    """A temporary copy of ``urdf`` without visual, collision and gazebo elements; returns its path (the caller
+    deletes it)."""
     tree = ET.parse(urdf)
     root = tree.getroot()
     for link in root.iter("link"):
@@ -40,178 +52,240 @@ def _stripped_urdf(urdf) -> str:
                 link.remove(e)
     for g in root.findall("gazebo"):
         root.remove(g)
-    fd, path = tempfile.mkstemp(suffix=".urdf", prefix="legkin_go2_")
+    fd, path = tempfile.mkstemp(suffix=".urdf", prefix="legkin_legs_")
     os.close(fd)
     tree.write(path)
     return path
 
 
-def _row(method: str, p: np.ndarray, q: np.ndarray, seconds: float, score, note: str = "") -> dict:
-    err, inside = score(p, q)
-    solved = inside & (err <= SOLVE_TOL)
-    return {
-        "method": method,
-        "targets": int(len(p)),
-        "solved": int(solved.sum()),
-        "success_rate": float(solved.mean()) if len(p) else float("nan"),
-        "us_per_target": 1e6 * seconds / max(len(p), 1),
-        "max_error": float(np.max(np.where(solved, err, 0.0))) if solved.any() else float("nan"),
-        "note": note,
-    }
+def urdf_chain(urdf, frame: str) -> tuple[str, str, list[str]]:
+    """``(root link, end link, [link, joint, link, ..., end link])`` from the URDF's root link to the link
+    ``frame`` (or to the child link of the joint ``frame``)."""
+    root = ET.parse(urdf).getroot()
+    parent = {}  # child link -> (joint, parent link)
+    child_of_joint = {}
+    for j in root.findall("joint"):
+        c, p = j.find("child"), j.find("parent")
+        if c is None or p is None:
+            continue
+        parent[c.get("link")] = (j.get("name"), p.get("link"))
+        child_of_joint[j.get("name")] = c.get("link")
+    links = {link.get("name") for link in root.findall("link")}
+    end = frame if frame in links else child_of_joint.get(frame)
+    if end is None:
+        raise ValueError(f"no link or joint {frame!r} in {urdf}")
+    path = [end]
+    while path[-1] in parent:
+        joint, up = parent[path[-1]]
+        path += [joint, up]
+    path.reverse()
+    return path[0], end, path
 
 
-def _skip(method: str, reason: str) -> dict:
-    return {"method": method, "targets": 0, "solved": 0, "success_rate": float("nan"),
-            "us_per_target": float("nan"), "max_error": float("nan"), "note": f"skipped: {reason}"}
+def build(name: str, n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
+    """The bench of robot ``name``'s leg :data:`LEG` (or first leg).
 
-
-def bench_go2(n: int = 10_000, seed: int = 0) -> list[dict]:
-    """Success rate and time per target of each IK method on ``n`` go2 FL foot targets.
-
-    Rows: ``legkin Leg.ik`` as one batch and as single calls (all ``n`` targets), Pinocchio CLIK (damped Newton
-    ``dq = J^T (J J^T + lambda I)^-1 e`` on the leg's three joints from the mid-limit configuration, clipped into
-    the limits, <= :data:`CLIK_MAX_ITER` iterations; ``10 * PEER_TARGETS`` targets), ikpy and roboticstoolbox
-    ``ik_LM`` (:data:`PEER_TARGETS` targets each) when importable.
-
-    Returns:
-        one dict per method: ``method, targets, solved, success_rate, us_per_target, max_error`` (m, over the
-        solved targets), ``note``.
+    Rows: ``Leg.ik`` as one batch and as single calls, Pinocchio CLIK (damped Newton
+    ``dq = J^T (J J^T + lambda I)^-1 e`` on the leg's three joints from mid-limit, clipped into the limits,
+    <= :data:`CLIK_MAX_ITER` iterations), ikpy and roboticstoolbox ``ik_LM`` (position only) when installed.
     """
     import pinocchio as pin
 
-    from .erd import erd_files, load_erd
-    from .extract import from_model
+    from .. import load
+    from ..errors import LegkinError
 
-    model, urdf, _ = load_erd("go2")
-    leg = from_model(model, LEG)
+    n_batch, n_single, n_iter = _sizes(n, quick)
+    n_clik = min(n_batch, 10 * n_iter)
+    robot = load(name)
+    model = robot.model
     data = model.createData()
+    legs = robot.geometry
+    leg_name = LEG if LEG in legs else next(iter(legs))
+    leg = legs[leg_name]
     fid = model.getFrameId(leg.foot_frame)
     iq, iv = list(leg.idx_q), list(leg.idx_v)
-    q0 = pin.neutral(model)
-    rng = np.random.default_rng(seed)
-    q_true = rng.uniform(leg.lower, leg.upper, (n, 3))
+    lower, upper, q_ref = leg.lower, leg.upper, leg.q_ref
+    q_base = np.array(robot.q0, dtype=float)
+    q_true = rng.uniform(lower, upper, (n_batch, 3))
 
     def pin_foot(qleg: np.ndarray) -> np.ndarray:
-        out = np.empty((len(qleg), 3))
-        q = q0.copy()
-        for k, row in enumerate(qleg):
-            q[iq] = row
+        out = np.full((len(qleg), 3), np.nan)
+        q = q_base.copy()
+        for k in np.flatnonzero(np.isfinite(qleg).all(axis=-1)):
+            q[iq] = qleg[k]
             pin.forwardKinematics(model, data, q)
             out[k] = pin.updateFramePlacement(model, data, fid).translation
         return out
 
-    p = pin_foot(q_true)
+    targets = pin_foot(q_true)
 
-    def score(pt: np.ndarray, q: np.ndarray):
-        ok = np.isfinite(q).all(axis=-1)
-        err = np.full(len(pt), np.inf)
-        if ok.any():
-            err[ok] = np.linalg.norm(pin_foot(q[ok]) - pt[ok], axis=-1)
-        inside = ok & np.all((np.nan_to_num(q) >= leg.lower) & (np.nan_to_num(q) <= leg.upper), axis=-1)
-        return err, inside
+    def score(p: np.ndarray, q: np.ndarray, iters=None) -> Score:
+        q = np.asarray(q, dtype=float)
+        err = np.linalg.norm(pin_foot(q) - p, axis=-1)  # NaN where there is no answer
+        inside = np.all((q >= lower) & (q <= upper), axis=-1)  # False on NaN
+        reached = err <= SOLVE_TOL
+        return Score(error=err, solved=reached & inside, reached=reached, iterations=iters)
 
-    rows = []
-    # ---------------------------------------------------------------- legkin, batch and single calls
-    leg.ik(p[:2])
-    leg.ik(p[0])  # compiled / loaded from the cache before timing
-    best = np.inf
-    for _ in range(3):
-        t0 = time.perf_counter()
-        q = leg.ik(p)
-        best = min(best, time.perf_counter() - t0)
-    rows.append(_row("legkin Leg.ik (batch)", p, q, best, score, "closed form, compiled prange loop"))
-    q = np.full((n, 3), np.nan)
-    t0 = time.perf_counter()
-    for k in range(n):
-        try:
-            q[k] = leg.ik(p[k])
-        except Exception:  # noqa: BLE001 - an unsolved target stays NaN
-            pass
-    rows.append(_row("legkin Leg.ik (single calls)", p, q, time.perf_counter() - t0, score))
+    def score_iter(p, out) -> Score:
+        return score(p, out[0], out[1])
+
+    # ---------------------------------------------------------------- legkin
+    leg.ik(targets[:2])
+    leg.ik(targets[0])  # compiled / loaded from numba's cache before timing
+
+    def batch(p):
+        return leg.ik(p)
+
+    def single(p):
+        out = np.full((len(p), 3), np.nan)
+        ik = leg.ik
+        for k in range(len(p)):
+            try:
+                out[k] = ik(p[k])
+            except LegkinError:
+                pass
+        return out
 
     # ---------------------------------------------------------------- Pinocchio CLIK
-    m = min(n, 10 * PEER_TARGETS)
-    q = np.empty((m, 3))
-    t0 = time.perf_counter()
-    for k in range(m):
-        qk = q0.copy()
-        qk[iq] = leg.q_ref
-        for _ in range(CLIK_MAX_ITER):
-            pin.forwardKinematics(model, data, qk)
-            e = p[k] - pin.updateFramePlacement(model, data, fid).translation
-            if np.linalg.norm(e) <= 0.1 * SOLVE_TOL:
-                break
-            jac = pin.computeFrameJacobian(model, data, qk, fid, pin.LOCAL_WORLD_ALIGNED)[:3, iv]
-            dq = jac.T @ np.linalg.solve(jac @ jac.T + CLIK_DAMPING * np.eye(3), e)
-            qk[iq] = np.clip(qk[iq] + dq, leg.lower, leg.upper)
-        q[k] = qk[iq]
-    rows.append(_row("Pinocchio CLIK (damped Newton, 3 leg joints)", p[:m], q, time.perf_counter() - t0, score,
-                     f"from mid-limit, damping {CLIK_DAMPING:g}, <= {CLIK_MAX_ITER} iterations, clipped into limits"))
+    def clik(p):
+        q = np.full((len(p), 3), np.nan)
+        iters = np.zeros(len(p))
+        eye = CLIK_DAMPING * np.eye(3)
+        for k in range(len(p)):
+            qk = q_base.copy()
+            qk[iq] = q_ref
+            for it in range(CLIK_MAX_ITER + 1):
+                pin.forwardKinematics(model, data, qk)
+                e = p[k] - pin.updateFramePlacement(model, data, fid).translation
+                if np.linalg.norm(e) <= PEER_TOL or it == CLIK_MAX_ITER:
+                    break
+                jac = pin.computeFrameJacobian(model, data, qk, fid, pin.LOCAL_WORLD_ALIGNED)[:3, iv]
+                qk[iq] = np.clip(qk[iq] + jac.T @ np.linalg.solve(jac @ jac.T + eye, e), lower, upper)
+            q[k], iters[k] = qk[iq], it
+        return q, iters
 
-    m = min(n, PEER_TARGETS)
-    path = None
+    methods = [
+        Method(f"legkin Leg.ik batch (closed form; {n_batch} at once)", targets, batch, score, repeats=5),
+        Method("legkin Leg.ik single calls (Python loop)", targets, single, score, max_targets=n_single, repeats=3),
+        Method("pinocchio CLIK (damped Newton, 3 leg joints)", targets, clik, score_iter, max_targets=n_clik,
+               repeats=1 if quick else 3),
+    ]
+    methods += _peers(name, leg, targets, n_iter, score_iter, quick)
+    notes = [
+        f"{name} leg {leg_name} ({', '.join(leg.joint_names)} -> {leg.foot_frame}), fixed base; targets: "
+        f"Pinocchio's {leg.foot_frame} for {n_batch} joint vectors uniform in the URDF limits (other joints at q0); "
+        f"single calls solve the first {n_single}, CLIK the first {n_clik}, the peers the first {n_iter}",
+        "err = |Pinocchio foot at the answer - target| (m); solved also needs the joints inside the URDF limits, "
+        "reached does not",
+        f"pinocchio CLIK: from mid-limit, damping {CLIK_DAMPING:g}, stop at |e| <= {PEER_TOL:g} m or "
+        f"{CLIK_MAX_ITER} iterations, each step clipped into the limits",
+    ]
+
+    def summary(results: list[MethodResult]) -> list[str]:
+        b = next(r for r in results if "batch" in r.name)
+        s = next(r for r in results if "single" in r.name)
+        lines = []
+        for r in results:
+            if r is b or r is s:
+                continue
+            lines.append(f"batch Leg.ik is {r.time_per_target_s / b.time_per_target_s:,.0f}x and a single call "
+                         f"{r.time_per_target_s / s.time_per_target_s:,.1f}x faster than {r.name.split(' (')[0]}")
+        return lines
+
+    return ModelBench(
+        methods=methods,
+        units={"ik": "m"},
+        tolerance=f"foot error <= {SOLVE_TOL:g} m and joints inside the URDF limits",
+        notes=notes,
+        summary=summary,
+    )
+
+
+def _peers(name: str, leg, targets: np.ndarray, n_iter: int, score: Callable, quick: bool) -> list[Method]:
+    """The ikpy and roboticstoolbox rows (set up here, untimed), or skipped rows saying why."""
+    from .erd import ERD_ROBOTS, erd_files
+
+    ikpy_name = "ikpy inverse_kinematics (position)"
+    rtb_name = "roboticstoolbox ik_LM (position mask)"
+    if name not in ERD_ROBOTS:
+        why = f"{name} is not an example-robot-data robot (no URDF file for the peers)"
+        return [Method(ikpy_name, skip=why), Method(rtb_name, skip=why)]
+    repeats = 1 if quick else 3
+    out: list[Method] = []
+    path = stripped_urdf(erd_files(name)[0])
     try:
-        path = _stripped_urdf(erd_files("go2")[0])
-        # ---------------------------------------------------------------- ikpy
-        try:
-            import ikpy.chain
-
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                chain = ikpy.chain.Chain.from_urdf_file(path, base_elements=["base", leg.joint_names[0]])
-                mask = [link.joint_type != "fixed" for link in chain.links]
-                chain = ikpy.chain.Chain.from_urdf_file(path, base_elements=["base", leg.joint_names[0]],
-                                                        active_links_mask=mask)
-            active = np.flatnonzero(mask)
-            init = np.zeros(len(chain.links))
-            init[active] = leg.q_ref
-            q = np.empty((m, 3))
-            t0 = time.perf_counter()
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                for k in range(m):
-                    q[k] = chain.inverse_kinematics(p[k], initial_position=init)[active]
-            rows.append(_row("ikpy inverse_kinematics (position)", p[:m], q, time.perf_counter() - t0, score,
-                             "from mid-limit, ikpy defaults"))
-        except ImportError as exc:
-            rows.append(_skip("ikpy inverse_kinematics (position)", f"not installed ({exc})"))
-        except Exception as exc:  # noqa: BLE001 - a peer that cannot be set up is a skipped row
-            rows.append(_skip("ikpy inverse_kinematics (position)", f"{type(exc).__name__}: {exc}"))
-        # ---------------------------------------------------------------- roboticstoolbox
-        try:
-            import roboticstoolbox as rtb
-
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
-                rob = rtb.Robot.URDF(path)
-            ets = rob.ets(start="base", end=leg.foot_frame)
-            tol = 0.5 * (0.1 * SOLVE_TOL) ** 2  # ik_LM's tol bounds 1/2 |e|^2
-            wmask = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
-            tep = np.eye(4)
-            q = np.empty((m, 3))
-            t0 = time.perf_counter()
-            for k in range(m):
-                tep[:3, 3] = p[k]
-                q[k] = ets.ik_LM(tep, q0=np.array(leg.q_ref), mask=wmask, tol=tol, joint_limits=True)[0]
-            rows.append(_row("roboticstoolbox ik_LM (position mask)", p[:m], q, time.perf_counter() - t0, score,
-                             "from mid-limit, joint_limits=True, defaults otherwise"))
-        except ImportError as exc:
-            rows.append(_skip("roboticstoolbox ik_LM (position mask)", f"not installed ({exc})"))
-        except Exception as exc:  # noqa: BLE001
-            rows.append(_skip("roboticstoolbox ik_LM (position mask)", f"{type(exc).__name__}: {exc}"))
+        base, end, chain_names = urdf_chain(path, leg.foot_frame)
+        reason = missing("ikpy")
+        if reason:
+            out.append(Method(ikpy_name, skip=reason))
+        else:
+            try:
+                out.append(_ikpy(ikpy_name, path, chain_names, leg, targets, n_iter, score, repeats))
+            except Exception as exc:  # noqa: BLE001 - a peer that cannot be set up is a skipped row
+                out.append(Method(ikpy_name, skip=f"cannot set up: {type(exc).__name__}: {exc}"))
+        reason = missing("roboticstoolbox-python", "roboticstoolbox")
+        if reason:
+            out.append(Method(rtb_name, skip=reason))
+        else:
+            try:
+                out.append(_rtb(rtb_name, path, base, end, leg, targets, n_iter, score, repeats))
+            except Exception as exc:  # noqa: BLE001
+                out.append(Method(rtb_name, skip=f"cannot set up: {type(exc).__name__}: {exc}"))
     finally:
-        if path is not None:
-            os.unlink(path)
-    return rows
+        os.unlink(path)
+    return out
 
 
-def format_rows(rows: list[dict]) -> str:
-    """A Markdown table of :func:`bench_go2`'s rows."""
-    lines = ["| method | targets | solved | success | us / target | max error (m) | note |",
-             "|---|---:|---:|---:|---:|---:|---|"]
-    for r in rows:
-        lines.append(
-            f"| {r['method']} | {r['targets']} | {r['solved']} | {r['success_rate']:.1%} | {r['us_per_target']:.3g} | "
-            f"{r['max_error']:.2e} | {r['note']} |"
-        )
-    return "\n".join(lines)
+def _ikpy(label, path, chain_names, leg, targets, n_iter, score, repeats) -> Method:
+    import ikpy.chain
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        chain = ikpy.chain.Chain.from_urdf_file(path, base_elements=list(chain_names))
+        names = [link.name for link in chain.links]
+        mask = [link.joint_type != "fixed" for link in chain.links]
+        chain = ikpy.chain.Chain.from_urdf_file(path, base_elements=list(chain_names), active_links_mask=mask)
+    active = [i for i, nm in enumerate(names) if nm in leg.joint_names]
+    if [names[i] for i in active] != list(leg.joint_names) or chain.links[-1].name != chain_names[-2]:
+        raise ValueError(f"ikpy's chain {names} is not the leg's ({leg.joint_names} -> {chain_names[-1]})")
+    init = np.zeros(len(chain.links))
+    init[active] = leg.q_ref
+
+    def run(p):
+        q = np.full((len(p), 3), np.nan)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            for k in range(len(p)):
+                q[k] = chain.inverse_kinematics(p[k], initial_position=init)[active]
+        return q, None
+
+    return Method(label, targets, run, score, max_targets=n_iter, repeats=repeats,
+                  note="Chain.from_urdf_file (root link to foot), from mid-limit, position only, ikpy defaults")
+
+
+def _rtb(label, path, base, end, leg, targets, n_iter, score, repeats) -> Method:
+    import roboticstoolbox as rtb
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rob = rtb.Robot.URDF(path)
+    ets = rob.ets(start=base, end=end)
+    if ets.n != 3:
+        raise ValueError(f"the ETS {base} -> {end} has {ets.n} joints, not 3")
+    tol = 0.5 * PEER_TOL**2  # ik_LM's tol bounds 1/2 |e|^2 on the masked rows
+    wmask = np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
+    q0 = np.array(leg.q_ref)
+
+    def run(p):
+        q = np.full((len(p), 3), np.nan)
+        iters = np.zeros(len(p))
+        tep = np.eye(4)
+        for k in range(len(p)):
+            tep[:3, 3] = p[k]
+            sol: Any = ets.ik_LM(tep, q0=q0, mask=wmask, tol=tol, joint_limits=True)
+            q[k], iters[k] = sol.q, sol.iterations
+        return q, iters
+
+    return Method(label, targets, run, score, max_targets=n_iter, repeats=repeats,
+                  note=f"Robot.URDF, ets({base}..{end}).ik_LM(mask=[1,1,1,0,0,0], tol=1/2 {PEER_TOL:g}^2, "
+                  "joint_limits=True, q0=mid-limit), defaults otherwise")

@@ -248,17 +248,11 @@ _FOLD = np.array(FOLD_OFFSETS)
 
 
 @kernel
-def solutions_k(t1, t2, tol, max_iter, xs, bl, sdet):
-    """Every platform pose within the joint limits closing both rods for motors (t1, t2): xs (m, 2), motor
-    branch bl (m, 2) (0 on a chain's reach boundary), sign det N sdet (m,). Returns m (duplicates possible).
-
-    The roots of the degree-8 polynomial in tan(roll / 2) with |roll| <= ~pi/2 (and nearly real complex pairs),
-    their pitch from the two rod equations (linear in cos, sin pitch), each polished by Newton; near the forward
-    singularity, extra Newton runs from both sides of each near-singular solution with the det N barrier.
-    """
-    tip = np.empty((2, 3))
-    dtip = np.empty((2, 3))
-    tips_k(t1, t2, tip, dtip)
+def seeds_k(tip, x0, imag):
+    """Starting poses x0 (k, 2) for Newton from the roots of the degree-8 polynomial of the lever tips tip (2, 3): the
+    roots with |roll| <= ~pi/2 (and nearly real complex pairs, imag (k,) their imaginary part), the pitch of each
+    from the two rod equations (linear in cos, sin pitch), and where those equations are (nearly) parallel the two
+    pitches that close the better-conditioned one. Returns k."""
     poly = np.empty(9)
     al = np.empty((2, 3))
     be = np.empty((2, 3))
@@ -266,8 +260,6 @@ def solutions_k(t1, t2, tol, max_iter, xs, bl, sdet):
     roll_poly_k(tip, poly, al, be, ga)
     z = np.empty(8, dtype=np.complex128)
     nr = roots_k(poly, z)
-    x0 = np.empty((MAX_SOL, 2))
-    imag = np.empty(MAX_SOL)
     m = 0
     nbad = 0
     bad = np.empty((8, 4))  # roll, base, c, imag of the seeds whose rod equations are (nearly) parallel
@@ -311,9 +303,15 @@ def solutions_k(t1, t2, tol, max_iter, xs, bl, sdet):
             x0[m, 1] = p_ if math.isfinite(p_) else 0.0
             imag[m] = bad[j, 3]
             m += 1
-    nseed = m
-    x = np.empty((MAX_SOL, 2))
-    err = np.empty(MAX_SOL)
+    return m
+
+
+@kernel
+def polish_k(tip, x0, imag, nseed, tol, max_iter, x, err):
+    """Newton on the rod equations from each seed x0[:nseed] into x, err (rod-length error, m); near the forward
+    singularity also from both sides of each near-singular solution (or unconverged nearly real root), along the
+    null vector of N, with the det N barrier. Returns the number of poses in x."""
+    m = nseed
     g = np.empty(2)
     nm = np.empty((2, 2))
     v = np.empty(2)
@@ -349,6 +347,15 @@ def solutions_k(t1, t2, tol, max_iter, xs, bl, sdet):
                 x[m, 1] = near[j, 1] + sgn * h * near[j, 3]
                 err[m] = rod_newton_k(x[m], tip, max_iter, True)
                 m += 1
+    return m
+
+
+@kernel
+def label_k(tip, dtip, x, err, m, tol, xs, bl, sdet):
+    """The poses x[:m] within the joint limits that close both rods within tol, into xs, with their motor branch
+    bl (0 on a chain's reach boundary) and sign of det N sdet. Returns their number."""
+    g = np.empty(2)
+    nm = np.empty((2, 2))
     kk = np.empty(2)
     th = np.empty(2)
     rot = np.empty((3, 3))
@@ -379,3 +386,25 @@ def solutions_k(t1, t2, tol, max_iter, xs, bl, sdet):
         sdet[out] = sgn_k(nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0])
         out += 1
     return out
+
+
+
+@kernel
+def solutions_k(t1, t2, tol, max_iter, xs, bl, sdet):
+    """Every platform pose within the joint limits closing both rods for motors (t1, t2): xs (m, 2), motor
+    branch bl (m, 2) (0 on a chain's reach boundary), sign det N sdet (m,). Returns m (duplicates possible).
+
+    The roots of the degree-8 polynomial in tan(roll / 2) with |roll| <= ~pi/2 (and nearly real complex pairs),
+    their pitch from the two rod equations (linear in cos, sin pitch), each polished by Newton; near the forward
+    singularity, extra Newton runs from both sides of each near-singular solution with the det N barrier.
+    """
+    tip = np.empty((2, 3))
+    dtip = np.empty((2, 3))
+    tips_k(t1, t2, tip, dtip)
+    x0 = np.empty((MAX_SOL, 2))
+    imag = np.empty(MAX_SOL)
+    nseed = seeds_k(tip, x0, imag)
+    x = np.empty((MAX_SOL, 2))
+    err = np.empty(MAX_SOL)
+    m = polish_k(tip, x0, imag, nseed, tol, max_iter, x, err)
+    return label_k(tip, dtip, x, err, m, tol, xs, bl, sdet)

@@ -74,65 +74,67 @@ def single_calls() -> list[SingleCall]:
     ]
 
 
-def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
-    n_batch, n_scalar, n_iter = _sizes(n, quick)
-    import pinocchio as pin
+class _Setup:
+    """The bench's model, targets' contact frames and scoring, shared by every method."""
 
-    robot = load("wheel_leg")
-    model, data = robot.model, robot.data
-    geo = wl.Geometry.from_params(robot.params)
-    k_leg = wl.LEGS.index(LEG)
+    def __init__(self, rng: np.random.Generator, n_batch: int):
+        self.robot = robot = load("wheel_leg")
+        self.model, self.data = robot.model, robot.data
+        self.geo = wl.Geometry.from_params(robot.params)
+        self.k_leg = wl.LEGS.index(LEG)
+        q_leg = sample_leg_q(n_batch, rng)
+        alpha = rng.uniform(-np.pi, np.pi, n_batch)
+        w = rng.uniform(-self.geo.T / 2, self.geo.T / 2, n_batch)
+        self.local, seg = local_contact_point(alpha, w, self.geo)
+        self.frame_ids = np.array([robot.frame_id(f"{LEG}_{SEGMENT_LINKS[s][0]}") for s in range(4)])[seg]
+        self.i_theta = (robot.idx_q(f"{LEG}_phi_L"), robot.idx_q(f"{LEG}_phi_R"))
+        targets, _ = self.contact_and_residual(self.full_config(q_leg), np.arange(n_batch))
+        self.inputs = (targets, alpha, w)
 
-    q_leg = sample_leg_q(n_batch, rng)
-    alpha = rng.uniform(-np.pi, np.pi, n_batch)
-    w = rng.uniform(-geo.T / 2, geo.T / 2, n_batch)
-    local, seg = local_contact_point(alpha, w, geo)
-    frame_ids = np.array([robot.frame_id(f"{LEG}_{SEGMENT_LINKS[s][0]}") for s in range(4)])[seg]
-
-    def full_config(leg_q: np.ndarray) -> np.ndarray:
+    def full_config(self, leg_q: np.ndarray) -> np.ndarray:
         """Configurations closing every loop: leg FL at ``leg_q``, the other legs in wheel mode."""
         all_q = np.tile(np.array([wl.THETA0, 0.0, 0.0]), (len(leg_q), 4, 1))
-        all_q[:, k_leg] = leg_q
-        return configuration(robot, all_q)
+        all_q[:, self.k_leg] = leg_q
+        return configuration(self.robot, all_q)
 
-    def contact_and_residual(qs: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def contact_and_residual(self, qs: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Pinocchio's contact point and loop residual of configurations ``qs`` (the targets' rows)."""
+        import pinocchio as pin
+
         pos = np.full((len(qs), 3), np.nan)
         res = np.full(len(qs), np.nan)
         for i, q in zip(rows, qs):
             if np.all(np.isfinite(q)):
-                pin.framesForwardKinematics(model, data, q)
-                M = data.oMf[int(frame_ids[i])]
-                pos[i] = M.translation + M.rotation @ local[i]
-                res[i] = np.linalg.norm(robot.constraint_residual(q))
+                pin.framesForwardKinematics(self.model, self.data, q)
+                M = self.data.oMf[int(self.frame_ids[i])]
+                pos[i] = M.translation + M.rotation @ self.local[i]
+                res[i] = np.linalg.norm(self.robot.constraint_residual(q))
         return pos, res
 
-    targets, _ = contact_and_residual(full_config(q_leg), np.arange(n_batch))
-    inputs = (targets, alpha, w)
-    i_theta = (robot.idx_q(f"{LEG}_phi_L"), robot.idx_q(f"{LEG}_phi_R"))
-
-    def theta_ok(theta):
-        with np.errstate(invalid="ignore"):
-            return (theta >= wl.THETA_MIN - 1e-12) & (theta <= wl.THETA_MAX + 1e-12)
-
-    def score_configs(inp, qs, theta, iters, evals) -> Score:
-        k = len(inp[0])
-        pos, res = contact_and_residual(qs, np.arange(k))
+    def score_configs(self, inp, qs, theta, iters, evals) -> Score:
+        pos, res = self.contact_and_residual(qs, np.arange(len(inp[0])))
         err = np.linalg.norm(pos - inp[0], axis=-1)
-        ok = (err <= SOLVE_TOL) & (res <= SOLVE_TOL) & theta_ok(theta)
+        with np.errstate(invalid="ignore"):
+            theta_ok = (theta >= wl.THETA_MIN - 1e-12) & (theta <= wl.THETA_MAX + 1e-12)
+        ok = (err <= SOLVE_TOL) & (res <= SOLVE_TOL) & theta_ok
         return Score(error=err, solved=ok, orientation=res, iterations=iters, fk_evals=evals, reached=err <= SOLVE_TOL)
 
     # ---------------------------------------------------------------- legkin
-    def analytic(method: str, scalar: bool = False):
+    def analytic(self, method: str, scalar: bool = False):
+        """(run, score) of ``wl.ik(method=method)``: one batch call, or single calls in a Python loop."""
+        geo = self.geo
+
         def run(inp):
             t, a, ww = inp
             if not scalar:
-                return wl.ik(t, LEG, alpha=a, w=ww, method=method, options=OPTIONS, geometry=geo, return_info=True)
+                return wl.ik(t, LEG, alpha=a, w=ww, method=method, options=OPTIONS, geometry=geo,  # type: ignore[call-overload]
+                             return_info=True)
             q, its = np.full((len(t), 3), np.nan), np.zeros(len(t), dtype=int)
             evals = np.full(len(t), np.nan)
             for i in range(len(t)):
                 try:
-                    q[i], info = wl.ik(t[i], LEG, alpha=a[i], w=ww[i], method=method, options=OPTIONS, geometry=geo,
-                                       return_info=True)
+                    q[i], info = wl.ik(t[i], LEG, alpha=a[i], w=ww[i], method=method, options=OPTIONS,  # type: ignore[call-overload]
+                                       geometry=geo, return_info=True)
                     its[i], evals[i] = info.iterations, info.evaluations
                 except UnreachableError:
                     pass
@@ -143,31 +145,35 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
             k = len(q)
             evals = np.full(k, np.nanmean(info.evaluations))  # IKInfo.evaluations: linkage evaluations per target
             finite = np.all(np.isfinite(q), axis=-1)
-            qs = np.full((k, model.nq), np.nan)
+            qs = np.full((k, self.model.nq), np.nan)
             if finite.any():
-                qs[finite] = full_config(q[finite])
-            return score_configs(inp, qs, q[:, 0], info.iterations.astype(float), evals)
+                qs[finite] = self.full_config(q[finite])
+            return self.score_configs(inp, qs, q[:, 0], info.iterations.astype(float), evals)
 
         return run, score
 
     # ---------------------------------------------------------------- Pinocchio closed-loop IK
-    free = np.zeros(model.nv, dtype=bool)
-    for j in leg_joint_names(LEG):
-        free[robot.idx_v(j)] = True
-    loopset = robot._loopset
-    ldata = loopset.data
+    def pin_ik(self, inp):
+        """The Levenberg-Marquardt of Robot.solve_loops on [16 loop residuals; contact point - target], the 11
+        joints of leg FL free, from the analytic IK's first start."""
+        import pinocchio as pin
 
-    def pin_ik(inp):
+        model = self.model
+        free = np.zeros(model.nv, dtype=bool)
+        for j in leg_joint_names(LEG):
+            free[self.robot.idx_v(j)] = True
+        loopset = self.robot._loopset
+        ldata = loopset.data
         t, a, ww = inp
         k = len(t)
-        starts = ik_start(t, LEG, alpha=a, w=ww, geometry=geo)  # the analytic IK's start
+        starts = ik_start(t, LEG, alpha=a, w=ww, geometry=self.geo)
         qs = np.full((k, model.nq), np.nan)
         iters, evals = np.full(k, np.nan), np.full(k, np.nan)
-        q_start = full_config(np.column_stack([np.clip(starts[:, 0], wl.THETA_MIN, wl.THETA_MAX), starts[:, 1:]]))
+        q_start = self.full_config(np.column_stack([np.clip(starts[:, 0], wl.THETA_MIN, wl.THETA_MAX), starts[:, 1:]]))
         for i in range(k):
-            fid, loc, target = int(frame_ids[i]), local[i], t[i]
+            fid, loc, target = int(self.frame_ids[i]), self.local[i], t[i]
 
-            def residual_and_jacobian(q):
+            def residual_and_jacobian(q, fid=fid, loc=loc, target=target):
                 r, jc = loopset.residual_and_jacobian(q)  # forwardKinematics + computeJointJacobians in ldata
                 pin.updateFramePlacement(model, ldata, fid)
                 M = ldata.oMf[fid]
@@ -182,31 +188,14 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
                 qs[i] = q
         return qs, iters, evals
 
-    def pin_score(inp, out) -> Score:
+    def pin_score(self, inp, out) -> Score:
         qs, iters, evals = out
-        theta = (qs[:, i_theta[0]] - qs[:, i_theta[1]]) / 2 + wl.THETA0
-        return score_configs(inp, qs, theta, iters, evals)
+        theta = (qs[:, self.i_theta[0]] - qs[:, self.i_theta[1]]) / 2 + wl.THETA0
+        return self.score_configs(inp, qs, theta, iters, evals)
 
-    run_d, score_d = analytic("damped")
-    run_s, score_s = analytic("gauss_newton_fd")
-    run_r, score_r = analytic("radial")
-    run_d1, score_d1 = analytic("damped", scalar=True)
-    run_s1, score_s1 = analytic("gauss_newton_fd", scalar=True)
-    run_r1, score_r1 = analytic("radial", scalar=True)
-    methods = [
-        Method(f"legkin batch ik, analytic Jacobian (method='damped'; {n_batch} at once)", inputs, run_d, score_d,
-               repeats=5),
-        Method(f"legkin batch ik, radial (method='radial'; {n_batch} at once)", inputs, run_r, score_r, repeats=5),
-        Method("seed Gauss-Newton, forward differences (method='gauss_newton_fd'; batch)", inputs, run_s, score_s,
-               repeats=5),
-        Method("legkin scalar ik (damped), Python loop", inputs, run_d1, score_d1, max_targets=n_scalar, repeats=3),
-        Method("legkin scalar ik (radial), Python loop", inputs, run_r1, score_r1, max_targets=n_scalar, repeats=3),
-        Method("seed forward-difference Gauss-Newton, scalar calls in a loop", inputs, run_s1, score_s1,
-               max_targets=n_scalar, repeats=3),
-        Method("pinocchio closed-loop IK (LM on loops + contact point)", inputs, pin_ik, pin_score,
-               max_targets=n_iter, repeats=3),
-    ]
-    notes = [
+
+def _notes(n_batch: int, n_scalar: int, n_iter: int) -> list[str]:
+    return [
         f"targets: Pinocchio contact point of leg {LEG} for {n_batch} random (theta in [17, 160] deg, "
         "beta in [-pi, pi], "
         f"|gamma| <= 0.6), alpha in [-pi, pi], |w| <= T/2; scalar loops solve the first {n_scalar}, Pinocchio the "
@@ -217,48 +206,73 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         "method's FK also returns the Jacobian; radial: rows of its leg-plane closed form with theta-derivative "
         "(Newton steps) plus the final contact FK that checks the answer, its 17-node grid and start table "
         "look-ups are not counted; Pinocchio: residual + Jacobian evaluations)",
-        f"every method is given tolerance {TOL:g} m; the legkin methods are vectorised over the batch; damped "
-        "and seed start from the same geometric guess, the damped method restarts failures from two more "
+        f"every method is given tolerance {TOL:g} m; the legkin methods are compiled per target; damped "
+        "and gauss_newton_fd start from the same geometric guess, the damped method restarts failures from two more "
         "guesses and takes one polishing step; radial solves gamma and beta in closed form and theta by a "
         "bracketed 1-D Newton (no start needed, every root found, the first returned); the Pinocchio IK starts "
-        "from the configuration of the damped/seed first guess",
+        "from the configuration of the damped/gauss_newton_fd first guess (configuration.ik_start)",
         "pinocchio closed-loop IK: the Levenberg-Marquardt of Robot.solve_loops on [16 loop residuals; contact "
         "point - target] with the 11 joints of the leg free, contact Jacobian from getFrameJacobian",
     ]
 
-    def summary(results: list[MethodResult]) -> list[str]:
-        d = next(r for r in results if "batch ik, analytic" in r.name)
-        r = next(r for r in results if "batch ik, radial" in r.name)
-        s = next(r for r in results if "forward differences" in r.name)
-        d1 = next(r for r in results if "scalar ik (damped)" in r.name)
-        r1 = next(r for r in results if "scalar ik (radial)" in r.name)
-        s1 = next(r for r in results if "scalar calls" in r.name)
-        p = next(r for r in results if "pinocchio" in r.name)
 
-        def acc(x):
-            if not np.isfinite(x.max_error):
-                return f"{x.solved:.1f}% solved, some targets unsolved"
-            worst = f"max error {x.max_error:.1e} m"
-            return f"{x.solved:.1f}% solved, {worst}"
+def _summary(results: list[MethodResult]) -> list[str]:
+    d = next(r for r in results if "batch ik, analytic" in r.name)
+    r = next(r for r in results if "batch ik, radial" in r.name)
+    s = next(r for r in results if "forward differences" in r.name)
+    d1 = next(r for r in results if "scalar ik (damped)" in r.name)
+    r1 = next(r for r in results if "scalar ik (radial)" in r.name)
+    s1 = next(r for r in results if "scalar calls" in r.name)
+    p = next(r for r in results if "pinocchio" in r.name)
 
-        return [
-            "speed-up over the seed's finite-difference iteration (target >= 10x at equal or better accuracy): "
-            f"damped (analytic Jacobian) {s.time_per_target_s / d.time_per_target_s:.2f}x batch, "
-            f"{s1.time_per_target_s / d1.time_per_target_s:.2f}x scalar calls; radial "
-            f"{s.time_per_target_s / r.time_per_target_s:.2f}x batch, "
-            f"{s1.time_per_target_s / r1.time_per_target_s:.2f}x scalar calls",
-            f"accuracy (batch): damped {acc(d)}; radial {acc(r)}; seed {acc(s)}",
-            f"batch ik is {p.time_per_target_s / d.time_per_target_s:,.0f}x (damped) / "
-            f"{p.time_per_target_s / r.time_per_target_s:,.0f}x (radial) and the scalar call "
-            f"{p.time_per_target_s / d1.time_per_target_s:,.1f}x / {p.time_per_target_s / r1.time_per_target_s:,.1f}x "
-            "faster than the Pinocchio closed-loop IK",
-        ]
+    def acc(x):
+        if not np.isfinite(x.max_error):
+            return f"{x.solved:.1f}% solved, some targets unsolved"
+        return f"{x.solved:.1f}% solved, max error {x.max_error:.1e} m"
 
+    return [
+        "speed-up over the seed's finite-difference iteration (target >= 10x at equal or better accuracy): "
+        f"damped (analytic Jacobian) {s.time_per_target_s / d.time_per_target_s:.2f}x batch, "
+        f"{s1.time_per_target_s / d1.time_per_target_s:.2f}x scalar calls; radial "
+        f"{s.time_per_target_s / r.time_per_target_s:.2f}x batch, "
+        f"{s1.time_per_target_s / r1.time_per_target_s:.2f}x scalar calls",
+        f"accuracy (batch): damped {acc(d)}; radial {acc(r)}; seed {acc(s)}",
+        f"batch ik is {p.time_per_target_s / d.time_per_target_s:,.0f}x (damped) / "
+        f"{p.time_per_target_s / r.time_per_target_s:,.0f}x (radial) and the scalar call "
+        f"{p.time_per_target_s / d1.time_per_target_s:,.1f}x / {p.time_per_target_s / r1.time_per_target_s:,.1f}x "
+        "faster than the Pinocchio closed-loop IK",
+    ]
+
+
+def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
+    """The IK methods on the same Pinocchio-made targets of leg FL (see the module docstring)."""
+    n_batch, n_scalar, n_iter = _sizes(n, quick)
+    setup = _Setup(rng, n_batch)
+    inputs = setup.inputs
+    run_d, score_d = setup.analytic("damped")
+    run_s, score_s = setup.analytic("gauss_newton_fd")
+    run_r, score_r = setup.analytic("radial")
+    run_d1, score_d1 = setup.analytic("damped", scalar=True)
+    run_s1, score_s1 = setup.analytic("gauss_newton_fd", scalar=True)
+    run_r1, score_r1 = setup.analytic("radial", scalar=True)
+    methods = [
+        Method(f"legkin batch ik, analytic Jacobian (method='damped'; {n_batch} at once)", inputs, run_d, score_d,
+               repeats=5),
+        Method(f"legkin batch ik, radial (method='radial'; {n_batch} at once)", inputs, run_r, score_r, repeats=5),
+        Method("seed Gauss-Newton, forward differences (method='gauss_newton_fd'; batch)", inputs, run_s, score_s,
+               repeats=5),
+        Method("legkin scalar ik (damped), Python loop", inputs, run_d1, score_d1, max_targets=n_scalar, repeats=3),
+        Method("legkin scalar ik (radial), Python loop", inputs, run_r1, score_r1, max_targets=n_scalar, repeats=3),
+        Method("seed forward-difference Gauss-Newton, scalar calls in a loop", inputs, run_s1, score_s1,
+               max_targets=n_scalar, repeats=3),
+        Method("pinocchio closed-loop IK (LM on loops + contact point)", inputs, setup.pin_ik, setup.pin_score,
+               max_targets=n_iter, repeats=3),
+    ]
     return ModelBench(
         methods=methods,
         units={"ik": "m"},
         tolerance=f"contact error <= {SOLVE_TOL:g} m, loop |r| <= {SOLVE_TOL:g}, theta in [17, 160] deg",
-        notes=notes,
-        summary=summary,
+        notes=_notes(n_batch, n_scalar, n_iter),
+        summary=_summary,
         secondary="loop |r|",
     )

@@ -279,11 +279,11 @@ def solution_distance(solutions: np.ndarray, q: np.ndarray) -> np.ndarray:
 def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 2000) -> CheckResult:
     """The IK contract row: the default :func:`wl.ik` on ``n`` random targets in and around the workspace.
 
-    Half the targets (``made``) are :func:`wl.contact_point` of random joints inside the URDF limits (theta over
+    Half the targets (``made``) are :func:`wl.fk` of random joints inside the URDF limits (theta over
     [17, 160] deg, beta over the circle, gamma over [-pi/2, pi/2], 10 % of them on a limit) at random rim
     points (alpha, w); a quarter are such targets pushed off by up to 5 cm in a random direction; a quarter are
     uniform in a 0.8 m box around the module origin. Legs in turn. Each solved answer is scored by the
-    default :func:`wl.contact_point`; up to ``classify`` unsolved targets are classified by single calls.
+    default :func:`wl.fk`; up to ``classify`` unsolved targets are classified by single calls.
     """
     from ..validation import classify_failures, robustness_row
 

@@ -349,7 +349,7 @@ def _k_fk(theta, beta, gamma, upper, right, e, seed, K, KC, s, a, o0, o1, o2, wa
 
 @kernel
 def _k_contact(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac, p, J):
-    """:func:`contact_point` / :func:`contact_jacobian` for one item, inputs range-checked (status codes)."""
+    """:func:`fk` / :func:`jacobian` for one item, inputs range-checked (status codes)."""
     theta = q[0]
     if not (math.isfinite(theta) and math.isfinite(q[1]) and math.isfinite(q[2]) and math.isfinite(alpha)
             and math.isfinite(w)):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from .. import load
@@ -91,12 +93,45 @@ def platform_dof(robot, q: np.ndarray, locked=ACTUATED, tol: float = 1e-9) -> tu
     return r, axis * np.sign(axis[2]) if r else axis
 
 
+@dataclass
+class _Workspace:
+    """The samples the rows share: platform poses of the neutral mode, their motors and FK, LL angles, closed
+    configurations and the Pinocchio feet."""
+
+    roll: np.ndarray
+    pitch: np.ndarray
+    th: np.ndarray
+    x: np.ndarray
+    tll: np.ndarray
+    qs: np.ndarray
+    pos: np.ndarray
+    theta0: np.ndarray
+
+
 def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
-    rows: list[CheckResult] = []
+    """The ``legkin check hybrid_leg`` rows (without the IK-contract row, :func:`ik_robustness`)."""
     robot = load("hybrid_leg")
     n = int(samples)
     ns = min(n, SOLVE_SAMPLES)
+    rows = _motor_rows(robot, n, rng)
+    roll, pitch = sample_workspace(n, rng)
+    th = ah.motor_angles(roll, pitch)
+    x = ah.platform_orientation(th[:, 0], th[:, 1])
+    rows += _orientation_rows(roll, pitch, x, n, rng)
+    tll = rng.uniform(*LL_RANGE, n)
+    qs = closed_configuration(robot, np.stack([roll, pitch], -1), tll)
+    pos = pinocchio_frames(robot, qs, ["FCS"])[0][:, 0]
+    w = _Workspace(roll, pitch, th, x, tll, qs, pos, np.asarray(ah.extension_motor_angle(tll)))
+    rows += _solve_loops_rows(robot, w, ns, rng)
+    rows += _foot_rows(w)
+    rows += _ik_rows(robot, w, ns)
+    rows += _jacobian_rows(robot, w, n)
+    rows += _mobility_rows(robot, roll[:ns], pitch[:ns], rng)
+    return rows
 
+
+def _motor_rows(robot, n: int, rng: np.random.Generator) -> list[CheckResult]:  # noqa: ANN001
+    rows: list[CheckResult] = []
     # -- motor_angles -> Pinocchio: loops closed, platform as asked (all four motor branches)
     r0 = rng.uniform(-1.0, 1.0, 4 * n)
     p0 = rng.uniform(-1.0, 1.1, 4 * n)
@@ -110,11 +145,13 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         rot_err.append(np.abs(rot[:, 0] - ah.platform_rotation(r0[idx], p0[idx])).max(axis=(-1, -2)))
     rows.append(compare("motor_angles (4 branches) -> Pinocchio loop residual (m)", np.concatenate(res_all), TOL))
     rows.append(compare("motor_angles (4 branches) -> Pinocchio platform rotation", np.concatenate(rot_err), TOL))
+    return rows
 
+
+def _orientation_rows(roll: np.ndarray, pitch: np.ndarray, x: np.ndarray, n: int,
+                      rng: np.random.Generator) -> list[CheckResult]:
+    rows: list[CheckResult] = []
     # -- platform_orientation: round trip through motor_angles, well-conditioned and near-singular
-    roll, pitch = sample_workspace(n, rng)
-    th = ah.motor_angles(roll, pitch)
-    x = ah.platform_orientation(th[:, 0], th[:, 1])
     rows.append(
         compare(f"platform_orientation(motor_angles(x)) = x, sigma_min >= {SIGMA_MIN:g}",
                 np.abs(x - np.stack([roll, pitch], -1)).max(-1), TOL)
@@ -124,10 +161,13 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     xn = ah.platform_orientation(thn[:, 0], thn[:, 1])
     scaled = np.abs(xn - np.stack([rn, pn], -1)).max(-1) * _sigma_min(rn, pn)
     rows.append(compare("platform_orientation near forward singularity: error x sigma_min", scaled, TOL_SCALED))
+    return rows
 
+
+def _solve_loops_rows(robot, w: _Workspace, ns: int, rng: np.random.Generator) -> list[CheckResult]:  # noqa: ANN001
+    rows: list[CheckResult] = []
+    roll, pitch, th, x, qs = w.roll, w.pitch, w.th, w.x, w.qs
     # -- platform_orientation vs Robot.solve_loops with the motors held
-    tll = rng.uniform(*LL_RANGE, n)
-    qs = closed_configuration(robot, np.stack([roll, pitch], -1), tll)
     pas = [robot.idx_q(j) for j in PASSIVE_U]
     err = np.empty(ns)
     # start the solver near the sample's assembly: passive joints perturbed by N(0, 0.1 sigma_min) rad (the
@@ -150,15 +190,23 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     rows.append(compare(
         f"platform_orientation vs Robot.solve_loops (motors held, {ns} samples; {int(other_mode.sum())} "
         "closed in another assembly mode, skipped)", err[~other_mode], TOL))
+    return rows
 
+
+def _foot_rows(w: _Workspace) -> list[CheckResult]:
+    rows: list[CheckResult] = []
+    roll, pitch, th, tll, pos, theta0 = w.roll, w.pitch, w.th, w.tll, w.pos, w.theta0
     # -- foot position (Newton FK + eq 19 + eqs 17-20) vs Pinocchio FCS
-    pos = pinocchio_frames(robot, qs, ["FCS"])[0][:, 0]
-    theta0 = np.asarray(ah.extension_motor_angle(tll))
     rows.append(compare("foot_position_from_platform vs Pinocchio FCS (m)",
                         per_sample(ah.foot_position_from_platform(roll, pitch, tll) - pos), TOL))
     rows.append(compare("fk(theta1, theta2, theta0) vs Pinocchio FCS (m)",
                         per_sample(ah.fk(np.column_stack([th, theta0])) - pos), TOL))
+    return rows
 
+
+def _ik_rows(robot, w: _Workspace, ns: int) -> list[CheckResult]:  # noqa: ANN001
+    rows: list[CheckResult] = []
+    roll, pitch, th, tll, pos, theta0 = w.roll, w.pitch, w.th, w.tll, w.pos, w.theta0
     # -- ik: default branch round trip, and every branch closes in Pinocchio at the target.
     # Its conditioning: kappa = max(1, sigma_max(dtheta/dx)) * max(1 / alpha, |u| / rho), alpha = |theta_LL -
     # LL_DELTA| (the two LL branches merge at alpha = 0: acos near 1) and rho = distance of the foot from the
@@ -194,7 +242,12 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         foot_b.append(per_sample(pinocchio_frames(robot, qb, ["FCS"])[0][:, 0] - pos[idx]))
     rows.append(compare("ik_all every branch -> Pinocchio loop residual (m)", np.concatenate(res_b), TOL))
     rows.append(compare("ik_all every branch -> Pinocchio FCS at the target (m)", np.concatenate(foot_b), TOL))
+    return rows
 
+
+def _jacobian_rows(robot, w: _Workspace, n: int) -> list[CheckResult]:  # noqa: ANN001
+    rows: list[CheckResult] = []
+    roll, pitch, th, qs, theta0 = w.roll, w.pitch, w.th, w.qs, w.theta0
     # -- foot Jacobian vs Pinocchio's closed-loop Jacobian. Given motor angles, the platform comes from the
     # FK (error ~ eps / sigma_min) and the Jacobian's sensitivity grows as 1 / sigma_min^2: error ~ 1 / sigma^3.
     nj = min(n, JAC_SAMPLES)
@@ -210,8 +263,6 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
                         jerr[wj], TOL))
     rows.append(compare(f"jacobian vs Pinocchio closed-loop Jacobian, sigma_min < {SIGMA_JAC:g}: error x sigma_min^3",
                         jerr[~wj] * smin[~wj] ** 3, TOL_SIGMA3))
-
-    rows += _mobility_rows(robot, roll[:ns], pitch[:ns], rng)
     return rows
 
 

@@ -500,3 +500,40 @@ def test_bench_cli_external_robot(capsys):
     assert main(["bench", "solo12", "--quick", "--n", "50", "--quiet"]) == 0
     out = capsys.readouterr().out
     assert "solo12" in out and "legkin Leg.ik batch" in out and "FL_FOOT" in out
+
+
+# ------------------------------------------------------------------------------------------- clips
+@pytest.mark.parametrize("name", ROBOTS)
+def test_feet_circles_clip_traces_the_circles(name):
+    import legkin
+    from legkin.legs.clips import ANIMATIONS, FRAMES, RADIUS
+
+    robot = legkin.load(name)
+    assert robot.model.nq == 12
+    qs = np.array(ANIMATIONS["feet_circles"](robot))
+    assert qs.shape == (FRAMES, 12) and np.isfinite(qs).all()
+    found = robot.geometry
+    inside = all(leg.within_limits(robot.q0[list(leg.idx_q)]) for leg in found.values())
+    assert inside == (name != "laikago")  # laikago has no SRDF: its q0 (zero) leaves the knees outside the limits
+    if inside:
+        np.testing.assert_allclose(qs[0], robot.q0, atol=1e-12, rtol=0)
+    data = robot.model.createData()
+    fids = [robot.model.getFrameId(leg.foot_frame) for leg in found.values()]
+    feet = np.empty((FRAMES, len(fids), 3))
+    for i, q in enumerate(qs):
+        pin.framesForwardKinematics(robot.model, data, q)
+        feet[i] = [data.oMf[f].translation for f in fids]
+    t = 2.0 * np.pi * np.arange(FRAMES) / FRAMES
+    circle = RADIUS * np.stack([np.sin(t), 0.0 * t, 1.0 - np.cos(t)], -1)  # forward-up-back-down, from frame 0
+    np.testing.assert_allclose(feet, feet[:1] + circle[:, None], atol=1e-12, rtol=0)
+    for leg in found.values():
+        assert leg.within_limits(qs[:, list(leg.idx_q)]).all()
+    assert np.abs(np.diff(qs, axis=0)).max() < 0.2  # continuous: each frame near the previous one
+
+
+def test_view_animate_feet_circles_html(tmp_path):
+    from legkin.__main__ import main
+
+    out = tmp_path / "g.html"
+    assert main(["view", "go2", "--animate", "feet_circles", "--html", str(out)]) == 0
+    assert out.stat().st_size > 1000

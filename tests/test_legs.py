@@ -537,3 +537,13 @@ def test_view_animate_feet_circles_html(tmp_path):
     out = tmp_path / "g.html"
     assert main(["view", "go2", "--animate", "feet_circles", "--html", str(out)]) == 0
     assert out.stat().st_size > 1000
+
+
+def test_quadruped_check_has_the_generic_leg_rows():
+    from legkin.quadruped import checks as qc
+
+    rows = qc.run(100, np.random.default_rng(1))
+    generic = [r for r in rows if r.name.startswith("legs.Leg: ")]
+    assert len(generic) == 4 and all(r.passed for r in generic), [(r.name, r.max_error) for r in generic]
+    assert "400/400 solved" in generic[2].name
+    assert len(rows) > len(generic)  # the quadruped's own rows are all still there

@@ -54,7 +54,22 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         rows.append(compare(f"{leg} IK round trip, foot position", per_sample(aq.fk(q_ik, leg) - p_all), TOL))
     rows += _geometry_rows(samples, rng)
     rows.append(_yourdfpy_row(robot, qs[: min(samples, YOURDFPY_SAMPLES)], pos, frames))
+    rows += _generic_leg_rows(samples, rng)
     return rows
+
+
+#: Prefix of the rows of the generic leg (:mod:`legkin.legs`, measured from POPI's model).
+GENERIC_PREFIX = "legs.Leg: "
+
+
+def _generic_leg_rows(samples: int, rng: np.random.Generator) -> list[CheckResult]:
+    """POPI through the code path of any URDF quadruped: :func:`legkin.legs.checks.run` on its model (the four
+    legs found and measured by :func:`legkin.legs.from_model`), rows prefixed :data:`GENERIC_PREFIX`."""
+    from dataclasses import replace
+
+    from ..legs import checks as leg_checks
+
+    return [replace(r, name=GENERIC_PREFIX + r.name) for r in leg_checks.run("quadruped", samples, rng)]
 
 
 #: The non-default geometry of the geometry rows: POPI's own URDF value of foot_z (m).

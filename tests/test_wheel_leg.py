@@ -648,7 +648,10 @@ def test_geometry_from_params_and_keyword():
     p = wl.fk(q, "FL", geometry=big)
     assert np.linalg.norm(p - wl.fk(q, "FL")) > 1e-3
     assert wl.ik(p, "FL", geometry=big) == pytest.approx(q, abs=1e-9)
-    for fn in (lambda: wl.fk(q, "FL", geometry={"R": 0.1}), lambda: wl.linkage_points(1.0, geometry=0.1)):
+    bad = {"R": 0.1}
+    for fn in (lambda: wl.fk(q, "FL", geometry=bad), lambda: wl.linkage_points(1.0, geometry=bad),
+               lambda: wl.motor_angles(1.0, 0.0, geometry=bad), lambda: wl.rim_segment(0.1, geometry=bad),
+               lambda: wl.ik_all(p, "FL", geometry=bad), lambda: wl.module_origin("FL", geometry=bad)):
         with pytest.raises(legkin.InvalidParameterError, match="Geometry"):
             fn()
 

@@ -389,22 +389,30 @@ def passive_angles(theta: ArrayLike, beta: ArrayLike = 0.0, *,
     return dict(zip(PASSIVE_JOINTS, out.T.reshape((len(PASSIVE_JOINTS),) + shape)))
 
 
-def motor_angles(theta: ArrayLike, beta: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+def motor_angles(theta: ArrayLike, beta: ArrayLike, *,
+                 geometry: Geometry | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(phi_L, phi_R) = (beta + theta - theta0, beta - theta + theta0) (reference, motor mapping).
 
-    A linear map: numpy on the broadcast inputs (no kernel needed); two numbers give two 0-d arrays.
+    A linear map: numpy on the broadcast inputs (no kernel needed); two numbers give two 0-d arrays. It does not
+    depend on the geometry (``geometry`` is checked, for a uniform signature).
     """
+    if geometry is not None:
+        _geometry(geometry)
     if type(theta) is float and type(beta) is float and math.isfinite(theta) and math.isfinite(beta):
         return np.asarray(beta + (theta - THETA0)), np.asarray(beta - (theta - THETA0))
     theta, beta = as_angles(theta, beta, names=("theta", "beta"))
     return np.asarray(beta + (theta - THETA0)), np.asarray(beta - (theta - THETA0))
 
 
-def theta_beta(phi_L: ArrayLike, phi_R: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+def theta_beta(phi_L: ArrayLike, phi_R: ArrayLike, *,
+               geometry: Geometry | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(theta, beta) = ((phi_L - phi_R)/2 + theta0, (phi_L + phi_R)/2); inverse of :func:`motor_angles`.
 
-    theta is not range-checked here (the motors can be commanded anywhere; the linkage cannot).
+    theta is not range-checked here (the motors can be commanded anywhere; the linkage cannot). Independent of
+    the geometry (``geometry`` is checked, for a uniform signature).
     """
+    if geometry is not None:
+        _geometry(geometry)
     if type(phi_L) is float and type(phi_R) is float and math.isfinite(phi_L) and math.isfinite(phi_R):
         return np.asarray((phi_L - phi_R) / 2 + THETA0), np.asarray((phi_L + phi_R) / 2)
     phi_L, phi_R = as_angles(phi_L, phi_R, names=("phi_L", "phi_R"))

@@ -25,12 +25,15 @@ _SEGMENTS = (
 _SEG_A0 = (-_ARC_FG, 0.0, 0.0, _ARC_FG)  # alpha at which the segment's reference point is reached
 
 
-def rim_segment(alpha: ArrayLike) -> np.ndarray:
+def rim_segment(alpha: ArrayLike, *, geometry: Geometry | None = None) -> np.ndarray:
     """Index (0-3) of the rim link that carries the contact point of parameter ``alpha`` in :func:`rim_point`.
 
     0: upper rim left (alpha < -50 deg), 1: lower rim left (-50 deg <= alpha < 0), 2: lower rim right
-    (0 <= alpha <= 50 deg), 3: upper rim right (alpha > 50 deg).
+    (0 <= alpha <= 50 deg), 3: upper rim right (alpha > 50 deg). Independent of the geometry (``geometry`` is
+    checked, for a uniform signature).
     """
+    if geometry is not None:
+        _geometry(geometry)
     if type(alpha) is float:
         return np.asarray(0 if alpha < -_ARC_FG else (1 if alpha < 0.0 else (2 if alpha <= _ARC_FG else 3)))
     a = np.asarray(alpha, dtype=float)

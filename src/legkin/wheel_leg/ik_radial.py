@@ -14,17 +14,19 @@ from .frames import _k_fk
 from .geometry import _LIMIT_ROUNDING, ABAD_LIMIT, FOOT_OFFSET, THETA_MAX, THETA_MIN
 from .linkage import _closed_form, _constants, _kconst
 from .radial_roots import _k_lower_bound, _k_radial_extremum, _k_radial_newton
-from .rim import _k_plane, _Sel
+from .rim import _k_plane
 
 
 @lru_cache(maxsize=32)
 def _arc_table(R: float, seed: bool, nodes: int) -> tuple[np.ndarray, np.ndarray]:
     """``|c(theta, alpha)|^2`` and its theta-derivative on a theta grid, as a matrix for all alpha at once.
 
-    For an arc ``c = ctr + e v`` (``v = ref - ctr``, made unit for the seed rim; :func:`_plane`),
+    For an arc ``c = ctr + e v`` (``v = ref - ctr``, made unit for the three-arc rim; ``rim._k_plane``),
     ``|c|^2 = A + |e|^2 V + 2 Re(W e)`` with ``A = |ctr|^2``, ``V = |v|^2``, ``W = conj(ctr) v``: functions
     of theta alone, tabulated once per geometry. Returns ``grid`` (K,) and ``table`` (9, 2K) such that
-    :func:`_arc_coefficients` ``@ table`` is ``[f(grid), f'(grid)]``, ``f = |c|^2 - r^2``.
+    the target's coefficient row ``[u, u |e|^2, 2 u Re e, -2 u Im e, l, l |e|^2, 2 l Re e, -2 l Im e, -r^2]``
+    (u = 1 on the upper rim, l = 1 - u; built in :func:`_k_ik_radial`) ``@ table`` is ``[f(grid), f'(grid)]``,
+    ``f = |c|^2 - r^2``.
     """
     grid = np.linspace(THETA_MIN, THETA_MAX, nodes)
     coef = _arc_terms(grid, R, seed)
@@ -57,24 +59,7 @@ def _arc_terms(theta: np.ndarray, R: float, seed: bool) -> np.ndarray:
     return np.array(rows)
 
 
-def _arc_coefficients(sel: _Sel, r2) -> np.ndarray:
-    """(n, 9) rows ``[u, u |e|^2, 2 u Re e, -2 u Im e, l, l |e|^2, 2 l Re e, -2 l Im e, -r^2]`` (u = 1 on the
-    upper rim, l = 1 - u) that turn :func:`_arc_table`'s table into ``f, f'`` for each item."""
-    e = sel.e
-    ee = e.real * e.real + e.imag * e.imag
-    coef = np.empty(e.shape + (9,))
-    for base, on in ((0, sel.upper), (4, ~sel.upper)):
-        w8 = on.astype(float)
-        coef[..., base] = w8
-        coef[..., base + 1] = w8 * ee
-        coef[..., base + 2] = w8 * 2.0 * e.real
-        coef[..., base + 3] = w8 * -2.0 * e.imag
-    coef[..., 8] = -r2
-    return coef
 
-
-
-# ---------------------------------------------------------------- radial IK (method="radial")
 #: Nodes of the theta grid that brackets the roots of the radial equation (8.9 deg cells).
 _RADIAL_NODES = 17
 #: Sub-cells per cell of the fine coefficient table that refines the Newton start (0.14 deg).

@@ -125,7 +125,7 @@ def _k_radial_newton(lo, hi, flo, fhi, glo, ghi, guess, coef, fine, fine_rows, u
 
     Start (no linkage evaluation): the root of the cubic Hermite model of f on the bracket
     (:func:`_k_hermite_root`) picks a sub-cell of the fine table (0.14 deg); if f (from the table and
-    ``coef`` (9,), the target's :func:`_arc_coefficients`) does not change sign there, bisection on the
+    ``coef`` (9,), the target's coefficient row of ``_arc_table``) does not change sign there, bisection on the
     table's nodes inside the bracket finds one; the start is then the root of the cubic model on that
     sub-cell, which becomes the bracket (if the table's signs do not bracket the root, e.g. a root at a
     node, the start on the whole bracket is kept). ``guess`` (NaN: none) overrides the start (the

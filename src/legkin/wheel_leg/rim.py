@@ -14,17 +14,8 @@ from ._common import _SCALARS, _check_alpha, _check_theta, _check_w, _loop
 from .geometry import _ARC_FG, _DEFAULT_GEOMETRY, FOOT_OFFSET, PSI_FG, THETA_MAX, THETA_MIN, Geometry, _geometry
 from .linkage import _IF, _IG, _IJ, _IL, _IOR, _IU, _k_closed, _kconst
 
+
 # ---------------------------------------------------------------- rim contact points
-#: Segments of the continuous rim: (name, alpha start, alpha end, link, centre point, reference point).
-_SEGMENTS = (
-    ("rim_upper_L", -math.pi, -_ARC_FG, "U_L", "F_L"),
-    ("rim_lower_L", -_ARC_FG, 0.0, "L_L", "G"),
-    ("rim_lower_R", 0.0, _ARC_FG, "L_R", "G"),
-    ("rim_upper_R", _ARC_FG, math.pi, "U_R", "F_R"),
-)
-_SEG_A0 = (-_ARC_FG, 0.0, 0.0, _ARC_FG)  # alpha at which the segment's reference point is reached
-
-
 def rim_segment(alpha: ArrayLike, *, geometry: Geometry | None = None) -> np.ndarray:
     """Index (0-3) of the rim link that carries the contact point of parameter ``alpha`` in :func:`rim_point`.
 
@@ -117,7 +108,7 @@ def _k_select_batch(alpha, seed, rho, R, upper, right, e):
 
 
 def _select(alpha: np.ndarray, seed: bool, radius: float, R: float) -> _Sel:
-    """The arc of every alpha (:data:`_SEGMENTS` for the continuous rim; seed 1.1's three arcs): the batch of
+    """The arc of every alpha (the four links of :func:`rim_point`; seed 1.1's three arcs): the batch of
     :func:`_k_select`."""
     alpha = np.asarray(alpha, dtype=np.float64)
     flat = as_rows(alpha, 1)[:, 0]
@@ -125,15 +116,6 @@ def _select(alpha: np.ndarray, seed: bool, radius: float, R: float) -> _Sel:
     upper, right, e = np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.bool_), np.empty(n, dtype=np.complex128)
     _k_select_batch(flat, bool(seed), float(radius), float(R), upper, right, e)
     return _Sel(seed, upper.reshape(alpha.shape), right.reshape(alpha.shape), e.reshape(alpha.shape))
-
-
-@_loop(32768)
-def _k_plane_batch(theta, upper, right, e, seed, K, KC, z):
-    """:func:`_k_plane` (no derivative, right halves conjugated) over theta and the arc choice (n,) into z."""
-    for i in prange(theta.shape[0]):
-        z[i], _dz = _k_plane(theta[i], upper[i], right[i], e[i], seed, K, KC, False, True)
-
-
 
 
 @kernel

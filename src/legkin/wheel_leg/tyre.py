@@ -11,7 +11,10 @@ alpha). Its offset at distance ``r`` is closed into one curve:
   delta > 0 (measured: G for every theta > theta0): the outer offsets part, joined by a *fillet* of radius r
   about X (span delta), while the inner offsets overlap and are *trimmed* at their intersection (a zero-length
   corner piece). delta < 0 (measured: F_L, F_R): the outer offsets overlap and are trimmed, the inner side gets
-  the fillet. |delta| <= 1e-9 rad (wheel mode): a fillet on both sides;
+  the fillet. |delta| <= 1e-9 rad (wheel mode): a fillet on both sides. Where the overlapping offsets do not
+  meet inside both arcs (the inner lower rims at G for theta > ~110 deg: the inner circles about L_L and L_R
+  no longer intersect), the two ends are joined by the arc of radius r about X the short way instead
+  (span -delta: it runs inside the swept region);
 * at the tips H_R, H_L a half circle of radius r about the tip (the *caps*) joins the outer and inner sides.
 
 Every point of the curve is at distance r from the pitch curve, and the curve contains the boundary of the swept
@@ -78,14 +81,32 @@ def _k_wrap_pos(a):
 @kernel
 def _k_meet(c1, c2, rho, X):
     """The intersection of the circles (c1, rho) and (c2, rho) on the side of X of the line c1 c2 (X lies on
-    their perpendicular bisector: |X - c1| = |X - c2| = R)."""
+    their perpendicular bisector: |X - c1| = |X - c2| = R) and whether they meet."""
     m = 0.5 * (c1 + c2)
     dv = c2 - c1
     D = abs(dv)
+    h2 = rho * rho - 0.25 * D * D
+    if not (D > 0.0 and h2 > 0.0):
+        return m, False
     perp = 1j * dv / D
-    h = math.sqrt(max(rho * rho - 0.25 * D * D, 0.0))
+    h = math.sqrt(h2)
     side = ((X - m).conjugate() * perp).real
-    return m + (h if side >= 0.0 else -h) * perp
+    return m + (h if side >= 0.0 else -h) * perp, True
+
+
+@kernel
+def _k_trim(c1, c2, rho, X, a1_lo, a1_hi, a2_lo, a2_hi):
+    """Trim the end (angle ``a1_hi``) of the arc (c1, rho) over [a1_lo, a1_hi] and the start (``a2_lo``) of the
+    arc (c2, rho) over [a2_lo, a2_hi] at their intersection near X: (ok, P, new a1_hi, new a2_lo). ``ok`` is
+    False when the circles do not meet or the intersection lies outside either arc (then no trim)."""
+    P, met = _k_meet(c1, c2, rho, X)
+    if not met:
+        return False, P, a1_hi, a2_lo
+    b1 = a1_hi + wrap_k(math.atan2((P - c1).imag, (P - c1).real) - a1_hi)
+    b2 = a2_lo + wrap_k(math.atan2((P - c2).imag, (P - c2).real) - a2_lo)
+    if b1 < a1_lo or b1 > a1_hi or b2 < a2_lo or b2 > a2_hi:
+        return False, P, a1_hi, a2_lo
+    return True, P, b1, b2
 
 
 @kernel
@@ -108,9 +129,9 @@ def _k_pieces(theta, r, K, KC, C, RAD, A0, SPAN):
         a_e[k] = a_s[k] + _k_wrap_pos(ae - a_s[k])
     o_s, o_e, i_s, i_e = a_s.copy(), a_e.copy(), a_s.copy(), a_e.copy()
     h_oc = np.empty(3, dtype=np.complex128)
-    h_o0, h_osp = np.empty(3), np.empty(3)
+    h_o0, h_osp, h_or = np.empty(3), np.empty(3), np.full(3, r)
     h_ic = np.empty(3, dtype=np.complex128)
-    h_i0, h_isp = np.empty(3), np.empty(3)
+    h_i0, h_isp, h_ir = np.empty(3), np.empty(3), np.full(3, r)
     ro, ri = R + r, R - r
     for j in range(3):
         X, c1, c2 = hin[j], cen[j], cen[j + 1]
@@ -118,28 +139,31 @@ def _k_pieces(theta, r, K, KC, C, RAD, A0, SPAN):
         dlt = wrap_k(n2 - e1)
         h_oc[j] = X
         h_ic[j] = X
-        if dlt >= -_FLAT:  # outer fillet from the normal of arc j to that of arc j + 1
-            h_o0[j], h_osp[j] = e1, dlt
-        else:  # outer offsets overlap: trimmed at their intersection
-            P = _k_meet(c1, c2, ro, X)
-            o_e[j] = e1 + wrap_k(math.atan2((P - c1).imag, (P - c1).real) - e1)
-            o_s[j + 1] = n2 + wrap_k(math.atan2((P - c2).imag, (P - c2).real) - n2)
-            h_o0[j], h_osp[j] = math.atan2((P - X).imag, (P - X).real), 0.0
-        if dlt <= _FLAT:  # inner fillet, traversed from arc j + 1 back to arc j
-            h_i0[j], h_isp[j] = n2 + math.pi, -dlt
+        # the side where the offsets part: a fillet about X (from the normal of arc j to that of arc j + 1);
+        # the side where they overlap: trimmed at their intersection (a corner piece of zero length), or, where
+        # they do not meet inside both arcs, joined by the arc about X the short way (inside the swept region)
+        ok = False
+        if dlt < -_FLAT:
+            ok, P, o_e[j], o_s[j + 1] = _k_trim(c1, c2, ro, X, o_s[j], o_e[j], o_s[j + 1], o_e[j + 1])
+        if ok:
+            h_oc[j], h_o0[j], h_osp[j], h_or[j] = P, 0.0, 0.0, 0.0  # the corner: a point
         else:
-            P = _k_meet(c1, c2, ri, X)
-            i_e[j] = e1 + wrap_k(math.atan2((P - c1).imag, (P - c1).real) - e1)
-            i_s[j + 1] = n2 + wrap_k(math.atan2((P - c2).imag, (P - c2).real) - n2)
-            h_i0[j], h_isp[j] = math.atan2((P - X).imag, (P - X).real), 0.0
+            h_o0[j], h_osp[j] = e1, dlt
+        ok = False
+        if dlt > _FLAT:
+            ok, P, i_e[j], i_s[j + 1] = _k_trim(c1, c2, ri, X, i_s[j], i_e[j], i_s[j + 1], i_e[j + 1])
+        if ok:
+            h_ic[j], h_i0[j], h_isp[j], h_ir[j] = P, 0.0, 0.0, 0.0
+        else:  # traversed from arc j + 1 back to arc j
+            h_i0[j], h_isp[j] = n2 + math.pi, -dlt
     for k in range(4):  # outer arcs: pieces 0, 2, 4, 6; inner arcs (reversed): 14, 12, 10, 8
         C[2 * k], RAD[2 * k], A0[2 * k], SPAN[2 * k] = cen[k], ro, o_s[k], o_e[k] - o_s[k]
         p = 14 - 2 * k
         C[p], RAD[p], A0[p], SPAN[p] = cen[k], ri, i_e[k], i_s[k] - i_e[k]
     for j in range(3):  # outer hinges 1, 3, 5; inner hinges 13, 11, 9
-        C[2 * j + 1], RAD[2 * j + 1], A0[2 * j + 1], SPAN[2 * j + 1] = h_oc[j], r, h_o0[j], h_osp[j]
+        C[2 * j + 1], RAD[2 * j + 1], A0[2 * j + 1], SPAN[2 * j + 1] = h_oc[j], h_or[j], h_o0[j], h_osp[j]
         p = 13 - 2 * j
-        C[p], RAD[p], A0[p], SPAN[p] = h_ic[j], r, h_i0[j], h_isp[j]
+        C[p], RAD[p], A0[p], SPAN[p] = h_ic[j], h_ir[j], h_i0[j], h_isp[j]
     C[7], RAD[7], A0[7], SPAN[7] = HR, r, a_e[3], math.pi
     C[15], RAD[15], A0[15], SPAN[15] = HL, r, a_s[0] + math.pi, math.pi
 

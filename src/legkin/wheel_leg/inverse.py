@@ -11,6 +11,7 @@ Methods (``method=``):
 
 from __future__ import annotations
 
+import inspect
 import math
 from dataclasses import dataclass
 from functools import lru_cache
@@ -322,6 +323,19 @@ def _in_limits(sols: np.ndarray) -> np.ndarray:
         inside = np.abs(sols[..., 2]) <= ABAD_LIMIT + _LIMIT_ROUNDING
     sols[..., 2] = np.where(inside, np.clip(sols[..., 2], -ABAD_LIMIT, ABAD_LIMIT), sols[..., 2])
     return inside
+
+
+def _ik_signature(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0,
+                  q_near: ArrayLike | None = None, q_start: ArrayLike | None = None, method: Method = "radial",
+                  rim: Rim = "continuous", radius: float | None = None, limits: bool = True,
+                  options: IKOptions | None = None, geometry: Geometry | None = None, return_mask: bool = False,
+                  return_info: bool = False) -> (np.ndarray | tuple[np.ndarray, np.ndarray] | tuple[np.ndarray, IKInfo]
+                                                 | tuple[np.ndarray, np.ndarray, IKInfo]):
+    raise NotImplementedError  # a signature only
+
+
+# help() and inspect show today's call form (the implementation also takes legkin 0.1's, see _legacy)
+ik.__signature__ = inspect.signature(_ik_signature)  # type: ignore[attr-defined]
 
 
 @overload

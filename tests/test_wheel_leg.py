@@ -295,7 +295,7 @@ def test_radial_ik_lists_the_sampled_configuration_at_the_theta_ends(rim):
         assert missing.size == 0, (leg, q[missing[:3]], alpha[missing[:3]], w[missing[:3]])
 
 
-def test_radial_ik_batch_matches_scalar_and_other_methods():
+def test_radial_ik_batch_and_other_methods():
     rng = np.random.default_rng(11)
     q = configuration.sample_leg_q(300, rng)
     alpha, w = rng.uniform(-math.pi, math.pi, 300), rng.uniform(-0.02, 0.02, 300)
@@ -722,3 +722,26 @@ def test_docs_examples_run():
         warnings.simplefilter("error", DeprecationWarning)  # the docs show the 0.2 API
         for code in blocks:
             exec(compile(code, "docs/wheel_leg.md", "exec"), {})
+
+
+@pytest.mark.parametrize("method", ["radial", "damped", "gauss_newton_fd"])
+def test_single_call_with_q_near_q_start_limits_equals_the_batch_row(method):
+    rng = np.random.default_rng(21)
+    q = configuration.sample_q_in_limits(40, rng)
+    alpha, w = rng.uniform(-math.pi, math.pi, 40), rng.uniform(-0.02, 0.02, 40)
+    target = wl.fk(q, "RR", alpha=alpha, w=w)
+    near = np.clip(q + rng.normal(0.0, 0.2, q.shape), [wl.THETA_MIN, -9, -9], [wl.THETA_MAX, 9, 9])
+    keys = [{"q_near": near}, {"limits": False}, {"q_near": near, "limits": False}]
+    if method != "radial":
+        keys.append({"q_start": near})
+    for kw in keys:
+        batch, ok = wl.ik(target, "RR", alpha=alpha, w=w, method=method, return_mask=True, **kw)
+        for i in range(0, 40, 3):
+            one = {k: (v[i] if isinstance(v, np.ndarray) else v) for k, v in kw.items()}
+            for a, ww in ((float(alpha[i]), float(w[i])), (alpha[i], w[i])):  # the fast path, the general one
+                if ok[i]:
+                    np.testing.assert_array_equal(wl.ik(target[i], "RR", alpha=a, w=ww, method=method, **one),
+                                                  batch[i])
+                else:
+                    with pytest.raises(legkin.UnreachableError):
+                        wl.ik(target[i], "RR", alpha=a, w=ww, method=method, **one)

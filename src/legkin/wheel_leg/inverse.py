@@ -98,10 +98,15 @@ def _single_ctx(leg, rim, radius, geo: Geometry, method: str):
     return kc, ik_iterative.guess_table(geo.R, kc[0])
 
 
-def _single(target, alpha, w, leg, rim, radius, geo, method, opts, return_mask, return_info, limits=True):
-    """One target with default keywords: the method's kernel called directly. None (the general path then
-    decides, and raises) unless solved."""
+def _single(target, alpha, w, leg, rim, radius, geo, method, opts, return_mask, return_info, limits=True,
+            q0=None):
+    """One target (numbers and float64 (3,) arrays): the method's kernel called directly; ``q0``: q_near
+    (radial) or the start (iterative methods). None (the general path then decides, and raises) unless
+    solved."""
     if not (abs(alpha) <= math.pi + 1e-12 and abs(w) <= geo.T / 2 + 1e-15):
+        return None
+    if q0 is not None and not (THETA_MIN - 1e-12 <= q0[0] <= THETA_MAX + 1e-12 and math.isfinite(q0[1])
+                               and math.isfinite(q0[2])):
         return None
     try:
         kc, tables = _single_ctx(leg, rim, radius, geo, method)
@@ -115,19 +120,21 @@ def _single(target, alpha, w, leg, rim, radius, geo, method, opts, return_mask, 
     if method == "radial":
         max_iter = 60 if opts.max_iter is None else opts.max_iter
         sols = np.empty((_RADIAL_SOLS, 3))
+        q_near = _NO_Q0[0] if q0 is None else q0
         its, err, reason, _nr, nsol = _k_ik_radial(target, upper, right, e, a, seed, K, KC, s, o0, o1, o2, *tables,
-                                                   opts.tol, max_iter, _NO_Q0[0], False, limits, q, sols)
+                                                   opts.tol, max_iter, q_near, q0 is not None, limits, q, sols)
         ev = its + 1
         if reason == _SOLVED and return_info and nsol > _RADIAL_SOLS:
             sols = np.empty((nsol, 3))
             _k_ik_radial(target, upper, right, e, a, seed, K, KC, s, o0, o1, o2, *tables, opts.tol, max_iter,
-                         _NO_Q0[0], False, limits, np.empty(3), sols)
+                         q_near, q0 is not None, limits, np.empty(3), sols)
         sols = sols[:nsol]
     else:
         max_iter = ik_iterative.DEFAULT_MAX_ITER[method] if opts.max_iter is None else opts.max_iter
         its, err, reason, ev = ik_iterative._k_ik_iterative(
             target, upper, right, e, a, seed, K, KC, s, o0, o1, o2, *tables, ik_iterative.METHOD_IDS[method],
-            ik_iterative._STARTS[method], opts.tol, max_iter, opts.delta, ik_iterative._NO_START[0], False, True, q)
+            ik_iterative._STARTS[method], opts.tol, max_iter, opts.delta,
+            ik_iterative._NO_START[0] if q0 is None else q0, q0 is not None, limits, q)
     if reason != _SOLVED:
         return None
     out = (q, np.array(True)) if return_mask else q
@@ -299,13 +306,17 @@ def ik(target, leg=None, /, *args, alpha=0.0, w=0.0, q_near=None, q_start=None, 
     opts = _options(options)
     method = method_name(method)
     rim = rim_name(rim)
-    if (q_near is None and q_start is None and limits is True and type(target) is np.ndarray
-            and target.shape == (3,) and target.dtype == np.float64 and type(alpha) in _SCALARS
-            and type(w) in _SCALARS and type(method) is str and return_mask in (True, False)
-            and return_info in (True, False)):
-        out = _single(target, float(alpha), float(w), leg, rim, radius, geo, method, opts, return_mask, return_info)
-        if out is not None:
-            return out
+    if (type(target) is np.ndarray and target.shape == (3,) and target.dtype == np.float64 and type(alpha) in _SCALARS
+            and type(w) in _SCALARS and type(method) is str and type(limits) is bool
+            and return_mask in (True, False) and return_info in (True, False)):
+        start = q_start if q_near is None else (q_near if q_start is None else None)
+        both = q_near is not None and q_start is not None
+        if not both and (start is None or (type(start) is np.ndarray and start.shape == (3,)
+                                           and start.dtype == np.float64 and (q_start is None or method != "radial"))):
+            out = _single(target, float(alpha), float(w), leg, rim, radius, geo, method, opts, return_mask,
+                          return_info, limits, start)
+            if out is not None:
+                return out
     return_mask = check_flag(return_mask, "return_mask")
     return_info = check_flag(return_info, "return_info")
     run, q_raw = _run(target, alpha, w, leg, q_near, q_start, method, rim, radius, limits, opts, geo)

@@ -11,9 +11,9 @@ from hypothesis import strategies as st
 
 import legkin
 from legkin import _generate
-from legkin.wheel_leg import kinematics as wl
 from legkin.wheel_leg import checks as checks
 from legkin.wheel_leg import configuration
+from legkin.wheel_leg import kinematics as wl
 from legkin.wheel_leg.spec import SPEC, annular_sector, rim_meshes
 
 DEG = math.pi / 180
@@ -187,9 +187,10 @@ def test_seed_rim_jump_matches_reference():
 
 
 @given(st.floats(17 * DEG, 160 * DEG), st.floats(-math.pi, math.pi), st.floats(-0.6, 0.6),
-       st.floats(-math.pi, math.pi), st.floats(-0.02, 0.02), st.sampled_from(wl.LEGS), st.sampled_from(["continuous", "three_arc"]))
+       st.floats(-math.pi, math.pi), st.floats(-0.02, 0.02), st.sampled_from(wl.LEGS),
+       st.sampled_from(["continuous", "three_arc"]))
 @settings(max_examples=60, deadline=None)
-def test_contact_jacobian_matches_central_differences(theta, beta, gamma, alpha, w, leg, rim):
+def test_jacobian_matches_central_differences_over_the_rim(theta, beta, gamma, alpha, w, leg, rim):
     q = np.array([theta, beta, gamma])
     J = wl.jacobian(q, leg, alpha=alpha, w=w, rim=rim)
     h = 1e-6
@@ -309,9 +310,11 @@ def test_radial_ik_batch_and_other_methods():
         assert same[okd].mean() > 0.9  # both take the branch y_L <= 0; they differ only where several theta exist
         assert np.all(np.isnan(info.solutions[:, :, 0]).sum(axis=1) < info.solutions.shape[1])
     # leading dimensions kept
-    q2, info2 = wl.ik(t.reshape(3, 100, 3), "RL", alpha=alpha.reshape(3, 100), w=w.reshape(3, 100), method="radial", rim="three_arc", return_info=True)
+    q2, info2 = wl.ik(t.reshape(3, 100, 3), "RL", alpha=alpha.reshape(3, 100), w=w.reshape(3, 100), method="radial",
+                      rim="three_arc", return_info=True)
     assert q2.shape == (3, 100, 3) and info2.solutions.shape[:2] == (3, 100) and info2.error.shape == (3, 100)
-    assert wl.ik(t[0], "RL", alpha=alpha[0], w=w[0], method="damped", rim="three_arc", return_info=True)[1].solutions is None
+    one = wl.ik(t[0], "RL", alpha=alpha[0], w=w[0], method="damped", rim="three_arc", return_info=True)
+    assert one[1].solutions is None
 
 
 def test_radial_ik_two_roots_near_a_fold():
@@ -368,7 +371,8 @@ def test_radial_ik_unreachable():
     near = wl.leg_frame_to_robot([0.0, -0.03, 0.0], 0.0, "FL")  # inside the wheel radius
     inside = wl.fk([1.0, 0.1, 0.0], "FL")
     on_axis = wl.module_origin("FL") + [-0.05, 0.0, 0.0]  # closer to the ABAD axis than d_wheel
-    qs, ok, info = wl.ik(np.stack([far, inside, near, on_axis]), "FL", method="radial", return_mask=True, return_info=True)
+    qs, ok, info = wl.ik(np.stack([far, inside, near, on_axis]), "FL", method="radial", return_mask=True,
+                         return_info=True)
     assert ok.tolist() == [False, True, False, False]
     assert np.all(np.isnan(qs[~ok])) and np.all(np.isfinite(qs[1]))
     assert np.all(np.isnan(info.solutions[[0, 2, 3]])) and np.all(info.error[~ok] > 1e-3)
@@ -381,7 +385,8 @@ def test_ik_batch_and_methods():
     for rim in ("continuous", "three_arc"):
         t = wl.fk(q, "FR", alpha=alpha, w=0.0, rim=rim)
         for method in ("damped", "gauss_newton_fd", "radial"):
-            qs, ok, info = wl.ik(t, "FR", alpha=alpha, w=0.0, method=method, rim=rim, return_mask=True, return_info=True)
+            qs, ok, info = wl.ik(t, "FR", alpha=alpha, w=0.0, method=method, rim=rim, return_mask=True,
+                                 return_info=True)
             assert qs.shape == (200, 3) and ok.shape == (200,) and info.iterations.shape == (200,)
             assert np.all(np.isnan(qs[~ok]))
             assert ok.mean() > {"damped": 0.999, "gauss_newton_fd": 0.95, "radial": 0.9999}[method]
@@ -456,9 +461,10 @@ def test_invalid_choices():
 # ---------------------------------------------------------------- the IK contract (issue 10)
 #: Slightly unreachable targets on which the damped step's 3x3 solve used to raise numpy's LinAlgError
 #: ("Singular matrix") and abort the whole batch (found by bisection on 10^6 perturbed targets).
-SINGULAR_STEP_TARGETS = [
+SINGULAR_STEP_TARGETS = [  # fmt: skip
     ([0.3671926525548385, 0.1841563765356252, -0.007407738060030997], -0.8674801011446105, 0.0006185796230125488, "FL"),
-    ([0.12458215887018051, -0.17272748123695433, -0.025051981391774794], -0.976671629088858, -0.007639002632478884, "FR"),
+    ([0.12458215887018051, -0.17272748123695433, -0.025051981391774794], -0.976671629088858, -0.007639002632478884,
+     "FR"),
     ([-0.3827757402597827, -0.20401883867890871, 0.10254649552575955], 0.8906034126757216, -0.008245358133955771, "RR"),
 ]
 

@@ -693,6 +693,8 @@ def test_legkin_01_calls_warn_and_agree():
     np.testing.assert_array_equal(old, wl.fk(q, "FL", alpha=0.5, rim="three_arc"))
     with pytest.raises(TypeError, match="unexpected keyword"):
         wl.ik(target, "FL", q00=q)
+    with pytest.raises(TypeError, match="2 positional arguments"):
+        wl.ik(target, "FL", 0.5)
 
 
 def test_no_warning_from_the_new_api():

@@ -43,6 +43,9 @@ def legacy_ik_call(leg: Any, args: tuple, deprecated: dict[str, Any], *, alpha: 
     if unknown:
         raise TypeError(f"ik() got an unexpected keyword argument {unknown[0]!r}")
     old: list[str] = []
+    if isinstance(leg, str) and args:
+        raise TypeError(f"ik() takes 2 positional arguments (target, leg), {2 + len(args)} given; pass alpha=, w= "
+                        "and the rest as keywords")
     if leg is not None and not (_is_leg(leg) and not args):  # a number second: ik(target, alpha, w, leg, q0)
         if len(args) > 3:
             raise TypeError(f"ik() takes at most 5 positional arguments ({2 + len(args)} given)")

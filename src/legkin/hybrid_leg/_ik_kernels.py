@@ -239,13 +239,29 @@ def ik_all_k(ux, uy, uz, sv, fk_in_band, motors, pose, info, fk):
         fk[j] = live and reproduced_k(pose[j], motors[j], b1, b2, info[j, 2])
 
 
+@kernel
+def ik_all_out_k(ux, uy, uz, sv, motors, pose, mask, asm, within, valid):
+    """:func:`ik_all` of one target: motors, pose (16, 3) (NaN where the branch does not exist), mask (exists),
+    asm (assembly mode, int), within (inside the limits, and exists), valid (fk reproduces it, off the band)."""
+    info = np.empty((16, 7))
+    fk = np.empty(16, dtype=np.bool_)
+    ik_all_k(ux, uy, uz, sv, False, motors, pose, info, fk)
+    for j in range(16):
+        mask[j] = info[j, 0] == 1.0
+        if not mask[j]:
+            pose[j, 0], pose[j, 1], pose[j, 2] = math.nan, math.nan, math.nan
+        asm[j] = int(info[j, 2])
+        within[j] = info[j, 1] == 1.0 and mask[j]
+        valid[j] = fk[j] and info[j, 3] < FK_GAIN_MAX
+
+
 @batch_kernel
-def ik_all_b(u, sv, fk_in_band, motors, pose, info, fk):
+def ik_all_b(u, sv, motors, pose, mask, asm, within, valid):
     for j in prange(u.shape[0]):
-        ik_all_k(u[j, 0], u[j, 1], u[j, 2], sv, fk_in_band, motors[j], pose[j], info[j], fk[j])
+        ik_all_out_k(u[j, 0], u[j, 1], u[j, 2], sv, motors[j], pose[j], mask[j], asm[j], within[j], valid[j])
 
 
 @kernel
-def ik_all_s(u, sv, fk_in_band, motors, pose, info, fk):
+def ik_all_s(u, sv, motors, pose, mask, asm, within, valid):
     for j in range(u.shape[0]):
-        ik_all_k(u[j, 0], u[j, 1], u[j, 2], sv, fk_in_band, motors[j], pose[j], info[j], fk[j])
+        ik_all_out_k(u[j, 0], u[j, 1], u[j, 2], sv, motors[j], pose[j], mask[j], asm[j], within[j], valid[j])

@@ -12,7 +12,16 @@ from .._batch import as_input, finish
 from .._kernels import OK
 from ..errors import InvalidInputError, UnreachableError
 from ._ik_errors import arc_error, axis_error, ik_error, platform_pose
-from ._ik_kernels import foot_ik_b, foot_ik_k, foot_ik_s, ik_all_b, ik_all_s, platform_pose_b, platform_pose_s
+from ._ik_kernels import (
+    foot_ik_b,
+    foot_ik_k,
+    foot_ik_s,
+    ik_all_b,
+    ik_all_out_k,
+    ik_all_s,
+    platform_pose_b,
+    platform_pose_s,
+)
 from ._options import (
     UNSET,
     Unset,
@@ -29,7 +38,7 @@ from ._options import (
     resolve,
 )
 from .chains import CX, CY, CZ
-from .geometry import CENTER, FK_GAIN_MAX, FOOT_IK_ORDER, Geometry
+from .geometry import CENTER, FOOT_IK_ORDER, Geometry
 
 __all__ = ["foot_platform_ik", "ik", "ik_all", "FootIKSolutions", "foot_ik", "foot_ik_solutions"]
 
@@ -217,23 +226,28 @@ class FootIKSolutions(NamedTuple):
     valid: np.ndarray
 
 
+def _all_outputs(shape: tuple[int, ...]) -> tuple[np.ndarray, ...]:
+    return (np.empty(shape + (16, 3)), np.empty(shape + (16, 3)), np.empty(shape + (16,), dtype=np.bool_),
+            np.empty(shape + (16,), dtype=np.int64), np.empty(shape + (16,), dtype=np.bool_),
+            np.empty(shape + (16,), dtype=np.bool_))
+
+
 def ik_all(p: ArrayLike, *, geometry: Geometry | None = None) -> FootIKSolutions:
     """Every foot IK solution with its mode: the 16 closed-form branches ((ll_branch, roll_branch, b1, b2) in
     :data:`FOOT_IK_BRANCHES` order) with their assembly mode, joint-limit and validity flags (the compiled
-    :func:`._ik_kernels.ik_all_k` per target). Never raises for valid input."""
+    :func:`._ik_kernels.ik_all_out_k` per target). Never raises for valid input."""
+    g = fast_geometry(geometry)
+    if (type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64 and g is not None
+            and g.center == "universal" and np.isfinite(p).all()):
+        out = _all_outputs(())
+        ik_all_out_k(p[0] - CX, p[1] - CY, p[2] - CZ, g.starting_value, *out)
+        return FootIKSolutions(*out)
     g = resolve(geometry, universal="ik_all")
-    pp, u, shape = _targets(p)
+    _, u, shape = _targets(p)
     n = len(u)
-    motors, pose, info, fk = np.empty((n, 16, 3)), np.empty((n, 16, 3)), np.empty((n, 16, 7)), \
-        np.empty((n, 16), dtype=np.bool_)
-    loop(ik_all_b, ik_all_s, n)(np.ascontiguousarray(u), g.starting_value, False, motors, pose, info, fk)
-    exists = info[..., 0] == 1.0
-    return FootIKSolutions(
-        motors.reshape(shape + (16, 3)), np.where(exists[..., None], pose, np.nan).reshape(shape + (16, 3)),
-        exists.reshape(shape + (16,)), info[..., 2].astype(int).reshape(shape + (16,)),
-        ((info[..., 1] == 1.0) & exists).reshape(shape + (16,)),
-        (fk & (info[..., 3] < FK_GAIN_MAX)).reshape(shape + (16,)),
-    )
+    out = _all_outputs((n,))
+    loop(ik_all_b, ik_all_s, n)(np.ascontiguousarray(u), g.starting_value, *out)
+    return FootIKSolutions(*(a.reshape(shape + a.shape[1:]) for a in out))
 
 
 def foot_ik(p: ArrayLike, *, starting_value: float | Unset = UNSET, ll_branch: int | None = None,

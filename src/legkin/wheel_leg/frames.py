@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import inspect
 import math
 import warnings
 from functools import lru_cache
@@ -40,6 +41,14 @@ def module_origin(leg: Leg, *args: Geometry | None, geometry: Geometry | None = 
         geometry = legacy_geometry(  # type: ignore[assignment]
             "module_origin", ("geometry",), args, {}, geometry, positional_geometry=True)
     return _origin(leg, _geometry(geometry)).copy()
+
+
+def _module_origin_signature(leg: Leg, *, geometry: Geometry | None = None) -> np.ndarray:
+    raise NotImplementedError  # a signature only
+
+
+# help() and inspect show today's call form (the function also takes legkin 0.1's positional geometry)
+module_origin.__signature__ = inspect.signature(_module_origin_signature)  # type: ignore[attr-defined]
 
 
 @lru_cache(maxsize=64)

@@ -3,6 +3,7 @@ angles, motor mapping."""
 
 from __future__ import annotations
 
+import inspect
 import math
 from functools import lru_cache
 from typing import NamedTuple
@@ -55,6 +56,14 @@ def linkage_constants(*args: float, geometry: Geometry | None = None, **kwargs: 
         geometry = legacy_geometry("linkage_constants", ("R",), args, kwargs, geometry)  # type: ignore[assignment]
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     return _constants(geo.R)._asdict()
+
+
+def _linkage_constants_signature(*, geometry: Geometry | None = None) -> dict[str, float]:
+    raise NotImplementedError  # a signature only
+
+
+# help() and inspect show today's call form (the function also takes legkin 0.1's R)
+linkage_constants.__signature__ = inspect.signature(_linkage_constants_signature)  # type: ignore[attr-defined]
 
 
 @lru_cache(maxsize=16)

@@ -1,0 +1,435 @@
+"""Where the leg-wheel touches flat ground (issue 12): the lowest point of the tyre surface (:mod:`.tyre`) along a
+ground normal, its material-point Jacobian, and the stance IK that puts that point on a target.
+
+The tyre in 3-D is the closed leg-plane curve of :mod:`.tyre` extruded over the width w in [-T/2, T/2] (T =
+``geometry.T``) along z_L. For a ground normal n (robot frame, unit) the height of the tyre point (s, w) is
+``<p(s), n_plane> + w n_z`` with n written in {L}: ``n_L = (R0 Rz(gamma) R_LM)^T n``, ``n_plane`` its leg-plane
+part, ``n_z`` its lateral part. So:
+
+* **w**: ``-sign(n_z) T/2`` (an edge of the tyre; with ABAD tilt gamma != 0 and n = z the lowest point is on the
+  edge that tilts down); where ``|n_z| <= 1e-12`` the lowest set is a segment across the width and **w = 0** (its
+  centre) is returned.
+* **s**: the support point of the leg-plane curve toward ``-n_plane``: per piece (a circle of radius rho about
+  c), ``c - rho n_plane/|n_plane|`` if that direction lies inside the piece's angle span, else the lower of its
+  two ends; the minimum over the 16 pieces. A tie (the same height on two pieces, e.g. a shared end point)
+  goes to the first piece in s order. The curve's points are all at distance r from the pitch curve and it
+  contains the swept region's boundary, so this is the lowest point of the pitch curve moved by ``-r n``.
+  Where ``|n_plane| <= 1e-12`` (the leg plane parallel to the ground) the whole side face is lowest: the point
+  of that face toward the toe G is returned (the support point for ``n_plane = -G/|G|``).
+* **Jacobian**: the derivative d p / d(theta, beta, gamma) of the *material point*: the point of the rim link
+  that carries the contact (:data:`.tyre.PIECE_LINKS`) fixed in that link at the solution, moved with the link.
+  It is not the derivative of the (rolling) contact point itself; the two differ by the rolling of the
+  contact along the tyre, which does not change the height: ``n . J`` is the derivative of the support height
+  (envelope theorem, checked). The point and Jacobian are those of :func:`~legkin.wheel_leg.fk` on that link.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+from typing import Literal, overload
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._batch import as_input, check_flag
+from .._kernels import OK, as_rows, kernel, prange
+from .._rotations import wrap
+from ..errors import InvalidInputError, JointLimitError, UnreachableError
+from ._common import Leg, _check_theta, _loop
+from .frames import _R_0, _R_LM, _k_fk, _origin
+from .geometry import _DEFAULT_GEOMETRY, ABAD_LIMIT, FOOT_OFFSET, THETA_MAX, THETA_MIN, Geometry, _geometry, _leg
+from .linkage import _IF, _IG, _IL, _IU, _k_closed, _kconst, linkage_points
+from .tyre import _LINK_A, _LINK_B, _NP, PIECES, TYRE_THICKNESS, _k_cumulative, _k_pieces, _thickness
+
+__all__ = ["GroundContact", "ground_contact", "stance_ik", "stance_ik_all", "normal_in_leg_frame"]
+
+_NONFINITE = 1
+#: Below this a normal component counts as zero (lateral: the lowest set is a segment; in-plane: a face).
+_ZERO = 1e-12
+
+
+@dataclass(frozen=True)
+class GroundContact:
+    """The lowest tyre point along a ground normal (:func:`ground_contact`).
+
+    Attributes:
+        point: (..., 3) the point in the robot frame {R}.
+        piece: (...) index into :data:`~legkin.wheel_leg.tyre.PIECES` of the tyre piece it lies on (-1: failed).
+        s: (...) its contact parameter (normalised arc length of the tyre curve).
+        w: (...) its lateral coordinate (-T/2, 0 or T/2).
+        jacobian: (..., 3, 3) d point / d(theta, beta, gamma) of the material point (module docstring).
+        link: (...) the rim link carrying the material point: index into :data:`~legkin.wheel_leg.tyre.LINK_NAMES`
+            (0 rim_upper_L, 1 rim_lower_L, 2 rim_lower_R, 3 rim_upper_R; -1: failed).
+    """
+
+    point: np.ndarray
+    piece: np.ndarray
+    s: np.ndarray
+    w: np.ndarray
+    jacobian: np.ndarray
+    link: np.ndarray
+
+    @property
+    def piece_name(self) -> np.ndarray:
+        """The names of :attr:`piece` (``""`` where it failed)."""
+        names = np.array(PIECES + ("",))
+        return names[np.where(self.piece < 0, len(PIECES), self.piece)]
+
+
+@kernel
+def _k_normal_leg(gamma, n, RLM, R0):
+    """The unit normal n (robot frame) in {L}: ``(R0 Rz(gamma) R_LM)^T n``."""
+    v0 = R0[0, 0] * n[0] + R0[1, 0] * n[1] + R0[2, 0] * n[2]
+    v1 = R0[0, 1] * n[0] + R0[1, 1] * n[1] + R0[2, 1] * n[2]
+    v2 = R0[0, 2] * n[0] + R0[1, 2] * n[1] + R0[2, 2] * n[2]
+    cg, sg = math.cos(gamma), math.sin(gamma)
+    u0, u1, u2 = cg * v0 + sg * v1, -sg * v0 + cg * v1, v2
+    return (RLM[0, 0] * u0 + RLM[1, 0] * u1 + RLM[2, 0] * u2, RLM[0, 1] * u0 + RLM[1, 1] * u1 + RLM[2, 1] * u2,
+            RLM[0, 2] * u0 + RLM[1, 2] * u1 + RLM[2, 2] * u2)
+
+
+@kernel
+def _k_support(C, RAD, A0, SPAN, d):
+    """The lowest point of the tyre curve along the unit direction ``d`` (pre-rotation plane): (piece, u, Y).
+
+    Per piece the minimum of ``Re(conj(p) d)`` over the arc: at ``c - rho d`` if the angle of ``-d`` is inside
+    the span, else at the lower end (u = 0 on a tie); the first piece wins a tie."""
+    psi = math.atan2(-d.imag, -d.real)
+    ad = math.atan2(d.imag, d.real)
+    best, bp, bu = math.inf, -1, 0.0
+    for p in range(_NP):
+        c, rho, a0, sp = C[p], RAD[p], A0[p], SPAN[p]
+        base = (c.conjugate() * d).real
+        spa = abs(sp)
+        rel = ((psi - a0) if sp > 0.0 else (a0 - psi)) % (2.0 * math.pi)
+        if spa > 0.0 and rho > 0.0 and rel <= spa:
+            h, u = base - rho, rel / spa
+        else:
+            h0 = base + rho * math.cos(a0 - ad)
+            h1 = base + rho * math.cos(a0 + sp - ad)
+            h, u = (h0, 0.0) if h0 <= h1 else (h1, 1.0)
+        if h < best:
+            best, bp, bu = h, p, u
+    c, rho = C[bp], RAD[bp]
+    if 0.0 < bu < 1.0:
+        Y = c - rho * d
+    else:
+        ang = A0[bp] + bu * SPAN[bp]
+        Y = c + rho * complex(math.cos(ang), math.sin(ang))
+    return bp, bu, Y
+
+
+@kernel
+def _k_ground(q, n, r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, p, J, info):
+    """:func:`ground_contact` for one item: point p (3,), Jacobian J (9,), info (4,) = (piece, s, w, link)."""
+    theta, beta, gamma = q[0], q[1], q[2]
+    if not (math.isfinite(theta) and math.isfinite(beta) and math.isfinite(gamma)):
+        return _NONFINITE
+    nl0, nl1, nl2 = _k_normal_leg(gamma, n, RLM, R0)
+    C = np.empty(_NP, dtype=np.complex128)
+    RAD, A0, SPAN, CUM = np.empty(_NP), np.empty(_NP), np.empty(_NP), np.empty(_NP + 1)
+    _k_pieces(theta, r, K, KC, C, RAD, A0, SPAN)
+    _k_cumulative(RAD, SPAN, CUM)
+    pts, _der = _k_closed(theta, K, KC, False)
+    rot = complex(math.cos(beta + math.pi / 2), math.sin(beta + math.pi / 2))
+    nz = complex(nl0, nl1)
+    mag = abs(nz)
+    if mag <= _ZERO:  # the leg plane is parallel to the ground: the face point toward the toe
+        G = pts[_IG]
+        d = -G / abs(G)
+    else:
+        d = rot.conjugate() * nz / mag
+    bp, bu, Y = _k_support(C, RAD, A0, SPAN, d)
+    w = -halfT if nl2 > _ZERO else (halfT if nl2 < -_ZERO else 0.0)
+    link = _LINK_A[bp] if bu < 0.5 else _LINK_B[bp]
+    upper = link == 0 or link == 3
+    right = link >= 2
+    ctr = pts[_IU] if upper else pts[_IL]
+    v = (pts[_IF] if upper else pts[_IG]) - ctr
+    e = ((Y.conjugate() if right else Y) - ctr) / v
+    status = _k_fk(theta, beta, gamma, upper, right, e, False, K, KC, sl, dwheel + sl * w, o0, o1, o2, True, p, J)
+    info[0] = bp
+    info[1] = (CUM[bp] + bu * (CUM[bp + 1] - CUM[bp])) / CUM[_NP]
+    info[2] = w
+    info[3] = link
+    return status
+
+
+@_loop(256)
+def _k_ground_batch(q, n, r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, P, J, info, status):
+    for i in prange(q.shape[0]):
+        status[i] = _k_ground(q[i], n[i], r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, P[i], J[i], info[i])
+
+
+def _normals(normal) -> np.ndarray:
+    n = as_input(normal, "normal", (3,))
+    size = np.linalg.norm(n, axis=-1)
+    if np.any(size <= 1e-300):
+        raise InvalidInputError("normal must be a nonzero vector")
+    return n / size[..., None]
+
+
+def _leg_consts(leg, geo: Geometry):
+    _i, side, _sx = _leg(leg)
+    o = _origin(leg, geo)
+    return (1.0 if side == "L" else -1.0), o, _R_LM[side], _R_0[side]
+
+
+@overload
+def ground_contact(q: ArrayLike, leg: Leg, normal: ArrayLike = ..., *, r: float = ..., geometry: Geometry | None = ...,
+                   return_mask: Literal[False] = False) -> GroundContact: ...
+@overload
+def ground_contact(q: ArrayLike, leg: Leg, normal: ArrayLike = ..., *, r: float = ..., geometry: Geometry | None = ...,
+                   return_mask: Literal[True]) -> tuple[GroundContact, np.ndarray]: ...
+def ground_contact(q: ArrayLike, leg: Leg, normal: ArrayLike = (0.0, 0.0, 1.0), *, r: float = TYRE_THICKNESS,
+                   geometry: Geometry | None = None,
+                   return_mask: bool = False) -> GroundContact | tuple[GroundContact, np.ndarray]:
+    """The lowest point of the tyre of ``leg`` along the ground normal (module docstring), in {R}.
+
+    Args:
+        q: (..., 3) (theta, beta, gamma) of that leg (rad), theta in [17 deg, 160 deg].
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        normal: (3,) or (..., 3) the ground normal in {R} (any nonzero length; broadcast with q): the point
+            returned is the support point toward ``-normal``.
+        r: tyre thickness (m) in (0, R); geometry: robot parameters.
+        return_mask: also return the mask of finite results (all True for valid inputs).
+
+    Returns:
+        :class:`GroundContact` (and the mask). Batch: NaN (piece -1) where an item fails.
+
+    Raises:
+        InvalidInputError: NaN/inf/complex/wrong shapes, theta out of range, a zero normal.
+        InvalidParameterError: unknown leg, r out of range, geometry not a Geometry.
+    """
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    return_mask = check_flag(return_mask, "return_mask")
+    rho = _thickness(r, geo)
+    sl, o, RLM, R0 = _leg_consts(leg, geo)
+    q = as_input(q, "q", (3,))
+    n = _normals(normal)
+    try:
+        shape = np.broadcast_shapes(q.shape[:-1], n.shape[:-1])
+    except ValueError as exc:
+        raise InvalidInputError(f"inputs do not broadcast together: q{q.shape}, normal{n.shape}") from exc
+    q = np.broadcast_to(q, shape + (3,))
+    _check_theta(q[..., 0], "theta (q[..., 0])")
+    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    qr = as_rows(q, 3)
+    nr = as_rows(np.broadcast_to(n, shape + (3,)), 3)
+    m = qr.shape[0]
+    P, Jm, info, status = np.empty((m, 3)), np.empty((m, 9)), np.empty((m, 4)), np.empty(m, dtype=np.int64)
+    args = (rho, K, KC, sl, geo.d_wheel, geo.T / 2, float(o[0]), float(o[1]), float(o[2]), RLM, R0)
+    if shape == ():
+        status[0] = _k_ground(qr[0], nr[0], *args, P[0], Jm[0], info[0])
+    else:
+        _k_ground_batch(qr, nr, *args, P, Jm, info, status)
+    ok = status == OK
+    P[~ok], Jm[~ok], info[~ok] = np.nan, np.nan, np.nan
+    piece = np.where(ok, info[:, 0], -1).astype(np.int64)
+    link = np.where(ok, info[:, 3], -1).astype(np.int64)
+    gc = GroundContact(P.reshape(shape + (3,)), piece.reshape(shape), info[:, 1].reshape(shape),
+                       info[:, 2].reshape(shape), Jm.reshape(shape + (3, 3)), link.reshape(shape))
+    if shape == () and not bool(ok[0]):
+        raise InvalidInputError(f"the ground contact is not finite at q={q.tolist()}")
+    return (gc, ok.reshape(shape)) if return_mask else gc
+
+
+def normal_in_leg_frame(gamma: ArrayLike, leg: Leg, normal: ArrayLike = (0.0, 0.0, 1.0)) -> np.ndarray:
+    """The unit ground normal (robot frame) written in the leg frame {L} at ABAD angle gamma: (..., 3)."""
+    sl, _o, RLM, R0 = _leg_consts(leg, _DEFAULT_GEOMETRY)
+    n = _normals(normal)
+    g = as_input(gamma, "gamma")
+    c, s = np.cos(g)[..., None], np.sin(g)[..., None]
+    v = n @ R0  # R0^T n
+    u = np.stack([c[..., 0] * v[..., 0] + s[..., 0] * v[..., 1], -s[..., 0] * v[..., 0] + c[..., 0] * v[..., 1],
+                  np.broadcast_to(v[..., 2], np.broadcast_shapes(v[..., 2].shape, g.shape))], -1)
+    return u @ RLM  # RLM^T u
+
+
+# ---------------------------------------------------------------- stance IK
+#: The centres whose circles carry the support point: (point name, offset radius: "R+r" or "r").
+_CENTRES = (("U_L", True), ("L_L", True), ("L_R", True), ("U_R", True), ("F_L", False), ("G", False),
+            ("F_R", False), ("H_L", False), ("H_R", False))
+_GRID = 2001
+_BISECT = 56
+#: A candidate whose ground contact is farther than this from the target is not a solution (m).
+VERIFY_TOL = 1e-9
+
+
+@lru_cache(maxsize=8)
+def _centre_table(geo: Geometry) -> tuple[np.ndarray, np.ndarray]:
+    """theta grid (M,) and |c_k(theta)|^2 (9, M) of the support circles' centres (pre-rotation plane)."""
+    th = np.linspace(THETA_MIN, THETA_MAX, _GRID)
+    pts = linkage_points(th, -np.pi / 2, geometry=geo)
+    tab = np.stack([pts[name][:, 0] ** 2 + pts[name][:, 1] ** 2 for name, _ in _CENTRES])
+    th.setflags(write=False)
+    tab.setflags(write=False)
+    return th, tab
+
+
+def _centres_at(theta: np.ndarray, k: np.ndarray, geo: Geometry) -> np.ndarray:
+    """Centre k[i] at theta[i] (pre-rotation plane), complex."""
+    pts = linkage_points(theta, -np.pi / 2, geometry=geo)
+    allc = np.stack([pts[name][:, 0] + 1j * pts[name][:, 1] for name, _ in _CENTRES])
+    return allc[k, np.arange(theta.shape[0])]
+
+
+def _candidates(t: np.ndarray, n: np.ndarray, sl: float, o: np.ndarray, geo: Geometry, rho: float, leg) -> np.ndarray:
+    """Every candidate (theta, beta, gamma) of one target (unverified): per lateral choice w and out-of-plane
+    branch, gamma in closed form, then per support circle the roots of |c_k(theta)| = |Z| on the grid."""
+    th, tab = _centre_table(geo)
+    d = t - o
+    out = []
+    for w in (-geo.T / 2, geo.T / 2, 0.0):
+        a = geo.d_wheel + sl * w
+        rr = d[1] ** 2 + d[2] ** 2 - a * a
+        if rr < -1e-15:
+            continue
+        for yl in {-math.sqrt(max(rr, 0.0)), math.sqrt(max(rr, 0.0))}:
+            gamma = float(np.angle((sl * d[1] + 1j * d[2]) / (a + 1j * yl)))
+            nl = normal_in_leg_frame(gamma, leg, n)
+            w_rule = -geo.T / 2 if nl[2] > _ZERO else (geo.T / 2 if nl[2] < -_ZERO else 0.0)
+            nzv = complex(nl[0], nl[1])
+            if w_rule != w or abs(nzv) <= _ZERO:
+                continue
+            zt = complex(-d[0], yl)
+            Z = np.array([zt + (geo.R + rho if big else rho) * nzv / abs(nzv) for _name, big in _CENTRES])
+            f = tab - (np.abs(Z) ** 2)[:, None]
+            kk, jj = np.nonzero(np.signbit(f[:, :-1]) != np.signbit(f[:, 1:]))
+            lo, hi = th[jj].copy(), th[jj + 1].copy()
+            flo = f[kk, jj]
+            for _ in range(_BISECT):
+                mid = 0.5 * (lo + hi)
+                fm = np.abs(_centres_at(mid, kk, geo)) ** 2 - np.abs(Z[kk]) ** 2
+                left = np.signbit(fm) == np.signbit(flo)
+                lo = np.where(left, mid, lo)
+                hi = np.where(left, hi, mid)
+            roots = 0.5 * (lo + hi)
+            # a root on a bound of [17, 160] deg where f does not change sign across the grid's end cell
+            for end in (0, -1):
+                ke = np.flatnonzero(np.abs(f[:, end]) <= 1e-15)
+                roots, kk = np.concatenate([roots, np.full(ke.size, th[end])]), np.concatenate([kk, ke])
+            if roots.size == 0:
+                continue
+            c = _centres_at(roots, kk, geo)
+            beta = wrap(np.angle(Z[kk] / c) - np.pi / 2)
+            out.append(np.stack([roots, beta, np.full(roots.size, gamma)], -1))
+    return np.concatenate(out) if out else np.empty((0, 3))
+
+
+def _solutions(t: np.ndarray, n: np.ndarray, leg, geo: Geometry, rho: float) -> np.ndarray:
+    """The verified, de-duplicated solutions of one target, sorted by |gamma| then theta."""
+    sl, o, _RLM, _R0 = _leg_consts(leg, geo)
+    cand = _candidates(t, n, sl, o, geo, rho, leg)
+    if cand.shape[0] == 0:
+        return cand
+    gc = ground_contact(cand, leg, n, r=rho, geometry=geo)
+    ok = np.linalg.norm(gc.point - t, axis=-1) <= VERIFY_TOL
+    sol = cand[ok]
+    sol = sol[np.lexsort((sol[:, 0], np.abs(sol[:, 2])))]
+    keep: list[np.ndarray] = []
+    for qv in sol:
+        if all(np.abs(np.concatenate([[qv[0] - k[0]], wrap(qv[1:] - k[1:])])).max() > 1e-9 for k in keep):
+            keep.append(qv)
+    return np.array(keep).reshape(-1, 3)
+
+
+def _targets(target, normal):
+    t = as_input(target, "target", (3,))
+    n = _normals(normal)
+    try:
+        shape = np.broadcast_shapes(t.shape[:-1], n.shape[:-1])
+    except ValueError as exc:
+        raise InvalidInputError(f"inputs do not broadcast together: target{t.shape}, normal{n.shape}") from exc
+    return (as_rows(np.broadcast_to(t, shape + (3,)), 3), as_rows(np.broadcast_to(n, shape + (3,)), 3), shape)
+
+
+def stance_ik_all(target: ArrayLike, leg: Leg, *, normal: ArrayLike = (0.0, 0.0, 1.0), r: float = TYRE_THICKNESS,
+                  limits: bool = False, geometry: Geometry | None = None) -> np.ndarray:
+    """Every (theta, beta, gamma) whose ground contact (:func:`ground_contact`) is ``target``, (..., S, 3), NaN-padded.
+
+    How every solution is found: the lateral coordinate is one of -T/2, T/2, 0 (the rule of
+    :func:`ground_contact`); for each, the target's distance from the module axis gives the leg-plane height
+    y_L (two branches) and gamma in closed form (as the radial IK); then for each circle that can carry the
+    support point (offset arcs about U_L, L_L, L_R, U_R of radius R + r; fillets and caps about F_L, G, F_R,
+    H_L, H_R of radius r) the support point is ``rot(beta) c_k(theta) - rho n_plane``, so
+    ``|c_k(theta)| = |target + rho n_plane|``: every sign change on a 2001-node theta grid over [17, 160] deg is
+    bisected to full precision, beta follows from the angle. Each candidate is kept only if
+    :func:`ground_contact` at it reproduces the target to 1e-9 m (the brute-force verification: the circle must
+    really carry the lowest point). Roots where |c_k|^2 touches the level without crossing it inside one grid
+    cell (a fold) can be missed. Sorted by |gamma|, then theta. ``limits=True``: only |gamma| <= ABAD_LIMIT.
+    """
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    rho = _thickness(r, geo)
+    limits = check_flag(limits, "limits")
+    _leg(leg)
+    t, n, shape = _targets(target, normal)
+    sols = []
+    for i in range(t.shape[0]):
+        s = _solutions(t[i], n[i], leg, geo, rho)
+        if limits:
+            s = s[np.abs(s[:, 2]) <= ABAD_LIMIT + 1e-12]
+        sols.append(s)
+    S = max([1] + [s.shape[0] for s in sols])
+    out = np.full((t.shape[0], S, 3), np.nan)
+    for i, s in enumerate(sols):
+        out[i, : s.shape[0]] = s
+    return out.reshape(shape + (S, 3))
+
+
+@overload
+def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = ..., q_near: ArrayLike | None = ..., r: float = ...,
+              limits: bool = ..., geometry: Geometry | None = ..., return_mask: Literal[False] = False) -> np.ndarray: ...
+@overload
+def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = ..., q_near: ArrayLike | None = ..., r: float = ...,
+              limits: bool = ..., geometry: Geometry | None = ...,
+              return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = (0.0, 0.0, 1.0), q_near: ArrayLike | None = None,
+              r: float = TYRE_THICKNESS, limits: bool = True, geometry: Geometry | None = None,
+              return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """(theta, beta, gamma) placing the ground contact point (:func:`ground_contact`) of ``leg`` at ``target``.
+
+    The solutions are :func:`stance_ik_all`'s; with ``limits=True`` (default) only those inside the joint limits
+    (theta in [17, 160] deg always; |gamma| <= ABAD_LIMIT). Default: the first (smallest |gamma|, then theta);
+    with ``q_near`` (3,) or (..., 3): the nearest to it (max-norm, beta and gamma wrapped).
+
+    Raises (single target): UnreachableError (no solution), JointLimitError (solutions only outside the limits),
+    InvalidInputError (bad input). A batch gives NaN and mask False instead.
+    """
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    rho = _thickness(r, geo)
+    limits = check_flag(limits, "limits")
+    return_mask = check_flag(return_mask, "return_mask")
+    _leg(leg)
+    t, n, shape = _targets(target, normal)
+    near = None if q_near is None else as_rows(np.broadcast_to(as_input(q_near, "q_near", (3,)), shape + (3,)), 3)
+    out = np.full((t.shape[0], 3), np.nan)
+    why = np.zeros(t.shape[0], dtype=np.int64)  # 0 solved, 1 unreachable, 2 only outside the limits
+    for i in range(t.shape[0]):
+        s = _solutions(t[i], n[i], leg, geo, rho)
+        if limits and s.shape[0]:
+            inside = s[np.abs(s[:, 2]) <= ABAD_LIMIT + 1e-12]
+            why[i] = 2 if inside.shape[0] == 0 else 0
+            s = inside
+        elif s.shape[0] == 0:
+            why[i] = 1
+        if s.shape[0] == 0:
+            why[i] = why[i] or 1
+            continue
+        if near is None:
+            out[i] = s[0]
+        else:
+            dist = np.abs(np.concatenate([s[:, :1] - near[i, 0], wrap(s[:, 1:] - near[i, 1:])], 1)).max(1)
+            out[i] = s[int(np.argmin(dist))]
+    ok = why == 0
+    if shape == ():
+        if why[0] == 2:
+            raise JointLimitError(f"target {t[0].tolist()} is reached only with |gamma| > ABAD_LIMIT", target=t[0])
+        if why[0] == 1:
+            raise UnreachableError(f"no configuration puts the ground contact of {leg} at {t[0].tolist()}",
+                                   target=t[0])
+        return out[0]
+    q = out.reshape(shape + (3,))
+    return (q, ok.reshape(shape)) if return_mask else q

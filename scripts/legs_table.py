@@ -38,7 +38,8 @@ def geometry_table() -> str:
         s3 = sorted({int(leg.knee_sign) for leg in found.values()})
         dev = max(max(leg.axis_deviation) for leg in found.values())
         lines.append(
-            f"| {name} | {', '.join(found)} | {', '.join(first.joint_names)} | {first.foot_frame} | {' ; '.join(axes)} | "
+            f"| {name} | {', '.join(found)} | {', '.join(first.joint_names)} | {first.foot_frame} | "
+            f"{' ; '.join(axes)} | "
             f"{d} | {' ; '.join(hs)} | {first.thigh_length:.4f} | {first.shank_length:.4f} | "
             f"{' ; '.join(f'{v:g}' for v in tz)} | {' ; '.join(f'{v:g}' for v in kz)} | "
             f"{' ; '.join(f'{v:+d}' for v in s3)} | {dev:.1e} |"
@@ -48,8 +49,8 @@ def geometry_table() -> str:
 
 def error_table(samples: int, seed: int) -> str:
     lines = [
-        "| robot | samples x legs | FK vs oMf (m) | Jacobian vs getFrameJacobian | IK round trip (m) | solved in limits | "
-        "all branches (m) | branches | time (s) |",
+        "| robot | samples x legs | FK vs oMf (m) | Jacobian vs getFrameJacobian | IK round trip (m) | "
+        "solved in limits | all branches (m) | branches | time (s) |",
         "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     for name in legs.ERD_ROBOTS:

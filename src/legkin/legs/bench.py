@@ -62,15 +62,15 @@ def urdf_chain(urdf, frame: str) -> tuple[str, str, list[str]]:
     """``(root link, end link, [link, joint, link, ..., end link])`` from the URDF's root link to the link
     ``frame`` (or to the child link of the joint ``frame``)."""
     root = ET.parse(urdf).getroot()
-    parent = {}  # child link -> (joint, parent link)
-    child_of_joint = {}
+    parent: dict[str, tuple[str, str]] = {}  # child link -> (joint, parent link)
+    child_of_joint: dict[str, str] = {}
     for j in root.findall("joint"):
         c, p = j.find("child"), j.find("parent")
         if c is None or p is None:
             continue
-        parent[c.get("link")] = (j.get("name"), p.get("link"))
-        child_of_joint[j.get("name")] = c.get("link")
-    links = {link.get("name") for link in root.findall("link")}
+        parent[str(c.get("link"))] = (str(j.get("name")), str(p.get("link")))
+        child_of_joint[str(j.get("name"))] = str(c.get("link"))
+    links = {str(link.get("name")) for link in root.findall("link")}
     end = frame if frame in links else child_of_joint.get(frame)
     if end is None:
         raise ValueError(f"no link or joint {frame!r} in {urdf}")

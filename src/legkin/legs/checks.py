@@ -56,7 +56,7 @@ def pinocchio_feet(model, legs: dict, qs: np.ndarray, jacobians: bool = False):
     cols = [list(leg.idx_v) for leg in legs.values()]
     n = len(qs)
     pos = np.empty((n, len(fids), 3))
-    jac = np.empty((n, len(fids), 3, 3)) if jacobians else None
+    jac = np.empty((n if jacobians else 0, len(fids), 3, 3))
     for i, q in enumerate(qs):
         if jacobians:
             pin.computeJointJacobians(model, data, q)
@@ -92,7 +92,8 @@ def run(robot_name: str, samples: int, rng: np.random.Generator) -> list[CheckRe
     jk = np.stack([leg.jacobian(qleg[:, k]) for k, leg in enumerate(legs.values())], axis=1)
     rows = [
         compare(f"{nl} feet: FK vs oMf", np.linalg.norm(fk - pos, axis=-1), TOL),
-        compare(f"{nl} feet: Jacobian vs getFrameJacobian (LWA, leg columns)", np.abs(jk - jac).max(axis=(-1, -2)), TOL),
+        compare(f"{nl} feet: Jacobian vs getFrameJacobian (LWA, leg columns)", np.abs(jk - jac).max(axis=(-1, -2)),
+                TOL),
     ]
     # IK round trip: the default branch (inside the limits, nearest mid-limit), checked by Pinocchio.
     q_ik = np.empty_like(qleg)
@@ -110,7 +111,9 @@ def run(robot_name: str, samples: int, rng: np.random.Generator) -> list[CheckRe
         q_all[:, k], mask[:, k] = leg.ik_all(pos[:, k])
     errs = []
     for b in range(4):
-        back = pinocchio_feet(model, legs, _with_legs(model, legs, qs, np.where(mask[:, :, b, None], q_all[:, :, b], 0.0)))
+        qb = np.where(mask[:, :, b, None], q_all[:, :, b], 0.0)
+        back = pinocchio_feet(model, legs, _with_legs(model, legs, qs, qb))
         errs.append(np.linalg.norm(back - pos, axis=-1)[mask[:, :, b]])
-    rows.append(compare(f"IK all branches, Pinocchio FK of ik_all(p) ({int(mask.sum())} branches)", np.concatenate(errs), TOL))
+    name = f"IK all branches, Pinocchio FK of ik_all(p) ({int(mask.sum())} branches)"
+    rows.append(compare(name, np.concatenate(errs), TOL))
     return rows

@@ -86,7 +86,9 @@ def _robot(name: str) -> ErdRobot:
     try:
         return ERD_ROBOTS[name]
     except (KeyError, TypeError):
-        raise UnknownModelError(f"unknown example-robot-data quadruped {name!r}; known: {', '.join(ERD_ROBOTS)}") from None
+        raise UnknownModelError(
+            f"unknown example-robot-data quadruped {name!r}; known: {', '.join(ERD_ROBOTS)}"
+        ) from None
 
 
 def erd_files(name: str) -> tuple[Path, Path | None, list[str]]:
@@ -141,7 +143,10 @@ def load_erd(name: str, *, free_flyer: bool | None = None):
     urdf, srdf, dirs = erd_files(name)
     ff = robot.free_flyer if free_flyer is None else bool(free_flyer)
     try:
-        model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer()) if ff else pin.buildModelFromUrdf(str(urdf))
+        if ff:
+            model = pin.buildModelFromUrdf(str(urdf), pin.JointModelFreeFlyer())
+        else:
+            model = pin.buildModelFromUrdf(str(urdf))
         if srdf is not None:
             pin.loadReferenceConfigurations(model, str(srdf), False)
     except Exception as exc:  # noqa: BLE001 - Pinocchio's parse errors become a legkin error

@@ -93,7 +93,9 @@ def find_chains(model, foot_frames: Iterable[str] | None = None) -> list[tuple[t
         for name in foot_frames:
             if not isinstance(name, str) or not model.existFrame(name):
                 known = [f.name for f in model.frames if _FOOT.search(f.name)]
-                raise InvalidParameterError(f"foot frame {name!r} is not a frame of the model (foot-like frames: {known})")
+                raise InvalidParameterError(
+                    f"foot frame {name!r} is not a frame of the model (foot-like frames: {known})"
+                )
             j3 = model.frames[model.getFrameId(name)].parentJoint
             j2 = model.parents[j3] if j3 > 0 else 0
             j1 = model.parents[j2] if j2 > 0 else 0
@@ -143,7 +145,8 @@ def _measure(model, data, root: int, chain: tuple[int, int, int], foot: str):
         jac = pin.getJointJacobian(model, data, j, pin.LOCAL)[:, model.joints[j].idx_v]
         if np.linalg.norm(jac[:3]) > 1e-12 or abs(np.linalg.norm(jac[3:]) - 1.0) > 1e-9:
             raise LegStructureError(
-                f"joint {model.names[j]} is not a pure rotation about a unit axis (motion subspace {jac.round(6).tolist()})"
+                f"joint {model.names[j]} is not a pure rotation about a unit axis "
+                f"(motion subspace {jac.round(6).tolist()})"
             )
         m = base * data.oMi[j]
         origins.append(np.array(m.translation))
@@ -174,7 +177,7 @@ def _build(model, root: int, chain: tuple[int, int, int], foot: str, name: str) 
     leg = Leg.from_geometry(name, names, foot, origins, axes, f, lower, upper, idx_q=iq, idx_v=iv)
     # The closed form must reproduce Pinocchio: at zero (the leg's joints) and at _VERIFY_Q.
     fid = model.getFrameId(foot)
-    worst, where = 0.0, None
+    worst, where = 0.0, np.zeros(3)
     for qleg in np.vstack([np.zeros(3), _VERIFY_Q]):
         q = q0.copy()
         q[list(iq)] = qleg

@@ -158,7 +158,8 @@ def _fk3_k(q0, q1, q2, g):
 
 @kernel
 def _fk_k(q, g, out) -> int:
-    """Foot position: :func:`_fk3_k`, ``p = o1 + R(a1, q1) [(o2 - o1) + R(a2, q2) ((o3 - o2) + R(a3, q3) (f - o3))]``."""
+    """Foot position: :func:`_fk3_k`,
+    ``p = o1 + R(a1, q1) [(o2 - o1) + R(a2, q2) ((o3 - o2) + R(a3, q3) (f - o3))]``."""
     if not _finite3(q):
         return _BAD_INPUT
     out[0], out[1], out[2] = _fk3_k(q[0], q[1], q[2], g)
@@ -196,7 +197,8 @@ def _jacobian_k(q, g, out) -> int:
 @kernel
 def _polish_k(p, g, q, jac) -> float:
     """At most :data:`POLISH_STEPS` damped Newton steps on the exact forward map while the foot error exceeds
-    :data:`POLISH_BELOW`, each kept only if it reduces the error: ``e = p - fk(q)``, ``dq = J^T (J J^T + lambda^2 I)^-1 e`` (``lambda`` = :data:`POLISH_DAMPING`).
+    :data:`POLISH_BELOW`, each kept only if it reduces the error: ``e = p - fk(q)``,
+    ``dq = J^T (J J^T + lambda^2 I)^-1 e`` (``lambda`` = :data:`POLISH_DAMPING`).
 
     The closed form is exact for the ideal structure (a1 perpendicular to a2 = +-a3); URDF angles written
     with 11 digits (``rpy="0 1.57079632679 0"``) leave axes ~5e-12 off, i.e. ~1e-12 m at the foot, and near the
@@ -446,6 +448,10 @@ def _ik_batch(p, g, ref, out, status, info) -> None:
 
 
 # ---------------------------------------------------------------- geometry helpers (Python)
+def _never() -> Exception:  # pragma: no cover - a batch call never raises
+    raise AssertionError("finish() asked a batch call for its error")
+
+
 def _unit(v: np.ndarray, what: str) -> np.ndarray:
     n = float(np.linalg.norm(v))
     if not n > 1e-12 or not math.isfinite(n):
@@ -516,7 +522,7 @@ class Leg:
     q_ref: np.ndarray
     idx_q: tuple[int, int, int] = (-1, -1, -1)
     idx_v: tuple[int, int, int] = (-1, -1, -1)
-    params: np.ndarray = field(default=None, repr=False)
+    params: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # always set by from_geometry
 
     # ------------------------------------------------------------ construction
     @classmethod
@@ -582,7 +588,9 @@ class Leg:
                 f"leg {name}: the KFE axis ({j3}) passes through the HFE axis ({j2}): thigh length {kn:.3g} m"
             )
         if ln <= 1e-9:
-            raise LegStructureError(f"leg {name}: the foot ({foot_frame}) lies on the KFE axis ({j3}): shank length {ln:.3g} m")
+            raise LegStructureError(
+                f"leg {name}: the foot ({foot_frame}) lies on the KFE axis ({j3}): shank length {ln:.3g} m"
+            )
         d = float(e2 @ (f - o[0]))
         lo = np.asarray(lower, dtype=float).reshape(3)
         hi = np.asarray(upper, dtype=float).reshape(3)
@@ -608,8 +616,8 @@ class Leg:
             lower=_frozen(lo), upper=_frozen(hi), origin=_frozen(o[0]), axes=_frozen(np.stack([a1, a2, a3])),
             hfe_origin=_frozen(o[1]), kfe_origin=_frozen(o[2]), foot_origin=_frozen(f),
             frame=_frozen(np.stack([e1, e2, e3])), lateral_offset=d, hip_offset=_frozen(h), thigh=_frozen(k),
-            shank=_frozen(l), knee_sign=s3, q_ref=_frozen(mid), idx_q=tuple(int(i) for i in idx_q),
-            idx_v=tuple(int(i) for i in idx_v), params=_frozen(g),
+            shank=_frozen(l), knee_sign=s3, q_ref=_frozen(mid), idx_q=(int(idx_q[0]), int(idx_q[1]), int(idx_q[2])),
+            idx_v=(int(idx_v[0]), int(idx_v[1]), int(idx_v[2])), params=_frozen(g),
         )
 
     # ------------------------------------------------------------ derived numbers
@@ -749,13 +757,14 @@ class Leg:
             miss, why = float(info[0]), info[1]
             lo, hi = self.reach
             if why == _IN_CYLINDER:
-                text = (f"it lies {miss:.6g} m inside the abduction cylinder (radius |d| = {abs(self.lateral_offset):.6g} m "
-                        f"about the HAA axis)")
+                text = (f"it lies {miss:.6g} m inside the abduction cylinder "
+                        f"(radius |d| = {abs(self.lateral_offset):.6g} m about the HAA axis)")
             elif why == _TOO_FAR:
                 text = f"it lies {miss:.6g} m beyond the leg's full stretch (|k| + |l| = {hi:.6g} m in the pitch plane)"
             else:
                 text = f"it lies {miss:.6g} m inside the knee's inner reach (| |k| - |l| | = {lo:.6g} m)"
-            return UnreachableError(f"target {tgt} is out of reach of leg {self.name} by {miss:.6g} m: {text}", target=p)
+            return UnreachableError(f"target {tgt} is out of reach of leg {self.name} by {miss:.6g} m: {text}",
+                                    target=p)
         if status == _JOINT_LIMIT:
             branches = self.ik_all(p)[0]
             return JointLimitError(
@@ -823,11 +832,11 @@ class Leg:
         if q_near is None and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast
             out = np.empty(3)
             info = np.zeros(2)
-            status = _ik_k(p, self.params, self.q_ref, out, info)
-            if status == OK:
+            st = _ik_k(p, self.params, self.q_ref, out, info)
+            if st == OK:
                 return (out, np.array(True)) if return_mask else out
-            if status != _BAD_INPUT:
-                raise self._error(status, info, p.copy())
+            if st != _BAD_INPUT:
+                raise self._error(st, info, p.copy())
         rows, ref, batch, single = self._prepare(p, q_near)
         n = rows.shape[0]
         out = np.empty((n, 3))
@@ -837,7 +846,7 @@ class Leg:
         ok = status == OK
         if single:
             return finish(out[0], ok[0], True, return_mask, lambda: self._error(int(status[0]), info[0], rows[0]))
-        return finish(out.reshape(batch + (3,)), ok.reshape(batch), False, return_mask, lambda: None)
+        return finish(out.reshape(batch + (3,)), ok.reshape(batch), False, return_mask, _never)
 
     def within_limits(self, q, tol: float = 0.0) -> np.ndarray | bool:
         """Whether the joint values ``q`` (3,) or (..., 3) lie inside the URDF limits (widened by ``tol`` rad)."""

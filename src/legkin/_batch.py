@@ -13,7 +13,7 @@ from typing import Callable
 
 import numpy as np
 
-from .errors import InvalidInputError, InvalidParameterError
+from .errors import InvalidArgumentError, InvalidInputError
 
 __all__ = [
     "as_input",
@@ -102,8 +102,12 @@ def real_number(value, name: str, valid) -> float:
         ok, value = True, value.item()
     if not ok:
         text = valid() if callable(valid) else valid
-        raise InvalidParameterError(f"{name} must be a real number, got {value!r}; valid range {text}")
-    return float(value)
+        raise InvalidArgumentError(f"{name} must be a real number, got {value!r}; valid range {text}")
+    try:
+        return float(value)
+    except OverflowError:  # an int beyond the float range
+        text = valid() if callable(valid) else valid
+        raise InvalidArgumentError(f"{name}={value!r} is out of range: valid range {text}") from None
 
 
 def _range_text(low, high, low_open: bool, high_open: bool) -> str:
@@ -119,21 +123,24 @@ def check_number(
     """A keyword parameter that must be one finite real number in a range; returns it as a float.
 
     Raises:
-        InvalidParameterError: (a ``ValueError``) not a real number, NaN/inf, or outside the range; the
+        InvalidArgumentError: (a ``ValueError``) not a real number, NaN/inf, or outside the range; the
             message names the value and the range.
     """
     rng = _range_text(low, high, low_open, high_open)
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
         if not (isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf"):
-            raise InvalidParameterError(f"{name} must be a real number in {rng}, got {value!r}")
-    v = float(value)
+            raise InvalidArgumentError(f"{name} must be a real number in {rng}, got {value!r}")
+    try:
+        v = float(value)
+    except OverflowError:  # an int beyond the float range
+        raise InvalidArgumentError(f"{name}={value!r} is out of range: must be a finite number in {rng}") from None
     bad = not np.isfinite(v)
     if low is not None:
         bad |= v <= low if low_open else v < low
     if high is not None:
         bad |= v >= high if high_open else v > high
     if bad:
-        raise InvalidParameterError(f"{name}={v!r} is out of range: must be a finite number in {rng}")
+        raise InvalidArgumentError(f"{name}={v!r} is out of range: must be a finite number in {rng}")
     return v
 
 
@@ -141,18 +148,18 @@ def check_integer(value, name: str, low: int | None = None, high: int | None = N
     """A keyword parameter that must be an integer in ``[low, high]``."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
         span = _range_text(low, high, False, False)
-        raise InvalidParameterError(f"{name} must be an integer in {span}, got {value!r}")
+        raise InvalidArgumentError(f"{name} must be an integer in {span}, got {value!r}")
     v = int(value)
     if (low is not None and v < low) or (high is not None and v > high):
         span = _range_text(low, high, False, False)
-        raise InvalidParameterError(f"{name}={v} is out of range: must be an integer in {span}")
+        raise InvalidArgumentError(f"{name}={v} is out of range: must be an integer in {span}")
     return v
 
 
 def check_flag(value, name: str) -> bool:
     """A keyword parameter that must be a bool."""
     if not isinstance(value, (bool, np.bool_)):
-        raise InvalidParameterError(f"{name} must be True or False, got {value!r}")
+        raise InvalidArgumentError(f"{name} must be True or False, got {value!r}")
     return bool(value)
 
 
@@ -163,5 +170,5 @@ def check_choice(value, name: str, choices) -> object:
     except Exception:  # noqa: BLE001 - an unhashable or array value is simply not a valid choice
         ok = False
     if isinstance(value, np.ndarray) or not ok:
-        raise InvalidParameterError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
+        raise InvalidArgumentError(f"{name} must be one of {', '.join(map(repr, choices))}, got {value!r}")
     return value

@@ -141,3 +141,22 @@ def test_check_rows_pass_and_include_a_jacobian_against_pinocchio(model):
     failed = [r.name for r in rows if not r.passed]
     assert not failed, f"check rows failed: {failed}"
     assert any("jacobian" in r.name.lower() for r in rows), [r.name for r in rows]
+
+
+@pytest.mark.parametrize("model", legkin.list_models("legkin"))
+def test_the_package_exports_its_kinematics_and_no_submodule_hides_a_function(model):
+    """``legkin.<name>.X`` is the function ``kinematics.X`` for every public X, even after every submodule of
+    the package has been imported (a submodule named like a function would replace it on the package)."""
+    import pkgutil
+    import types
+
+    pkg = importlib.import_module(f"legkin.{model}")
+    for info in pkgutil.iter_modules(pkg.__path__):
+        importlib.import_module(f"legkin.{model}.{info.name}")
+    kinematics = pkg.kinematics
+    assert kinematics.__all__
+    for name in kinematics.__all__:
+        value = getattr(pkg, name)
+        assert not isinstance(value, types.ModuleType), f"legkin.{model}.{name} is a module"
+        assert value is getattr(kinematics, name), name
+    assert pkg.Geometry.from_params(legkin.load(model).params) == pkg.Geometry()

@@ -21,16 +21,22 @@ _SUBMODULES = ("kinematics", "geometry", "configuration", "contract", "checks", 
 
 
 def __getattr__(name: str) -> Any:
+    """The lazy re-export; a name found once is kept in the package's namespace (later look-ups are plain
+    attribute reads, not a trip through here)."""
     if name in _SUBMODULES:
         return importlib.import_module(f"{__name__}.{name}")
     if name == "Geometry":  # light: no numba
-        return importlib.import_module(f"{__name__}.geometry").Geometry
-    kinematics = importlib.import_module(f"{__name__}.kinematics")
-    if name == "__all__":
-        return ["SPEC", *kinematics.__all__]
-    if name in kinematics.__all__:
-        return getattr(kinematics, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+        value = importlib.import_module(f"{__name__}.geometry").Geometry
+    else:
+        kinematics = importlib.import_module(f"{__name__}.kinematics")
+        if name == "__all__":
+            value = ["SPEC", *kinematics.__all__]
+        elif name in kinematics.__all__:
+            value = getattr(kinematics, name)
+        else:
+            raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    globals()[name] = value
+    return value
 
 
 def __dir__() -> list[str]:

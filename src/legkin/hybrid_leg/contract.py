@@ -16,7 +16,7 @@ import numpy as np
 from .._contract import Case, Contract
 from .configuration import sample_joints, within_limits
 from .foot import fk, jacobian
-from .foot_ik import ik
+from .foot_inverse import ik
 from .geometry import CENTER
 
 __all__ = ["contract", "SIGMA_CONTRACT"]

@@ -10,7 +10,7 @@ The public API, re-exported from the modules that implement it (each kernel besi
 * :mod:`.forward`: the closed sub-chain's forward kinematics (:func:`platform_orientation`, :func:`platform_poses`;
   the degree-8 polynomial of :mod:`.polynomial`);
 * :mod:`.foot`: the foot (eqs 17, 18, 20), the leg's forward kinematics :func:`fk` and :func:`jacobian`;
-* :mod:`.foot_ik`: the foot IK :func:`ik`, :func:`ik_all`, :func:`foot_platform_ik`.
+* :mod:`.foot_inverse`: the foot IK :func:`ik`, :func:`ik_all`, :func:`foot_platform_ik`.
 
 Assembly modes: :func:`fk`, :func:`jacobian`, :func:`platform_orientation` and :func:`ik` take ``branch`` and
 ``assembly`` (:func:`assembly_mode`), by default ``(1, 1)`` and ``+1``, the mode of the SRDF reference pose
@@ -27,7 +27,7 @@ from __future__ import annotations
 from ..errors import InvalidArgumentError
 from .extension import extension_motor_angle, ll_angle
 from .foot import fk, foot_jacobian, foot_position, foot_position_from_platform, jacobian
-from .foot_ik import FootIKSolutions, foot_ik, foot_ik_solutions, foot_platform_ik, ik, ik_all
+from .foot_inverse import FootIKSolutions, foot_ik, foot_ik_solutions, foot_platform_ik, ik, ik_all
 from .forward import PlatformPoses, platform_orientation, platform_poses
 from .geometry import (
     ARC_RADIUS,

@@ -389,19 +389,51 @@ def passive_angles(theta: ArrayLike, beta: ArrayLike = 0.0, *,
     return dict(zip(PASSIVE_JOINTS, out.T.reshape((len(PASSIVE_JOINTS),) + shape)))
 
 
+@kernel
+def _k_motor_angles(theta, beta):
+    """The motor mapping (reference): ``phi_L = beta + (theta - theta0)``, ``phi_R = beta - (theta - theta0)``."""
+    return beta + (theta - THETA0), beta - (theta - THETA0)
+
+
+@kernel
+def _k_theta_beta(phi_L, phi_R):
+    """Its inverse: ``theta = (phi_L - phi_R) / 2 + theta0``, ``beta = (phi_L + phi_R) / 2``."""
+    return (phi_L - phi_R) / 2 + THETA0, (phi_L + phi_R) / 2
+
+
+@_loop(32768)
+def _k_pair_batch(x, y, inverse, u, v):
+    """:func:`_k_motor_angles` (or, ``inverse``, :func:`_k_theta_beta`) over x, y (n,) into u, v (n,)."""
+    for i in prange(x.shape[0]):
+        if inverse:
+            u[i], v[i] = _k_theta_beta(x[i], y[i])
+        else:
+            u[i], v[i] = _k_motor_angles(x[i], y[i])
+
+
+def _pair(x, y, names: tuple[str, str], inverse: bool) -> tuple[np.ndarray, np.ndarray]:
+    """The wrapper of :func:`motor_angles` / :func:`theta_beta`: two numbers -> the kernel, else the batch."""
+    if type(x) is float and type(y) is float and math.isfinite(x) and math.isfinite(y):
+        u, v = _k_theta_beta(x, y) if inverse else _k_motor_angles(x, y)
+        return np.asarray(u), np.asarray(v)
+    x, y = as_angles(x, y, names=names)
+    shape = x.shape
+    n = x.size
+    u, v = np.empty(n), np.empty(n)
+    _k_pair_batch(as_rows(x, 1)[:, 0], as_rows(y, 1)[:, 0], inverse, u, v)
+    return u.reshape(shape), v.reshape(shape)
+
+
 def motor_angles(theta: ArrayLike, beta: ArrayLike, *,
                  geometry: Geometry | None = None) -> tuple[np.ndarray, np.ndarray]:
     """(phi_L, phi_R) = (beta + theta - theta0, beta - theta + theta0) (reference, motor mapping).
 
-    A linear map: numpy on the broadcast inputs (no kernel needed); two numbers give two 0-d arrays. It does not
-    depend on the geometry (``geometry`` is checked, for a uniform signature).
+    Broadcast together; two numbers give two 0-d arrays. It does not depend on the geometry (``geometry`` is
+    checked, for a uniform signature).
     """
     if geometry is not None:
         _geometry(geometry)
-    if type(theta) is float and type(beta) is float and math.isfinite(theta) and math.isfinite(beta):
-        return np.asarray(beta + (theta - THETA0)), np.asarray(beta - (theta - THETA0))
-    theta, beta = as_angles(theta, beta, names=("theta", "beta"))
-    return np.asarray(beta + (theta - THETA0)), np.asarray(beta - (theta - THETA0))
+    return _pair(theta, beta, ("theta", "beta"), False)
 
 
 def theta_beta(phi_L: ArrayLike, phi_R: ArrayLike, *,
@@ -413,8 +445,5 @@ def theta_beta(phi_L: ArrayLike, phi_R: ArrayLike, *,
     """
     if geometry is not None:
         _geometry(geometry)
-    if type(phi_L) is float and type(phi_R) is float and math.isfinite(phi_L) and math.isfinite(phi_R):
-        return np.asarray((phi_L - phi_R) / 2 + THETA0), np.asarray((phi_L + phi_R) / 2)
-    phi_L, phi_R = as_angles(phi_L, phi_R, names=("phi_L", "phi_R"))
-    return np.asarray((phi_L - phi_R) / 2 + THETA0), np.asarray((phi_L + phi_R) / 2)
+    return _pair(phi_L, phi_R, ("phi_L", "phi_R"), True)
 

@@ -25,10 +25,29 @@ def rim_segment(alpha: ArrayLike, *, geometry: Geometry | None = None) -> np.nda
     """
     if geometry is not None:
         _geometry(geometry)
-    if type(alpha) is float:
-        return np.asarray(0 if alpha < -_ARC_FG else (1 if alpha < 0.0 else (2 if alpha <= _ARC_FG else 3)))
-    a = np.asarray(alpha, dtype=float)
-    return np.where(a < -_ARC_FG, 0, np.where(a < 0.0, 1, np.where(a <= _ARC_FG, 2, 3)))
+    if type(alpha) is float and math.isfinite(alpha):
+        return np.asarray(_k_segment(alpha))
+    a = as_input(alpha, "alpha")
+    out = np.empty(a.size, dtype=np.int64)
+    _k_segment_batch(as_rows(a, 1)[:, 0], out)
+    return out.reshape(a.shape)
+
+
+@kernel
+def _k_segment(alpha):
+    """:func:`rim_segment` for one alpha."""
+    if alpha < -_ARC_FG:
+        return 0
+    if alpha < 0.0:
+        return 1
+    return 2 if alpha <= _ARC_FG else 3
+
+
+@_loop(32768)
+def _k_segment_batch(alpha, out):
+    """:func:`_k_segment` over alpha (n,) into out (n,)."""
+    for i in prange(alpha.shape[0]):
+        out[i] = _k_segment(alpha[i])
 
 
 class _Sel(NamedTuple):

@@ -59,7 +59,8 @@ CASES = [
      legkin.InvalidInputError),
     ("tripod", "ik((0, pi))  (the flip)", lambda: at.ik(np.array([0.0, math.pi])), legkin.SingularityError),
     ("tripod", "ik((0.2 + 1j, 0))", lambda: at.ik(np.array([0.2 + 1j, 0.0])), legkin.InvalidInputError),
-    ("tripod", "ik(0.2, -0.1, d=nan)  (deprecated form)", lambda: at.ik(0.2, -0.1, d=NAN), legkin.InvalidParameterError),
+    ("tripod", "ik(0.2, -0.1, d=nan)  (deprecated form)", lambda: at.ik(0.2, -0.1, d=NAN),
+     legkin.InvalidParameterError),
     # ---- wheel_leg
     ("wheel_leg", "IKOptions(tol=nan)", lambda: wl.IKOptions(tol=NAN), legkin.InvalidParameterError),
     ("wheel_leg", "IKOptions(max_iter=0)", lambda: wl.IKOptions(max_iter=0), legkin.InvalidParameterError),

@@ -110,7 +110,7 @@ RIMS = ("continuous", "three_arc")
 
 def rim_name(rim: object, stacklevel: int = 3) -> str:
     """``rim`` checked; legkin 0.1's ``"seed"`` is accepted as ``"three_arc"`` with a DeprecationWarning."""
-    if rim == "continuous" and type(rim) is str:
+    if type(rim) is str and rim == "continuous":
         return "continuous"
     if isinstance(rim, str) and rim == "seed":
         warnings.warn("rim='seed' is deprecated; use rim='three_arc' (the seed's three-arc formula)",

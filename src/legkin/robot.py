@@ -99,6 +99,12 @@ class Robot:
         if self.srdf_path is not None:
             pin.loadReferenceConfigurations(self.model, str(self.srdf_path), False)
         self.poses = {e.key(): np.array(e.data()) for e in self.model.referenceConfigurations}
+        if spec.external and spec.reference_pose and spec.reference_pose not in self.poses:
+            from .legs.erd import standing_pose
+
+            pose = standing_pose(self.model, name)  # a robot without SRDF: legkin's own standing pose
+            if pose is not None:
+                self.poses[spec.reference_pose] = pose
         self.q0 = self.poses.get(spec.reference_pose, pin.neutral(self.model)).copy()
 
     @property

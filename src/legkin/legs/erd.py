@@ -33,6 +33,8 @@ class ErdRobot:
         srdf: the SRDF's relative path (None: the package ships none).
         reference_pose: the SRDF ``group_state`` used as the reference configuration (None without SRDF).
         free_flyer: the robot is loaded with a free-flyer root joint.
+        standing_leg: for a robot without SRDF, the (HAA, HFE, KFE) of every leg in legkin's own "standing"
+            pose (the neutral configuration puts laikago's knees outside their limits).
     """
 
     name: str
@@ -41,6 +43,7 @@ class ErdRobot:
     srdf: str | None
     reference_pose: str | None = "standing"
     free_flyer: bool = True
+    standing_leg: tuple[float, float, float] | None = None
 
 
 #: The nine quadrupeds, by legkin name.
@@ -57,7 +60,9 @@ ERD_ROBOTS: dict[str, ErdRobot] = {
         ErdRobot("go2", "Go2 (Unitree)", "go2_description/urdf/go2.urdf", "go2_description/srdf/go2.srdf"),
         ErdRobot("a1", "A1 (Unitree)", "a1_description/urdf/a1.urdf", "a1_description/srdf/a1.srdf"),
         ErdRobot("b1", "B1 (Unitree)", "b1_description/urdf/b1.urdf", "b1_description/srdf/b1.srdf"),
-        ErdRobot("laikago", "Laikago (Unitree)", "laikago_description/urdf/laikago.urdf", None, None),
+        # No SRDF: legkin's standing pose, the legs of Unitree's robots bent as a1's SRDF "standing" is.
+        ErdRobot("laikago", "Laikago (Unitree)", "laikago_description/urdf/laikago.urdf", None, "standing",
+                 standing_leg=(0.0, 0.8, -1.5)),
     )
 }
 
@@ -113,14 +118,31 @@ def erd_files(name: str) -> tuple[Path, Path | None, list[str]]:
     return urdf, srdf, [str(share), str(robots_dir)]
 
 
+def standing_pose(model, name: str) -> np.ndarray | None:
+    """legkin's standing configuration of ``model`` for a robot without SRDF (:attr:`ErdRobot.standing_leg`
+    on every three-joint leg, the free flyer at the neutral placement), else None."""
+    import pinocchio as pin
+
+    robot = _robot(name)
+    if robot.standing_leg is None:
+        return None
+    q = pin.neutral(model)
+    legs = [j for j in model.joints[1:] if j.nq == 1]  # HAA, HFE, KFE of each leg, in model order
+    for k, joint in enumerate(legs):
+        q[joint.idx_q] = robot.standing_leg[k % 3]
+    return q
+
+
 def reference_configuration(model, name: str) -> np.ndarray:
-    """The robot's SRDF reference pose (``model``'s neutral configuration if it has none)."""
+    """The robot's SRDF reference pose (legkin's :func:`standing_pose`, else ``model``'s neutral configuration,
+    if it has none)."""
     import pinocchio as pin
 
     robot = _robot(name)
     _, srdf, _ = erd_files(name)
     if srdf is None or robot.reference_pose is None:
-        return pin.neutral(model)
+        pose = standing_pose(model, name)
+        return pin.neutral(model) if pose is None else pose
     pin.loadReferenceConfigurations(model, str(srdf), False)
     return np.array(model.referenceConfigurations[robot.reference_pose])
 

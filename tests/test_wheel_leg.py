@@ -753,3 +753,15 @@ def test_single_call_with_q_near_q_start_limits_equals_the_batch_row(method):
                 else:
                     with pytest.raises(legkin.UnreachableError):
                         wl.ik(target[i], "RR", alpha=a, w=ww, method=method, **one)
+
+
+def test_odd_keyword_values_get_legkin_errors():
+    """Keyword values of the wrong kind (arrays for flags, unknown names, unhashable legs) get legkin errors,
+    never numpy's or Python's."""
+    target = wl.fk([1.2, 0.3, 0.2], "FL", alpha=0.5)
+    for call in (lambda: wl.ik(target, "FL", method="x"), lambda: wl.ik(target, "FL", return_mask=np.ones(2)),
+                 lambda: wl.ik(target, "FL", return_info=np.ones(2)), lambda: wl.module_origin([1, 2]),
+                 lambda: wl.fk([1.0, 0.0, 0.0], "FL", rim=np.array(["continuous", "x"])),
+                 lambda: wl.ik_all(target, "FL", limits="yes")):
+        with pytest.raises(legkin.InvalidParameterError):
+            call()

@@ -40,7 +40,12 @@ def module_origin(leg: Leg, *args: Geometry | None, geometry: Geometry | None = 
     if args:
         geometry = legacy_geometry(  # type: ignore[assignment]
             "module_origin", ("geometry",), args, {}, geometry, positional_geometry=True)
-    return _origin(leg, _geometry(geometry)).copy()
+    geo = _geometry(geometry)
+    try:
+        return _origin(leg, geo).copy()
+    except TypeError:  # unhashable: let _leg name it
+        _leg(leg)
+        raise
 
 
 def _module_origin_signature(leg: Leg, *, geometry: Geometry | None = None) -> np.ndarray:

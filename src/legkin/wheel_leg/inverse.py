@@ -307,8 +307,8 @@ def ik(target, leg=None, /, *args, alpha=0.0, w=0.0, q_near=None, q_start=None, 
     method = method_name(method)
     rim = rim_name(rim)
     if (type(target) is np.ndarray and target.shape == (3,) and target.dtype == np.float64 and type(alpha) in _SCALARS
-            and type(w) in _SCALARS and type(method) is str and type(limits) is bool
-            and return_mask in (True, False) and return_info in (True, False)):
+            and type(w) in _SCALARS and type(method) is str and method in METHODS and type(limits) is bool
+            and type(return_mask) is bool and type(return_info) is bool):
         start = q_start if q_near is None else (q_near if q_start is None else None)
         both = q_near is not None and q_start is not None
         if not both and (start is None or (type(start) is np.ndarray and start.shape == (3,)

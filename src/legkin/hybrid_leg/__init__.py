@@ -8,9 +8,9 @@ so that ``import legkin`` stays light), its checks against Pinocchio (``checks``
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from .._lazy import lazy_exports
 from .spec import SPEC as SPEC
 
 if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they load on first use
@@ -20,24 +20,7 @@ if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they l
 _SUBMODULES = ("kinematics", "geometry", "configuration", "contract", "checks", "bench", "figures", "clips")
 
 
-def __getattr__(name: str) -> Any:
-    """The lazy re-export; a name found once is kept in the package's namespace (later look-ups are plain
-    attribute reads, not a trip through here)."""
-    if name in _SUBMODULES:
-        return importlib.import_module(f"{__name__}.{name}")
-    if name == "Geometry":  # light: no numba
-        value = importlib.import_module(f"{__name__}.geometry").Geometry
-    else:
-        kinematics = importlib.import_module(f"{__name__}.kinematics")
-        if name == "__all__":
-            value = ["SPEC", *kinematics.__all__]
-        elif name in kinematics.__all__:
-            value = getattr(kinematics, name)
-        else:
-            raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    globals()[name] = value
-    return value
+#: Names served without importing the kernels (numba).
+_LIGHT = {"Geometry": "geometry"}
 
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_SUBMODULES) | set(importlib.import_module(f"{__name__}.kinematics").__all__))
+__getattr__, __dir__ = lazy_exports(__name__, globals(), _SUBMODULES, _LIGHT)

@@ -9,9 +9,9 @@ into ``legs``, ``platform``, ``closure``, ``inverse``, ``forward_kernels``, ``fo
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from .._lazy import lazy_exports
 from .spec import SPEC as SPEC
 
 if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they load on first use
@@ -21,18 +21,7 @@ if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they l
 _SUBMODULES = ("kinematics", "geometry", "configuration", "contract", "checks", "bench", "figures", "clips")
 
 
-def __getattr__(name: str) -> Any:
-    if name in _SUBMODULES:
-        return importlib.import_module(f"{__name__}.{name}")
-    kinematics = importlib.import_module(f"{__name__}.kinematics")
-    if name == "__all__":
-        return ["SPEC", *kinematics.__all__]
-    if name in kinematics.__all__:
-        value = getattr(kinematics, name)
-        globals()[name] = value  # later look-ups skip this function
-        return value
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+#: Names served without importing the kernels (numba).
+_LIGHT = {"Geometry": "geometry"}
 
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_SUBMODULES) | set(importlib.import_module(f"{__name__}.kinematics").__all__))
+__getattr__, __dir__ = lazy_exports(__name__, globals(), _SUBMODULES, _LIGHT)

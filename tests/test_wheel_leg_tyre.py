@@ -1,0 +1,183 @@
+"""wheel_leg tyre surface, ground contact and stance IK (issue 12)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from legkin.errors import InvalidInputError, InvalidParameterError, UnreachableError
+from legkin.wheel_leg import ground as gd
+from legkin.wheel_leg import tyre as ty
+from legkin.wheel_leg import tyre_checks as tc
+from legkin.wheel_leg.frames import leg_frame_to_robot
+from legkin.wheel_leg.geometry import ABAD_LIMIT, LEGS, THETA0, THETA_MAX, THETA_MIN, Geometry
+
+DEG = math.pi / 180
+GEO = Geometry()
+R_T = ty.TYRE_THICKNESS
+
+
+def _heights(q, leg, normal, m=3000, r=R_T):
+    """Sampled minimum height of the tyre (m s samples x 3 w) and the sampling resolution bound."""
+    h, res = tc._brute_heights(np.asarray(q, dtype=float)[None], leg, np.asarray(normal, dtype=float), r, m, GEO)
+    return h[0], res[0]
+
+
+# ---------------------------------------------------------------- the surface
+@pytest.mark.parametrize("theta_deg", [17.0, 17.5, 30.0, 90.0, 110.4, 111.0, 140.0, 160.0])
+def test_tyre_curve_closed_and_continuous(theta_deg):
+    pcs = ty.tyre_pieces(theta_deg * DEG, 0.4)
+    for k in range(16):
+        assert np.linalg.norm(pcs.point(k, 1.0) - pcs.point((k + 1) % 16, 0.0)) < 1e-15
+    assert np.all(np.diff(pcs.s_start) >= 0) and pcs.s_start[0] == 0 and abs(pcs.s_end[-1] - 1) < 1e-15
+    s = np.linspace(0, 1, 5001)
+    p = ty.tyre_point(np.full(s.shape, theta_deg * DEG), 0.4, s)
+    assert np.linalg.norm(np.diff(p, axis=0), axis=1).max() <= float(pcs.length) / 5000 * (1 + 1e-9)
+    assert np.linalg.norm(p[0] - p[-1]) < 1e-15
+
+
+def test_tyre_pieces_kinds():
+    # wheel mode: one circle of radius R + r about O on the outer side, the fillets have zero span
+    pcs = ty.tyre_pieces(THETA0)
+    for k in (0, 2, 4, 6):
+        assert np.linalg.norm(pcs.centre[k]) < 1e-15 and pcs.radius[k] == pytest.approx(GEO.R + R_T, abs=1e-16)
+    assert np.abs(pcs.span[[1, 3, 5]]).max() < 1e-12
+    # open leg: a fillet about G on the outer side, the outer offsets at F trimmed (a point), caps of 180 deg
+    pcs = ty.tyre_pieces(90 * DEG)
+    G = pcs.names.index("G")
+    assert pcs.span[G] > 1.0 and pcs.radius[G] == R_T
+    assert pcs.radius[pcs.names.index("F_L")] == 0.0 and pcs.span[pcs.names.index("F_L_inner")] > 1.0
+    assert pcs.span[pcs.names.index("cap_H_R")] == pytest.approx(math.pi)
+
+
+# ---------------------------------------------------------------- ground contact
+@settings(max_examples=25, deadline=None)
+@given(theta=st.floats(THETA_MIN, THETA_MAX), beta=st.floats(-math.pi, math.pi), gamma=st.floats(-1.3, 1.3),
+       tilt=st.tuples(st.floats(-0.4, 0.4), st.floats(-0.4, 0.4)), leg=st.sampled_from(LEGS))
+def test_support_point_is_the_lowest(theta, beta, gamma, tilt, leg):
+    n = np.array([tilt[0], tilt[1], 1.0])
+    n /= np.linalg.norm(n)
+    gc = gd.ground_contact(np.array([theta, beta, gamma]), leg, n)
+    h = float(gc.point @ n)
+    hmin, res = _heights([theta, beta, gamma], leg, n)
+    assert h <= hmin + 1e-13  # never above a sampled surface point
+    assert hmin - h <= res  # and the sampled minimum to the sampling resolution
+
+
+def test_wheel_mode_depth():
+    rng = np.random.default_rng(3)
+    beta = rng.uniform(-np.pi, np.pi, 500)
+    for leg in LEGS:
+        gc = gd.ground_contact(np.stack([np.full(500, THETA0), beta, np.zeros(500)], -1), leg)
+        O = leg_frame_to_robot(np.zeros(3), 0.0, leg)
+        np.testing.assert_allclose(O[2] - gc.point[:, 2], GEO.R + R_T, rtol=0, atol=1e-12)
+        assert np.all(gc.w == 0.0)
+
+
+def test_tilt_moves_contact_to_an_edge():
+    q = np.array([60 * DEG, 0.2, 0.3])
+    for leg in LEGS:
+        gc = gd.ground_contact(q, leg)
+        assert abs(float(gc.w)) == GEO.T / 2
+        qm = q * [1, 1, -1]
+        assert float(gd.ground_contact(qm, leg).w) == -float(gc.w)
+        assert float(gd.ground_contact(q * [1, 1, 0], leg).w) == 0.0
+
+
+def test_envelope_jacobian():
+    rng = np.random.default_rng(5)
+    q = np.stack([rng.uniform(THETA_MIN + 1e-4, THETA_MAX - 1e-4, 50), rng.uniform(-3, 3, 50),
+                  rng.uniform(-1, 1, 50)], -1)
+    gc = gd.ground_contact(q, "RR")
+    for c in range(3):
+        dq = np.zeros(3)
+        dq[c] = 1e-6
+        fd = (gd.ground_contact(q + dq, "RR").point[:, 2] - gd.ground_contact(q - dq, "RR").point[:, 2]) / 2e-6
+        np.testing.assert_allclose(fd, gc.jacobian[:, 2, c], atol=1e-8)
+
+
+def test_pinocchio_material_jacobian(monkeypatch):
+    monkeypatch.setattr(tc, "PIN_SAMPLES", 24)
+    rows = tc._pinocchio_rows(np.random.default_rng(2), R_T)
+    assert all(r.passed for r in rows), [(r.name, r.max_error) for r in rows]
+
+
+def test_lab_contact_map_comparison():
+    c = tc.lab_comparison(2000, np.random.default_rng(11), 0.019)
+    assert c["agree"] == c["answered"] and c["diff"].max() < 1e-12
+    frac = 1 - c["answered"] / c["n"]
+    assert 0.10 < frac < 0.25  # the lab's ~16 % "no normal contact"
+    assert c["none_caps"] + c["none_above_hip"] >= 0.9 * (c["n"] - c["answered"])
+
+
+# ---------------------------------------------------------------- contract rules
+def test_single_equals_batch_row():
+    rng = np.random.default_rng(8)
+    q = np.stack([rng.uniform(THETA_MIN, THETA_MAX, 7), rng.uniform(-3, 3, 7), rng.uniform(-1, 1, 7)], -1)
+    n = np.array([0.1, -0.2, 1.0])
+    for leg in ("FL", "RR"):
+        b = gd.ground_contact(q, leg, n)
+        for i in range(7):
+            s = gd.ground_contact(q[i], leg, n)
+            assert np.array_equal(s.point, b.point[i]) and np.array_equal(s.jacobian, b.jacobian[i])
+            assert int(s.piece) == b.piece[i] and float(s.s) == b.s[i] and float(s.w) == b.w[i]
+    s_ = np.linspace(0, 1, 7)
+    pb = ty.tyre_point(q[:, 0], q[:, 1], s_)
+    for i in range(7):
+        assert np.array_equal(ty.tyre_point(q[i, 0], q[i, 1], s_[i]), pb[i])
+
+
+def test_bad_inputs():
+    q = np.array([1.0, 0.1, 0.0])
+    for bad in ([np.nan, 0, 0], [1.0, np.inf, 0], [1.0 + 0j, 0, 0], [1.0, 0.0], [0.1, 0, 0], [3.0, 0, 0]):
+        with pytest.raises(InvalidInputError):
+            gd.ground_contact(np.array(bad), "FL")
+    with pytest.raises(InvalidInputError):
+        gd.ground_contact(q, "FL", (0.0, 0.0, 0.0))
+    with pytest.raises(InvalidInputError):
+        gd.ground_contact(q, "FL", (0.0, np.nan, 1.0))
+    with pytest.raises(InvalidParameterError):
+        gd.ground_contact(q, "XX")
+    with pytest.raises(InvalidParameterError):
+        gd.ground_contact(q, "FL", r=0.2)
+    with pytest.raises(InvalidInputError):
+        ty.tyre_point(1.0, 0.0, 1.5)
+    with pytest.raises(InvalidInputError):
+        ty.tyre_point(1.0, 0.0, np.nan)
+    with pytest.raises(InvalidInputError):
+        gd.stance_ik(np.array([np.nan, 0, 0]), "FL")
+    with pytest.raises(InvalidInputError):
+        gd.stance_ik(np.zeros(2), "FL")
+
+
+# ---------------------------------------------------------------- stance IK
+def test_stance_ik_round_trip_and_all_solutions():
+    rng = np.random.default_rng(21)
+    n = 12
+    q = np.stack([rng.uniform(THETA_MIN, THETA_MAX, n), rng.uniform(-np.pi, np.pi, n),
+                  rng.uniform(-1.4, 1.4, n)], -1)
+    for leg in ("FL", "FR"):
+        target = gd.ground_contact(q, leg).point
+        qs, ok = gd.stance_ik(target, leg, return_mask=True)
+        assert ok.all()
+        assert np.abs(qs[:, 2]).max() <= ABAD_LIMIT
+        np.testing.assert_allclose(gd.ground_contact(qs, leg).point, target, atol=1e-12, rtol=0)
+        allq = gd.stance_ik_all(target, leg)
+        d = allq - q[:, None, :]
+        d[..., 1:] = np.pi - np.mod(np.pi - d[..., 1:], 2 * np.pi)
+        assert np.nanmin(np.abs(d).max(-1), axis=1).max() < 1e-9
+        near = gd.stance_ik(target[0], leg, q_near=q[0])
+        assert np.abs(near - q[0]).max() < 1e-9 or np.allclose(gd.ground_contact(near, leg).point, target[0])
+
+
+def test_stance_ik_unreachable():
+    far = np.array([2.0, 2.0, -2.0])
+    with pytest.raises(UnreachableError):
+        gd.stance_ik(far, "FL")
+    t = np.stack([far, gd.ground_contact(np.array([1.0, 0.2, 0.1]), "FL").point])
+    qs, ok = gd.stance_ik(t, "FL", return_mask=True)
+    assert ok.tolist() == [False, True] and np.isnan(qs[0]).all() and np.isfinite(qs[1]).all()

@@ -311,7 +311,9 @@ def _load_bench_module(name: str):
         module = importlib.import_module("legkin.legs.bench")
         if not hasattr(module, "build"):
             return None
-        return types.SimpleNamespace(build=functools.partial(module.build, name))
+        return types.SimpleNamespace(
+            build=functools.partial(module.build, name), single_calls=functools.partial(module.single_calls, name)
+        )
     modname = f"legkin.{name}.bench"
     try:
         return importlib.import_module(modname)
@@ -422,6 +424,11 @@ def _closed_configuration(robot) -> np.ndarray:
 
 
 def _frame_name(name: str, robot) -> str:
+    if robot.spec.external:  # the foot of the benched leg (legkin.legs.bench.LEG)
+        from .legs.bench import LEG
+
+        legs = robot.geometry
+        return legs[LEG if LEG in legs else next(iter(legs))].foot_frame
     return YARDSTICK_FRAMES.get(name) or robot.model.frames[len(robot.model.frames) - 1].name
 
 

@@ -289,3 +289,24 @@ def _rtb(label, path, base, end, leg, targets, n_iter, score, repeats) -> Method
     return Method(label, targets, run, score, max_targets=n_iter, repeats=repeats,
                   note=f"Robot.URDF, ets({base}..{end}).ik_LM(mask=[1,1,1,0,0,0], tol=1/2 {PEER_TOL:g}^2, "
                   "joint_limits=True, q0=mid-limit), defaults otherwise")
+
+
+def single_calls(name: str) -> list:
+    """One single call per public function of :class:`~legkin.legs.Leg` for robot ``name``'s leg :data:`LEG`,
+    inputs bound (the standing pose and its foot), against Pinocchio's FK + frame (and frame Jacobian) of
+    that leg's foot on the same model (``legkin bench <name>``'s single-call table)."""
+    from .. import load
+    from .._single_call import SingleCall
+
+    robot = load(name)
+    legs = robot.geometry
+    leg = legs[LEG if LEG in legs else next(iter(legs))]
+    q = np.array(robot.q0[list(leg.idx_q)], dtype=float)
+    q = np.clip(q, leg.lower, leg.upper)
+    p = leg.fk(q)
+    return [
+        SingleCall("Leg.fk", lambda: leg.fk(q), "fk"),
+        SingleCall("Leg.jacobian", lambda: leg.jacobian(q), "jacobian"),
+        SingleCall("Leg.ik", lambda: leg.ik(p), "fk"),
+        SingleCall("Leg.ik_all", lambda: leg.ik_all(p), "fk"),
+    ]

@@ -381,7 +381,8 @@ def stance_ik_all(target: ArrayLike, leg: Leg, *, normal: ArrayLike = (0.0, 0.0,
 
 @overload
 def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = ..., q_near: ArrayLike | None = ..., r: float = ...,
-              limits: bool = ..., geometry: Geometry | None = ..., return_mask: Literal[False] = False) -> np.ndarray: ...
+              limits: bool = ..., geometry: Geometry | None = ...,
+              return_mask: Literal[False] = False) -> np.ndarray: ...
 @overload
 def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = ..., q_near: ArrayLike | None = ..., r: float = ...,
               limits: bool = ..., geometry: Geometry | None = ...,

@@ -99,7 +99,8 @@ def figures(outdir: Path) -> list[Path]:
     ax_p.set_title("piece carrying the lowest point", fontsize=9)
     ax_p.grid(alpha=0.3)
     handles = [Line2D([], [], color=c, lw=2, label=k) for k, c in _COLOURS.items()]
-    handles += [Line2D([], [], color="tab:orange", marker="x", ls="none", label="zero-length piece (trimmed corner; fillet in wheel mode)"),
+    handles += [Line2D([], [], color="tab:orange", marker="x", ls="none",
+                       label="zero-length piece (trimmed corner; fillet in wheel mode)"),
                 Line2D([], [], color="k", ls="--", lw=0.8, label="pitch curve (R = 0.1 m)"),
                 Line2D([], [], color="tab:brown", marker="*", ls="none", label="lowest point (n = z), ground")]
     fig.legend(handles=handles, loc="lower center", ncol=8, fontsize=8, frameon=False)

@@ -9,9 +9,9 @@ here, imported on first use so that ``import legkin`` stays light), helpers (``c
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
+from .._lazy import lazy_exports
 from .spec import SPEC as SPEC
 
 if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they load on first use
@@ -24,16 +24,7 @@ _SUBMODULES = (
 )
 
 
-def __getattr__(name: str) -> Any:
-    if name in _SUBMODULES:
-        return importlib.import_module(f"{__name__}.{name}")
-    kinematics = importlib.import_module(f"{__name__}.kinematics")
-    if name == "__all__":
-        return ["SPEC", *kinematics.__all__]
-    if name in kinematics.__all__:
-        return getattr(kinematics, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+#: Names served without importing the kernels (numba).
+_LIGHT = {"Geometry": "geometry"}
 
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_SUBMODULES) | set(importlib.import_module(f"{__name__}.kinematics").__all__))
+__getattr__, __dir__ = lazy_exports(__name__, globals(), _SUBMODULES, _LIGHT)

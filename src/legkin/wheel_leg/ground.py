@@ -28,7 +28,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Literal, overload
+from typing import Any, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -177,13 +177,43 @@ def _leg_consts(leg, geo: Geometry):
     return (1.0 if side == "L" else -1.0), o, _R_LM[side], _R_0[side]
 
 
+@lru_cache(maxsize=64)
+def _kernel_args(leg, r, geometry) -> tuple[Any, ...]:
+    """The ground kernel's per-call constants for (leg, r, geometry), validated (the single-call fast path)."""
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    rho = _thickness(r, geo)
+    sl, o, RLM, R0 = _leg_consts(leg, geo)
+    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    return (rho, K, KC, sl, geo.d_wheel, geo.T / 2, float(o[0]), float(o[1]), float(o[2]), RLM, R0)
+
+
+_Z = (0.0, 0.0, 1.0)
+_Z_ARRAY = np.array(_Z)
+_Z_ARRAY.setflags(write=False)
+
+
+def _single(q: np.ndarray, leg, r, geometry) -> GroundContact | None:
+    """The fast path of one (3,) float64 q with the default normal: None when anything needs the full checks."""
+    if not (THETA_MIN - 1e-12 <= q[0] <= THETA_MAX + 1e-12 and math.isfinite(q[1]) and math.isfinite(q[2])):
+        return None
+    try:
+        args = _kernel_args(leg, r, geometry)
+    except Exception:  # noqa: BLE001 - the full checks raise the documented error
+        return None
+    P, Jm, info = np.empty(3), np.empty(9), np.empty(4)
+    if _k_ground(q, _Z_ARRAY, *args, P, Jm, info) != OK:  # type: ignore[call-arg]
+        return None
+    return GroundContact(P, np.asarray(int(info[0])), np.asarray(info[1]), np.asarray(info[2]), Jm.reshape(3, 3),
+                         np.asarray(int(info[3])))
+
+
 @overload
 def ground_contact(q: ArrayLike, leg: Leg, normal: ArrayLike = ..., *, r: float = ..., geometry: Geometry | None = ...,
                    return_mask: Literal[False] = False) -> GroundContact: ...
 @overload
 def ground_contact(q: ArrayLike, leg: Leg, normal: ArrayLike = ..., *, r: float = ..., geometry: Geometry | None = ...,
                    return_mask: Literal[True]) -> tuple[GroundContact, np.ndarray]: ...
-def ground_contact(q: ArrayLike, leg: Leg, normal: ArrayLike = (0.0, 0.0, 1.0), *, r: float = TYRE_THICKNESS,
+def ground_contact(q: ArrayLike, leg: Leg, normal: ArrayLike = _Z, *, r: float = TYRE_THICKNESS,
                    geometry: Geometry | None = None,
                    return_mask: bool = False) -> GroundContact | tuple[GroundContact, np.ndarray]:
     """The lowest point of the tyre of ``leg`` along the ground normal (module docstring), in {R}.
@@ -203,6 +233,10 @@ def ground_contact(q: ArrayLike, leg: Leg, normal: ArrayLike = (0.0, 0.0, 1.0), 
         InvalidInputError: NaN/inf/complex/wrong shapes, theta out of range, a zero normal.
         InvalidParameterError: unknown leg, r out of range, geometry not a Geometry.
     """
+    if normal is _Z and type(q) is np.ndarray and q.shape == (3,) and q.dtype == np.float64 and return_mask is False:
+        fast = _single(q, leg, r, geometry)
+        if fast is not None:
+            return fast
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     return_mask = check_flag(return_mask, "return_mask")
     rho = _thickness(r, geo)

@@ -513,10 +513,9 @@ def test_feet_circles_clip_traces_the_circles(name):
     qs = np.array(ANIMATIONS["feet_circles"](robot))
     assert qs.shape == (FRAMES, 12) and np.isfinite(qs).all()
     found = robot.geometry
-    inside = all(leg.within_limits(robot.q0[list(leg.idx_q)]) for leg in found.values())
-    assert inside == (name != "laikago")  # laikago has no SRDF: its q0 (zero) leaves the knees outside the limits
-    if inside:
-        np.testing.assert_allclose(qs[0], robot.q0, atol=1e-12, rtol=0)
+    # every reference pose is in limits (laikago has no SRDF: legkin's standing pose, legs.erd.standing_pose)
+    assert all(leg.within_limits(robot.q0[list(leg.idx_q)]) for leg in found.values())
+    np.testing.assert_allclose(qs[0], robot.q0, atol=1e-12, rtol=0)
     data = robot.model.createData()
     fids = [robot.model.getFrameId(leg.foot_frame) for leg in found.values()]
     feet = np.empty((FRAMES, len(fids), 3))

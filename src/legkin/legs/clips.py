@@ -29,8 +29,9 @@ def feet_circles(robot: Any, frames: int = FRAMES, radius: float = RADIUS) -> li
     standing positions :meth:`Leg.fk` of ``robot.q0``'s leg joints (the root frame; with a free flyer, the base
     stays where ``q0`` puts it). Each frame's leg joints are ``Leg.ik(p, q_near=previous frame's)``, starting
     from ``q0``; every other coordinate keeps its ``q0`` value. A leg whose ``q0`` joints lie outside its URDF
-    limits (laikago: no SRDF, ``q0`` = zero, the knee straight while its limits keep it bent) starts from them
-    moved :data:`LIMIT_MARGIN` of each limit range inside the limits.
+    limits (none of the nine: laikago, which has no SRDF, gets legkin's standing pose,
+    :func:`legkin.legs.erd.standing_pose`) starts from them moved :data:`LIMIT_MARGIN` of each limit range
+    inside the limits.
 
     Raises:
         UnreachableError, JointLimitError: a circle point out of a leg's reach or limits (then ``radius`` is too

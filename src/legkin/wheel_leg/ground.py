@@ -310,64 +310,77 @@ def _centres_at(theta: np.ndarray, k: np.ndarray, geo: Geometry) -> np.ndarray:
     return allc[k, np.arange(theta.shape[0])]
 
 
-def _candidates(t: np.ndarray, n: np.ndarray, sl: float, o: np.ndarray, geo: Geometry, rho: float, leg) -> np.ndarray:
-    """Every candidate (theta, beta, gamma) of one target (unverified): per lateral choice w and out-of-plane
-    branch, gamma in closed form, then per support circle the roots of |c_k(theta)| = |Z| on the grid."""
+_CHUNK = 128
+
+
+def _candidates_batch(t: np.ndarray, n: np.ndarray, leg, geo: Geometry, rho: float) -> tuple[np.ndarray, np.ndarray]:
+    """Every candidate (theta, beta, gamma) of the targets t (N, 3) (unverified): per lateral choice w and
+    out-of-plane branch, gamma in closed form, then per support circle the roots of |c_k(theta)| = |Z| on the
+    grid, bisected (vectorised over targets in chunks of :data:`_CHUNK`). Returns (candidates (C, 3), their
+    target index (C,))."""
+    sl, o, _RLM, _R0 = _leg_consts(leg, geo)
     th, tab = _centre_table(geo)
+    rad = np.array([geo.R + rho if big else rho for _name, big in _CENTRES])
     d = t - o
-    out = []
+    qs, owner = [], []
     for w in (-geo.T / 2, geo.T / 2, 0.0):
         a = geo.d_wheel + sl * w
-        rr = d[1] ** 2 + d[2] ** 2 - a * a
-        if rr < -1e-15:
-            continue
-        for yl in {-math.sqrt(max(rr, 0.0)), math.sqrt(max(rr, 0.0))}:
-            gamma = float(np.angle((sl * d[1] + 1j * d[2]) / (a + 1j * yl)))
+        rr = d[:, 1] ** 2 + d[:, 2] ** 2 - a * a
+        for sign in (-1.0, 1.0):
+            yl = sign * np.sqrt(np.maximum(rr, 0.0))
+            gamma = np.angle((sl * d[:, 1] + 1j * d[:, 2]) / (a + 1j * yl))
             nl = normal_in_leg_frame(gamma, leg, n)
-            w_rule = -geo.T / 2 if nl[2] > _ZERO else (geo.T / 2 if nl[2] < -_ZERO else 0.0)
-            nzv = complex(nl[0], nl[1])
-            if w_rule != w or abs(nzv) <= _ZERO:
-                continue
-            zt = complex(-d[0], yl)
-            Z = np.array([zt + (geo.R + rho if big else rho) * nzv / abs(nzv) for _name, big in _CENTRES])
-            f = tab - (np.abs(Z) ** 2)[:, None]
-            kk, jj = np.nonzero(np.signbit(f[:, :-1]) != np.signbit(f[:, 1:]))
-            lo, hi = th[jj].copy(), th[jj + 1].copy()
-            flo = f[kk, jj]
-            for _ in range(_BISECT):
-                mid = 0.5 * (lo + hi)
-                fm = np.abs(_centres_at(mid, kk, geo)) ** 2 - np.abs(Z[kk]) ** 2
-                left = np.signbit(fm) == np.signbit(flo)
-                lo = np.where(left, mid, lo)
-                hi = np.where(left, hi, mid)
-            roots = 0.5 * (lo + hi)
-            # a root on a bound of [17, 160] deg where f does not change sign across the grid's end cell
-            for end in (0, -1):
-                ke = np.flatnonzero(np.abs(f[:, end]) <= 1e-15)
-                roots, kk = np.concatenate([roots, np.full(ke.size, th[end])]), np.concatenate([kk, ke])
-            if roots.size == 0:
-                continue
-            c = _centres_at(roots, kk, geo)
-            beta = wrap(np.angle(Z[kk] / c) - np.pi / 2)
-            out.append(np.stack([roots, beta, np.full(roots.size, gamma)], -1))
-    return np.concatenate(out) if out else np.empty((0, 3))
+            w_rule = np.where(nl[:, 2] > _ZERO, -geo.T / 2, np.where(nl[:, 2] < -_ZERO, geo.T / 2, 0.0))
+            nzv = nl[:, 0] + 1j * nl[:, 1]
+            keep = np.flatnonzero((rr >= -1e-15) & (w_rule == w) & (np.abs(nzv) > _ZERO))
+            for start in range(0, keep.size, _CHUNK):
+                idx = keep[start:start + _CHUNK]
+                Z = (-d[idx, 0] + 1j * yl[idx])[:, None] + rad[None, :] * (nzv[idx] / np.abs(nzv[idx]))[:, None]
+                Z2 = np.abs(Z) ** 2
+                f = tab[None] - Z2[:, :, None]
+                ii, kk, jj = np.nonzero(np.signbit(f[:, :, :-1]) != np.signbit(f[:, :, 1:]))
+                lo, hi, flo, z2 = th[jj].copy(), th[jj + 1].copy(), f[ii, kk, jj], Z2[ii, kk]
+                for _ in range(_BISECT):
+                    mid = 0.5 * (lo + hi)
+                    fm = np.abs(_centres_at(mid, kk, geo)) ** 2 - z2
+                    left = np.signbit(fm) == np.signbit(flo)
+                    lo = np.where(left, mid, lo)
+                    hi = np.where(left, hi, mid)
+                roots = 0.5 * (lo + hi)
+                for end in (0, -1):  # a root on a bound of [17, 160] deg without a sign change in the end cell
+                    ie, ke = np.nonzero(np.abs(f[:, :, end]) <= 1e-15)
+                    roots = np.concatenate([roots, np.full(ie.size, th[end])])
+                    ii, kk = np.concatenate([ii, ie]), np.concatenate([kk, ke])
+                if roots.size == 0:
+                    continue
+                beta = wrap(np.angle(Z[ii, kk] / _centres_at(roots, kk, geo)) - np.pi / 2)
+                qs.append(np.stack([roots, beta, gamma[idx][ii]], -1))
+                owner.append(idx[ii])
+    if not qs:
+        return np.empty((0, 3)), np.empty(0, dtype=np.int64)
+    return np.concatenate(qs), np.concatenate(owner)
 
 
-def _solutions(t: np.ndarray, n: np.ndarray, leg, geo: Geometry, rho: float) -> np.ndarray:
-    """The verified, de-duplicated solutions of one target, sorted by |gamma| then theta."""
-    sl, o, _RLM, _R0 = _leg_consts(leg, geo)
-    cand = _candidates(t, n, sl, o, geo, rho, leg)
+def _solutions_batch(t: np.ndarray, n: np.ndarray, leg, geo: Geometry, rho: float) -> list[np.ndarray]:
+    """The verified (:func:`ground_contact` reproduces the target to :data:`VERIFY_TOL`), de-duplicated solutions
+    of each target, sorted by |gamma| then theta: one (S_i, 3) array per target."""
+    cand, owner = _candidates_batch(t, n, leg, geo, rho)
+    out = [np.empty((0, 3)) for _ in range(t.shape[0])]
     if cand.shape[0] == 0:
-        return cand
-    gc = ground_contact(cand, leg, n, r=rho, geometry=geo)
-    ok = np.linalg.norm(gc.point - t, axis=-1) <= VERIFY_TOL
-    sol = cand[ok]
-    sol = sol[np.lexsort((sol[:, 0], np.abs(sol[:, 2])))]
-    keep: list[np.ndarray] = []
-    for qv in sol:
-        if all(np.abs(np.concatenate([[qv[0] - k[0]], wrap(qv[1:] - k[1:])])).max() > 1e-9 for k in keep):
-            keep.append(qv)
-    return np.array(keep).reshape(-1, 3)
+        return out
+    gc = ground_contact(cand, leg, n[owner], r=rho, geometry=geo)
+    ok = np.linalg.norm(gc.point - t[owner], axis=-1) <= VERIFY_TOL
+    cand, owner = cand[ok], owner[ok]
+    order = np.lexsort((cand[:, 0], np.abs(cand[:, 2]), owner))
+    cand, owner = cand[order], owner[order]
+    bounds = np.searchsorted(owner, np.arange(t.shape[0] + 1))
+    for i in range(t.shape[0]):
+        keep: list[np.ndarray] = []
+        for qv in cand[bounds[i]:bounds[i + 1]]:
+            if all(np.abs(np.concatenate([[qv[0] - k[0]], wrap(qv[1:] - k[1:])])).max() > 1e-9 for k in keep):
+                keep.append(qv)
+        out[i] = np.array(keep).reshape(-1, 3)
+    return out
 
 
 def _targets(target, normal):
@@ -401,8 +414,7 @@ def stance_ik_all(target: ArrayLike, leg: Leg, *, normal: ArrayLike = (0.0, 0.0,
     _leg(leg)
     t, n, shape = _targets(target, normal)
     sols = []
-    for i in range(t.shape[0]):
-        s = _solutions(t[i], n[i], leg, geo, rho)
+    for s in _solutions_batch(t, n, leg, geo, rho):
         if limits:
             s = s[np.abs(s[:, 2]) <= ABAD_LIMIT + 1e-12]
         sols.append(s)
@@ -442,8 +454,7 @@ def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = (0.0, 0.0, 1.0
     near = None if q_near is None else as_rows(np.broadcast_to(as_input(q_near, "q_near", (3,)), shape + (3,)), 3)
     out = np.full((t.shape[0], 3), np.nan)
     why = np.zeros(t.shape[0], dtype=np.int64)  # 0 solved, 1 unreachable, 2 only outside the limits
-    for i in range(t.shape[0]):
-        s = _solutions(t[i], n[i], leg, geo, rho)
+    for i, s in enumerate(_solutions_batch(t, n, leg, geo, rho)):
         if limits and s.shape[0]:
             inside = s[np.abs(s[:, 2]) <= ABAD_LIMIT + 1e-12]
             why[i] = 2 if inside.shape[0] == 0 else 0

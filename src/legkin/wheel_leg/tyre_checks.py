@@ -27,7 +27,7 @@ LAB_R = (0.019, 0.01)
 #: Samples of the costlier rows (brute force over the surface, Pinocchio Jacobians, stance IK).
 BRUTE_SAMPLES, BRUTE_S = 400, 4000
 PIN_SAMPLES = 300
-IK_SAMPLES = 100
+IK_SAMPLES = 1000
 
 
 class LabContact(NamedTuple):
@@ -397,7 +397,7 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
     rows.append(_envelope_row(rng, geo, r, max(samples, 100)))
     rows += _pinocchio_rows(rng, r)
     rows += _lab_rows(rng, max(samples, 1000))
-    rows += _ik_rows(rng, r, min(max(samples // 100, 20), IK_SAMPLES))
+    rows += _ik_rows(rng, r, min(max(samples // 10, 20), IK_SAMPLES))
     heights = standing_base_heights(r)
     rows.append(compare(f"standing base height, wheel_leg pose 'wheel': {heights['wheel_leg']:.6f} m "
                         "(ground_contact) vs R + r - z(O) (Pinocchio)",

@@ -60,6 +60,7 @@ def open_viewer(robot: Robot, camera: Sequence[float] | None = None) -> Iterator
             viz.loadViewerModel(rootNodeName=robot.name)
             cam = camera if camera is not None else _camera_for(robot)
             viewer["/Cameras/default/rotated/<object>"].set_property("position", list(map(float, cam)))
+            _add_ground(viewer, robot)
             yield viz
         finally:
             _stop_server(viewer)
@@ -76,6 +77,48 @@ def _stop_server(viewer) -> None:
     except subprocess.TimeoutExpired:
         proc.kill()
         proc.wait(timeout=10)
+
+
+#: Size (m) and thickness of the ground plane shown under a walking robot.
+GROUND_SIZE = 4.0
+GROUND_THICKNESS = 0.002
+
+
+def ground_height(robot: Robot) -> float | None:
+    """Height of the ground in the model's world frame, or None for a mechanism that does not walk.
+
+    A floating-base robot stands on z = 0 (its SRDF poses put the base at the height where the feet touch it);
+    a fixed-base model of a walking robot has its base at the origin, so the ground is the reference pose's
+    base height below it (read from the SRDF's ``root_joint`` entry; None if there is none).
+    """
+    import xml.etree.ElementTree as ET
+
+    if not robot.spec.floating:
+        return None
+    if robot.floating:
+        return 0.0
+    if robot.srdf_path is None:
+        return None
+    for state in ET.parse(robot.srdf_path).getroot().iter("group_state"):
+        if state.get("name") != robot.spec.reference_pose:
+            continue
+        for joint in state.iter("joint"):
+            if joint.get("name") == "root_joint":
+                return -float(joint.get("value", "0 0 0").split()[2])
+    return None
+
+
+def _add_ground(viewer: Any, robot: Robot) -> None:
+    """A light grey plane at :func:`ground_height` (nothing for a mechanism that does not walk)."""
+    import meshcat.geometry as mg
+    import meshcat.transformations as mt
+
+    z = ground_height(robot)
+    if z is None:
+        return
+    box = mg.Box([GROUND_SIZE, GROUND_SIZE, GROUND_THICKNESS])
+    viewer["/legkin/ground"].set_object(box, mg.MeshLambertMaterial(color=0xD8D8D8, opacity=0.9))
+    viewer["/legkin/ground"].set_transform(mt.translation_matrix([0.0, 0.0, z - GROUND_THICKNESS / 2]))
 
 
 def _camera_for(robot: Robot) -> tuple[float, float, float]:

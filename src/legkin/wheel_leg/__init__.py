@@ -1,10 +1,11 @@
 """The Corgi leg-wheel robot of BioRoLa (wheel-leg, seed 001).
 
-The package is the mechanism: its registry entry (``spec``), its geometry (``geometry``), its kinematics (``linkage``,
-``rim``, ``frames``, ``inverse``, ``ik_radial``, ``ik_iterative``; the public API re-exported by ``kinematics`` and
-here, imported on first use so that ``import legkin`` stays light), helpers (``configuration``), its contract
-(``contract``), its checks against Pinocchio (``checks``), bench (``bench``), figures (``figures``) and clips
-(``clips``).
+The package is the mechanism: its registry entry (``spec``), its geometry (``geometry``), its kinematics
+(``linkage``, ``rim``, ``frames``, ``inverse``, ``ik_radial``, ``ik_iterative``; the tyre surface ``tyre``; the
+ground contact and stance IK ``ground``; the public API re-exported by ``kinematics`` and here, imported on first
+use so that ``import legkin`` stays light), helpers (``configuration``), its contract (``contract``), its checks
+against Pinocchio (``checks``, ``tyre_checks``), bench (``bench``), figures (``figures``, ``tyre_figures``) and
+clips (``clips``).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they l
 
 _SUBMODULES = (
     "kinematics", "geometry", "linkage", "rim", "frames", "inverse", "ik_radial", "ik_iterative", "configuration",
-    "contract", "checks", "bench", "figures", "clips",
+    "contract", "checks", "bench", "figures", "clips", "tyre", "ground", "tyre_checks", "tyre_figures",
 )
 
 

@@ -10,6 +10,7 @@ from .. import load
 from .._rotations import wrap
 from ..validation import CheckResult, compare, per_sample, pinocchio_frames
 from . import kinematics as wl
+from . import tyre_checks
 from .configuration import SEGMENT_LINKS, configuration, leg_joint_names, local_contact_point, sample_leg_q
 
 TOL = 1e-12
@@ -265,6 +266,7 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         for rim in ("continuous", "three_arc"):
             rows += _ik_round_trip_rows(s, method, rim)
     rows.append(_ik_vs_pinocchio_row(s))
+    rows += tyre_checks.run(samples, rng)
     return rows
 
 

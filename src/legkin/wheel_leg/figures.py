@@ -9,6 +9,7 @@ import numpy as np
 
 from ..figures import new_figure
 from . import kinematics as wl
+from . import tyre_figures
 
 #: Leg opening angles of the figure (deg): wheel mode, slightly open, half open, leg mode.
 THETAS_DEG = (17.0, 30.0, 90.0, 160.0)
@@ -127,4 +128,4 @@ def figures(outdir: Path) -> list[Path]:
     out = Path(outdir) / "wheel_leg_contact.png"
     fig.savefig(out, dpi=90)
     plt.close(fig)
-    return [out]
+    return [out] + tyre_figures.figures(outdir)

@@ -15,7 +15,7 @@ from .._batch import as_input, check_choice, check_flag, check_number, finish
 from .._kernels import OK, as_rows, kernel, prange
 from ..errors import InvalidInputError
 from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, _loop, legacy_geometry, rim_name
-from .geometry import _DEFAULT_GEOMETRY, FOOT_OFFSET, THETA_MAX, THETA_MIN, Geometry, _geometry, _leg
+from .geometry import _DEFAULT_GEOMETRY, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry, _leg
 from .linkage import _Const, _constants, _kconst
 from .rim import _k_plane, _k_select, _Sel, _select
 
@@ -140,7 +140,7 @@ def _context(alpha, w, leg, rim, geo, radius) -> _Ctx:
     seed = _rim_kind(rim)
     _, side, _ = _leg(leg)
     if radius is None:
-        rho = geo.R + FOOT_OFFSET if seed else geo.R
+        rho = geo.R + TYRE_THICKNESS if seed else geo.R
     else:
         rho = check_number(radius, "radius", 0.0, 2.0 * geo.R, low_open=True)
     sel = _select(alpha, seed, rho, geo.R)
@@ -166,7 +166,7 @@ def _fk(q: np.ndarray, ctx: _Ctx, want_jac: bool):
 
     sel = ctx.sel
     a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)
-    K, KC = _kconst(ctx.c.R, ctx.geo.R + FOOT_OFFSET)
+    K, KC = _kconst(ctx.c.R, ctx.geo.R + TYRE_THICKNESS)
     P = np.empty((n, 3))
     J = np.empty((n, 9) if want_jac else (n, 0))
     o = ctx.origin
@@ -198,10 +198,10 @@ def _q_inputs(q, alpha, w, geo):
 def _kctx_cached(leg, rim, radius, geo: Geometry):
     ctx = _context(np.zeros(()), 0.0, leg, rim, geo, radius)
     if radius is None:
-        rho = geo.R + FOOT_OFFSET if ctx.seed else geo.R
+        rho = geo.R + TYRE_THICKNESS if ctx.seed else geo.R
     else:
         rho = float(radius)
-    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
     o = ctx.origin
     return (ctx.seed, rho, K, KC, ctx.s, geo.d_wheel, geo.T / 2, float(o[0]), float(o[1]), float(o[2]))
 

@@ -17,10 +17,15 @@ THETA_MIN = math.radians(17.0)
 THETA_MAX = math.radians(160.0)
 #: Half-angle of the seed's toe arc (rad).
 PSI_FG = math.radians(40.0)
-#: Foot radius minus the pitch radius in the seed's rim formula: 0.02225 + 0.01225 m (tyre included).
-FOOT_OFFSET = 0.0345
-#: Outer (collision/visual) tyre radius minus the pitch radius: 0.135 - 0.100 m.
-TYRE_OFFSET = 0.035
+#: The tyre thickness (m), one constant for one surface: the tyre surface of :mod:`.tyre` is the pitch curve
+#: (radius R) offset by it; it is the foot radius minus the pitch radius of the seed's rim formula
+#: (0.02225 + 0.01225 m: R + 0.0345 = 0.1345 m) and the outer radius of the rim meshes (R + TYRE_THICKNESS).
+TYRE_THICKNESS = 0.0345
+#: Deprecated alias of :data:`TYRE_THICKNESS` (the seed's foot radius minus the pitch radius); kept for one release.
+FOOT_OFFSET = TYRE_THICKNESS
+#: Deprecated alias of :data:`TYRE_THICKNESS` (was 0.035, the visual rim's outer radius minus R, before the rim
+#: meshes took the tyre thickness); kept for one release.
+TYRE_OFFSET = TYRE_THICKNESS
 
 _ARC_HF = math.radians(130.0)
 _ARC_BC = math.radians(101.0)

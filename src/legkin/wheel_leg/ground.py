@@ -39,9 +39,9 @@ from .._rotations import wrap
 from ..errors import InvalidInputError, JointLimitError, UnreachableError
 from ._common import Leg, _check_theta, _loop
 from .frames import _R_0, _R_LM, _k_fk, _origin
-from .geometry import _DEFAULT_GEOMETRY, ABAD_LIMIT, FOOT_OFFSET, THETA_MAX, THETA_MIN, Geometry, _geometry, _leg
+from .geometry import _DEFAULT_GEOMETRY, ABAD_LIMIT, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry, _leg
 from .linkage import _IF, _IG, _IL, _IU, _k_closed, _kconst, linkage_points
-from .tyre import _LINK_A, _LINK_B, _NP, PIECES, TYRE_THICKNESS, _k_cumulative, _k_pieces, _thickness
+from .tyre import _LINK_A, _LINK_B, _NP, PIECES, _k_cumulative, _k_pieces, _thickness
 
 __all__ = ["GroundContact", "ground_contact", "stance_ik", "stance_ik_all", "normal_in_leg_frame"]
 
@@ -183,7 +183,7 @@ def _kernel_args(leg, r, geometry) -> tuple[Any, ...]:
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     rho = _thickness(r, geo)
     sl, o, RLM, R0 = _leg_consts(leg, geo)
-    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
     return (rho, K, KC, sl, geo.d_wheel, geo.T / 2, float(o[0]), float(o[1]), float(o[2]), RLM, R0)
 
 
@@ -249,7 +249,7 @@ def ground_contact(q: ArrayLike, leg: Leg, normal: ArrayLike = _Z, *, r: float =
         raise InvalidInputError(f"inputs do not broadcast together: q{q.shape}, normal{n.shape}") from exc
     q = np.broadcast_to(q, shape + (3,))
     _check_theta(q[..., 0], "theta (q[..., 0])")
-    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
     qr = as_rows(q, 3)
     nr = as_rows(np.broadcast_to(n, shape + (3,)), 3)
     m = qr.shape[0]

@@ -19,7 +19,7 @@ from .._kernels import as_rows, kernel, prange
 from .._rotations import wrap_k
 from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip, _loop
 from .frames import _Ctx, _k_fk
-from .geometry import _LIMIT_ROUNDING, ABAD_LIMIT, FOOT_OFFSET, THETA_MAX, THETA_MIN
+from .geometry import _LIMIT_ROUNDING, ABAD_LIMIT, THETA_MAX, THETA_MIN, TYRE_THICKNESS
 from .ik_radial import _arc_table
 from .linkage import _kconst
 from .rim import _k_plane
@@ -317,7 +317,7 @@ def starts(target: np.ndarray, ctx: _Ctx, count: int = 1, branch: float = -1.0) 
 
     upper, right, e = items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128)
     a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)
-    K, KC = _kconst(ctx.c.R, ctx.geo.R + FOOT_OFFSET)
+    K, KC = _kconst(ctx.c.R, ctx.geo.R + TYRE_THICKNESS)
     grid, table = guess_table(ctx.geo.R, ctx.seed)
     o = ctx.origin
     tgt = as_rows(target, 3)
@@ -339,7 +339,7 @@ def solve(target, ctx: _Ctx, q_start, method: str, tol: float, max_iter: int | N
 
     upper, right, e = items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128)
     a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)
-    K, KC = _kconst(ctx.c.R, ctx.geo.R + FOOT_OFFSET)
+    K, KC = _kconst(ctx.c.R, ctx.geo.R + TYRE_THICKNESS)
     grid, table = guess_table(ctx.geo.R, ctx.seed)
     o = ctx.origin
     q = np.empty((n, 3))

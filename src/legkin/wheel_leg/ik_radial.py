@@ -11,7 +11,7 @@ from .._kernels import as_rows, kernel, prange
 from .._rotations import wrap_k
 from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip, _k_max, _k_min, _k_phase, _loop
 from .frames import _k_fk
-from .geometry import _LIMIT_ROUNDING, ABAD_LIMIT, FOOT_OFFSET, THETA_MAX, THETA_MIN
+from .geometry import _LIMIT_ROUNDING, ABAD_LIMIT, THETA_MAX, THETA_MIN, TYRE_THICKNESS
 from .linkage import _closed_form, _constants, _kconst
 from .radial_roots import _k_lower_bound, _k_radial_extremum, _k_radial_newton
 from .rim import _k_plane
@@ -43,7 +43,7 @@ def _arc_table(R: float, seed: bool, nodes: int) -> tuple[np.ndarray, np.ndarray
 
 def _arc_terms(theta: np.ndarray, R: float, seed: bool) -> np.ndarray:
     """(2 arc kinds, 8, ...): A, V, Re W, Im W and their theta-derivatives (see :func:`_arc_table`)."""
-    pts, der = _closed_form(theta, _constants(R), R + FOOT_OFFSET, True, full=seed)
+    pts, der = _closed_form(theta, _constants(R), R + TYRE_THICKNESS, True, full=seed)
     assert der is not None
     rows = []
     for ctr_name, ref_name in ((("U", "J"), ("O_r", "G")) if seed else (("U", "F"), ("L", "G"))):
@@ -377,7 +377,7 @@ def _ik_radial(target, ctx, tol, max_iter, q0, limits=True):
     max_iter = 60 if max_iter is None else max_iter
     n = target.shape[0]
     grid, table, m2, fine, fine_rows = _radial_table(ctx.geo.R, ctx.seed)
-    K, KC = _kconst(ctx.c.R, ctx.geo.R + FOOT_OFFSET)
+    K, KC = _kconst(ctx.c.R, ctx.geo.R + TYRE_THICKNESS)
     sel = ctx.sel
 
     def items(x, dtype):

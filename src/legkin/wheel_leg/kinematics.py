@@ -20,7 +20,8 @@ Conventions (metres, radians at every API, theta included):
 
 Files: :mod:`.geometry` (constants, :class:`Geometry`), :mod:`.linkage` (closed form), :mod:`.rim` (rim
 contact points in {L}), :mod:`.frames` (frames, :func:`fk`, :func:`jacobian`), :mod:`.inverse` (:func:`ik`,
-:func:`ik_all`), :mod:`.ik_radial`, :mod:`.ik_iterative`. This module re-exports the public API.
+:func:`ik_all`), :mod:`.ik_radial`, :mod:`.ik_iterative`, :mod:`.tyre` (the tyre surface), :mod:`.ground`
+(:func:`ground_contact`, :func:`stance_ik`). This module re-exports the public API.
 
 A single input returns plain arrays and raises on failure; a batch (leading dimensions) returns NaN where
 an item fails, and ``return_mask=True`` also returns the mask of successes.
@@ -29,7 +30,19 @@ an item fails, and ``return_mask=True`` also returns the mask of successes.
 from __future__ import annotations
 
 from .frames import contact_jacobian, contact_point, fk, jacobian, leg_frame_to_robot, module_origin
-from .geometry import ABAD_LIMIT, FOOT_OFFSET, LEGS, PSI_FG, THETA0, THETA_MAX, THETA_MIN, TYRE_OFFSET, Geometry
+from .geometry import (
+    ABAD_LIMIT,
+    FOOT_OFFSET,
+    LEGS,
+    PSI_FG,
+    THETA0,
+    THETA_MAX,
+    THETA_MIN,
+    TYRE_OFFSET,
+    TYRE_THICKNESS,
+    Geometry,
+)
+from .ground import GroundContact, ground_contact, stance_ik, stance_ik_all
 from .inverse import IKInfo, IKOptions, ik, ik_all
 from .linkage import (
     PASSIVE_JOINTS,
@@ -41,6 +54,7 @@ from .linkage import (
     theta_beta,
 )
 from .rim import rim_jump_seed, rim_point, rim_point_seed, rim_segment
+from .tyre import TyrePieces, tyre_length, tyre_pieces, tyre_point
 
 __all__ = [
     "LEGS",
@@ -48,8 +62,7 @@ __all__ = [
     "THETA_MIN",
     "THETA_MAX",
     "PSI_FG",
-    "FOOT_OFFSET",
-    "TYRE_OFFSET",
+    "TYRE_THICKNESS",
     "ABAD_LIMIT",
     "Geometry",
     "linkage_constants",
@@ -71,7 +84,17 @@ __all__ = [
     "ik_all",
     "IKOptions",
     "IKInfo",
+    "tyre_point",
+    "tyre_pieces",
+    "tyre_length",
+    "TyrePieces",
+    "ground_contact",
+    "GroundContact",
+    "stance_ik",
+    "stance_ik_all",
     # deprecated (legkin 0.1), kept for one release
+    "FOOT_OFFSET",
+    "TYRE_OFFSET",
     "contact_point",
     "contact_jacobian",
 ]

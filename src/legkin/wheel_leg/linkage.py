@@ -19,10 +19,10 @@ from .geometry import (
     _ARC_HF,
     _DEFAULT_GEOMETRY,
     _J_ANGLE,
-    FOOT_OFFSET,
     THETA0,
     THETA_MAX,
     THETA_MIN,
+    TYRE_THICKNESS,
     Geometry,
     _geometry,
 )
@@ -313,7 +313,7 @@ def _k_ref_links(K, KC, out):
 def _ref_links(R: float) -> np.ndarray:
     """The left-half link vectors of :func:`_k_links` at theta0 (wheel mode), once per geometry."""
     out = np.empty(5, dtype=np.complex128)
-    _k_ref_links(*_kconst(R, R + FOOT_OFFSET), out)
+    _k_ref_links(*_kconst(R, R + TYRE_THICKNESS), out)
     out.setflags(write=False)
     return out
 
@@ -350,7 +350,7 @@ def linkage_points(theta: ArrayLike, beta: ArrayLike = 0.0, *,
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     t, b, shape = _angle_pair(theta, beta)
-    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
     out = np.empty((t.shape[0], len(POINTS), 3))
     if shape == ():
         _k_linkage(t[0], b[0], K, KC, _PT_INDEX, _PT_CONJ, out[0])
@@ -380,7 +380,7 @@ def passive_angles(theta: ArrayLike, beta: ArrayLike = 0.0, *,
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     t, b, shape = _angle_pair(theta, beta)
-    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
     out = np.empty((t.shape[0], len(PASSIVE_JOINTS)))
     if shape == ():
         _k_passive(t[0], b[0], K, KC, _ref_links(geo.R), out[0])

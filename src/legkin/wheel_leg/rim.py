@@ -11,7 +11,7 @@ from numpy.typing import ArrayLike
 from .._batch import as_angles, as_input, check_number
 from .._kernels import as_rows, kernel, prange
 from ._common import _SCALARS, _check_alpha, _check_theta, _check_w, _loop
-from .geometry import _ARC_FG, _DEFAULT_GEOMETRY, FOOT_OFFSET, PSI_FG, THETA_MAX, THETA_MIN, Geometry, _geometry
+from .geometry import _ARC_FG, _DEFAULT_GEOMETRY, PSI_FG, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry
 from .linkage import _IF, _IG, _IJ, _IL, _IOR, _IU, _k_closed, _kconst
 
 
@@ -180,10 +180,10 @@ def _rim_call(theta, beta, alpha, w, radius, geometry, seed):
     the batch of :func:`_k_rim`."""
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     if radius is None:
-        rho = geo.R + FOOT_OFFSET if seed else geo.R
+        rho = geo.R + TYRE_THICKNESS if seed else geo.R
     else:
         rho = check_number(radius, "radius", 0.0, 2.0 * geo.R, low_open=True)
-    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
     scalars = type(theta) in _SCALARS and type(beta) in _SCALARS and type(alpha) in _SCALARS and type(w) in _SCALARS
     if (scalars
             and THETA_MIN - 1e-12 <= theta <= THETA_MAX + 1e-12 and math.isfinite(beta)
@@ -262,8 +262,8 @@ def rim_jump_seed(theta: ArrayLike, *, radius: float | None = None, geometry: Ge
     The distance between the toe-arc point at alpha = psi_FG and the upper-rim point at alpha -> psi_FG+.
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
-    rho = geo.R + FOOT_OFFSET if radius is None else check_number(radius, "radius", 0.0, 2.0 * geo.R, low_open=True)
-    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    rho = geo.R + TYRE_THICKNESS if radius is None else check_number(radius, "radius", 0.0, 2.0 * geo.R, low_open=True)
+    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
     if type(theta) is float and THETA_MIN - 1e-12 <= theta <= THETA_MAX + 1e-12:
         return np.asarray(_k_jump(theta, rho, K, KC))
     theta = as_input(theta, "theta")

@@ -11,9 +11,19 @@ from .._registry import ModelSpec, Param
 
 LEGS = ("FL", "FR", "RR", "RL")
 
-#: Rim section of the visual/collision meshes: inner radius 0.9 R, outer radius R + 0.035 m.
+#: Rim section of the visual/collision meshes: inner radius 0.9 R, outer radius R + TYRE_THICKNESS (0.0345 m,
+#: the tyre surface of :mod:`.tyre`).
 RIM_INNER = 0.9
-RIM_TYRE = 0.035
+
+
+def __getattr__(name: str) -> float:
+    """``RIM_TYRE``: deprecated alias of :data:`legkin.wheel_leg.geometry.TYRE_THICKNESS` (was 0.035), kept for
+    one release (served lazily: geometry validates against this module's SPEC)."""
+    if name == "RIM_TYRE":
+        from .geometry import TYRE_THICKNESS
+
+        return TYRE_THICKNESS
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 SPEC = ModelSpec(
     name="wheel_leg",
@@ -78,10 +88,12 @@ def rim_meshes(args: dict) -> dict[str, bytes]:
     """The two rim-arc meshes for the xacro arguments ``args`` (paths relative to ``urdf/``).
 
     Upper rim: 130 deg arc, lower rim: 50 deg arc, both centred on the arc centre and symmetric about +x
-    (the URDF rotates them into place); section from ``0.9 R`` to ``R + 0.035`` m, thickness ``T``.
+    (the URDF rotates them into place); section from ``0.9 R`` to ``R + TYRE_THICKNESS`` (0.0345 m), thickness ``T``.
     """
+    from .geometry import TYRE_THICKNESS  # here: geometry imports this module's SPEC
+
     R, T = float(args["R"]), float(args["T"])
-    r1, r2 = RIM_INNER * R, R + RIM_TYRE
+    r1, r2 = RIM_INNER * R, R + TYRE_THICKNESS
     out = {}
     for name, deg, seg in (("rim_upper", 130.0, 52), ("rim_lower", 50.0, 20)):
         tris = annular_sector(r1, r2, math.radians(deg) / 2, T, seg)

@@ -42,14 +42,10 @@ from .._kernels import as_rows, kernel, prange
 from .._rotations import wrap_k
 from ..errors import InvalidInputError
 from ._common import _check_theta, _loop
-from .geometry import _DEFAULT_GEOMETRY, FOOT_OFFSET, Geometry, _geometry
+from .geometry import _DEFAULT_GEOMETRY, TYRE_THICKNESS, Geometry, _geometry
 from .linkage import _IF, _IG, _IH, _IL, _IU, _k_closed, _kconst
 
 __all__ = ["TYRE_THICKNESS", "PIECES", "PIECE_LINKS", "TyrePieces", "tyre_pieces", "tyre_point", "tyre_length"]
-
-#: The tyre thickness (m): the surface is the pitch curve (radius R) offset by this; 0.02225 + 0.01225 m, the
-#: foot radius R + 0.0345 = 0.1345 m of the seed's rim formula (= ``FOOT_OFFSET``; one constant for one surface).
-TYRE_THICKNESS = FOOT_OFFSET
 
 #: The 16 pieces of the closed tyre curve in the order of s. ``X`` = the piece at hinge X (a fillet of radius r
 #: about X, or a trimmed corner of zero length, see the module docstring); ``cap_H`` = half circles about the tips.
@@ -254,7 +250,7 @@ def _prepared(theta, beta, r, geometry) -> tuple[np.ndarray, np.ndarray, tuple[i
     rho = _thickness(r, geo)
     theta, beta = as_angles(theta, beta, names=("theta", "beta"))
     _check_theta(theta)
-    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
     return as_rows(theta, 1)[:, 0], as_rows(beta, 1)[:, 0], theta.shape, rho, K, KC
 
 
@@ -312,7 +308,7 @@ def tyre_point(theta: ArrayLike, beta: ArrayLike, s: ArrayLike, w: ArrayLike = 0
         raise InvalidInputError(f"s={float(s[(s < 0) | (s > 1)].ravel()[0])!r} is out of range: must be in [0, 1]")
     if np.any(np.abs(w) > geo.T / 2 + 1e-15):
         raise InvalidInputError(f"w is out of range: must be in [-T/2, T/2] = [{-geo.T / 2:g}, {geo.T / 2:g}]")
-    K, KC = _kconst(geo.R, geo.R + FOOT_OFFSET)
+    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
     shape = theta.shape
     rows = [as_rows(x, 1)[:, 0] for x in (theta, beta, s, w)]
     out = np.empty((rows[0].shape[0], 3))

@@ -364,7 +364,8 @@ def standing_base_heights(r: float = TYRE_THICKNESS) -> dict[str, float]:
     """Base heights (m) that put the lowest foot / tyre point of the SRDF standing poses at z = 0 (floating
     base, identity orientation): wheel_leg pose ``wheel`` (ground_contact of each leg at the pose's (theta,
     beta, gamma) = (17 deg, 0, 0), n = z) and quadruped pose ``standing`` (Pinocchio foot frames minus the
-    collision sphere radius 0.022 m; also without it)."""
+    collision sphere radius 0.022 m; also without it). Measured from the poses' own base heights (the SRDFs'
+    ``root_joint`` entries, 0 where absent), which are also returned."""
     import pinocchio as pin
 
     from .. import load
@@ -376,10 +377,13 @@ def standing_base_heights(r: float = TYRE_THICKNESS) -> dict[str, float]:
     out["wheel_leg"] = -min(z)
     pin.framesForwardKinematics(wl_robot.model, wl_robot.data, wl_robot.poses["wheel"])
     o_z = [float(wl_robot.data.oMf[wl_robot.frame_id(f"{leg}_leg")].translation[2]) for leg in LEGS]
-    out["wheel_leg (Pinocchio: R + r - z of O)"] = geo.R + r - min(o_z)
+    z_base = float(wl_robot.poses["wheel"][2])  # the SRDF pose's own base height (0 before it had one)
+    out["wheel_leg (Pinocchio: R + r - z of O)"] = geo.R + r - (min(o_z) - z_base)
+    out["wheel_leg (SRDF pose 'wheel' base z)"] = z_base
     quad = load("quadruped", floating=True)
     pin.framesForwardKinematics(quad.model, quad.data, quad.poses["standing"])
-    feet = [float(quad.data.oMf[quad.frame_id(f"{f}_FOOT")].translation[2]) for f in ("LF", "LH", "RF", "RH")]
+    zq = float(quad.poses["standing"][2])  # measured from the pose's own base height
+    feet = [float(quad.data.oMf[quad.frame_id(f"{f}_FOOT")].translation[2]) - zq for f in ("LF", "LH", "RF", "RH")]
     out["quadruped (foot spheres r = 0.022)"] = -min(feet) + 0.022
     out["quadruped (foot frames)"] = -min(feet)
     return out

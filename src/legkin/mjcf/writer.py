@@ -192,9 +192,9 @@ def _gains(robot: "Robot", joints: Sequence[_Joint], o: Mapping[str, Any]) -> tu
     return kp, kv
 
 
-def _build_xml(robot: "Robot", o: Mapping[str, Any]) -> str:
-    model = robot.model
-    joints: list[Any] = [None] + [_joint(model, i) for i in range(1, model.njoints)]  # 0: the universe
+def _header(robot: "Robot", o: Mapping[str, Any]) -> tuple[ET.Element, ET.Element, ET.Element]:
+    """The ``<mujoco>`` root with its compiler, option, visual and default classes; returns
+    ``(root, asset, worldbody)`` (the asset element still empty)."""
     root = ET.Element("mujoco", model=robot.name)
     root.append(ET.Comment(
         f" legkin {robot.name}: written by legkin.mjcf.to_mjcf from {robot.urdf_path.name} "
@@ -217,8 +217,31 @@ def _build_xml(robot: "Robot", o: Mapping[str, Any]) -> str:
     ET.SubElement(fr, "site", size="0.004", group="4", rgba="1 0.2 0.2 1")
     asset = ET.SubElement(root, "asset")
     world = ET.SubElement(root, "worldbody")
+    return root, asset, world
 
-    # bodies, one per joint, nested as the kinematic tree
+
+def _joint_element(body: ET.Element, model: pin.Model, j: _Joint) -> None:
+    """The ``<freejoint>`` or ``<joint>`` of ``j`` in ``body``, with its axis, range, damping, friction, armature."""
+    if j.kind == "free":
+        ET.SubElement(body, "freejoint", name=j.name)
+        return
+    jel = ET.SubElement(body, "joint", name=j.name, type="hinge" if j.kind == "hinge_rub" else j.kind)
+    if j.kind in ("hinge", "slide", "hinge_rub"):
+        jel.set("axis", _vec(j.axis))
+    if j.kind in ("hinge", "slide"):
+        lo, hi = model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q]
+        if np.isfinite(lo) and np.isfinite(hi) and lo < hi and max(abs(lo), abs(hi)) < 1e10:
+            jel.set("range", _vec([lo, hi]))
+    dyn = (("damping", model.damping), ("frictionloss", model.friction), ("armature", model.armature))
+    for attr, arr in dyn:
+        val = float(np.max(arr[j.idx_v : j.idx_v + j.nv]))
+        if val > 0:
+            jel.set(attr, _num(val))
+
+
+def _bodies(model: pin.Model, joints: Sequence[Any], world: ET.Element,
+            o: Mapping[str, Any]) -> tuple[dict[int, ET.Element], list[str]]:
+    """Bodies, one per joint, nested as the kinematic tree; returns ``(joint index -> body, inertia notes)``."""
     bodies: dict[int, ET.Element] = {0: world}
     link_of: dict[int, str] = {}
     for f in model.frames:
@@ -236,24 +259,14 @@ def _build_xml(robot: "Robot", o: Mapping[str, Any]) -> str:
             notes.append(f"{body.get('name')}: {note}")
             body.append(ET.Comment(f" {note} "))
         body.append(inertial)
-        if j.kind == "free":
-            ET.SubElement(body, "freejoint", name=j.name)
-        else:
-            jel = ET.SubElement(body, "joint", name=j.name, type="hinge" if j.kind == "hinge_rub" else j.kind)
-            if j.kind in ("hinge", "slide", "hinge_rub"):
-                jel.set("axis", _vec(j.axis))
-            if j.kind in ("hinge", "slide"):
-                lo, hi = model.lowerPositionLimit[j.idx_q], model.upperPositionLimit[j.idx_q]
-                if np.isfinite(lo) and np.isfinite(hi) and lo < hi and max(abs(lo), abs(hi)) < 1e10:
-                    jel.set("range", _vec([lo, hi]))
-            dyn = (("damping", model.damping), ("frictionloss", model.friction), ("armature", model.armature))
-            for attr, arr in dyn:
-                val = float(np.max(arr[j.idx_v : j.idx_v + j.nv]))
-                if val > 0:
-                    jel.set(attr, _num(val))
+        _joint_element(body, model, j)
         bodies[i] = body
+    return bodies, notes
 
-    # sites at the body and operational frames, then the visuals
+
+def _sites_and_visuals(robot: "Robot", bodies: Mapping[int, ET.Element], asset: ET.Element) -> set[str]:
+    """Sites at the body and operational frames, then the visuals; returns the names of the sites."""
+    model = robot.model
     seen = set()
     for f in model.frames:
         if f.type not in (pin.FrameType.BODY, pin.FrameType.OP_FRAME) or f.name in seen:
@@ -265,31 +278,39 @@ def _build_xml(robot: "Robot", o: Mapping[str, Any]) -> str:
     mesh_assets: dict = {}
     for g in robot.visual_model.geometryObjects:
         bodies[g.parentJoint].append(_geom(g, mesh_assets, asset))
-    if o["floor"]:
-        ET.SubElement(asset, "texture", name="grid", type="2d", builtin="checker", width="512", height="512",
-                      rgb1="0.82 0.84 0.86", rgb2="0.72 0.74 0.77")
-        ET.SubElement(asset, "material", name="grid", texture="grid", texrepeat="8 8", reflectance="0.05")
-        low = _lowest_point(robot)
-        ET.SubElement(world, "geom", name="floor", type="plane", size="0 0 0.05", material="grid",
-                      pos=_vec([0, 0, low]), contype="0", conaffinity="0", group="0")
-        ET.SubElement(world, "light", name="sun", pos="0 0 3", dir="0.3 0.2 -1", directional="true",
-                      diffuse="0.5 0.5 0.5", castshadow="true")
-    if not len(asset):
-        root.remove(asset)
+    return seen
 
-    # loop closures
-    if robot.loops:
-        eq = ET.SubElement(root, "equality")
-        for lp in robot.loops:
-            for fname in (lp.frame1, lp.frame2):
-                if fname not in seen:
-                    raise LegkinError(f"loop {lp.name!r}: frame {fname!r} is not a body or operational frame")
-            ET.SubElement(
-                eq, "connect" if lp.type == "point" else "weld", name=lp.name, site1=lp.frame1, site2=lp.frame2,
-                solref=_vec(o["eq_solref"]), solimp=_vec(o["eq_solimp"]),
-            )
 
-    # actuators and keyframes
+def _floor(robot: "Robot", asset: ET.Element, world: ET.Element) -> None:
+    """A visual checkered ground plane a little under the model, and a sun light."""
+    ET.SubElement(asset, "texture", name="grid", type="2d", builtin="checker", width="512", height="512",
+                  rgb1="0.82 0.84 0.86", rgb2="0.72 0.74 0.77")
+    ET.SubElement(asset, "material", name="grid", texture="grid", texrepeat="8 8", reflectance="0.05")
+    low = _lowest_point(robot)
+    ET.SubElement(world, "geom", name="floor", type="plane", size="0 0 0.05", material="grid",
+                  pos=_vec([0, 0, low]), contype="0", conaffinity="0", group="0")
+    ET.SubElement(world, "light", name="sun", pos="0 0 3", dir="0.3 0.2 -1", directional="true",
+                  diffuse="0.5 0.5 0.5", castshadow="true")
+
+
+def _equalities(root: ET.Element, robot: "Robot", seen: set[str], o: Mapping[str, Any]) -> None:
+    """The loop closures as ``<connect>`` (point) or ``<weld>`` equalities between sites."""
+    if not robot.loops:
+        return
+    eq = ET.SubElement(root, "equality")
+    for lp in robot.loops:
+        for fname in (lp.frame1, lp.frame2):
+            if fname not in seen:
+                raise LegkinError(f"loop {lp.name!r}: frame {fname!r} is not a body or operational frame")
+        ET.SubElement(
+            eq, "connect" if lp.type == "point" else "weld", name=lp.name, site1=lp.frame1, site2=lp.frame2,
+            solref=_vec(o["eq_solref"]), solimp=_vec(o["eq_solimp"]),
+        )
+
+
+def _actuators(root: ET.Element, robot: "Robot", joints: Sequence[Any], o: Mapping[str, Any]) -> None:
+    """One position actuator per actuated joint, with its gains, control range and force range."""
+    model = robot.model
     kp, kv = _gains(robot, [j for j in joints if j is not None], o)
     act = ET.SubElement(root, "actuator")
     for name in robot.actuated_joints:
@@ -303,6 +324,10 @@ def _build_xml(robot: "Robot", o: Mapping[str, Any]) -> str:
         effort = float(model.effortLimit[j.idx_v])
         if o["force_limits"] and 0 < effort < 1e10:
             a.set("forcerange", _vec([-effort, effort]))
+
+
+def _keyframes(root: ET.Element, robot: "Robot", joints: Sequence[Any]) -> None:
+    """The reference pose and the SRDF poses whose loops are closed, as keyframes."""
     keys = ET.SubElement(root, "keyframe")
     poses = {robot.spec.reference_pose: robot.q0, **robot.poses}
     for pose_name, q in poses.items():
@@ -310,6 +335,21 @@ def _build_xml(robot: "Robot", o: Mapping[str, Any]) -> str:
             continue  # a pose of the open tree only: MuJoCo would snap it shut on the first step
         ET.SubElement(keys, "key", name=pose_name, qpos=_vec(_qpos(joints, q)),
                       ctrl=_vec(q[robot.idx_q(a)] for a in robot.actuated_joints))
+
+
+def _build_xml(robot: "Robot", o: Mapping[str, Any]) -> str:
+    model = robot.model
+    joints: list[Any] = [None] + [_joint(model, i) for i in range(1, model.njoints)]  # 0: the universe
+    root, asset, world = _header(robot, o)
+    bodies, notes = _bodies(model, joints, world, o)
+    seen = _sites_and_visuals(robot, bodies, asset)
+    if o["floor"]:
+        _floor(robot, asset, world)
+    if not len(asset):
+        root.remove(asset)
+    _equalities(root, robot, seen, o)
+    _actuators(root, robot, joints, o)
+    _keyframes(root, robot, joints)
     if notes:
         root.insert(1, ET.Comment(" inertias raised: " + "; ".join(notes) + " "))
     ET.indent(root, space="  ")

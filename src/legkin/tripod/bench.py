@@ -27,26 +27,37 @@ def _sizes(n: int | None, quick: bool) -> tuple[int, int, int]:
     return sizes(n, quick, full=(20_000, 2_000, 200), small=(1_000, 100, 10))
 
 
-def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
-    n_batch, n_scalar, n_iter = _sizes(n, quick)
-    robot = load("tripod")
+def _pin_rot_and_residual(robot, qs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pinocchio's platform rotation and loop-residual norm at each finite joint configuration (NaN elsewhere)."""
+    rot = np.full((len(qs), 3, 3), np.nan)
+    res = np.full(len(qs), np.nan)
+    for i, q in enumerate(qs):
+        if np.all(np.isfinite(q)):
+            rot[i] = robot.frame_placement(q, "platform").rotation
+            res[i] = np.linalg.norm(robot.constraint_residual(q))
+    return rot, res
+
+
+def _joints_scorer(robot, r_true: np.ndarray):
+    """Score of a joint answer (``qs`` or ``(qs, iterations)``): rotation error and loop residual."""
+
+    def joints_score(rows, out) -> Score:
+        qs, iters = out if isinstance(out, tuple) else (out, None)
+        k = len(rows)
+        rot, res = _pin_rot_and_residual(robot, qs)
+        err = rotation_error(rot, r_true[:k])
+        ok = (err <= SOLVE_TOL) & (res <= SOLVE_TOL)
+        return Score(error=err, solved=ok, orientation=res, iterations=iters)
+
+    return joints_score
+
+
+def _fk_methods(robot, motors: np.ndarray, r_true: np.ndarray, n_batch: int, n_scalar: int,
+                n_iter: int) -> list[Method]:
+    """fk: motors -> orientation (batch, scalar loop, ``Robot.solve_loops``)."""
     model = robot.model
-    fid = robot.frame_id("platform")
-    ay, az = sample_workspace(n_batch, rng)
-    r_true = at.platform_rotation(ay, az)
-    orient = np.stack([ay, az], axis=-1)
-    motors = at.ik(orient)
+    joints_score = _joints_scorer(robot, r_true)
 
-    def pin_rot_and_residual(qs: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        rot = np.full((len(qs), 3, 3), np.nan)
-        res = np.full(len(qs), np.nan)
-        for i, q in enumerate(qs):
-            if np.all(np.isfinite(q)):
-                rot[i] = robot.frame_placement(q, "platform").rotation
-                res[i] = np.linalg.norm(robot.constraint_residual(q))
-        return rot, res
-
-    # ---------------------------------------------------------------- fk: motors -> orientation
     def fk_batch(m):
         return at.fk(m, tol=TOL)
 
@@ -79,29 +90,23 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
             qs[i], iters[i] = q, info.iterations
         return qs, iters
 
-    def joints_score(rows, out) -> Score:
-        qs, iters = out if isinstance(out, tuple) else (out, None)
-        k = len(rows)
-        rot, res = pin_rot_and_residual(qs)
-        err = rotation_error(rot, r_true[:k])
-        ok = (err <= SOLVE_TOL) & (res <= SOLVE_TOL)
-        return Score(error=err, solved=ok, orientation=res, iterations=iters)
+    return [
+        Method(f"legkin batch fk (Gauss-Newton, analytic A_u; {n_batch} at once)", motors, fk_batch, fk_score,
+               group="fk", repeats=5),
+        Method("legkin scalar fk, Python loop", motors, fk_scalar, fk_score, group="fk", max_targets=n_scalar,
+               repeats=3),
+        Method("pinocchio Robot.solve_loops (motors held, start q0)", motors, solve_loops_run, joints_score,
+               group="fk", max_targets=n_iter, repeats=3),
+    ]
 
-    # ---------------------------------------------------------------- ik: orientation -> joints
-    def ik_batch(u):
-        return at.ik_joints(u)
 
-    def ik_scalar(u):
-        out = np.full((len(u), 12), np.nan)
-        for i, row in enumerate(u):
-            try:
-                out[i] = at.ik_joints(row)
-            except LegkinError:
-                pass
-        return out
-
+def _pin_inverse(robot):
+    """Pinocchio-only inverse: Levenberg-Marquardt on [loop residual; log3(R_target^T R_platform)], every joint
+    free; returns ``(qs, iterations, fk evaluations)``."""
     import pinocchio as pin
 
+    model = robot.model
+    fid = robot.frame_id("platform")
     loopset = robot._loopset
     ldata = loopset.data
     free = np.ones(model.nv, dtype=bool)
@@ -127,6 +132,28 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
                 qs[i] = q
         return qs, iters, evals
 
+    return pin_inverse
+
+
+def _ik_methods(robot, orient: np.ndarray, r_true: np.ndarray, n_batch: int, n_scalar: int,
+                n_iter: int) -> list[Method]:
+    """ik: orientation -> joints (batch closed form, scalar loop, Pinocchio-only inverse)."""
+    joints_score = _joints_scorer(robot, r_true)
+
+    def ik_batch(u):
+        return at.ik_joints(u)
+
+    def ik_scalar(u):
+        out = np.full((len(u), 12), np.nan)
+        for i, row in enumerate(u):
+            try:
+                out[i] = at.ik_joints(row)
+            except LegkinError:
+                pass
+        return out
+
+    pin_inverse = _pin_inverse(robot)
+
     def pin_inverse_score(rows, out) -> Score:
         s = joints_score(rows, out[:2])
         s.fk_evals = out[2]
@@ -135,13 +162,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
     def ik_score(rows, qs) -> Score:
         return joints_score(rows, qs)
 
-    methods = [
-        Method(f"legkin batch fk (Gauss-Newton, analytic A_u; {n_batch} at once)", motors, fk_batch, fk_score,
-               group="fk", repeats=5),
-        Method("legkin scalar fk, Python loop", motors, fk_scalar, fk_score, group="fk", max_targets=n_scalar,
-               repeats=3),
-        Method("pinocchio Robot.solve_loops (motors held, start q0)", motors, solve_loops_run, joints_score,
-               group="fk", max_targets=n_iter, repeats=3),
+    return [
         Method(f"legkin batch ik (closed form; {n_batch} at once)", orient, ik_batch, ik_score, group="ik",
                repeats=5),
         Method("legkin scalar ik, Python loop", orient, ik_scalar, ik_score, group="ik", max_targets=n_scalar,
@@ -150,7 +171,9 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
                pin_inverse_score, group="ik", max_targets=n_iter, repeats=3),
     ]
 
-    notes = [
+
+def _notes(n_batch: int, n_scalar: int, n_iter: int) -> list[str]:
+    return [
         f"targets: {n_batch} platform orientations uniform over the workspace (alpha_y in [-pi/2, pi/2], alpha_z in "
         f"[-pi, pi], kept where ik succeeds), motors = ik(target); slow methods use the first {n_scalar} (loops) "
         f"or {n_iter} (Pinocchio) of the same targets",
@@ -165,25 +188,37 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         "with getFrameJacobian(LOCAL) and Jlog3, every joint free",
     ]
 
-    def summary(results: list[MethodResult]) -> list[str]:
-        lines = []
-        for g, batch_key, pin_key in (("fk", "batch fk", "solve_loops"), ("ik", "batch ik", "pinocchio-only")):
-            b = next(r for r in results if batch_key in r.name)
-            p = next(r for r in results if pin_key in r.name)
-            s = next(r for r in results if r.group == g and "scalar" in r.name)
-            lines.append(
-                f"{g}: batch is {p.time_per_target_s / b.time_per_target_s:,.0f}x and the scalar call "
-                f"{p.time_per_target_s / s.time_per_target_s:,.1f}x faster than {p.name.split(' (')[0]} (target >= 10x"
-                f"{' for fk' if g == 'fk' else ''})"
-            )
-        return lines
 
+def _summary(results: list[MethodResult]) -> list[str]:
+    lines = []
+    for g, batch_key, pin_key in (("fk", "batch fk", "solve_loops"), ("ik", "batch ik", "pinocchio-only")):
+        b = next(r for r in results if batch_key in r.name)
+        p = next(r for r in results if pin_key in r.name)
+        s = next(r for r in results if r.group == g and "scalar" in r.name)
+        lines.append(
+            f"{g}: batch is {p.time_per_target_s / b.time_per_target_s:,.0f}x and the scalar call "
+            f"{p.time_per_target_s / s.time_per_target_s:,.1f}x faster than {p.name.split(' (')[0]} (target >= 10x"
+            f"{' for fk' if g == 'fk' else ''})"
+        )
+    return lines
+
+
+def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
+    n_batch, n_scalar, n_iter = _sizes(n, quick)
+    robot = load("tripod")
+    ay, az = sample_workspace(n_batch, rng)
+    r_true = at.platform_rotation(ay, az)
+    orient = np.stack([ay, az], axis=-1)
+    motors = at.ik(orient)
+    methods = _fk_methods(robot, motors, r_true, n_batch, n_scalar, n_iter) + _ik_methods(
+        robot, orient, r_true, n_batch, n_scalar, n_iter
+    )
     return ModelBench(
         methods=methods,
         units={"fk": "rad", "ik": "rad"},
         tolerance=f"rotation error <= {SOLVE_TOL:g} rad (and loop |r| <= {SOLVE_TOL:g} for joint answers)",
-        notes=notes,
-        summary=summary,
+        notes=_notes(n_batch, n_scalar, n_iter),
+        summary=_summary,
         secondary="loop |r|",
     )
 

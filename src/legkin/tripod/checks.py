@@ -125,12 +125,9 @@ def _is_cv_branch(q: np.ndarray) -> bool:
     )
 
 
-def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -> list[CheckResult]:
-    robot = load("tripod") if tag == "pi/3" else load("tripod", alpha=alpha)
-    geo = at.Geometry(alpha=alpha)
-    pre = f"[alpha={tag}] "
+def _open_chain_rows(robot, geo: at.Geometry, pre: str, samples: int, rng: np.random.Generator) -> list[CheckResult]:
+    """Open chains (every joint random) and eq (10) on the CV branch (q3 = q2, q4 = q1) against Pinocchio."""
     rows: list[CheckResult] = []
-    # --- open chains: every joint random
     qs = rng.uniform(-np.pi, np.pi, (samples, 12))
     pos, rot = pinocchio_frames(robot, qs, [f"{k}_ee" for k in at.LEGS])
     perr, rerr, cverr = [], [], []
@@ -150,8 +147,18 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
         t = at.leg_transform_cv(qcv[:, 4 * k : 4 * k + 2], leg, geometry=geo)
         cverr.append(np.maximum(per_sample(t[:, :3, 3] - pos[:, k]), _rot_err(t[:, :3, :3], rot[:, k])))
     rows.append(compare(pre + "eq (10) leg_transform_cv vs oMf K_ee, q3=q2, q4=q1 (m | rad)", cverr, TOL))
+    return rows
 
-    # --- ik -> Pinocchio
+
+def _ik_rows(robot, geo: at.Geometry, alpha: float, pre: str, samples: int,
+             rng: np.random.Generator) -> tuple[list[CheckResult], np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """ik -> Pinocchio (loop residual, platform pose), inside the workspace and near its boundary.
+
+    Returns:
+        The rows, and the joints ``q``, the orientations ``ay``, ``az`` and the mask ``far`` (from the flip)
+        of the workspace samples.
+    """
+    rows: list[CheckResult] = []
     ay, az = sample_workspace(samples, rng, geo)
     fy, fz = sample_near_flip(max(samples // 10, 50), rng, alpha)
     if len(fy):  # the workspace reaches the platform singularity only for alpha <= pi/3 (default eta)
@@ -177,8 +184,13 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
         if sel.any():
             rows.append(compare(pre + f"ik -> loop residual, near boundary (1-|cos q2| in [1e-10, 1e-3]) ({tag_})",
                                 resb[sel], tol))
+    return rows, q, ay, az, far
 
-    # --- actuation Jacobian
+
+def _jacobian_rows(robot, geo: at.Geometry, alpha: float, pre: str, q: np.ndarray, ay: np.ndarray, az: np.ndarray,
+                   far: np.ndarray) -> list[CheckResult]:
+    """The actuation Jacobian A_u against Pinocchio's closed-loop null space and against finite differences."""
+    rows: list[CheckResult] = []
     a_an = at.jacobian(np.stack([ay, az], axis=-1), geometry=geo)
     err, cond = np.empty(len(q)), np.empty(len(q))
     for i, qi in enumerate(q):
@@ -194,8 +206,13 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
     scale = np.maximum(1.0, np.abs(a_an[fd_ok]).max(axis=(-1, -2)))
     rows.append(compare(pre + f"A_u vs Richardson central differences of ik, rel. (h={H:g})",
                         np.abs(a_fd - a_an[fd_ok]).max(axis=(-1, -2)) / scale, TOL_FD))
+    return rows
 
-    # --- fk
+
+def _fk_rows(geo: at.Geometry, pre: str, q: np.ndarray, ay: np.ndarray, az: np.ndarray,
+             far: np.ndarray) -> list[CheckResult]:
+    """fk(ik(u)) round trip and the inconsistency of consistent motors."""
+    rows: list[CheckResult] = []
     # near the flip the motors' rounding noise is amplified (|A_u| ~ 1 / (1 + c_y c_z)): measured
     # inconsistency up to 5e-9 rad there, so those samples accept up to 1e-6 (the default is 1e-9)
     u, u_ok, u_info = at.fk(q[:, list(MOTOR_COLUMNS)], geometry=geo, return_mask=True, return_info=True,
@@ -205,7 +222,6 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
     fk_rot = _rot_err(at.platform_rotation(np.nan_to_num(u[:, 0]), np.nan_to_num(u[:, 1])),
                       at.platform_rotation(ay, az))
     fk_rot[~u_ok] = np.nan  # a failure counts against the row
-    far = 1 + np.cos(ay) * np.cos(az) > NEAR_FLIP
     rows.append(compare(pre + f"fk(ik(u)) round trip, platform rotation (rad) (1 + c_y c_z > {NEAR_FLIP:g})",
                         fk_rot[far], TOL))
     if (~far).any():
@@ -213,7 +229,13 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
                             fk_rot[~far], TOL_FLIP))
     rows.append(compare(pre + f"fk(ik(u)) inconsistency of consistent motors (rad) (1 + c_y c_z > {NEAR_FLIP:g})",
                         inconsistency[far], TOL))
-    q, ay, az = q[far], ay[far], az[far]
+    return rows
+
+
+def _solve_loops_rows(robot, geo: at.Geometry, pre: str, q: np.ndarray, ay: np.ndarray, az: np.ndarray,
+                      samples: int, rng: np.random.Generator) -> list[CheckResult]:
+    """fk against ``Robot.solve_loops`` with A_q1 and B_q1 held, started 0.15 rad away (samples far from the flip)."""
+    rows: list[CheckResult] = []
     m = min(samples, SOLVE_SAMPLES)
     delta = rng.normal(0.0, 0.15, (m, 2))
     q_start, ok = at.ik_joints(np.stack([ay[:m] + delta[:, 0], az[:m] + delta[:, 1]], axis=-1), geometry=geo,
@@ -247,6 +269,20 @@ def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -
         rows.append(compare(head + f", loop gain <= {GAIN_MAX:g}", errs[well], TOL))
     if (~well).any():
         rows.append(compare(head + f", loop gain > {GAIN_MAX:g}: error / gain", errs[~well] / gain[~well], TOL_GAIN))
+    return rows
+
+
+def _run_alpha(tag: str, alpha: float, samples: int, rng: np.random.Generator) -> list[CheckResult]:
+    robot = load("tripod") if tag == "pi/3" else load("tripod", alpha=alpha)
+    geo = at.Geometry(alpha=alpha)
+    pre = f"[alpha={tag}] "
+    rows = _open_chain_rows(robot, geo, pre, samples, rng)
+    ik_rows, q, ay, az, far = _ik_rows(robot, geo, alpha, pre, samples, rng)
+    rows += ik_rows
+    rows += _jacobian_rows(robot, geo, alpha, pre, q, ay, az, far)
+    rows += _fk_rows(geo, pre, q, ay, az, far)
+    q, ay, az = q[far], ay[far], az[far]
+    rows += _solve_loops_rows(robot, geo, pre, q, ay, az, samples, rng)
     # --- mobility
     mob = [robot.mobility(qi) for qi in q[: min(samples, 1000)]]
     rows.append(compare(pre + "Robot.mobility - 2 at random workspace poses", np.asarray(mob) - 2, 0.0))

@@ -11,14 +11,16 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 from .._kernels import OK, batch_kernel, kernel, prange
 from .._rotations import wrap_k
+from ._ik_certify import CERTIFY_WORK, certify_k
 from ._options import ST_ASSEMBLE, ST_INPUT, ST_REACH
-from .chains import OX, OZ, chain_k, ref_of, rod_system_k, rot_k, sgn_k, tips_k
+from .chains import OX, OZ, chain_k, ref_of, rod_system_rates_cs_k, rot_cs_k, sgn_k, tips_k
 from .extension import theta0_k
-from .foot import gain_k
+from .foot import gain_cs_k
 from .forward import fk_select_k
 from .geometry import (
     CLIP_FOOT_TOL,
@@ -82,43 +84,40 @@ def platform_pose_s(u, llb, rb, pose, info):
         platform_pose_k(u[j, 0], u[j, 1], u[j, 2], llb, rb, pose[j], info[j])
 
 
-@kernel
-def ik_candidate_k(ux, uy, uz, sv, llb, rb, b1, b2, pose, motors, info):
-    """One (ll_branch, roll_branch, motor branch) closed-form candidate for the target u = p - CENTER.
-
-    pose (3,) = (theta_LL, roll, pitch) (:func:`platform_pose_k`, clipped to the platform limits within rounding),
-    motors (3,) = (theta1, theta2, theta0) (the chains with IK_K_TOL, eq 19 inverted), NaN where the candidate does
-    not exist; info (7,) = (exists, inlim, mode, gain, kk, reach, axis) as floats. Returns OK if the candidate
-    exists, else ST_REACH.
-    """
-    arc = np.empty(3)
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def candidate_pose_k(ux, uy, uz, llb, rb, pose, arc, rot, trig):
+    """The platform pose (3,) of one (ll_branch, roll_branch) (:func:`platform_pose_k`, arc (3,) its info), roll
+    and pitch clipped to the platform limits within rounding, its rotation rot (3, 3) and trig (6,) = (cos, sin)
+    of roll, pitch and theta_LL. Returns inside the limits."""
     platform_pose_k(ux, uy, uz, llb, rb, pose, arc)
-    kk, reach, rho = arc[0], arc[1] == 1.0, arc[2]
-    x0, x1, x2 = pose[0], pose[1], pose[2]
+    x1, x2 = pose[1], pose[2]
     near1 = abs(x1) <= PLATFORM_LIMIT + LIMIT_TOL
     near2 = abs(x2) <= PLATFORM_LIMIT + LIMIT_TOL
-    inlim = near1 and near2
     if near1:  # rounding at a limit
         x1 = min(max(x1, -PLATFORM_LIMIT), PLATFORM_LIMIT)
     if near2:
         x2 = min(max(x2, -PLATFORM_LIMIT), PLATFORM_LIMIT)
     pose[1], pose[2] = x1, x2
-    rot = np.empty((3, 3))
-    rot_k(x1, x2, rot)
-    th = np.empty(2)
-    kx = np.empty(2)
-    ok1 = chain_k(rot, 0, b1, IK_K_TOL, th, kx)
-    ok2 = chain_k(rot, 1, b2, IK_K_TOL, th, kx)
-    exists = reach and ok1 and ok2
+    trig[0], trig[1], trig[2], trig[3] = math.cos(x1), math.sin(x1), math.cos(x2), math.sin(x2)
+    trig[4], trig[5] = math.cos(pose[0]), math.sin(pose[0])
+    rot_cs_k(trig[0], trig[1], trig[2], trig[3], rot)
+    return near1 and near2
+
+
+@numba.njit(cache=True, error_model="numpy", inline="always")
+def candidate_motors_k(ux, uy, uz, sv, pose, arc, trig, inlim, b1, b2, th, kx, ok, motors, info, tip, dtip, g, nm,
+                       dd):
+    """The rest of one candidate (:func:`ik_candidate_k`) from its pose (3,), arc (3,) and trig (6,)
+    (:func:`candidate_pose_k`) and the chains' motor angles th (2,), reach ratios kx (2,) and reach ok on
+    branch (b1, b2); tip, dtip (2, 3), g, dd (2,), nm (2, 2) are work arrays. Returns the candidate exists."""
+    kk, reach, rho = arc[0], arc[1] == 1.0, arc[2]
+    x0 = pose[0]
+    exists = reach and ok
     gain = math.inf
     mode = 0.0
     if exists:
-        tip = np.empty((2, 3))
-        dtip = np.empty((2, 3))
         tips_k(th[0], th[1], tip, dtip)
-        g = np.empty(2)
-        nm = np.empty((2, 2))
-        rod_system_k(x1, x2, tip, g, nm)
+        rod_system_rates_cs_k(trig[0], trig[1], trig[2], trig[3], tip, dtip, g, nm, dd)
         # a chain clipped at its reach boundary (|k| up to 1 + IK_K_TOL) leaves its rod off by g: the FK pose of
         # these motor angles moves by ~N^-1 g and the foot by at most |u| sqrt(2) times that
         det = nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0]
@@ -129,7 +128,7 @@ def ik_candidate_k(ux, uy, uz, sv, llb, rb, b1, b2, pose, motors, info):
         exists = (not clipped) or shift <= CLIP_FOOT_TOL
         if exists:
             mode = sgn_k(det) * ref_of(b1, b2)
-            gain = gain_k(x1, x2, x0, tip, dtip)
+            gain = gain_cs_k(trig[0], trig[1], trig[2], trig[3], trig[4], trig[5], nm, dd)
     if exists:
         motors[0], motors[1], motors[2] = th[0], th[1], theta0_k(x0, sv)
     else:
@@ -139,15 +138,46 @@ def ik_candidate_k(ux, uy, uz, sv, llb, rb, b1, b2, pose, motors, info):
     info[2], info[3], info[4] = mode, gain, kk
     info[5] = 1.0 if reach else 0.0
     info[6] = 0.0 if rho > 0.0 else 1.0
+    return exists
+
+
+@kernel
+def ik_candidate_k(ux, uy, uz, sv, llb, rb, b1, b2, pose, motors, info):
+    """One (ll_branch, roll_branch, motor branch) closed-form candidate for the target u = p - CENTER.
+
+    pose (3,) = (theta_LL, roll, pitch) (:func:`platform_pose_k`, clipped to the platform limits within rounding),
+    motors (3,) = (theta1, theta2, theta0) (the chains with IK_K_TOL, eq 19 inverted), NaN where the candidate does
+    not exist; info (7,) = (exists, inlim, mode, gain, kk, reach, axis) as floats. Returns OK if the candidate
+    exists, else ST_REACH.
+    """
+    arc = np.empty(3)
+    rot = np.empty((3, 3))
+    trig = np.empty(6)
+    inlim = candidate_pose_k(ux, uy, uz, llb, rb, pose, arc, rot, trig)
+    th = np.empty(2)
+    kx = np.empty(2)
+    ok1 = chain_k(rot, 0, b1, IK_K_TOL, th, kx)
+    ok2 = chain_k(rot, 1, b2, IK_K_TOL, th, kx)
+    tip = np.empty((2, 3))
+    dtip = np.empty((2, 3))
+    g = np.empty(2)
+    nm = np.empty((2, 2))
+    dd = np.empty(2)
+    exists = candidate_motors_k(ux, uy, uz, sv, pose, arc, trig, inlim, b1, b2, th, kx, ok1 and ok2, motors, info,
+                                tip, dtip, g, nm, dd)
     return OK if exists else ST_REACH
 
 
 @kernel
-def reproduced_k(pose, motors, b1, b2, s):
+def reproduced_k(pose, motors, b1, b2, s, work):
     """The forward kinematics of the candidate's motors in mode (b1, b2), s returns its pose. The neutral aspect
     (branch (1, 1), mode +1, pitch < PITCH_SPLIT) is one-to-one and nearer R_P = I than the other region of that
-    mode: there the forward kinematics returns exactly these poses; elsewhere it is asked."""
+    mode: there the forward kinematics returns exactly these poses; elsewhere the certificate of
+    :func:`._ik_certify.certify_k` (no nearer pose of the mode among the rods' polynomial roots) decides, and
+    where it cannot, the forward kinematics is asked. work: (CERTIFY_WORK,)."""
     if b1 == 1.0 and b2 == 1.0 and s == 1.0 and pose[2] < PITCH_SPLIT:
+        return True
+    if certify_k(pose, motors, b1, b2, s, work):
         return True
     xf = np.empty(2)
     if fk_select_k(motors[0], motors[1], b1, b2, s, 1e-12, 50, xf) != OK:
@@ -156,12 +186,12 @@ def reproduced_k(pose, motors, b1, b2, s):
 
 
 @kernel
-def accepted_k(pose, motors, info, b1, b2, s):
+def accepted_k(pose, motors, info, b1, b2, s, work):
     """The mode-checked IK keeps the candidate: inside the limits, in mode (b1, b2), s, off the forward-singularity
     band, and reproduced by the forward kinematics (:func:`reproduced_k`)."""
     if not (info[0] == 1.0 and info[1] == 1.0 and info[2] == s and info[3] < FK_GAIN_MAX):
         return False
-    return reproduced_k(pose, motors, b1, b2, s)
+    return reproduced_k(pose, motors, b1, b2, s, work)
 
 
 @kernel
@@ -188,12 +218,13 @@ def foot_ik_k(ux, uy, uz, sv, combos, b1, b2, s, limits_only, axis_ok, near, mot
     best = math.inf
     bm = np.empty(3)
     bp = np.empty(3)
+    work = np.empty(CERTIFY_WORK)
     for c in range(combos.shape[0]):
         ik_candidate_k(ux, uy, uz, sv, combos[c, 0], combos[c, 1], b1, b2, pose, motors, info)
         if limits_only:
             acc = info[5] == 1.0 and info[1] == 1.0
         else:
-            acc = accepted_k(pose, motors, info, b1, b2, s)
+            acc = accepted_k(pose, motors, info, b1, b2, s, work)
         if acc and (axis_ok or info[6] == 0.0):
             if not use_near:
                 return OK
@@ -230,19 +261,44 @@ def ik_all_k(ux, uy, uz, sv, fk_in_band, motors, pose, info, fk):
     """Every closed-form branch (BRANCHES order) of one target u = p - CENTER: motors (16, 3), pose (16, 3), info
     (16, 7) (:func:`ik_candidate_k`) and fk (16,): the branch exists inside the limits in a mode (+-1) and the
     forward kinematics of its motors in that mode returns its pose (judged in the forward-singularity band only
-    with fk_in_band; False there otherwise)."""
-    for j in range(BRANCHES.shape[0]):
-        b1, b2 = BRANCHES[j, 2], BRANCHES[j, 3]
-        ik_candidate_k(ux, uy, uz, sv, BRANCHES[j, 0], BRANCHES[j, 1], b1, b2, pose[j], motors[j], info[j])
-        live = info[j, 0] == 1.0 and info[j, 1] == 1.0 and info[j, 2] != 0.0
-        live = live and (fk_in_band or info[j, 3] < FK_GAIN_MAX)
-        fk[j] = live and reproduced_k(pose[j], motors[j], b1, b2, info[j, 2])
+    with fk_in_band; False there otherwise). The four motor branches of one (ll_branch, roll_branch) share its
+    platform pose and the chains' equations (BRANCHES lists them together, chain 1's branch +1 first)."""
+    arc = np.empty(3)
+    rot = np.empty((3, 3))
+    trig = np.empty(6)
+    th2 = np.empty((2, 2))  # [branch index, chain]: the motor angles on branch +1 (index 0) and -1
+    kx2 = np.empty((2, 2))
+    ok2 = np.empty((2, 2), dtype=np.bool_)
+    th = np.empty(2)
+    kx = np.empty(2)
+    tip = np.empty((2, 3))
+    dtip = np.empty((2, 3))
+    g = np.empty(2)
+    nm = np.empty((2, 2))
+    dd = np.empty(2)
+    work = np.empty(CERTIFY_WORK)
+    for c in range(0, BRANCHES.shape[0], 4):
+        inlim = candidate_pose_k(ux, uy, uz, BRANCHES[c, 0], BRANCHES[c, 1], pose[c], arc, rot, trig)
+        for q in range(2):
+            for i in range(2):
+                ok2[q, i] = chain_k(rot, i, 1.0 - 2.0 * q, IK_K_TOL, th2[q], kx2[q])
+        for j in range(c, c + 4):
+            b1, b2 = BRANCHES[j, 2], BRANCHES[j, 3]
+            q1, q2 = (0 if b1 > 0.0 else 1), (0 if b2 > 0.0 else 1)
+            th[0], th[1], kx[0], kx[1] = th2[q1, 0], th2[q2, 1], kx2[q1, 0], kx2[q2, 1]
+            pose[j, 0], pose[j, 1], pose[j, 2] = pose[c, 0], pose[c, 1], pose[c, 2]
+            candidate_motors_k(ux, uy, uz, sv, pose[j], arc, trig, inlim, b1, b2, th, kx, ok2[q1, 0] and ok2[q2, 1],
+                               motors[j], info[j], tip, dtip, g, nm, dd)
+            live = info[j, 0] == 1.0 and info[j, 1] == 1.0 and info[j, 2] != 0.0
+            live = live and (fk_in_band or info[j, 3] < FK_GAIN_MAX)
+            fk[j] = live and reproduced_k(pose[j], motors[j], b1, b2, info[j, 2], work)
 
 
 @kernel
 def ik_all_out_k(ux, uy, uz, sv, motors, pose, mask, asm, within, valid):
     """:func:`ik_all` of one target: motors, pose (16, 3) (NaN where the branch does not exist), mask (exists),
-    asm (assembly mode, int), within (inside the limits, and exists), valid (fk reproduces it, off the band)."""
+    asm (assembly mode, int), within (inside the limits, and exists), valid (fk reproduces it, off the band).
+    Returns the target is finite (a non-finite one has no branch)."""
     info = np.empty((16, 7))
     fk = np.empty(16, dtype=np.bool_)
     ik_all_k(ux, uy, uz, sv, False, motors, pose, info, fk)
@@ -253,6 +309,7 @@ def ik_all_out_k(ux, uy, uz, sv, motors, pose, mask, asm, within, valid):
         asm[j] = int(info[j, 2])
         within[j] = info[j, 1] == 1.0 and mask[j]
         valid[j] = fk[j] and info[j, 3] < FK_GAIN_MAX
+    return math.isfinite(ux) and math.isfinite(uy) and math.isfinite(uz)
 
 
 @batch_kernel

@@ -31,7 +31,12 @@ L = ROD_LENGTH
 @kernel
 def rot_k(r, p, m):
     """m (3, 3) = Rx(r) Ry(p), the universal centre (seed eq 2 with the universal joint)."""
-    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
+    rot_cs_k(math.cos(r), math.sin(r), math.cos(p), math.sin(p), m)
+
+
+@kernel
+def rot_cs_k(cr, sr, cp, sp, m):
+    """:func:`rot_k` from the cosines and sines of roll and pitch."""
     m[0, 0], m[0, 1], m[0, 2] = cp, 0.0, sp
     m[1, 0], m[1, 1], m[1, 2] = sr * sp, cr, -sr * cp
     m[2, 0], m[2, 1], m[2, 2] = -cr * sp, sr, cr * cp
@@ -132,7 +137,12 @@ def rod_system_k(x0, x1, tip, g, nm):
     """Rod equations g_i = (|A_i - S_i|^2 - L^2) / 2 (2,) and N (2, 2) (N_ik = d_i . dA_i/dx_k) at (x0, x1).
 
     Returns max |g_i| (NaN if not finite)."""
-    cr, sr, cp, sp = math.cos(x0), math.sin(x0), math.cos(x1), math.sin(x1)
+    return rod_system_cs_k(math.cos(x0), math.sin(x0), math.cos(x1), math.sin(x1), tip, g, nm)
+
+
+@kernel
+def rod_system_cs_k(cr, sr, cp, sp, tip, g, nm):
+    """:func:`rod_system_k` from the cosines and sines of roll and pitch."""
     worst = 0.0
     for i in range(2):
         if i == 0:
@@ -162,8 +172,19 @@ def rod_rates_k(r, p, tip, dtip, nm, dd):
     """The rod system's Jacobian ``N = dg/d(roll, pitch)`` (into nm) and ``D_i = (c_i - tip_i) . dtip_i``, the
     rate of rod i's residual per motor radian (into dd), at the pose (r, p) closed by the lever tips tip."""
     g = np.empty(2)
-    rod_system_k(r, p, tip, g, nm)
-    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
+    rod_system_rates_k(r, p, tip, dtip, g, nm, dd)
+
+
+@kernel
+def rod_system_rates_k(r, p, tip, dtip, g, nm, dd):
+    """:func:`rod_system_k` (g, nm) and the rates dd of :func:`rod_rates_k` at once (no work arrays)."""
+    rod_system_rates_cs_k(math.cos(r), math.sin(r), math.cos(p), math.sin(p), tip, dtip, g, nm, dd)
+
+
+@kernel
+def rod_system_rates_cs_k(cr, sr, cp, sp, tip, dtip, g, nm, dd):
+    """:func:`rod_system_rates_k` from the cosines and sines of roll and pitch."""
+    rod_system_cs_k(cr, sr, cp, sp, tip, g, nm)
     for i in range(2):
         if i == 0:
             ax, ay, az = AX0, AY0, AZ0

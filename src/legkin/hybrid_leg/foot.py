@@ -78,13 +78,24 @@ def gain_k(r, p, tll, tip, dtip):
     nm = np.empty((2, 2))
     dd = np.empty(2)
     rod_rates_k(r, p, tip, dtip, nm, dd)
-    cr, sr, cp, sp = math.cos(r), math.sin(r), math.cos(p), math.sin(p)
+    return gain_of_rates_k(r, p, tll, nm, dd)
+
+
+@kernel
+def gain_of_rates_k(r, p, tll, nm, dd):
+    """:func:`gain_k` from the rod system's Jacobian nm (2, 2) and rates dd (2,) (:func:`.chains.rod_rates_k`)."""
+    return gain_cs_k(math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(tll), math.sin(tll), nm, dd)
+
+
+@kernel
+def gain_cs_k(cr, sr, cp, sp, ct, st, nm, dd):
+    """:func:`gain_of_rates_k` from the cosines and sines of roll, pitch and theta_LL."""
     det = nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0]
     # adj(N) diag(D)
     j00, j01 = nm[1, 1] * dd[0], -nm[0, 1] * dd[1]
     j10, j11 = -nm[1, 0] * dd[0], nm[0, 0] * dd[1]
-    ffx = OX + FOOT_X * math.cos(tll)
-    ffz = OZ - FOOT_X * math.sin(tll)
+    ffx = OX + FOOT_X * ct
+    ffz = OZ - FOOT_X * st
     fx = cp * ffx + sp * ffz
     fy = sr * sp * ffx - sr * cp * ffz
     fz = -cr * sp * ffx + cr * cp * ffz

@@ -238,10 +238,10 @@ def ik_all(p: ArrayLike, *, geometry: Geometry | None = None) -> FootIKSolutions
     :func:`._ik_kernels.ik_all_out_k` per target). Never raises for valid input."""
     g = fast_geometry(geometry)
     if (type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64 and g is not None
-            and g.center == "universal" and np.isfinite(p).all()):
+            and g.center == "universal"):
         out = _all_outputs(())
-        ik_all_out_k(p[0] - CX, p[1] - CY, p[2] - CZ, g.starting_value, *out)
-        return FootIKSolutions(*out)
+        if ik_all_out_k(p[0] - CX, p[1] - CY, p[2] - CZ, g.starting_value, *out):
+            return FootIKSolutions(*out)
     g = resolve(geometry, universal="ik_all")
     _, u, shape = _targets(p)
     n = len(u)

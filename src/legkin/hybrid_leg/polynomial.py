@@ -36,17 +36,6 @@ FOLD_OFFSETS = (1e-9, 1e-7, 1e-5, 1e-3)
 
 
 @kernel
-def pconv_k(a, b, k):
-    """Coefficient k of the product of the polynomials a, b (ascending coefficients), summed over ascending i."""
-    s = 0.0
-    for i in range(a.shape[0]):
-        j = k - i
-        if 0 <= j < b.shape[0]:
-            s += a[i] * b[j]
-    return s
-
-
-@kernel
 def roll_poly_k(tip, poly, al, be, ga):
     """The degree-8 polynomial poly (9,) in t = tan(roll / 2) and the per-rod quadratics al, be, ga (2, 3)."""
     for i in range(2):
@@ -70,11 +59,23 @@ def roll_poly_k(tip, poly, al, be, ga):
     # det = al0 be1 - al1 be0, cc = be0 ga1 - be1 ga0, ss = al1 ga0 - al0 ga1 (degree 4); poly = cc^2 + ss^2 - det^2
     w = np.empty((3, 5))
     for k in range(5):
-        w[0, k] = pconv_k(al[0], be[1], k) - pconv_k(al[1], be[0], k)
-        w[1, k] = pconv_k(be[0], ga[1], k) - pconv_k(be[1], ga[0], k)
-        w[2, k] = pconv_k(al[1], ga[0], k) - pconv_k(al[0], ga[1], k)
+        w[0, k] = _rows_conv_k(al, 0, be, 1, 3, k) - _rows_conv_k(al, 1, be, 0, 3, k)
+        w[1, k] = _rows_conv_k(be, 0, ga, 1, 3, k) - _rows_conv_k(be, 1, ga, 0, 3, k)
+        w[2, k] = _rows_conv_k(al, 1, ga, 0, 3, k) - _rows_conv_k(al, 0, ga, 1, 3, k)
     for k in range(9):
-        poly[k] = pconv_k(w[1], w[1], k) + pconv_k(w[2], w[2], k) - pconv_k(w[0], w[0], k)
+        poly[k] = _rows_conv_k(w, 1, w, 1, 5, k) + _rows_conv_k(w, 2, w, 2, 5, k) - _rows_conv_k(w, 0, w, 0, 5, k)
+
+
+@kernel
+def _rows_conv_k(a, ra, b, rb, n, k):
+    """Coefficient k of the product of the polynomials a[ra], b[rb] (n ascending coefficients each), summed over
+    ascending i (rows indexed in place: no array views)."""
+    s = 0.0
+    for i in range(n):
+        j = k - i
+        if 0 <= j < n:
+            s += a[ra, i] * b[rb, j]
+    return s
 
 
 @kernel

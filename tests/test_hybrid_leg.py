@@ -553,6 +553,39 @@ def test_other_assembly_mode_raises_and_modes_reach_it():
     assert every.valid.sum() == len(err.modes) and not (every.valid & (every.assembly == 1))[[0, 4, 8, 12]].any()
 
 
+def test_ik_all_fk_certificate_agrees_with_forward_kinematics():
+    """The cheap FK check of ik_all (_ik_certify.certify_k) accepts a candidate only where the full forward kinematics
+    of its motors in its mode returns its pose; and ik_all.valid is exactly 'fk of the motors in that mode is the
+    target' on branches off the neutral aspect (where it is not exact by construction)."""
+    from legkin.hybrid_leg._ik_certify import CERTIFY_WORK, certify_k
+    from legkin.hybrid_leg._ik_kernels import BRANCHES, ik_all_k
+    from legkin.hybrid_leg.forward import fk_select_k
+    from legkin.hybrid_leg.geometry import CENTER, FK_GAIN_MAX
+
+    rng = np.random.default_rng(5)
+    n = 300
+    q = np.column_stack([rng.uniform(-np.pi, np.pi, n), rng.uniform(-np.pi, np.pi, n), rng.uniform(-16, 40, n)])
+    targets = [ah.fk(q, branch=b, assembly=a, return_mask=True) for b in ((1, -1), (-1, 1), (-1, -1)) for a in (1, -1)]
+    p = np.concatenate([x[ok] for x, ok in targets])
+    work, xf = np.empty(CERTIFY_WORK), np.empty(2)
+    motors, pose, info, fk = np.empty((16, 3)), np.empty((16, 3)), np.empty((16, 7)), np.empty(16, dtype=np.bool_)
+    certified = checked = 0
+    for u in p - CENTER:
+        ik_all_k(u[0], u[1], u[2], 0.0, False, motors, pose, info, fk)
+        for j in range(16):
+            if not (info[j, 0] == 1 and info[j, 1] == 1 and info[j, 2] != 0 and info[j, 3] < FK_GAIN_MAX):
+                continue
+            b1, b2, s = BRANCHES[j, 2], BRANCHES[j, 3], info[j, 2]
+            found = fk_select_k(motors[j, 0], motors[j, 1], b1, b2, s, 1e-12, 50, xf) == 0
+            returned = found and max(abs(xf[0] - pose[j, 1]), abs(xf[1] - pose[j, 2])) <= 1e-7
+            checked += 1
+            if certify_k(pose[j], motors[j], b1, b2, s, work):
+                certified += 1
+                assert returned, (u, j)
+            assert fk[j] == returned or (b1 == b2 == s == 1 and pose[j, 2] < 1.2)
+    assert checked > 500 and certified > 0.9 * checked
+
+
 def test_joint_limit_error():
     """Reachable only with |roll| > pi/2 (LCS_x limit): JointLimitError, mask False; no answer outside the limits."""
     p = ah.foot_position_from_platform(-0.06284610557749781, -1.0207832560887642, 0.23457715140921453)

@@ -5,9 +5,10 @@
 >>> go2 = legs.from_model(model)            # {"FL": Leg, "FR": Leg, "RL": Leg, "RR": Leg}
 >>> q = go2["FL"].ik([0.19, 0.14, -0.3])    # the branch inside the URDF limits
 
-Modules: :mod:`.kinematics` (the :class:`Leg` and its compiled kernels), :mod:`.extract` (finding and measuring
-legs in a Pinocchio model), :mod:`.erd` (the nine quadrupeds of example-robot-data), :mod:`.registry`,
-:mod:`.checks` (rows of ``legkin check``), :mod:`.bench`.
+Modules: :mod:`.kinematics` (the :class:`Leg`; its compiled kernels in :mod:`._fk_kernels` (forward map, Jacobian)
+and :mod:`._ik_kernels` (closed-form IK, Newton polish), constants in :mod:`._layout`), :mod:`.extract` (finding
+and measuring legs in a Pinocchio model), :mod:`.erd` (the nine quadrupeds of example-robot-data),
+:mod:`.registry`, :mod:`.checks` (rows of ``legkin check``), :mod:`.bench`.
 """
 
 from __future__ import annotations

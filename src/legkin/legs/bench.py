@@ -82,54 +82,45 @@ def urdf_chain(urdf, frame: str) -> tuple[str, str, list[str]]:
     return path[0], end, path
 
 
-def build(name: str, n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
-    """The bench of robot ``name``'s leg :data:`LEG` (or first leg).
+class _Foot:
+    """Pinocchio's foot of one leg (the other joints at ``q_base``) and the score of a joint answer."""
 
-    Rows: ``Leg.ik`` as one batch and as single calls, Pinocchio CLIK (damped Newton
-    ``dq = J^T (J J^T + lambda I)^-1 e`` on the leg's three joints from mid-limit, clipped into the limits,
-    <= :data:`CLIK_MAX_ITER` iterations), ikpy and roboticstoolbox ``ik_LM`` (position only) when installed.
-    """
-    import pinocchio as pin
+    def __init__(self, model, leg, q_base: np.ndarray) -> None:
+        self.model = model
+        self.data = model.createData()
+        self.fid = model.getFrameId(leg.foot_frame)
+        self.iq, self.iv = list(leg.idx_q), list(leg.idx_v)
+        self.lower, self.upper, self.q_ref = leg.lower, leg.upper, leg.q_ref
+        self.q_base = q_base
 
-    from .. import load
-    from ..errors import LegkinError
+    def __call__(self, qleg: np.ndarray) -> np.ndarray:
+        """Pinocchio's foot position (m) at each row of leg joints (NaN for a row with a NaN)."""
+        import pinocchio as pin
 
-    n_batch, n_single, n_iter = _sizes(n, quick)
-    n_clik = min(n_batch, 10 * n_iter)
-    robot = load(name)
-    model = robot.model
-    data = model.createData()
-    legs = robot.geometry
-    leg_name = LEG if LEG in legs else next(iter(legs))
-    leg = legs[leg_name]
-    fid = model.getFrameId(leg.foot_frame)
-    iq, iv = list(leg.idx_q), list(leg.idx_v)
-    lower, upper, q_ref = leg.lower, leg.upper, leg.q_ref
-    q_base = np.array(robot.q0, dtype=float)
-    q_true = rng.uniform(lower, upper, (n_batch, 3))
-
-    def pin_foot(qleg: np.ndarray) -> np.ndarray:
+        model, data, fid = self.model, self.data, self.fid
         out = np.full((len(qleg), 3), np.nan)
-        q = q_base.copy()
+        q = self.q_base.copy()
         for k in np.flatnonzero(np.isfinite(qleg).all(axis=-1)):
-            q[iq] = qleg[k]
+            q[self.iq] = qleg[k]
             pin.forwardKinematics(model, data, q)
             out[k] = pin.updateFramePlacement(model, data, fid).translation
         return out
 
-    targets = pin_foot(q_true)
-
-    def score(p: np.ndarray, q: np.ndarray, iters=None) -> Score:
+    def score(self, p: np.ndarray, q: np.ndarray, iters=None) -> Score:
         q = np.asarray(q, dtype=float)
-        err = np.linalg.norm(pin_foot(q) - p, axis=-1)  # NaN where there is no answer
-        inside = np.all((q >= lower) & (q <= upper), axis=-1)  # False on NaN
+        err = np.linalg.norm(self(q) - p, axis=-1)  # NaN where there is no answer
+        inside = np.all((q >= self.lower) & (q <= self.upper), axis=-1)  # False on NaN
         reached = err <= SOLVE_TOL
         return Score(error=err, solved=reached & inside, reached=reached, iterations=iters)
 
-    def score_iter(p, out) -> Score:
-        return score(p, out[0], out[1])
+    def score_iter(self, p, out) -> Score:
+        return self.score(p, out[0], out[1])
 
-    # ---------------------------------------------------------------- legkin
+
+def _legkin_methods(leg, targets: np.ndarray, foot: _Foot, n_batch: int, n_single: int) -> list[Method]:
+    """``Leg.ik`` as one batch and as single calls (compiled / loaded from numba's cache before timing)."""
+    from ..errors import LegkinError
+
     leg.ik(targets[:2])
     leg.ik(targets[0])  # compiled / loaded from numba's cache before timing
 
@@ -146,7 +137,21 @@ def build(name: str, n: int | None, rng: np.random.Generator, quick: bool) -> Mo
                 pass
         return out
 
-    # ---------------------------------------------------------------- Pinocchio CLIK
+    return [
+        Method(f"legkin Leg.ik batch (closed form; {n_batch} at once)", targets, batch, foot.score, repeats=5),
+        Method("legkin Leg.ik single calls (Python loop)", targets, single, foot.score, max_targets=n_single,
+               repeats=3),
+    ]
+
+
+def _clik(foot: _Foot) -> Callable:
+    """Pinocchio CLIK: damped Newton ``dq = J^T (J J^T + lambda I)^-1 e`` on the leg's three joints from
+    mid-limit, clipped into the limits; returns ``(joints, iterations)``."""
+    import pinocchio as pin
+
+    model, data, fid, iq, iv = foot.model, foot.data, foot.fid, foot.iq, foot.iv
+    lower, upper, q_ref, q_base = foot.lower, foot.upper, foot.q_ref, foot.q_base
+
     def clik(p):
         q = np.full((len(p), 3), np.nan)
         iters = np.zeros(len(p))
@@ -164,14 +169,11 @@ def build(name: str, n: int | None, rng: np.random.Generator, quick: bool) -> Mo
             q[k], iters[k] = qk[iq], it
         return q, iters
 
-    methods = [
-        Method(f"legkin Leg.ik batch (closed form; {n_batch} at once)", targets, batch, score, repeats=5),
-        Method("legkin Leg.ik single calls (Python loop)", targets, single, score, max_targets=n_single, repeats=3),
-        Method("pinocchio CLIK (damped Newton, 3 leg joints)", targets, clik, score_iter, max_targets=n_clik,
-               repeats=1 if quick else 3),
-    ]
-    methods += _peers(name, leg, targets, n_iter, score_iter, quick)
-    notes = [
+    return clik
+
+
+def _notes(name: str, leg_name: str, leg, n_batch: int, n_single: int, n_clik: int, n_iter: int) -> list[str]:
+    return [
         f"{name} leg {leg_name} ({', '.join(leg.joint_names)} -> {leg.foot_frame}), fixed base; targets: "
         f"Pinocchio's {leg.foot_frame} for {n_batch} joint vectors uniform in the URDF limits (other joints at q0); "
         f"single calls solve the first {n_single}, CLIK the first {n_clik}, the peers the first {n_iter}",
@@ -181,23 +183,47 @@ def build(name: str, n: int | None, rng: np.random.Generator, quick: bool) -> Mo
         f"{CLIK_MAX_ITER} iterations, each step clipped into the limits",
     ]
 
-    def summary(results: list[MethodResult]) -> list[str]:
-        b = next(r for r in results if "batch" in r.name)
-        s = next(r for r in results if "single" in r.name)
-        lines = []
-        for r in results:
-            if r is b or r is s:
-                continue
-            lines.append(f"batch Leg.ik is {r.time_per_target_s / b.time_per_target_s:,.0f}x and a single call "
-                         f"{r.time_per_target_s / s.time_per_target_s:,.1f}x faster than {r.name.split(' (')[0]}")
-        return lines
 
+def _summary(results: list[MethodResult]) -> list[str]:
+    b = next(r for r in results if "batch" in r.name)
+    s = next(r for r in results if "single" in r.name)
+    lines = []
+    for r in results:
+        if r is b or r is s:
+            continue
+        lines.append(f"batch Leg.ik is {r.time_per_target_s / b.time_per_target_s:,.0f}x and a single call "
+                     f"{r.time_per_target_s / s.time_per_target_s:,.1f}x faster than {r.name.split(' (')[0]}")
+    return lines
+
+
+def build(name: str, n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
+    """The bench of robot ``name``'s leg :data:`LEG` (or first leg).
+
+    Rows: ``Leg.ik`` as one batch and as single calls, Pinocchio CLIK (damped Newton
+    ``dq = J^T (J J^T + lambda I)^-1 e`` on the leg's three joints from mid-limit, clipped into the limits,
+    <= :data:`CLIK_MAX_ITER` iterations), ikpy and roboticstoolbox ``ik_LM`` (position only) when installed.
+    """
+    from .. import load
+
+    n_batch, n_single, n_iter = _sizes(n, quick)
+    n_clik = min(n_batch, 10 * n_iter)
+    robot = load(name)
+    legs = robot.geometry
+    leg_name = LEG if LEG in legs else next(iter(legs))
+    leg = legs[leg_name]
+    foot = _Foot(robot.model, leg, np.array(robot.q0, dtype=float))
+    q_true = rng.uniform(leg.lower, leg.upper, (n_batch, 3))
+    targets = foot(q_true)
+    methods = _legkin_methods(leg, targets, foot, n_batch, n_single)
+    methods.append(Method("pinocchio CLIK (damped Newton, 3 leg joints)", targets, _clik(foot), foot.score_iter,
+                          max_targets=n_clik, repeats=1 if quick else 3))
+    methods += _peers(name, leg, targets, n_iter, foot.score_iter, quick)
     return ModelBench(
         methods=methods,
         units={"ik": "m"},
         tolerance=f"foot error <= {SOLVE_TOL:g} m and joints inside the URDF limits",
-        notes=notes,
-        summary=summary,
+        notes=_notes(name, leg_name, leg, n_batch, n_single, n_clik, n_iter),
+        summary=_summary,
     )
 
 

@@ -37,7 +37,10 @@ Each angle is then moved by a multiple of 2 pi: in :meth:`Leg.ik_all` to the rep
 reference configuration, in :meth:`Leg.ik` to the representative inside the URDF limits nearest ``q_near``.
 
 Implementation (issue 16, :mod:`legkin._kernels`): each function is one compiled scalar kernel; a batch is a
-compiled loop over it. The leg's geometry reaches the kernels as one float64 array (:attr:`Leg.params`).
+compiled loop over it. Where the code is: :mod:`._fk_kernels` (forward map, Jacobian), :mod:`._ik_kernels`
+(closed-form branches, the Newton polish, the branch inside the limits), :mod:`._layout` (tolerances, the layout of
+:attr:`Leg.params`, status codes); this module holds :class:`Leg` and re-exports the constants. The leg's geometry
+reaches the kernels as one float64 array (:attr:`Leg.params`).
 Single/batch contract of :mod:`legkin._batch`: a single input (3,) returns a plain array and raises a legkin
 error on failure; a batch (..., 3) returns NaN rows where an item fails (``return_mask=True`` adds the mask).
 """
@@ -50,8 +53,48 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from .._batch import as_input, check_flag, finish
-from .._kernels import OK, SERIAL_BELOW, as_rows, batch_kernel, kernel, prange
+from .._kernels import OK, as_rows
 from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
+from ._fk_kernels import _fk_batch, _fk_k, _jacobian_batch, _jacobian_k
+from ._ik_kernels import _ik_all_batch, _ik_batch, _ik_k
+from ._layout import (
+    _A1,
+    _A2,
+    _A3,
+    _BAD_INPUT,
+    _D,
+    _E1,
+    _E2,
+    _E3,
+    _H,
+    _HI,
+    _IN_CYLINDER,
+    _JOINT_LIMIT,
+    _K,
+    _KN,
+    _L,
+    _LN,
+    _LO,
+    _NPARAMS,
+    _O,
+    _PK,
+    _PL,
+    _S3,
+    _SLACK,
+    _TOO_FAR,
+    _UNREACHABLE,
+    _V3F,
+    _V21,
+    _V32,
+    BRANCHES,
+    LIMIT_TOL,
+    PARALLEL_TOL,
+    PERPENDICULAR_TOL,
+    REACH_TOL,
+)
+from ._layout import POLISH_BELOW as POLISH_BELOW  # public constants, re-exported (not in __all__)
+from ._layout import POLISH_DAMPING as POLISH_DAMPING
+from ._layout import POLISH_STEPS as POLISH_STEPS
 
 __all__ = [
     "Leg",
@@ -68,383 +111,8 @@ class LegStructureError(InvalidParameterError):
     """A kinematic chain that is not an HAA-HFE-KFE leg (the message names the deviation)."""
 
 
-#: |a1 . a2| (HAA vs HFE axis) above this is "not perpendicular" (rad, ~ the angle's deviation).
-PERPENDICULAR_TOL = 1e-9
-#: |a2 x a3| (HFE vs KFE axis) above this is "not parallel".
-PARALLEL_TOL = 1e-9
-#: A target up to this far (m) outside the reachable set is solved on its boundary.
-REACH_TOL = 1e-12
-#: A joint angle up to this far (rad) outside the URDF limits is clipped onto the limit (the foot then moves by
-#: at most LIMIT_TOL x the leg's reach, < 1e-10 m).
-LIMIT_TOL = 1e-10
-#: Damped Newton steps (at most) polishing each closed-form branch on the exact forward map (see _polish_k).
-POLISH_STEPS = 8
-#: Damping (m) of the polishing steps: bounds a step to ~|e| / (2 lambda) rad near a singularity.
-POLISH_DAMPING = 1e-7
-#: Foot error (m) below which a branch is not polished (a few ulps of a 1 m reach).
-POLISH_BELOW = 1e-15
-_POLISH_DONE = POLISH_BELOW**2
-#: Branch order of :meth:`Leg.ik_all`: ``(s_a, s_k)``, the abduction sign (sign of ``u3``, the foot's
-#: coordinate along ``e3 = a1 x a2`` in the abduction frame) and the knee sign (sign of ``beta``).
-BRANCHES = ((-1, -1), (-1, 1), (1, -1), (1, 1))
-
-# ---------------------------------------------------------------- layout of the geometry array (Leg.params)
-_O, _E1, _E2, _E3 = 0, 3, 6, 9  # o1, e1, e2, e3 (3 each)
-_D = 12  # lateral offset d
-_H, _K, _L = 13, 15, 17  # h, k, l in pitch-plane coordinates (X, Y)
-_S3 = 19  # knee axis sign
-_KN, _LN, _PK, _PL = 20, 21, 22, 23  # |k|, |l|, phi_k, phi_l
-_LO, _HI = 24, 27  # lower, upper limits (3 each)
-_A1, _A2, _A3 = 30, 33, 36  # the measured unit axes a1, a2, a3 (exact forward map)
-_V21, _V32, _V3F = 39, 42, 45  # o2 - o1, o3 - o2, f - o3
-_SLACK = 48  # reach slack of the ideal structure: REACH_TOL + its deviation bound (see Leg.from_geometry)
-_NPARAMS = 49
-
-_TWO_PI = 2.0 * math.pi
-_NAN = math.nan
-
-# kernel status codes (OK = 0)
-_UNREACHABLE = 1
-_JOINT_LIMIT = 2
-_BAD_INPUT = 3
-# reasons of _UNREACHABLE (info[1])
-_IN_CYLINDER = 1.0
-_TOO_FAR = 2.0
-_TOO_NEAR = 3.0
-
 _S3SHAPE = (3,)
 _F64 = np.dtype(np.float64)
-
-
-# ---------------------------------------------------------------- kernels
-@kernel
-def _finite3(x) -> bool:
-    return np.isfinite(x[0]) and np.isfinite(x[1]) and np.isfinite(x[2])
-
-
-@kernel
-def _rot_k(g, ia, c, s, vx, vy, vz):
-    """Rodrigues: ``R(a, t) v = cos t v + sin t (a x v) + (1 - cos t) (a . v) a`` with ``a = g[ia:ia + 3]``."""
-    ax, ay, az = g[ia], g[ia + 1], g[ia + 2]
-    k = (1.0 - c) * (ax * vx + ay * vy + az * vz)
-    return (
-        c * vx + s * (ay * vz - az * vy) + k * ax,
-        c * vy + s * (az * vx - ax * vz) + k * ay,
-        c * vz + s * (ax * vy - ay * vx) + k * az,
-    )
-
-
-@kernel
-def _cross_k(g, ia, vx, vy, vz):
-    """``a x v`` with ``a = g[ia:ia + 3]``."""
-    ax, ay, az = g[ia], g[ia + 1], g[ia + 2]
-    return ay * vz - az * vy, az * vx - ax * vz, ax * vy - ay * vx
-
-
-@kernel
-def _fk3_k(q0, q1, q2, g):
-    """The product of exponentials with the measured axes and origins (what Pinocchio computes)::
-
-        t3 = R(a3, q3) (f - o3),  t2 = R(a2, q2) [(o3 - o2) + t3],  p = o1 + R(a1, q1) [(o2 - o1) + t2]
-    """
-    c, s = math.cos(q2), math.sin(q2)
-    t3x, t3y, t3z = _rot_k(g, _A3, c, s, g[_V3F], g[_V3F + 1], g[_V3F + 2])
-    c, s = math.cos(q1), math.sin(q1)
-    t2x, t2y, t2z = _rot_k(g, _A2, c, s, g[_V32] + t3x, g[_V32 + 1] + t3y, g[_V32 + 2] + t3z)
-    c, s = math.cos(q0), math.sin(q0)
-    px, py, pz = _rot_k(g, _A1, c, s, g[_V21] + t2x, g[_V21 + 1] + t2y, g[_V21 + 2] + t2z)
-    return g[_O] + px, g[_O + 1] + py, g[_O + 2] + pz
-
-
-@kernel
-def _fk_k(q, g, out) -> int:
-    """Foot position: :func:`_fk3_k`,
-    ``p = o1 + R(a1, q1) [(o2 - o1) + R(a2, q2) ((o3 - o2) + R(a3, q3) (f - o3))]``."""
-    if not _finite3(q):
-        return _BAD_INPUT
-    out[0], out[1], out[2] = _fk3_k(q[0], q[1], q[2], g)
-    return OK
-
-
-@kernel
-def _jac3_k(q0, q1, q2, g, out) -> None:
-    """Columns ``a1 x R1 v1``, ``R1 (a2 x t2)``, ``R1 R2 (a3 x t3)`` (each joint: its spatial axis crossed with
-    the lever from its origin to the foot), with ``R_j = R(a_j, q_j)`` and ``t3, t2, v1`` of :func:`_fk3_k`."""
-    c3, s3 = math.cos(q2), math.sin(q2)
-    c2, s2 = math.cos(q1), math.sin(q1)
-    c1, s1 = math.cos(q0), math.sin(q0)
-    t3x, t3y, t3z = _rot_k(g, _A3, c3, s3, g[_V3F], g[_V3F + 1], g[_V3F + 2])
-    t2x, t2y, t2z = _rot_k(g, _A2, c2, s2, g[_V32] + t3x, g[_V32 + 1] + t3y, g[_V32 + 2] + t3z)
-    # column 1: a1 x R1 v1 = R1 (a1 x v1)
-    x, y, z = _cross_k(g, _A1, g[_V21] + t2x, g[_V21 + 1] + t2y, g[_V21 + 2] + t2z)
-    out[0, 0], out[1, 0], out[2, 0] = _rot_k(g, _A1, c1, s1, x, y, z)
-    x, y, z = _cross_k(g, _A2, t2x, t2y, t2z)
-    out[0, 1], out[1, 1], out[2, 1] = _rot_k(g, _A1, c1, s1, x, y, z)
-    x, y, z = _cross_k(g, _A3, t3x, t3y, t3z)
-    x, y, z = _rot_k(g, _A2, c2, s2, x, y, z)
-    out[0, 2], out[1, 2], out[2, 2] = _rot_k(g, _A1, c1, s1, x, y, z)
-
-
-@kernel
-def _jacobian_k(q, g, out) -> int:
-    """Foot Jacobian ``dp/dq`` (3, 3): :func:`_jac3_k`."""
-    if not _finite3(q):
-        return _BAD_INPUT
-    _jac3_k(q[0], q[1], q[2], g, out)
-    return OK
-
-
-@kernel
-def _polish_k(p, g, q, jac) -> float:
-    """At most :data:`POLISH_STEPS` damped Newton steps on the exact forward map while the foot error exceeds
-    :data:`POLISH_BELOW`, each kept only if it reduces the error: ``e = p - fk(q)``,
-    ``dq = J^T (J J^T + lambda^2 I)^-1 e`` (``lambda`` = :data:`POLISH_DAMPING`).
-
-    The closed form is exact for the ideal structure (a1 perpendicular to a2 = +-a3); URDF angles written
-    with 11 digits (``rpy="0 1.57079632679 0"``) leave axes ~5e-12 off, i.e. ~1e-12 m at the foot, and near the
-    fold of the knee (|w| -> 0 when |k| = |l|) the law of cosines loses digits: the steps remove both.
-    Returns the final foot error ``|e|`` (m).
-    """
-    fx, fy, fz = _fk3_k(q[0], q[1], q[2], g)
-    ex, ey, ez = p[0] - fx, p[1] - fy, p[2] - fz
-    err = ex * ex + ey * ey + ez * ez
-    lam2 = POLISH_DAMPING * POLISH_DAMPING
-    for _ in range(POLISH_STEPS):
-        if err <= _POLISH_DONE:
-            break
-        _jac3_k(q[0], q[1], q[2], g, jac)
-        # A = J J^T + lam^2 I (symmetric positive definite), solve A y = e by the adjugate, dq = J^T y
-        a00 = jac[0, 0] ** 2 + jac[0, 1] ** 2 + jac[0, 2] ** 2 + lam2
-        a11 = jac[1, 0] ** 2 + jac[1, 1] ** 2 + jac[1, 2] ** 2 + lam2
-        a22 = jac[2, 0] ** 2 + jac[2, 1] ** 2 + jac[2, 2] ** 2 + lam2
-        a01 = jac[0, 0] * jac[1, 0] + jac[0, 1] * jac[1, 1] + jac[0, 2] * jac[1, 2]
-        a02 = jac[0, 0] * jac[2, 0] + jac[0, 1] * jac[2, 1] + jac[0, 2] * jac[2, 2]
-        a12 = jac[1, 0] * jac[2, 0] + jac[1, 1] * jac[2, 1] + jac[1, 2] * jac[2, 2]
-        c00, c11, c22 = a11 * a22 - a12 * a12, a00 * a22 - a02 * a02, a00 * a11 - a01 * a01
-        c01, c02, c12 = a02 * a12 - a01 * a22, a01 * a12 - a02 * a11, a01 * a02 - a00 * a12
-        det = a00 * c00 + a01 * c01 + a02 * c02
-        if not det > 0.0:
-            break
-        yx = (c00 * ex + c01 * ey + c02 * ez) / det
-        yy = (c01 * ex + c11 * ey + c12 * ez) / det
-        yz = (c02 * ex + c12 * ey + c22 * ez) / det
-        n0 = q[0] + jac[0, 0] * yx + jac[1, 0] * yy + jac[2, 0] * yz
-        n1 = q[1] + jac[0, 1] * yx + jac[1, 1] * yy + jac[2, 1] * yz
-        n2 = q[2] + jac[0, 2] * yx + jac[1, 2] * yy + jac[2, 2] * yz
-        fx, fy, fz = _fk3_k(n0, n1, n2, g)
-        nx, ny, nz = p[0] - fx, p[1] - fy, p[2] - fz
-        new = nx * nx + ny * ny + nz * nz
-        if not new < err:
-            break
-        q[0], q[1], q[2] = n0, n1, n2
-        ex, ey, ez, err = nx, ny, nz, new
-    return math.sqrt(err)
-
-
-@kernel
-def _residual_k(p, g, q) -> float:
-    """``|p - fk(q)|`` on the exact forward map."""
-    fx, fy, fz = _fk3_k(q[0], q[1], q[2], g)
-    return math.sqrt((p[0] - fx) ** 2 + (p[1] - fy) ** 2 + (p[2] - fz) ** 2)
-
-
-@kernel
-def _near_k(a, r):
-    """The representative ``a + 2 pi n`` nearest ``r``."""
-    return a + _TWO_PI * math.floor((r - a) / _TWO_PI + 0.5)
-
-
-@kernel
-def _ik_all_k(p, g, ref, out, info) -> int:
-    """Every branch (rows in :data:`BRANCHES` order, NaN rows for absent ones) of the target ``p``.
-
-    ``r^2 = y^2 + z^2``, ``u3 = s_a sqrt(r^2 - d^2)``, ``q1 = atan2(z, y) - atan2(u3, d)``;
-    ``w = (u3, x1) - h``, ``cos beta = (|w|^2 - |k|^2 - |l|^2) / (2 |k||l|)``, ``beta = s_k acos(.)``,
-    ``q3 = s3 (beta - phi_l + phi_k)``, ``q2 = atan2(w) - atan2(k + Rot(s3 q3) l)``. Each angle is moved to
-    Each branch is then polished on the exact forward map (:func:`_polish_k`) and each angle moved to its
-    2 pi representative nearest ``ref``. ``info`` (2,): on failure the miss (m) and its reason.
-    """
-    for b in range(4):
-        for j in range(3):
-            out[b, j] = _NAN
-    if not _finite3(p):
-        return _BAD_INPUT
-    px, py, pz = p[0] - g[_O], p[1] - g[_O + 1], p[2] - g[_O + 2]
-    x1 = px * g[_E1] + py * g[_E1 + 1] + pz * g[_E1 + 2]
-    y = px * g[_E2] + py * g[_E2 + 1] + pz * g[_E2 + 2]
-    z = px * g[_E3] + py * g[_E3 + 1] + pz * g[_E3 + 2]
-    d = g[_D]
-    ad = abs(d)
-    r = math.hypot(y, z)
-    slack = g[_SLACK]
-    cyl = ad - r
-    if cyl > slack:
-        info[0], info[1] = cyl, _IN_CYLINDER
-        return _UNREACHABLE
-    disc = (r - ad) * (r + ad)
-    t = math.sqrt(disc) if disc > 0.0 else 0.0
-    phi = math.atan2(z, y)
-    kn, ln = g[_KN], g[_LN]
-    s3 = g[_S3]
-    best, why = math.inf, 0.0
-    if cyl > REACH_TOL:
-        best, why = cyl, _IN_CYLINDER
-    found = 0
-    qb = np.empty(3)
-    qt = np.empty(3)
-    jac = np.empty((3, 3))
-    for ia in range(2):
-        u3 = t if ia == 1 else -t
-        q1 = phi - math.atan2(u3, d)
-        wx, wy = u3 - g[_H], x1 - g[_H + 1]
-        wn = math.hypot(wx, wy)
-        far = wn - (kn + ln)
-        near = abs(kn - ln) - wn
-        miss = far if far > near else near
-        if miss > slack:
-            if miss < best:
-                best, why = miss, (_TOO_FAR if far > near else _TOO_NEAR)
-            continue
-        # within the slack of the ideal structure's boundary: kept only if the exact foot error is <= REACH_TOL
-        check = cyl > REACH_TOL or miss > REACH_TOL
-        c = (wn * wn - kn * kn - ln * ln) / (2.0 * kn * ln)
-        c = 1.0 if c > 1.0 else (-1.0 if c < -1.0 else c)
-        acb = math.acos(c)
-        for ik in range(2):
-            beta = acb if ik == 1 else -acb
-            a = beta - g[_PL] + g[_PK]  # = s3 q3
-            ca, sa = math.cos(a), math.sin(a)
-            vx = g[_K] + ca * g[_L] - sa * g[_L + 1]
-            vy = g[_K + 1] + sa * g[_L] + ca * g[_L + 1]
-            q2 = math.atan2(wy, wx) - math.atan2(vy, vx)
-            b = 2 * ia + ik
-            qb[0], qb[1], qb[2] = q1, q2, s3 * a
-            res = _polish_k(p, g, qb, jac)
-            if res > REACH_TOL:  # near a fold of the ideal structure: restart off it (Newton stalls on a fold)
-                eta = 4.0 * math.sqrt(res / min(kn, ln))
-                q0, q1b, q2b = qb[0], qb[1], qb[2]
-                for jr in range(6):
-                    qt[0], qt[1], qt[2] = q0, q1b, q2b
-                    qt[jr // 2] += eta if jr % 2 == 0 else -eta
-                    rt = _polish_k(p, g, qt, jac)
-                    if rt < res:
-                        res = rt
-                        qb[0], qb[1], qb[2] = qt[0], qt[1], qt[2]
-                    if res <= REACH_TOL:
-                        break
-            # a branch clamped onto the ideal structure's boundary is kept only if it reaches the target
-            if check and res > REACH_TOL:
-                if cyl <= REACH_TOL and res < best:
-                    best, why = res, (_TOO_FAR if far > near else _TOO_NEAR)
-                continue
-            out[b, 0] = _near_k(qb[0], ref[0])
-            out[b, 1] = _near_k(qb[1], ref[1])
-            out[b, 2] = _near_k(qb[2], ref[2])
-            found += 1
-    if found == 0:
-        info[0], info[1] = best, why
-        return _UNREACHABLE
-    return OK
-
-
-@kernel
-def _in_limits_k(a, r, lo, hi):
-    """The representative ``a + 2 pi n`` inside ``[lo, hi]`` (slack :data:`LIMIT_TOL`, then clipped) nearest ``r``;
-    NaN if none. Also returns the distance to the limits of the nearest representative (0 when inside)."""
-    rc = lo if r < lo else (hi if r > hi else r)
-    base = _near_k(a, rc)
-    best, dist, miss = _NAN, math.inf, math.inf
-    for n in range(-1, 2):
-        x = base + _TWO_PI * n
-        out_by = lo - x if x < lo else (x - hi if x > hi else 0.0)
-        if out_by < miss:
-            miss = out_by
-        if out_by <= LIMIT_TOL:
-            x = lo if x < lo else (hi if x > hi else x)
-            if abs(x - r) < dist:
-                best, dist = x, abs(x - r)
-    return best, miss
-
-
-@kernel
-def _ik_k(p, g, ref, out, info) -> int:
-    """The branch of :func:`_ik_all_k` inside the limits nearest ``ref`` (least sum of squared joint differences;
-    ties to the earlier branch). ``info``: the miss (m) and reason, or the least limit violation (rad) and the
-    number of geometric branches."""
-    qa = np.empty((4, 3))
-    status = _ik_all_k(p, g, ref, qa, info)
-    for j in range(3):
-        out[j] = _NAN
-    if status != OK:
-        return status
-    best, viol, nb = math.inf, math.inf, 0
-    for b in range(4):
-        if not np.isfinite(qa[b, 0]):
-            continue
-        nb += 1
-        x0, m0 = _in_limits_k(qa[b, 0], ref[0], g[_LO], g[_HI])
-        x1, m1 = _in_limits_k(qa[b, 1], ref[1], g[_LO + 1], g[_HI + 1])
-        x2, m2 = _in_limits_k(qa[b, 2], ref[2], g[_LO + 2], g[_HI + 2])
-        m = max(m0, max(m1, m2))
-        if m < viol:
-            viol = m
-        if not (np.isfinite(x0) and np.isfinite(x1) and np.isfinite(x2)):
-            continue
-        cost = (x0 - ref[0]) ** 2 + (x1 - ref[1]) ** 2 + (x2 - ref[2]) ** 2
-        if cost < best:
-            best = cost
-            out[0], out[1], out[2] = x0, x1, x2
-    if best == math.inf:
-        info[0], info[1] = viol, nb
-        return _JOINT_LIMIT
-    return OK
-
-
-@batch_kernel
-def _fk_batch(q, g, out) -> int:
-    n, bad = q.shape[0], 0
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            bad += _fk_k(q[i], g, out[i]) != OK
-    else:
-        for i in prange(n):
-            bad += _fk_k(q[i], g, out[i]) != OK
-    return bad
-
-
-@batch_kernel
-def _jacobian_batch(q, g, out) -> int:
-    n, bad = q.shape[0], 0
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            bad += _jacobian_k(q[i], g, out[i]) != OK
-    else:
-        for i in prange(n):
-            bad += _jacobian_k(q[i], g, out[i]) != OK
-    return bad
-
-
-@batch_kernel
-def _ik_all_batch(p, g, ref, out, status, info) -> None:
-    # ref: one row for all targets (m = 1) or one per target; ``i - i`` keeps the index type of prange's i
-    n, m = p.shape[0], ref.shape[0]
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            status[i] = _ik_all_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])
-    else:
-        for i in prange(n):
-            status[i] = _ik_all_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])
-
-
-@batch_kernel
-def _ik_batch(p, g, ref, out, status, info) -> None:
-    n, m = p.shape[0], ref.shape[0]
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            status[i] = _ik_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])
-    else:
-        for i in prange(n):
-            status[i] = _ik_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])
 
 
 # ---------------------------------------------------------------- geometry helpers (Python)

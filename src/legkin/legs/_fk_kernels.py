@@ -1,0 +1,112 @@
+"""Forward map and foot Jacobian kernels of an HAA-HFE-KFE leg (the product of exponentials with the measured
+axes, see :mod:`legkin.legs.kinematics`), scalar and batch."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._kernels import OK, SERIAL_BELOW, batch_kernel, kernel, prange
+from ._layout import _A1, _A2, _A3, _BAD_INPUT, _O, _V3F, _V21, _V32
+
+
+@kernel
+def _finite3(x) -> bool:
+    return np.isfinite(x[0]) and np.isfinite(x[1]) and np.isfinite(x[2])
+
+
+@kernel
+def _rot_k(g, ia, c, s, vx, vy, vz):
+    """Rodrigues: ``R(a, t) v = cos t v + sin t (a x v) + (1 - cos t) (a . v) a`` with ``a = g[ia:ia + 3]``."""
+    ax, ay, az = g[ia], g[ia + 1], g[ia + 2]
+    k = (1.0 - c) * (ax * vx + ay * vy + az * vz)
+    return (
+        c * vx + s * (ay * vz - az * vy) + k * ax,
+        c * vy + s * (az * vx - ax * vz) + k * ay,
+        c * vz + s * (ax * vy - ay * vx) + k * az,
+    )
+
+
+@kernel
+def _cross_k(g, ia, vx, vy, vz):
+    """``a x v`` with ``a = g[ia:ia + 3]``."""
+    ax, ay, az = g[ia], g[ia + 1], g[ia + 2]
+    return ay * vz - az * vy, az * vx - ax * vz, ax * vy - ay * vx
+
+
+@kernel
+def _fk3_k(q0, q1, q2, g):
+    """The product of exponentials with the measured axes and origins (what Pinocchio computes)::
+
+        t3 = R(a3, q3) (f - o3),  t2 = R(a2, q2) [(o3 - o2) + t3],  p = o1 + R(a1, q1) [(o2 - o1) + t2]
+    """
+    c, s = math.cos(q2), math.sin(q2)
+    t3x, t3y, t3z = _rot_k(g, _A3, c, s, g[_V3F], g[_V3F + 1], g[_V3F + 2])
+    c, s = math.cos(q1), math.sin(q1)
+    t2x, t2y, t2z = _rot_k(g, _A2, c, s, g[_V32] + t3x, g[_V32 + 1] + t3y, g[_V32 + 2] + t3z)
+    c, s = math.cos(q0), math.sin(q0)
+    px, py, pz = _rot_k(g, _A1, c, s, g[_V21] + t2x, g[_V21 + 1] + t2y, g[_V21 + 2] + t2z)
+    return g[_O] + px, g[_O + 1] + py, g[_O + 2] + pz
+
+
+@kernel
+def _fk_k(q, g, out) -> int:
+    """Foot position: :func:`_fk3_k`,
+    ``p = o1 + R(a1, q1) [(o2 - o1) + R(a2, q2) ((o3 - o2) + R(a3, q3) (f - o3))]``."""
+    if not _finite3(q):
+        return _BAD_INPUT
+    out[0], out[1], out[2] = _fk3_k(q[0], q[1], q[2], g)
+    return OK
+
+
+@kernel
+def _jac3_k(q0, q1, q2, g, out) -> None:
+    """Columns ``a1 x R1 v1``, ``R1 (a2 x t2)``, ``R1 R2 (a3 x t3)`` (each joint: its spatial axis crossed with
+    the lever from its origin to the foot), with ``R_j = R(a_j, q_j)`` and ``t3, t2, v1`` of :func:`_fk3_k`."""
+    c3, s3 = math.cos(q2), math.sin(q2)
+    c2, s2 = math.cos(q1), math.sin(q1)
+    c1, s1 = math.cos(q0), math.sin(q0)
+    t3x, t3y, t3z = _rot_k(g, _A3, c3, s3, g[_V3F], g[_V3F + 1], g[_V3F + 2])
+    t2x, t2y, t2z = _rot_k(g, _A2, c2, s2, g[_V32] + t3x, g[_V32 + 1] + t3y, g[_V32 + 2] + t3z)
+    # column 1: a1 x R1 v1 = R1 (a1 x v1)
+    x, y, z = _cross_k(g, _A1, g[_V21] + t2x, g[_V21 + 1] + t2y, g[_V21 + 2] + t2z)
+    out[0, 0], out[1, 0], out[2, 0] = _rot_k(g, _A1, c1, s1, x, y, z)
+    x, y, z = _cross_k(g, _A2, t2x, t2y, t2z)
+    out[0, 1], out[1, 1], out[2, 1] = _rot_k(g, _A1, c1, s1, x, y, z)
+    x, y, z = _cross_k(g, _A3, t3x, t3y, t3z)
+    x, y, z = _rot_k(g, _A2, c2, s2, x, y, z)
+    out[0, 2], out[1, 2], out[2, 2] = _rot_k(g, _A1, c1, s1, x, y, z)
+
+
+@kernel
+def _jacobian_k(q, g, out) -> int:
+    """Foot Jacobian ``dp/dq`` (3, 3): :func:`_jac3_k`."""
+    if not _finite3(q):
+        return _BAD_INPUT
+    _jac3_k(q[0], q[1], q[2], g, out)
+    return OK
+
+
+@batch_kernel
+def _fk_batch(q, g, out) -> int:
+    n, bad = q.shape[0], 0
+    if n < SERIAL_BELOW:
+        for i in range(n):
+            bad += _fk_k(q[i], g, out[i]) != OK
+    else:
+        for i in prange(n):
+            bad += _fk_k(q[i], g, out[i]) != OK
+    return bad
+
+
+@batch_kernel
+def _jacobian_batch(q, g, out) -> int:
+    n, bad = q.shape[0], 0
+    if n < SERIAL_BELOW:
+        for i in range(n):
+            bad += _jacobian_k(q[i], g, out[i]) != OK
+    else:
+        for i in prange(n):
+            bad += _jacobian_k(q[i], g, out[i]) != OK
+    return bad

@@ -1,0 +1,50 @@
+"""Constants of the leg kinematics (:mod:`legkin.legs.kinematics`): tolerances, the branch order, the layout of
+the geometry array :attr:`Leg.params` the kernels read, and the kernels' status codes."""
+
+from __future__ import annotations
+
+import math
+
+#: |a1 . a2| (HAA vs HFE axis) above this is "not perpendicular" (rad, ~ the angle's deviation).
+PERPENDICULAR_TOL = 1e-9
+#: |a2 x a3| (HFE vs KFE axis) above this is "not parallel".
+PARALLEL_TOL = 1e-9
+#: A target up to this far (m) outside the reachable set is solved on its boundary.
+REACH_TOL = 1e-12
+#: A joint angle up to this far (rad) outside the URDF limits is clipped onto the limit (the foot then moves by
+#: at most LIMIT_TOL x the leg's reach, < 1e-10 m).
+LIMIT_TOL = 1e-10
+#: Damped Newton steps (at most) polishing each closed-form branch on the exact forward map (see _polish_k).
+POLISH_STEPS = 8
+#: Damping (m) of the polishing steps: bounds a step to ~|e| / (2 lambda) rad near a singularity.
+POLISH_DAMPING = 1e-7
+#: Foot error (m) below which a branch is not polished (a few ulps of a 1 m reach).
+POLISH_BELOW = 1e-15
+_POLISH_DONE = POLISH_BELOW**2
+#: Branch order of :meth:`Leg.ik_all`: ``(s_a, s_k)``, the abduction sign (sign of ``u3``, the foot's
+#: coordinate along ``e3 = a1 x a2`` in the abduction frame) and the knee sign (sign of ``beta``).
+BRANCHES = ((-1, -1), (-1, 1), (1, -1), (1, 1))
+
+# ---------------------------------------------------------------- layout of the geometry array (Leg.params)
+_O, _E1, _E2, _E3 = 0, 3, 6, 9  # o1, e1, e2, e3 (3 each)
+_D = 12  # lateral offset d
+_H, _K, _L = 13, 15, 17  # h, k, l in pitch-plane coordinates (X, Y)
+_S3 = 19  # knee axis sign
+_KN, _LN, _PK, _PL = 20, 21, 22, 23  # |k|, |l|, phi_k, phi_l
+_LO, _HI = 24, 27  # lower, upper limits (3 each)
+_A1, _A2, _A3 = 30, 33, 36  # the measured unit axes a1, a2, a3 (exact forward map)
+_V21, _V32, _V3F = 39, 42, 45  # o2 - o1, o3 - o2, f - o3
+_SLACK = 48  # reach slack of the ideal structure: REACH_TOL + its deviation bound (see Leg.from_geometry)
+_NPARAMS = 49
+
+_TWO_PI = 2.0 * math.pi
+_NAN = math.nan
+
+# kernel status codes (OK = 0)
+_UNREACHABLE = 1
+_JOINT_LIMIT = 2
+_BAD_INPUT = 3
+# reasons of _UNREACHABLE (info[1])
+_IN_CYLINDER = 1.0
+_TOO_FAR = 2.0
+_TOO_NEAR = 3.0

@@ -9,6 +9,8 @@ assembly mode (:func:`legkin.hybrid_leg.fk`, validated against Pinocchio) vs the
 
 from __future__ import annotations
 
+from typing import Callable
+
 import numpy as np
 
 from .. import load
@@ -16,6 +18,7 @@ from .._benchkit import SOLVE_TOL, levenberg_marquardt, pinocchio_positions, siz
 from .._single_call import SingleCall
 from ..bench import Method, MethodResult, ModelBench, Score
 from ..errors import LegkinError
+from ..robot import Robot
 from . import kinematics as ah
 from .configuration import LL_RANGE, closed_configuration, sample_workspace
 
@@ -73,58 +76,63 @@ def single_calls() -> list[SingleCall]:
     ]
 
 
-def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
-    n_batch, n_scalar, n_iter = _sizes(n, quick)
+def _targets(robot: Robot, n: int, rng: np.random.Generator) -> np.ndarray:
+    """Pinocchio's FCS at ``n`` closed configurations: neutral-mode platform poses, theta_LL in [-0.3, delta]."""
+    roll, pitch = sample_workspace(n, rng)
+    theta_ll = rng.uniform(LL_RANGE[0], ah.LL_DELTA, n)
+    qs = closed_configuration(robot, np.stack([roll, pitch], -1), theta_ll)
+    targets, _ = pinocchio_positions(robot.model, robot.data, robot.frame_id("FCS"), qs)
+    return targets  # type: ignore[no-any-return]
+
+
+def _score_motors(p: np.ndarray, motors: np.ndarray, residual: np.ndarray | None = None,
+                  iters: np.ndarray | None = None, evals: np.ndarray | None = None) -> Score:
+    """The foot of the motors (theta1, theta2, theta0) in the neutral assembly mode (fk) vs the target."""
+    motors = np.asarray(motors, dtype=float)
+    ok_in = np.all(np.isfinite(motors), axis=-1)
+    foot = np.full((len(p), 3), np.nan)
+    if ok_in.any():
+        foot[ok_in] = ah.fk(motors[ok_in])
+    err = np.linalg.norm(foot - p, axis=-1)
+    solved = err <= SOLVE_TOL
+    if residual is not None:
+        solved &= residual <= SOLVE_TOL
+    return Score(error=err, solved=solved, orientation=residual, iterations=iters, fk_evals=evals)
+
+
+def _scalar_ik(p: np.ndarray) -> np.ndarray:
+    """ik one target at a time (a Python loop of single calls), NaN where it raises."""
+    out = np.full((len(p), 3), np.nan)
+    for i, pi in enumerate(p):
+        try:
+            out[i] = ah.ik(pi)
+        except LegkinError:
+            pass
+    return out
+
+
+def _pinocchio_ik(robot: Robot) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Pinocchio's closed-loop IK: the Levenberg-Marquardt of Robot.solve_loops on [loop closures; FCS - target],
+    every joint free, from q0 (the loop rows from the public ``constraint_residual`` / ``constraint_jacobian``, the
+    foot rows from ``forwardKinematics`` + ``getFrameJacobian`` in ``robot.data``)."""
     import pinocchio as pin
 
-    robot = load("hybrid_leg")
     model, data = robot.model, robot.data
     fid = robot.frame_id("FCS")
-    roll, pitch = sample_workspace(n_batch, rng)
-    theta_ll = rng.uniform(LL_RANGE[0], ah.LL_DELTA, n_batch)
-    qs_true = closed_configuration(robot, np.stack([roll, pitch], -1), theta_ll)
-    targets, _ = pinocchio_positions(model, data, fid, qs_true)
-    i_m = [robot.idx_q(j) for j in ("MCS1", "MCS2", "LL")]
-
-    def score_motors(p, motors, residual=None, iters=None, evals=None) -> Score:
-        motors = np.asarray(motors, dtype=float)
-        ok_in = np.all(np.isfinite(motors), axis=-1)
-        foot = np.full((len(p), 3), np.nan)
-        if ok_in.any():
-            foot[ok_in] = ah.fk(motors[ok_in])
-        err = np.linalg.norm(foot - p, axis=-1)
-        solved = err <= SOLVE_TOL
-        if residual is not None:
-            solved &= residual <= SOLVE_TOL
-        return Score(error=err, solved=solved, orientation=residual, iterations=iters, fk_evals=evals)
-
-    def batch_ik(p):
-        return ah.ik(p)
-
-    def scalar_ik(p):
-        out = np.full((len(p), 3), np.nan)
-        for i, pi in enumerate(p):
-            try:
-                out[i] = ah.ik(pi)
-            except LegkinError:
-                pass
-        return out
-
-    loopset = robot._loopset
-    ldata = loopset.data
     free = np.ones(model.nv, dtype=bool)
 
-    def pin_ik(p):
+    def solve(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         k = len(p)
         qs = np.full((k, model.nq), np.nan)
         iters, evals = np.full(k, np.nan), np.full(k, np.nan)
         for i, target in enumerate(p):
 
-            def residual_and_jacobian(q):
-                r, jc = loopset.residual_and_jacobian(q)  # forwardKinematics + computeJointJacobians in ldata
-                pin.updateFramePlacement(model, ldata, fid)
-                jf = pin.getFrameJacobian(model, ldata, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
-                return np.concatenate([r, ldata.oMf[fid].translation - target]), np.vstack([jc, jf])
+            def residual_and_jacobian(q: np.ndarray, target: np.ndarray = target) -> tuple[np.ndarray, np.ndarray]:
+                r, jc = robot.constraint_residual(q), robot.constraint_jacobian(q)
+                pin.computeJointJacobians(model, data, q)  # also the forward kinematics
+                pin.updateFramePlacement(model, data, fid)
+                jf = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
+                return np.concatenate([r, data.oMf[fid].translation - target]), np.vstack([jc, jf])
 
             q, it, ev, ok = levenberg_marquardt(model, residual_and_jacobian, robot.q0.copy(), free, TOL, MAX_ITER)
             iters[i], evals[i] = it, ev
@@ -132,21 +140,25 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
                 qs[i] = q
         return qs, iters, evals
 
-    def pin_score(p, out) -> Score:
+    return solve
+
+
+def _pinocchio_score(robot: Robot) -> Callable[[np.ndarray, tuple[np.ndarray, ...]], Score]:
+    """Scores Pinocchio's configurations as the closed forms' motors, with their loop residual."""
+    i_m = [robot.idx_q(j) for j in ("MCS1", "MCS2", "LL")]
+
+    def score(p: np.ndarray, out: tuple[np.ndarray, ...]) -> Score:
         qs, iters, evals = out
         motors = np.column_stack([qs[:, i_m[0]], qs[:, i_m[1]], ah.extension_motor_angle(qs[:, i_m[2]])])
-        res = np.array([np.linalg.norm(robot.constraint_residual(q)) if np.all(np.isfinite(q)) else np.nan for q in qs])
-        return score_motors(p, motors, res, iters, evals)
+        res = np.array([np.linalg.norm(robot.constraint_residual(q)) if np.all(np.isfinite(q)) else np.nan
+                        for q in qs])
+        return _score_motors(p, motors, res, iters, evals)
 
-    methods = [
-        Method(f"legkin batch closed form (ik; {n_batch} at once)", targets, batch_ik,
-               lambda p, m: score_motors(p, m), repeats=5),
-        Method("legkin scalar closed form, Python loop", targets, scalar_ik, lambda p, m: score_motors(p, m),
-               max_targets=n_scalar, repeats=3),
-        Method("pinocchio closed-loop IK (LM on loops + foot, start q0)", targets, pin_ik, pin_score,
-               max_targets=n_iter, repeats=3),
-    ]
-    notes = [
+    return score
+
+
+def _notes(n_batch: int, n_scalar: int, n_iter: int) -> list[str]:
+    return [
         f"targets: Pinocchio FCS of {n_batch} closed configurations, platform poses of the neutral assembly mode "
         "(sigma_min(dtheta/dx) >= 1e-2), theta_LL uniform in [-0.3, delta] (the ll_branch ik tries first); the "
         f"scalar loop solves the first {n_scalar}, Pinocchio the first {n_iter}",
@@ -154,24 +166,39 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         "target (m); loop |r| = Pinocchio loop residual of the Pinocchio answer; a Pinocchio answer closing the "
         "loops in another assembly mode lands elsewhere and counts as not solved",
         f"pinocchio closed-loop IK: the Levenberg-Marquardt of Robot.solve_loops on [2 rod closures; FCS - target] "
-        f"(getFrameJacobian LOCAL_WORLD_ALIGNED), every joint free, tolerance {TOL:g}, at most {MAX_ITER} iterations; "
-        "theta0 from theta_LL by eq 19",
+        f"(Robot.constraint_residual and constraint_jacobian, getFrameJacobian LOCAL_WORLD_ALIGNED), every joint "
+        f"free, tolerance {TOL:g}, at most {MAX_ITER} iterations; theta0 from theta_LL by eq 19",
     ]
 
-    def summary(results: list[MethodResult]) -> list[str]:
-        b = next(r for r in results if "batch" in r.name)
-        s = next(r for r in results if "scalar" in r.name)
-        p = next(r for r in results if "pinocchio" in r.name)
-        return [
-            f"batch ik is {p.time_per_target_s / b.time_per_target_s:,.0f}x and the scalar call "
-            f"{p.time_per_target_s / s.time_per_target_s:,.1f}x faster than the Pinocchio closed-loop IK"
-        ]
 
+def _summary(results: list[MethodResult]) -> list[str]:
+    b = next(r for r in results if "batch" in r.name)
+    s = next(r for r in results if "scalar" in r.name)
+    p = next(r for r in results if "pinocchio" in r.name)
+    return [
+        f"batch ik is {p.time_per_target_s / b.time_per_target_s:,.0f}x and the scalar call "
+        f"{p.time_per_target_s / s.time_per_target_s:,.1f}x faster than the Pinocchio closed-loop IK"
+    ]
+
+
+def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
+    """The ``legkin bench`` rows: batch and scalar ``ik`` vs Pinocchio's closed-loop IK on the same targets."""
+    n_batch, n_scalar, n_iter = _sizes(n, quick)
+    robot = load("hybrid_leg")
+    targets = _targets(robot, n_batch, rng)
+    methods = [
+        Method(f"legkin batch closed form (ik; {n_batch} at once)", targets, ah.ik,
+               lambda p, m: _score_motors(p, m), repeats=5),
+        Method("legkin scalar closed form, Python loop", targets, _scalar_ik, lambda p, m: _score_motors(p, m),
+               max_targets=n_scalar, repeats=3),
+        Method("pinocchio closed-loop IK (LM on loops + foot, start q0)", targets, _pinocchio_ik(robot),
+               _pinocchio_score(robot), max_targets=n_iter, repeats=3),
+    ]
     return ModelBench(
         methods=methods,
         units={"ik": "m"},
         tolerance=f"foot error <= {SOLVE_TOL:g} m (and loop |r| <= {SOLVE_TOL:g} for Pinocchio's configuration)",
-        notes=notes,
-        summary=summary,
+        notes=_notes(n_batch, n_scalar, n_iter),
+        summary=_summary,
         secondary="loop |r|",
     )

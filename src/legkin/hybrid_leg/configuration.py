@@ -11,13 +11,15 @@ import numpy as np
 from .._rotations import rot_x, rot_y, rot_z
 from .extension import extension_motor_angle, ll_angle
 from .foot import fk
+from .forward import platform_orientation
 from .geometry import LL_LIMIT, MOTOR_LIMIT, Geometry
-from .platform import motor_angles, motor_jacobian
+from .platform import assembly_mode, motor_angles, motor_jacobian
 from .rotation import motor_angles_from_rotation, sphere_joint_angles
 
 __all__ = [
     "ACTUATED", "PASSIVE_U", "LL_RANGE", "SIGMA_MIN", "sigma_min", "neutral_mode", "sample_workspace",
-    "sample_near_forward_singularity", "closed_configuration", "sample_joints", "within_limits", "sample_targets",
+    "sample_near_forward_singularity", "closed_configuration", "sample_joints", "sample_mode_joints", "within_limits",
+    "sample_targets",
 ]
 
 #: The actuated joints (the motors MCS1, MCS2 and the LL joint driven by theta0 through eq 19).
@@ -117,6 +119,35 @@ def sample_joints(rng: np.random.Generator, n: int, *, sigma: float = SIGMA_MIN,
     th = motor_angles(roll, pitch)
     t0 = extension_motor_angle(rng.uniform(*LL_RANGE, n), geometry=geometry)
     return np.column_stack([th, t0])
+
+
+def sample_mode_joints(rng: np.random.Generator, n: int, branch: Sequence[int], assembly: int, *,
+                       sigma: float = SIGMA_MIN, geometry: Geometry | None = None) -> np.ndarray:
+    """``n`` motor angle triples q (n, 3) inside the URDF limits whose :func:`fk` in the mode ``branch``,
+    ``assembly`` is defined and returns a platform pose with sigma_min(dtheta/dx) >= ``sigma`` on that branch.
+
+    Rejection sampling: platform poses uniform in the joint limits (|roll|, |pitch| <= pi/2) in that mode, their
+    motor angles on ``branch``, kept where the forward kinematics of the mode returns that pose (it returns the
+    pose of the mode nearest R_P = I) outside the forward-singularity band; theta_LL uniform in :data:`LL_RANGE`.
+    """
+    out, got = [], 0
+    for _ in range(1000):
+        m = 8 * n
+        r, p = rng.uniform(-np.pi / 2, np.pi / 2, m), rng.uniform(-np.pi / 2, np.pi / 2, m)
+        th, ok = motor_angles(r, p, branch, return_mask=True)
+        ok &= assembly_mode(np.where(ok, r, 0.0), np.where(ok, p, 0.0), branch, return_mask=True)[0] == assembly
+        ok[ok] &= sigma_min(r[ok], p[ok], branch) >= sigma
+        r, p, th = r[ok], p[ok], th[ok]
+        x, back = platform_orientation(th[:, 0], th[:, 1], branch, assembly=assembly, return_mask=True)
+        keep = back & (np.abs(x - np.stack([r, p], -1)).max(-1, initial=0.0) <= 1e-9)
+        q = np.column_stack([th[keep], extension_motor_angle(rng.uniform(*LL_RANGE, int(keep.sum())),
+                                                             geometry=geometry)])
+        defined = fk(q, branch=branch, assembly=assembly, geometry=geometry, return_mask=True)[1]
+        out.append(q[defined])
+        got += int(defined.sum())
+        if got >= n:
+            break
+    return np.concatenate(out)[:n]
 
 
 def within_limits(q: np.ndarray, *, geometry: Geometry | None = None, tol: float = 1e-12) -> np.ndarray:

@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from legkin.errors import InvalidInputError, InvalidParameterError, UnreachableError
+from legkin.errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
 from legkin.wheel_leg import ground as gd
 from legkin.wheel_leg import tyre as ty
 from legkin.wheel_leg import tyre_checks as tc
@@ -189,3 +189,40 @@ def test_stance_ik_unreachable():
     t = np.stack([far, gd.ground_contact(np.array([1.0, 0.2, 0.1]), "FL").point])
     qs, ok = gd.stance_ik(t, "FL", return_mask=True)
     assert ok.tolist() == [False, True] and np.isnan(qs[0]).all() and np.isfinite(qs[1]).all()
+
+
+def test_stance_ik_single_equals_batch_and_rules():
+    """The single-call fast path (one kernel call) and the batch loop give the same bits; the default answer is
+    the first solution of stance_ik_all inside the limits, q_near the nearest; a tilted normal takes the batch
+    path; JointLimitError when only |gamma| > ABAD_LIMIT solutions exist."""
+    rng = np.random.default_rng(5)
+    n = 8
+    q = np.stack([rng.uniform(THETA_MIN, THETA_MAX, n), rng.uniform(-np.pi, np.pi, n),
+                  rng.uniform(-1.4, 1.4, n)], -1)
+    for leg in ("RR", "RL"):
+        target = gd.ground_contact(q, leg).point
+        batch = gd.stance_ik(target, leg)
+        batch_all = gd.stance_ik_all(target, leg, limits=True)
+        near_b = gd.stance_ik(target, leg, q_near=q)
+        for i in range(n):
+            single = gd.stance_ik(target[i].copy(), leg)
+            assert np.array_equal(single, batch[i])
+            assert np.array_equal(single, batch_all[i, 0])
+            s_all = gd.stance_ik_all(target[i].copy(), leg, limits=True)
+            k = s_all.shape[0]
+            assert np.array_equal(s_all, batch_all[i, :k]) and np.isnan(batch_all[i, k:]).all()
+            assert np.array_equal(gd.stance_ik(target[i].copy(), leg, q_near=q[i].copy()), near_b[i])
+            lst = gd.stance_ik(target[i].tolist(), leg)  # a list: the checked path, the same answer
+            assert np.array_equal(lst, single)
+    tilt = np.array([0.1, -0.2, 1.0])
+    tq = np.array([1.0, 0.4, 0.2])
+    t = gd.ground_contact(tq, "FL", tilt).point
+    sol = gd.stance_ik(t, "FL", normal=tilt)
+    np.testing.assert_allclose(gd.ground_contact(sol, "FL", tilt).point, t, atol=1e-12, rtol=0)
+    # a target reached only with |gamma| > ABAD_LIMIT (the leg swung over the top, gamma ~ 2.6 rad)
+    t_out = gd.ground_contact(np.array([1.2, 0.3, 2.6]), "FL").point
+    sols = gd.stance_ik_all(t_out, "FL")
+    assert sols.shape[0] >= 1 and np.all(np.abs(sols[:, 2]) > ABAD_LIMIT)
+    with pytest.raises(JointLimitError):
+        gd.stance_ik(t_out, "FL")
+    assert gd.stance_ik(t_out, "FL", limits=False)[2] == pytest.approx(2.6, abs=1e-9)

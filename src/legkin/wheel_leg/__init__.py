@@ -21,7 +21,8 @@ if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they l
 
 _SUBMODULES = (
     "kinematics", "geometry", "linkage", "rim", "frames", "inverse", "ik_radial", "ik_iterative", "configuration",
-    "contract", "checks", "bench", "figures", "clips", "tyre", "ground", "tyre_checks", "tyre_figures",
+    "contract", "checks", "bench", "figures", "clips", "tyre", "ground", "stance", "tyre_checks",
+    "tyre_figures",
 )
 
 

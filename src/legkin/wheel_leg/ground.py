@@ -16,6 +16,7 @@ part, ``n_z`` its lateral part. So:
   contains the swept region's boundary, so this is the lowest point of the pitch curve moved by ``-r n``.
   Where ``|n_plane| <= 1e-12`` (the leg plane parallel to the ground) the whole side face is lowest: the point
   of that face toward the toe G is returned (the support point for ``n_plane = -G/|G|``).
+* **stance IK**: :func:`~legkin.wheel_leg.stance.stance_ik` (module :mod:`.stance`, also served here).
 * **Jacobian**: the derivative d p / d(theta, beta, gamma) of the *material point*: the point of the rim link
   that carries the contact (:data:`.tyre.PIECE_LINKS`) fixed in that link at the solution, moved with the link.
   It is not the derivative of the (rolling) contact point itself; the two differ by the rolling of the
@@ -35,15 +36,14 @@ from numpy.typing import ArrayLike
 
 from .._batch import as_input, check_flag
 from .._kernels import OK, as_rows, kernel, prange
-from .._rotations import wrap
-from ..errors import InvalidInputError, JointLimitError, UnreachableError
+from ..errors import InvalidInputError
 from ._common import Leg, _check_theta, _loop
 from .frames import _R_0, _R_LM, _k_fk, _origin
-from .geometry import _DEFAULT_GEOMETRY, ABAD_LIMIT, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry, _leg
-from .linkage import _IF, _IG, _IL, _IU, _k_closed, _kconst, linkage_points
+from .geometry import _DEFAULT_GEOMETRY, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry, _leg
+from .linkage import _IF, _IG, _IL, _IU, _k_closed, _kconst
 from .tyre import _LINK_A, _LINK_B, _NP, PIECES, _k_cumulative, _k_pieces, _thickness
 
-__all__ = ["GroundContact", "ground_contact", "stance_ik", "stance_ik_all", "normal_in_leg_frame"]
+__all__ = ["GroundContact", "ground_contact", "normal_in_leg_frame"]
 
 _NONFINITE = 1
 #: Below this a normal component counts as zero (lateral: the lowest set is a segment; in-plane: a face).
@@ -122,8 +122,9 @@ def _k_support(C, RAD, A0, SPAN, d):
 
 
 @kernel
-def _k_ground(q, n, r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, p, J, info):
-    """:func:`ground_contact` for one item: point p (3,), Jacobian J (9,), info (4,) = (piece, s, w, link)."""
+def _k_ground(q, n, r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, p, J, info, want_jac=True):
+    """:func:`ground_contact` for one item: point p (3,), Jacobian J (9,) (when ``want_jac``), info (4,) =
+    (piece, s, w, link)."""
     theta, beta, gamma = q[0], q[1], q[2]
     if not (math.isfinite(theta) and math.isfinite(beta) and math.isfinite(gamma)):
         return _NONFINITE
@@ -149,7 +150,8 @@ def _k_ground(q, n, r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, p, J, info
     ctr = pts[_IU] if upper else pts[_IL]
     v = (pts[_IF] if upper else pts[_IG]) - ctr
     e = ((Y.conjugate() if right else Y) - ctr) / v
-    status = _k_fk(theta, beta, gamma, upper, right, e, False, K, KC, sl, dwheel + sl * w, o0, o1, o2, True, p, J)
+    status = _k_fk(theta, beta, gamma, upper, right, e, False, K, KC, sl, dwheel + sl * w, o0, o1, o2, want_jac, p,
+                   J)
     info[0] = bp
     info[1] = (CUM[bp] + bu * (CUM[bp + 1] - CUM[bp])) / CUM[_NP]
     info[2] = w
@@ -282,200 +284,10 @@ def normal_in_leg_frame(gamma: ArrayLike, leg: Leg, normal: ArrayLike = (0.0, 0.
     return u @ RLM  # RLM^T u
 
 
-# ---------------------------------------------------------------- stance IK
-#: The centres whose circles carry the support point: (point name, offset radius: "R+r" or "r").
-_CENTRES = (("U_L", True), ("L_L", True), ("L_R", True), ("U_R", True), ("F_L", False), ("G", False),
-            ("F_R", False), ("H_L", False), ("H_R", False))
-_GRID = 2001
-_BISECT = 56
-#: A candidate whose ground contact is farther than this from the target is not a solution (m).
-VERIFY_TOL = 1e-9
+def __getattr__(name: str) -> Any:
+    """``stance_ik``, ``stance_ik_all``: served from :mod:`.stance` (which builds on this module)."""
+    if name in ("stance_ik", "stance_ik_all"):
+        from . import stance
 
-
-@lru_cache(maxsize=8)
-def _centre_table(geo: Geometry) -> tuple[np.ndarray, np.ndarray]:
-    """theta grid (M,) and |c_k(theta)|^2 (9, M) of the support circles' centres (pre-rotation plane)."""
-    th = np.linspace(THETA_MIN, THETA_MAX, _GRID)
-    pts = linkage_points(th, -np.pi / 2, geometry=geo)
-    tab = np.stack([pts[name][:, 0] ** 2 + pts[name][:, 1] ** 2 for name, _ in _CENTRES])
-    th.setflags(write=False)
-    tab.setflags(write=False)
-    return th, tab
-
-
-def _centres_at(theta: np.ndarray, k: np.ndarray, geo: Geometry) -> np.ndarray:
-    """Centre k[i] at theta[i] (pre-rotation plane), complex."""
-    pts = linkage_points(theta, -np.pi / 2, geometry=geo)
-    allc = np.stack([pts[name][:, 0] + 1j * pts[name][:, 1] for name, _ in _CENTRES])
-    return allc[k, np.arange(theta.shape[0])]
-
-
-_CHUNK = 128
-
-
-def _candidates_batch(t: np.ndarray, n: np.ndarray, leg, geo: Geometry, rho: float) -> tuple[np.ndarray, np.ndarray]:
-    """Every candidate (theta, beta, gamma) of the targets t (N, 3) (unverified): per lateral choice w and
-    out-of-plane branch, gamma in closed form, then per support circle the roots of |c_k(theta)| = |Z| on the
-    grid, bisected (vectorised over targets in chunks of :data:`_CHUNK`). Returns (candidates (C, 3), their
-    target index (C,))."""
-    sl, o, _RLM, _R0 = _leg_consts(leg, geo)
-    th, tab = _centre_table(geo)
-    rad = np.array([geo.R + rho if big else rho for _name, big in _CENTRES])
-    d = t - o
-    qs, owner = [], []
-    for w in (-geo.T / 2, geo.T / 2, 0.0):
-        a = geo.d_wheel + sl * w
-        rr = d[:, 1] ** 2 + d[:, 2] ** 2 - a * a
-        for sign in (-1.0, 1.0):
-            yl = sign * np.sqrt(np.maximum(rr, 0.0))
-            gamma = np.angle((sl * d[:, 1] + 1j * d[:, 2]) / (a + 1j * yl))
-            nl = normal_in_leg_frame(gamma, leg, n)
-            w_rule = np.where(nl[:, 2] > _ZERO, -geo.T / 2, np.where(nl[:, 2] < -_ZERO, geo.T / 2, 0.0))
-            nzv = nl[:, 0] + 1j * nl[:, 1]
-            keep = np.flatnonzero((rr >= -1e-15) & (w_rule == w) & (np.abs(nzv) > _ZERO))
-            for start in range(0, keep.size, _CHUNK):
-                idx = keep[start:start + _CHUNK]
-                Z = (-d[idx, 0] + 1j * yl[idx])[:, None] + rad[None, :] * (nzv[idx] / np.abs(nzv[idx]))[:, None]
-                Z2 = np.abs(Z) ** 2
-                f = tab[None] - Z2[:, :, None]
-                ii, kk, jj = np.nonzero(np.signbit(f[:, :, :-1]) != np.signbit(f[:, :, 1:]))
-                lo, hi, flo, z2 = th[jj].copy(), th[jj + 1].copy(), f[ii, kk, jj], Z2[ii, kk]
-                for _ in range(_BISECT):
-                    mid = 0.5 * (lo + hi)
-                    fm = np.abs(_centres_at(mid, kk, geo)) ** 2 - z2
-                    left = np.signbit(fm) == np.signbit(flo)
-                    lo = np.where(left, mid, lo)
-                    hi = np.where(left, hi, mid)
-                roots = 0.5 * (lo + hi)
-                for end in (0, -1):  # a root on a bound of [17, 160] deg without a sign change in the end cell
-                    ie, ke = np.nonzero(np.abs(f[:, :, end]) <= 1e-15)
-                    roots = np.concatenate([roots, np.full(ie.size, th[end])])
-                    ii, kk = np.concatenate([ii, ie]), np.concatenate([kk, ke])
-                if roots.size == 0:
-                    continue
-                beta = wrap(np.angle(Z[ii, kk] / _centres_at(roots, kk, geo)) - np.pi / 2)
-                qs.append(np.stack([roots, beta, gamma[idx][ii]], -1))
-                owner.append(idx[ii])
-    if not qs:
-        return np.empty((0, 3)), np.empty(0, dtype=np.int64)
-    return np.concatenate(qs), np.concatenate(owner)
-
-
-def _solutions_batch(t: np.ndarray, n: np.ndarray, leg, geo: Geometry, rho: float) -> list[np.ndarray]:
-    """The verified (:func:`ground_contact` reproduces the target to :data:`VERIFY_TOL`), de-duplicated solutions
-    of each target, sorted by |gamma| then theta: one (S_i, 3) array per target."""
-    cand, owner = _candidates_batch(t, n, leg, geo, rho)
-    out = [np.empty((0, 3)) for _ in range(t.shape[0])]
-    if cand.shape[0] == 0:
-        return out
-    gc = ground_contact(cand, leg, n[owner], r=rho, geometry=geo)
-    ok = np.linalg.norm(gc.point - t[owner], axis=-1) <= VERIFY_TOL
-    cand, owner = cand[ok], owner[ok]
-    order = np.lexsort((cand[:, 0], np.abs(cand[:, 2]), owner))
-    cand, owner = cand[order], owner[order]
-    bounds = np.searchsorted(owner, np.arange(t.shape[0] + 1))
-    for i in range(t.shape[0]):
-        keep: list[np.ndarray] = []
-        for qv in cand[bounds[i]:bounds[i + 1]]:
-            if all(np.abs(np.concatenate([[qv[0] - k[0]], wrap(qv[1:] - k[1:])])).max() > 1e-9 for k in keep):
-                keep.append(qv)
-        out[i] = np.array(keep).reshape(-1, 3)
-    return out
-
-
-def _targets(target, normal):
-    t = as_input(target, "target", (3,))
-    n = _normals(normal)
-    try:
-        shape = np.broadcast_shapes(t.shape[:-1], n.shape[:-1])
-    except ValueError as exc:
-        raise InvalidInputError(f"inputs do not broadcast together: target{t.shape}, normal{n.shape}") from exc
-    return (as_rows(np.broadcast_to(t, shape + (3,)), 3), as_rows(np.broadcast_to(n, shape + (3,)), 3), shape)
-
-
-def stance_ik_all(target: ArrayLike, leg: Leg, *, normal: ArrayLike = (0.0, 0.0, 1.0), r: float = TYRE_THICKNESS,
-                  limits: bool = False, geometry: Geometry | None = None) -> np.ndarray:
-    """Every (theta, beta, gamma) whose ground contact (:func:`ground_contact`) is ``target``, (..., S, 3), NaN-padded.
-
-    How every solution is found: the lateral coordinate is one of -T/2, T/2, 0 (the rule of
-    :func:`ground_contact`); for each, the target's distance from the module axis gives the leg-plane height
-    y_L (two branches) and gamma in closed form (as the radial IK); then for each circle that can carry the
-    support point (offset arcs about U_L, L_L, L_R, U_R of radius R + r; fillets and caps about F_L, G, F_R,
-    H_L, H_R of radius r) the support point is ``rot(beta) c_k(theta) - rho n_plane``, so
-    ``|c_k(theta)| = |target + rho n_plane|``: every sign change on a 2001-node theta grid over [17, 160] deg is
-    bisected to full precision, beta follows from the angle. Each candidate is kept only if
-    :func:`ground_contact` at it reproduces the target to 1e-9 m (the brute-force verification: the circle must
-    really carry the lowest point). Roots where |c_k|^2 touches the level without crossing it inside one grid
-    cell (a fold) can be missed. Sorted by |gamma|, then theta. ``limits=True``: only |gamma| <= ABAD_LIMIT.
-    """
-    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
-    rho = _thickness(r, geo)
-    limits = check_flag(limits, "limits")
-    _leg(leg)
-    t, n, shape = _targets(target, normal)
-    sols = []
-    for s in _solutions_batch(t, n, leg, geo, rho):
-        if limits:
-            s = s[np.abs(s[:, 2]) <= ABAD_LIMIT + 1e-12]
-        sols.append(s)
-    S = max([1] + [s.shape[0] for s in sols])
-    out = np.full((t.shape[0], S, 3), np.nan)
-    for i, s in enumerate(sols):
-        out[i, : s.shape[0]] = s
-    return out.reshape(shape + (S, 3))
-
-
-@overload
-def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = ..., q_near: ArrayLike | None = ..., r: float = ...,
-              limits: bool = ..., geometry: Geometry | None = ...,
-              return_mask: Literal[False] = False) -> np.ndarray: ...
-@overload
-def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = ..., q_near: ArrayLike | None = ..., r: float = ...,
-              limits: bool = ..., geometry: Geometry | None = ...,
-              return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
-def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = (0.0, 0.0, 1.0), q_near: ArrayLike | None = None,
-              r: float = TYRE_THICKNESS, limits: bool = True, geometry: Geometry | None = None,
-              return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
-    """(theta, beta, gamma) placing the ground contact point (:func:`ground_contact`) of ``leg`` at ``target``.
-
-    The solutions are :func:`stance_ik_all`'s; with ``limits=True`` (default) only those inside the joint limits
-    (theta in [17, 160] deg always; |gamma| <= ABAD_LIMIT). Default: the first (smallest |gamma|, then theta);
-    with ``q_near`` (3,) or (..., 3): the nearest to it (max-norm, beta and gamma wrapped).
-
-    Raises (single target): UnreachableError (no solution), JointLimitError (solutions only outside the limits),
-    InvalidInputError (bad input). A batch gives NaN and mask False instead.
-    """
-    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
-    rho = _thickness(r, geo)
-    limits = check_flag(limits, "limits")
-    return_mask = check_flag(return_mask, "return_mask")
-    _leg(leg)
-    t, n, shape = _targets(target, normal)
-    near = None if q_near is None else as_rows(np.broadcast_to(as_input(q_near, "q_near", (3,)), shape + (3,)), 3)
-    out = np.full((t.shape[0], 3), np.nan)
-    why = np.zeros(t.shape[0], dtype=np.int64)  # 0 solved, 1 unreachable, 2 only outside the limits
-    for i, s in enumerate(_solutions_batch(t, n, leg, geo, rho)):
-        if limits and s.shape[0]:
-            inside = s[np.abs(s[:, 2]) <= ABAD_LIMIT + 1e-12]
-            why[i] = 2 if inside.shape[0] == 0 else 0
-            s = inside
-        elif s.shape[0] == 0:
-            why[i] = 1
-        if s.shape[0] == 0:
-            why[i] = why[i] or 1
-            continue
-        if near is None:
-            out[i] = s[0]
-        else:
-            dist = np.abs(np.concatenate([s[:, :1] - near[i, 0], wrap(s[:, 1:] - near[i, 1:])], 1)).max(1)
-            out[i] = s[int(np.argmin(dist))]
-    ok = why == 0
-    if shape == ():
-        if why[0] == 2:
-            raise JointLimitError(f"target {t[0].tolist()} is reached only with |gamma| > ABAD_LIMIT", target=t[0])
-        if why[0] == 1:
-            raise UnreachableError(f"no configuration puts the ground contact of {leg} at {t[0].tolist()}",
-                                   target=t[0])
-        return out[0]
-    q = out.reshape(shape + (3,))
-    return (q, ok.reshape(shape)) if return_mask else q
+        return getattr(stance, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

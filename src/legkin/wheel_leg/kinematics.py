@@ -42,7 +42,7 @@ from .geometry import (
     TYRE_THICKNESS,
     Geometry,
 )
-from .ground import GroundContact, ground_contact, stance_ik, stance_ik_all
+from .ground import GroundContact, ground_contact
 from .inverse import IKInfo, IKOptions, ik, ik_all
 from .linkage import (
     PASSIVE_JOINTS,
@@ -54,6 +54,7 @@ from .linkage import (
     theta_beta,
 )
 from .rim import rim_jump_seed, rim_point, rim_point_seed, rim_segment
+from .stance import stance_ik, stance_ik_all
 from .tyre import TyrePieces, tyre_length, tyre_pieces, tyre_point
 
 __all__ = [

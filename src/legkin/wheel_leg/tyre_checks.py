@@ -15,8 +15,9 @@ from ..validation import CheckResult, compare, per_sample
 from .configuration import configuration
 from .frames import leg_frame_to_robot
 from .geometry import ABAD_LIMIT, LEGS, THETA0, THETA_MAX, THETA_MIN, Geometry
-from .ground import ground_contact, stance_ik, stance_ik_all
+from .ground import ground_contact
 from .linkage import linkage_points
+from .stance import stance_ik, stance_ik_all
 from .tyre import LINK_NAMES, PIECES, TYRE_THICKNESS, tyre_pieces, tyre_point
 
 TOL = 1e-12

@@ -765,3 +765,85 @@ def test_odd_keyword_values_get_legkin_errors():
                  lambda: wl.ik_all(target, "FL", limits="yes")):
         with pytest.raises(legkin.InvalidParameterError):
             call()
+
+
+# ---------------------------------------------------------------- the roll_and_step clip
+@pytest.fixture(scope="module")
+def roll_clip():
+    from legkin.wheel_leg import clips
+
+    robot = legkin.load("wheel_leg", floating=True)
+    return robot, clips.roll_and_step_plan(), clips.roll_and_step(robot)
+
+
+def test_roll_and_step_contacts_on_the_ground_pinocchio(roll_clip):
+    """Every frame's loops closed; each stance leg's lowest tyre point (ground_contact, the point fixed in its
+    rim link) placed by Pinocchio's floating-base model on z = 0 to 1e-9 m; swinging legs above it."""
+    import pinocchio as pin
+
+    from legkin.wheel_leg.tyre import LINK_NAMES
+
+    robot, plan, qs = roll_clip
+    fixed = legkin.load("wheel_leg")
+    assert len(qs) == plan.leg_q.shape[0] == 180
+    assert set(plan.phase) == {"roll", "transform", "step"}
+    lifted = 0
+    for f, q in enumerate(qs):
+        assert np.abs(robot.constraint_residual(q)).max() < 1e-12
+        pin.framesForwardKinematics(robot.model, robot.data, q)
+        qf = q[7:]
+        pin.framesForwardKinematics(fixed.model, fixed.data, qf)
+        for k, leg in enumerate(wl.LEGS):
+            gc = wl.ground_contact(plan.leg_q[f, k], leg)
+            link = f"{leg}_{LINK_NAMES[int(gc.link)]}"
+            local = fixed.data.oMf[fixed.frame_id(link)].actInv(gc.point)  # fixed in the link
+            world = robot.data.oMf[robot.frame_id(link)].act(local)
+            np.testing.assert_allclose(world, plan.base[f] + gc.point, atol=1e-12, rtol=0)
+            if plan.stance[f, k]:
+                assert abs(world[2]) <= 1e-9
+            else:
+                assert world[2] > 1e-3
+                lifted += 1
+    assert lifted == 4 * (60 // 4 - 1)  # every swing frame but the landing one
+
+
+def test_roll_and_step_base_height_and_rolling(roll_clip):
+    """The free flyer's height is the one that puts the lowest contact on z = 0 (Pinocchio: in wheel mode the leg
+    origins O are R + r above the ground); rolling: the base advances (R + r) dbeta and the contact's material
+    point does not slip (d point / d beta = -(R + r) x, the base's velocity cancels it)."""
+    import pinocchio as pin
+
+    robot, plan, qs = roll_clip
+    rho = 0.1 + wl.TYRE_THICKNESS
+    for f, q in enumerate(qs):
+        np.testing.assert_array_equal(q[:3], plan.base[f])
+        low = min(wl.ground_contact(plan.leg_q[f, k], leg).point[2] for k, leg in enumerate(wl.LEGS))
+        assert abs(q[2] + low) <= 1e-12
+        if plan.phase[f] == "roll":
+            pin.framesForwardKinematics(robot.model, robot.data, q)
+            for leg in wl.LEGS:
+                assert abs(robot.data.oMf[robot.frame_id(f"{leg}_leg")].translation[2] - rho) <= 1e-12
+    roll = np.flatnonzero(plan.phase == "roll")
+    dbeta = np.diff(plan.leg_q[roll, 0, 1])
+    np.testing.assert_allclose(np.diff(plan.base[roll, 0]), rho * dbeta, atol=1e-15, rtol=0)
+    for f in roll[::9]:
+        for k, leg in enumerate(wl.LEGS):
+            J = wl.ground_contact(plan.leg_q[f, k], leg).jacobian
+            np.testing.assert_allclose(J[:, 1] + [rho, 0.0, 0.0], 0.0, atol=1e-12)
+    step = plan.phase == "step"
+    assert np.ptp(plan.base[step, 2]) == 0.0 and plan.base[-1, 0] - plan.base[step][0, 0] > 0.08
+    assert np.abs(plan.leg_q[..., 2]).max() == 0.0  # the legs stay in their planes
+
+
+def test_roll_and_step_fixed_base(roll_clip):
+    """A fixed-base robot gets the same leg motion relative to the body (the base at the origin)."""
+    from legkin.wheel_leg import clips
+
+    robot, _plan, qs = roll_clip
+    fixed = legkin.load("wheel_leg")
+    qf = clips.roll_and_step(fixed)
+    assert len(qf) == len(qs) and qf[0].shape == (fixed.model.nq,)
+    np.testing.assert_array_equal(np.array(qf), np.array(qs)[:, 7:])
+    from legkin.clips import available
+
+    assert "roll_and_step" in available("wheel_leg")

@@ -19,7 +19,13 @@ The rule (issue 16), for every analytic module:
 
 Kernels are cached on disk by numba (``cache=True``): compiled on the first call after an install, loaded
 from the cache afterwards. When the package directory is read-only (a system site-packages), numba writes
-its cache to the user-wide cache directory instead; ``NUMBA_CACHE_DIR`` overrides both.
+its cache to the user-wide cache directory instead; ``NUMBA_CACHE_DIR`` overrides both. (Tested by
+``.ci/run``: legkin bind-mounted read-only, the second process loads every kernel from ``$HOME/.cache/numba``.)
+
+A cached kernel is invalidated when *its own* source file changes (numba keys the cache on that file's
+modification time), not when a kernel it calls in *another* module changes: after editing a kernel that
+kernels of other files call, delete the ``*.nbi``/``*.nbc`` files under ``src/legkin/**/__pycache__`` (a fresh
+install writes every file anew, so users never see a stale kernel).
 """
 
 from __future__ import annotations

@@ -238,3 +238,11 @@ def test_generate_out_writes_the_committed_files(tmp_path):
     bad = subprocess.run([sys.executable, "-m", "legkin", "generate", "tripod", "--out", str(tmp_path / "tripod.urdf")],
                          capture_output=True, text=True, timeout=300)
     assert bad.returncode != 0 and "Traceback" not in bad.stderr and "not a directory" in bad.stderr
+
+
+def test_view_floating_stands_on_the_ground(tmp_path, capsys):
+    page = tmp_path / "q.html"
+    assert main(["view", "quadruped", "--floating", "--html", str(page)]) == 0
+    assert page.stat().st_size > 10_000
+    assert main(["view", "tripod", "--floating", "--html", str(tmp_path / "t.html")]) == 2
+    assert "fixed-base" in capsys.readouterr().err

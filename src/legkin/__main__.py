@@ -177,7 +177,7 @@ def _cmd_view(args) -> int:
 
     if args.animate and (args.q is not None or args.pose is not None):
         raise UsageError("legkin view: error: --animate plays a clip: it takes no --pose or --q")
-    robot = load(args.model)
+    robot = load(args.model, floating=args.floating)
     if args.q is not None:
         if len(args.q) != robot.model.nq:
             raise errors.InvalidInputError(
@@ -265,6 +265,8 @@ def build_parser() -> argparse.ArgumentParser:
     g.add_argument("--pose", help="a named pose from the SRDF")
     g.add_argument("--q", type=finite_float, nargs="+", help="a configuration vector")
     p.add_argument("--animate", metavar="NAME", help="play an animation clip (the clips of legkin.<model>.clips)")
+    p.add_argument("--floating", action="store_true",
+                   help="a free-flyer base (walking robots): the standing poses put the feet on the ground z = 0")
     p.add_argument("--html", metavar="PATH", type=output_file, help="write a static page and exit")
     p.set_defaults(func=_cmd_view)
 

@@ -107,3 +107,14 @@ def test_live_view_serves_until_stopped(model, sig):
         for p in leaked:  # do not leave a server behind even when the test fails
             os.kill(p, signal.SIGKILL)
     assert not leaked, f"meshcat server(s) {leaked} still running after {sig}"
+
+
+@needs_chromium
+def test_ground_plane_is_drawn_under_a_walking_robot(tmp_path):
+    from legkin.viewer import ground_height
+
+    robot = legkin.load("quadruped", floating=True)
+    assert ground_height(robot) == 0.0 and ground_height(legkin.load("tripod")) is None
+    with_ground = shot(write_html(robot, robot.q0, tmp_path / "g.html"), tmp_path / "g.png")
+    without = shot(write_html(robot, robot.q0, tmp_path / "n.html", ground=False), tmp_path / "n.png")
+    assert (np.abs(with_ground - without).max(axis=-1) > 30).mean() > 0.05, "no ground plane drawn"

@@ -199,14 +199,14 @@ def _cmd_view(args) -> int:
 
         qs = frames(robot, args.animate)
         if args.html:
-            print(f"wrote {write_animation_html(robot, qs, args.html)}")
+            print(f"wrote {write_animation_html(robot, qs, args.html, ground=not args.no_ground)}")
             return 0
-        show(robot, qs[0], animation=qs)
+        show(robot, qs[0], animation=qs, ground=not args.no_ground)
         return 0
     if args.html:
-        print(f"wrote {write_html(robot, q, args.html)}")
+        print(f"wrote {write_html(robot, q, args.html, ground=not args.no_ground)}")
         return 0
-    show(robot, q)
+    show(robot, q, ground=not args.no_ground)
     return 0
 
 
@@ -267,6 +267,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--animate", metavar="NAME", help="play an animation clip (the clips of legkin.<model>.clips)")
     p.add_argument("--floating", action="store_true",
                    help="a free-flyer base (walking robots): the standing poses put the feet on the ground z = 0")
+    p.add_argument("--no-ground", action="store_true", help="no ground plane under a walking robot")
     p.add_argument("--html", metavar="PATH", type=output_file, help="write a static page and exit")
     p.set_defaults(func=_cmd_view)
 

@@ -41,7 +41,7 @@ def _sigterm_interrupts() -> Iterator[None]:
 
 
 @contextlib.contextmanager
-def open_viewer(robot: Robot, camera: Sequence[float] | None = None) -> Iterator[Any]:
+def open_viewer(robot: Robot, camera: Sequence[float] | None = None, ground: bool = True) -> Iterator[Any]:
     """A ``pinocchio.visualize.MeshcatVisualizer`` with ``robot`` loaded; its zmq server is always stopped.
 
     meshcat 0.3.2 starts the server as a child process and has no working ``close``: the context
@@ -60,7 +60,8 @@ def open_viewer(robot: Robot, camera: Sequence[float] | None = None) -> Iterator
             viz.loadViewerModel(rootNodeName=robot.name)
             cam = camera if camera is not None else _camera_for(robot)
             viewer["/Cameras/default/rotated/<object>"].set_property("position", list(map(float, cam)))
-            _add_ground(viewer, robot)
+            if ground:
+                _add_ground(viewer, robot)
             yield viz
         finally:
             _stop_server(viewer)
@@ -135,10 +136,10 @@ def _camera_for(robot: Robot) -> tuple[float, float, float]:
     return (s, 0.6 * s, s)
 
 
-def write_html(robot: Robot, q: np.ndarray, path: str | Path) -> Path:
+def write_html(robot: Robot, q: np.ndarray, path: str | Path, ground: bool = True) -> Path:
     """Write a self-contained static meshcat page showing ``robot`` at ``q``; returns the path."""
     q = robot.check_q(q)
-    with open_viewer(robot) as viz:
+    with open_viewer(robot, ground=ground) as viz:
         viz.display(q)
         html = viz.viewer.static_html()
     path = Path(path)
@@ -163,9 +164,11 @@ def _animation(robot: Robot, viz, qs: Sequence[np.ndarray], fps: int):
     return anim
 
 
-def write_animation_html(robot: Robot, qs: Sequence[np.ndarray], path: str | Path, fps: int = 30) -> Path:
+def write_animation_html(
+    robot: Robot, qs: Sequence[np.ndarray], path: str | Path, fps: int = 30, ground: bool = True
+) -> Path:
     """Write a static page that plays a meshcat clip of ``qs`` (loops; scrub it in the Animations menu)."""
-    with open_viewer(robot) as viz:
+    with open_viewer(robot, ground=ground) as viz:
         viz.display(robot.check_q(qs[0]))
         # three.js setLoop(LoopRepeat, n) plays n times, then meshcat pauses and resets to frame 0:
         # repetitions=0 plays the clip ONCE; Infinity (msgpack float) loops for ever.
@@ -176,12 +179,12 @@ def write_animation_html(robot: Robot, qs: Sequence[np.ndarray], path: str | Pat
     return path
 
 
-def show(robot: Robot, q: np.ndarray, animation: Sequence[np.ndarray] | None = None) -> None:
+def show(robot: Robot, q: np.ndarray, animation: Sequence[np.ndarray] | None = None, ground: bool = True) -> None:
     """Serve a live meshcat view of ``robot`` at ``q`` (playing ``animation`` if given) until Ctrl-C."""
     import time
 
     q = robot.check_q(q)
-    with open_viewer(robot) as viz:
+    with open_viewer(robot, ground=ground) as viz:
         viz.display(q)
         if animation is not None:
             viz.viewer.set_animation(_animation(robot, viz, animation, 30), play=True, repetitions=float("inf"))

@@ -36,7 +36,6 @@ is NaN in a batch (mask False) and a legkin error in a single call.
 from __future__ import annotations
 
 from .closed_form import ik_all
-from . import constants as _constants
 from .constants import (
     BRANCHES,
     CLIP_TOL,
@@ -64,7 +63,21 @@ from .textbook import textbook_frame, textbook_ik, textbook_to_joints
 __all__ = [
     "Geometry",
     "DEFAULT_GEOMETRY",
-    *_constants.__all__,  # LEGS, the link offsets X01 ... X34, JOINT_LIMITS and the tolerances
+    "LEGS",
+    "X01",
+    "Y01",
+    "Z01",
+    "Y12",
+    "X23",
+    "Z23",
+    "X34",
+    "JOINT_LIMITS",
+    "REACH_TOL",
+    "BRANCHES",
+    "LIMIT_TOL",
+    "LIMIT_SLACK",
+    "CLIP_TOL",
+    "KNEE_OFFSET",
     "fk",
     "jacobian",
     "ik",

@@ -195,6 +195,7 @@ workspace = st.tuples(st.floats(-1.0, 1.0), st.floats(-1.0, 1.1))
 @settings(max_examples=150, deadline=None)
 @given(workspace)
 @example((2.220446049250313e-16, 0.0))  # mirror-symmetric motors: roll = 0 is a double root of the FK polynomial
+@example((2.220446049250313e-16, 0.7767573355751394))  # ... which the root finder lost (CI, derandomized)
 def test_motor_angles_platform_orientation_round_trip(x):
     roll, pitch = x
     assume(_in_mode(roll, pitch))

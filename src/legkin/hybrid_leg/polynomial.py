@@ -82,19 +82,38 @@ def _rows_conv_k(a, ra, b, rb, n, k):
 def roots_k(c, z):
     """Complex roots z (8,) of the polynomial c (9,) (ascending), NaN-padded: Aberth-Ehrlich iteration.
 
-    Zero leading coefficients lower the degree (a pose at roll = pi); a non-finite polynomial has no roots.
-    Returns the number of roots.
+    Leading coefficients at the rounding level of the largest one lower the degree (roots beyond ~1e15: roll at
+    pi, outside the platform limits); trailing ones at that level are roots at 0, taken exactly (mirror-symmetric
+    motors make roll = 0 a double root, and the iteration started around the other roots would stall a few 1e-3
+    away from it: seen at (roll, pitch) = (2.2e-16, 0.7768)). A non-finite polynomial has no roots. Returns the
+    number of roots.
     """
     for j in range(8):
         z[j] = complex(math.nan, math.nan)
+    cmax = 0.0
     for j in range(9):
         if not math.isfinite(c[j]):
             return 0
+        cmax = max(cmax, abs(c[j]))
+    floor = 1e-15 * cmax
     n = 8
-    while n > 0 and c[n] == 0.0:
+    while n > 0 and abs(c[n]) <= floor:
         n -= 1
     if n == 0:
         return 0
+    lo = 0
+    while lo < n and abs(c[lo]) <= floor:
+        z[lo] = complex(0.0, 0.0)
+        lo += 1
+    if lo == n:
+        return n
+    nz = roots_aberth_k(c[lo : n + 1], n - lo, z[lo:])
+    return lo + nz
+
+
+@kernel
+def roots_aberth_k(c, n, z):
+    """Aberth-Ehrlich iteration for the n roots z[:n] of c[:n + 1] (ascending, c[n] and c[0] nonzero)."""
     lead = c[n]
     # starting points on a circle: the geometric mean of the roots' moduli, at most Fujiwara's bound
     rad = 0.0

@@ -282,13 +282,7 @@ def fk(q: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, geometry: Ge
         out, aux = np.empty(3), np.empty(3)
         if foot_position_k(q[0], q[1], q[2], fp[3], fp[0], fp[1], fp[2], out, aux) == OK:  # type: ignore[index]
             return out
-    g = resolve(geometry, universal="fk")
-    qq = as_input(q, "q", (3,))
-    b = check_branch(branch)
-    s = check_assembly(assembly)
-    flag(return_mask, "return_mask")
-    shape = qq.shape[:-1]
-    rows = np.ascontiguousarray(qq.reshape(-1, 3))
+    g, qq, b, s, shape, rows = _checked_motors(q, branch, assembly, geometry, return_mask, "fk")
     n = len(rows)
     p, aux, st = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.int64)
     loop(_fk_b, _fk_s, n)(rows, g.starting_value, float(b[0]), float(b[1]), s, p, aux, st)
@@ -327,13 +321,7 @@ def jacobian(q: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, geomet
         jac = np.empty((3, 3))
         if foot_jacobian_k(q[0], q[1], q[2], fp[3], fp[0], fp[1], fp[2], jac) == OK:  # type: ignore[index]
             return jac
-    g = resolve(geometry, universal="jacobian")
-    qq = as_input(q, "q", (3,))
-    b = check_branch(branch)
-    s = check_assembly(assembly)
-    flag(return_mask, "return_mask")
-    shape = qq.shape[:-1]
-    rows = np.ascontiguousarray(qq.reshape(-1, 3))
+    g, qq, b, s, shape, rows = _checked_motors(q, branch, assembly, geometry, return_mask, "jacobian")
     n = len(rows)
     jac, st = np.empty((n, 3, 3)), np.empty(n, dtype=np.int64)
     loop(_jacobian_b, _jacobian_s, n)(rows, g.starting_value, float(b[0]), float(b[1]), s, jac, st)
@@ -347,6 +335,18 @@ def jacobian(q: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, geomet
         )
 
     return finish(jac.reshape(shape + (3, 3)), (st == OK).reshape(shape), qq.ndim == 1, return_mask, error)
+
+
+def _checked_motors(q: ArrayLike, branch: Branch, assembly: int, geometry: Geometry | None, return_mask: bool,
+                    what: str) -> tuple[Geometry, np.ndarray, np.ndarray, float, tuple[int, ...], np.ndarray]:
+    """The checked inputs of :func:`fk` and :func:`jacobian` (``what``): geometry, q (..., 3), branch, assembly,
+    the batch shape and q as C-contiguous rows (n, 3); the checks in this order, each raising its legkin error."""
+    g = resolve(geometry, universal=what)
+    qq = as_input(q, "q", (3,))
+    b = check_branch(branch)
+    s = check_assembly(assembly)
+    flag(return_mask, "return_mask")
+    return g, qq, b, s, qq.shape[:-1], np.ascontiguousarray(qq.reshape(-1, 3))
 
 
 def _stack(theta1: ArrayLike, theta2: ArrayLike, theta0: ArrayLike) -> np.ndarray:

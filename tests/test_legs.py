@@ -365,11 +365,15 @@ def test_single_call_equals_batch_row(erd, rows, i, name):
 
 
 def test_big_batch_equals_single_calls_and_shapes(fl):
+    from legkin.legs._fk_kernels import _fk_batch
+    from legkin.legs._ik_kernels import _ik_batch
+
     rng = np.random.default_rng(3)
-    q = rng.uniform(fl.lower, fl.upper, (1000, 3))  # above SERIAL_BELOW: the parallel loop
+    n = max(_ik_batch.min_parallel, _fk_batch.min_parallel) + 3  # the parallel loops
+    q = rng.uniform(fl.lower, fl.upper, (n, 3))
     p = fl.fk(q)
     sol = fl.ik(p)
-    for i in range(0, 1000, 97):
+    for i in range(0, n, 397):
         np.testing.assert_array_equal(fl.ik(p[i]), sol[i])
     assert fl.fk(q.reshape(10, 100, 3)).shape == (10, 100, 3)
     assert fl.jacobian(q.reshape(10, 100, 3)).shape == (10, 100, 3, 3)

@@ -481,10 +481,10 @@ def test_ik_robustness_row_passes():
 def test_batch_is_the_single_call_kernel_item_by_item(rng):
     """The batch is a compiled loop over the single-call kernel: identical answers, bit for bit, on both
     the serial (small) and the parallel (large) path, with and without q_near, and on non-contiguous input."""
-    from legkin._kernels import SERIAL_BELOW
+    from legkin.quadruped.inverse import _ik_batch
 
     lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
-    n = SERIAL_BELOW + 44
+    n = _ik_batch.min_parallel + 44
     q = rng.uniform(lo - 0.05, hi + 0.05, (n, 3))
     p = aq.fk(q, "RH", geometry=G015)
     q_near = rng.uniform(lo, hi, (n, 3))

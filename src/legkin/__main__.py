@@ -142,6 +142,8 @@ def _cmd_check(args) -> int:
     from .validation import all_passed, format_table, run_checks, write_json
 
     models = _check_models(args.models)
+    if args.jobs is None:
+        args.jobs = min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
     if args.plots and importlib.util.find_spec("matplotlib") is None:
         raise errors.LegkinError('--plots needs matplotlib: pip install -e ".[plots]"')
     results = run_checks(
@@ -151,6 +153,7 @@ def _cmd_check(args) -> int:
         ik_targets=args.ik_targets,
         classify=None if args.classify_all else CLASSIFY_DEFAULT,
         progress=_show_progress(args),
+        jobs=args.jobs,
     )
     print(format_table(results))
     from .validation import mujoco_note
@@ -244,6 +247,8 @@ def build_parser() -> argparse.ArgumentParser:
     p = sub.add_parser("check", help="validate the analytic kinematics against Pinocchio")
     p.add_argument("models", nargs="*", help="models (default: all)")
     p.add_argument("--samples", type=positive_int, default=10_000, help="random samples per check (default 10000)")
+    p.add_argument("--jobs", "-j", type=positive_int, default=None, metavar="N",
+                   help="worker processes, one mechanism each (default: the CPUs available, at most 4)")
     p.add_argument("--random-seed", "--seed", dest="seed", type=nonnegative_int, default=0, metavar="S",
                    help="seed of the random samples, an integer >= 0 (default 0; --seed: the 0.1 spelling)")
     p.add_argument(

@@ -6,11 +6,12 @@ The rule (issue 16), for every analytic module:
   (``numba.njit(cache=True)``), beside the seed equations it implements. A kernel takes floats (and small
   preallocated output arrays), writes its result into the outputs and returns a status code
   (:data:`OK` or a module-specific failure code); it never raises.
-* The batch is a compiled loop over that same kernel, decorated with :func:`batch_kernel`
-  (``parallel=True``: ``numba.prange`` over the items). Its thread count is numba's own setting:
-  ``numba.set_num_threads(k)`` or the ``NUMBA_NUM_THREADS`` environment variable. Below
-  :data:`SERIAL_BELOW` items the loop runs on the calling thread (``range`` instead of ``prange`` in the
-  same compiled function): starting the worker threads costs a few microseconds.
+* The batch is a compiled loop over that same kernel, decorated with :func:`batch_kernel`: a plain
+  ``for i in range(n)`` loop compiled once, without the GIL (``nogil=True``). From ``min_parallel`` items on,
+  the call splits the item rows into contiguous chunks and runs one chunk per thread, the thread count being
+  numba's own setting (``numba.set_num_threads(k)`` or the ``NUMBA_NUM_THREADS`` environment variable); below it
+  the loop runs on the calling thread. (Not numba's ``prange``, except for the cheapest closed forms: numba's
+  parallel compiler took a third of the first-run compile time of legkin's kernels; see :class:`BatchLoop`.)
 * The Python wrapper only checks the inputs (lean: a float64 array of the core shape goes straight to the
   kernel), calls the kernel (single input) or the batch loop (leading dimensions), and applies the
   single/batch rule of :mod:`legkin._batch` (a single call raises a legkin error on failure, a batch
@@ -30,34 +31,133 @@ install writes every file anew, so users never see a stale kernel).
 
 from __future__ import annotations
 
+import inspect
+import threading
+from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, TypeVar
 
 import numba
 import numpy as np
+from numba.core import config, types
+from numba.core.registry import CPUDispatcher
 
-__all__ = ["kernel", "batch_kernel", "prange", "OK", "SERIAL_BELOW", "as_rows"]
+__all__ = ["kernel", "batch_kernel", "BatchLoop", "OK", "as_rows", "prange", "threads"]
 
 F = TypeVar("F", bound=Callable[..., Any])
 
 #: Status code of a kernel that succeeded (every failure code is a nonzero int of the module).
 OK = 0
 
-#: Batches with fewer items run serially (no thread start-up, ~3 us); frozen into the kernels at compile time
-#: (numba's cache does not see a change here: delete the ``__pycache__`` entries of the modules after one).
-SERIAL_BELOW = 256
 
-prange = numba.prange
+class KernelDispatcher(CPUDispatcher):
+    """numba's CPU dispatcher, except that a call from another kernel is compiled for the *non-literal* types of
+    its arguments: numba would compile one version of a kernel per constant it is called with
+    (``rot_k(0, a)``, ``rot_k(1, a)``, ``f(..., True)``), each with its whole call tree, and one more for the calls
+    from Python. A kernel's code never depends on a literal argument, so one version serves them all."""
+
+    def get_call_template(self, args, kws):  # noqa: D102 - numba API
+        args = tuple(types.unliteral(a) for a in args)
+        kws = {k: types.unliteral(v) for k, v in kws.items()}
+        return super().get_call_template(args, kws)
+
+
+def _njit(fn: Callable[..., Any], **options: Any) -> Any:
+    """``numba.njit(cache=True, error_model="numpy", **options)(fn)`` on a :class:`KernelDispatcher`."""
+    if config.DISABLE_JIT:
+        return fn
+    disp = KernelDispatcher(py_func=fn, locals={},
+                            targetoptions={"nopython": True, "boundscheck": None, "error_model": "numpy", **options})
+    disp.enable_caching()
+    return disp
 
 
 def kernel(fn: F) -> F:
     """Compile a scalar kernel: ``numba.njit(cache=True, error_model="numpy")`` (no ZeroDivisionError: IEEE
-    semantics, NaN/inf propagate and the kernel's status reports them)."""
-    return numba.njit(cache=True, error_model="numpy")(fn)  # type: ignore[return-value]
+    semantics, NaN/inf propagate and the kernel's status reports them), typed on non-literal arguments
+    (:class:`KernelDispatcher`)."""
+    return _njit(fn)  # type: ignore[no-any-return]
 
 
-def batch_kernel(fn: F) -> F:
-    """Compile a batch loop over a kernel: like :func:`kernel`, with ``parallel=True`` (use ``prange``)."""
-    return numba.njit(cache=True, error_model="numpy", parallel=True)(fn)  # type: ignore[return-value]
+_pool: ThreadPoolExecutor | None = None
+_pool_size = 0
+_pool_lock = threading.Lock()
+
+
+def threads() -> int:
+    """The thread count of a large batch: numba's setting (``numba.set_num_threads``, ``NUMBA_NUM_THREADS``)."""
+    return int(numba.get_num_threads())
+
+
+prange = numba.prange
+
+
+def _executor(workers: int) -> ThreadPoolExecutor:
+    global _pool, _pool_size
+    with _pool_lock:
+        if _pool is None or _pool_size < workers:
+            if _pool is not None:
+                _pool.shutdown(wait=False)
+            _pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="legkin")
+            _pool_size = workers
+        return _pool
+
+
+class BatchLoop:
+    """A compiled batch loop (:func:`batch_kernel`), called like its Python function. The arguments named in
+    ``rows`` hold one row per item (inputs and outputs alike); the first of them gives the item count n.
+
+    Below ``min_parallel`` items the loop runs on the calling thread. From there on, either (default) the rows
+    are split into contiguous chunks, one per thread, each run by the same compiled loop without the GIL (a row
+    argument with a single row, shared by all items, is passed whole; an int return value, a count, is summed
+    over the chunks); or, with ``parfor=True``, the loop's ``prange`` runs on numba's parallel backend, from a
+    second compilation of the same source made on the first large batch. ``parfor`` suits the cheapest loops
+    (~0.1 us an item: numba's parallel loop saves ~30 ns an item of array-view bookkeeping); the chunks need no
+    second compilation (numba's parallel compiler is slow) and suit everything else."""
+
+    def __init__(self, fn: Callable[..., Any], rows: str, min_parallel: int, parfor: bool = False):
+        names = list(inspect.signature(fn).parameters)
+        unknown = [r for r in rows.split() if r not in names]
+        if unknown or not rows.split():
+            raise TypeError(f"batch_kernel(rows={rows!r}): {fn.__name__} has no argument {unknown[0]!r}"
+                            if unknown else "batch_kernel needs the names of the row arguments")
+        self.kernel = _njit(fn, nogil=True)
+        self.rows = tuple(names.index(r) for r in rows.split())
+        self.min_parallel = int(min_parallel)
+        self.parfor = _njit(fn, parallel=True) if parfor else None
+        self.__name__, self.__qualname__, self.__doc__ = fn.__name__, fn.__qualname__, fn.__doc__
+        self.__module__, self.__wrapped__ = fn.__module__, fn
+
+    def __call__(self, *args: Any) -> Any:
+        n = args[self.rows[0]].shape[0]
+        if n < self.min_parallel:
+            return self.kernel(*args)
+        if self.parfor is not None:
+            return self.parfor(*args)
+        k = min(threads(), n)
+        if k <= 1:
+            return self.kernel(*args)
+        edges = [n * j // k for j in range(k + 1)]
+        chunks = []
+        for lo, hi in zip(edges[:-1], edges[1:]):
+            part = list(args)
+            for r in self.rows:
+                if args[r].shape[0] == n:  # a single row shared by all items (broadcast) is passed whole
+                    part[r] = args[r][lo:hi]
+            chunks.append(part)
+        pool = _executor(k - 1)
+        futures = [pool.submit(self.kernel, *part) for part in chunks[1:]]
+        first = self.kernel(*chunks[0])
+        rest = [f.result() for f in futures]
+        return first if first is None else first + sum(rest)
+
+
+def batch_kernel(rows: str, min_parallel: int, parfor: bool = False) -> Callable[[Callable[..., Any]], BatchLoop]:
+    """Compile a batch loop over a kernel (like :func:`kernel`, plus ``nogil=True``); see :class:`BatchLoop`.
+    ``rows``: the names of the arguments with one row per item. ``min_parallel``: the item count from which the
+    loop runs on several threads (choose it so that one thread's share takes at least ~0.2 ms, well above the
+    cost of handing work to a thread). ``parfor``: the loop is written with ``prange`` (``range`` below
+    ``min_parallel``) and runs on numba's parallel backend."""
+    return lambda fn: BatchLoop(fn, rows, min_parallel, parfor)
 
 
 def as_rows(x: np.ndarray, core: int) -> np.ndarray:

@@ -125,6 +125,7 @@ def run_checks(
     ik_targets: int | None = None,
     classify: int | None = 2000,
     progress: bool = False,
+    jobs: int = 1,
 ):
     """Run every check of each model; returns ``{model: (rows, seconds)}``.
 
@@ -132,26 +133,76 @@ def run_checks(
     row on ``n`` random targets in and around the workspace, see :func:`robustness_row`); it runs on
     ``ik_targets`` targets (default ``samples``), classifying at most ``classify`` unsolved ones (None: all)
     by single calls. ``progress=True`` shows a progress bar (tqdm) on stderr, one step per model and stage.
+    ``jobs`` > 1 runs the models in that many worker processes (the mechanisms whose kernels they share, such as
+    the external quadrupeds of :mod:`legkin.legs`, in one process); the rows are the same as with ``jobs=1``
+    (each model draws from its own ``default_rng(seed)``).
     """
     names = list(models or list_models())
     specs = [get_spec(name) for name in names]  # every unknown name raises before any work
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        from .errors import InvalidArgumentError
+
+        raise InvalidArgumentError(f"jobs={jobs!r} must be an integer >= 1")
     modules = [_checks_module(spec) for spec in specs]
-    steps = sum(2 if hasattr(m, "ik_robustness") else 1 for m in modules)
+    steps = {name: 2 if hasattr(m, "ik_robustness") else 1 for name, m in zip(names, modules)}
+    options = dict(samples=samples, seed=seed, ik_targets=ik_targets, classify=classify)
+    groups = _groups(names)
+    out: dict[str, tuple[list[CheckResult], float]] = {}
+    with progress_bar(sum(steps.values()), "legkin check", enabled=progress) as bar:
+        if jobs == 1 or len(groups) == 1:
+            for name in names:
+                out.update(_run_models([name], bar=bar, **options))
+        else:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor, as_completed
+
+            bar.set_postfix_str(f"{len(names)} models in {min(jobs, len(groups))} processes")
+            context = multiprocessing.get_context("spawn")  # no fork of a process with threads (numba, tqdm)
+            with ProcessPoolExecutor(max_workers=min(jobs, len(groups)), mp_context=context) as pool:
+                futures = {pool.submit(_run_models, group, **options): group for group in groups}
+                for future in as_completed(futures):
+                    out.update(future.result())
+                    bar.update(sum(steps[name] for name in futures[future]))
+    return {name: out[name] for name in names}
+
+
+#: The first-run cost of a mechanism's checks relative to the others (compiling its kernels dominates): the
+#: worker processes take the dearest first. Order only; the rows do not depend on it.
+_COST = {"wheel_leg": 5, "hybrid_leg": 4, "legs": 3, "tripod": 2}
+
+
+def _groups(names: list[str]) -> list[list[str]]:
+    """The models in groups run by one worker process each, dearest first: one group per mechanism package
+    (the external robots of :mod:`legkin.legs` share their kernels: one group)."""
+    groups: dict[str, list[str]] = {}
+    for name in names:
+        groups.setdefault("legs" if get_spec(name).external else name, []).append(name)
+    order = sorted(groups, key=lambda key: -_COST.get(key, 1))
+    return [groups[key] for key in order]
+
+
+def _run_models(names: list[str], *, samples: int, seed: int, ik_targets: int | None, classify: int | None,
+                bar: Any = None) -> dict[str, tuple[list[CheckResult], float]]:
+    """The rows of each model (``bar``: a progress bar to advance per model and stage)."""
     out = {}
-    with progress_bar(steps, "legkin check", enabled=progress) as bar:
-        for name, module in zip(names, modules):
-            rng = np.random.default_rng(seed)
-            t0 = time.perf_counter()
+    for name in names:
+        module = _checks_module(get_spec(name))
+        rng = np.random.default_rng(seed)
+        t0 = time.perf_counter()
+        if bar is not None:
             bar.set_postfix_str(f"{name}: checks ({samples} samples)")
-            rows = list(module.run(samples, rng))
-            rows += _mujoco_rows(name, samples, seed)
+        rows = list(module.run(samples, rng))
+        rows += _mujoco_rows(name, samples, seed)
+        if bar is not None:
             bar.update(1)
-            if hasattr(module, "ik_robustness"):
-                n = samples if ik_targets is None else ik_targets
+        if hasattr(module, "ik_robustness"):
+            n = samples if ik_targets is None else ik_targets
+            if bar is not None:
                 bar.set_postfix_str(f"{name}: IK robustness ({n} targets)")
-                rows.append(module.ik_robustness(n, np.random.default_rng(seed + 1), classify=classify))
+            rows.append(module.ik_robustness(n, np.random.default_rng(seed + 1), classify=classify))
+            if bar is not None:
                 bar.update(1)
-            out[name] = (rows, time.perf_counter() - t0)
+        out[name] = (rows, time.perf_counter() - t0)
     return out
 
 

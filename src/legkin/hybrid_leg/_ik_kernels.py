@@ -14,7 +14,7 @@ import math
 import numba
 import numpy as np
 
-from .._kernels import OK, batch_kernel, kernel, prange
+from .._kernels import OK, batch_kernel, kernel
 from .._rotations import wrap_k
 from ._ik_certify import CERTIFY_WORK, certify_k
 from ._options import ST_ASSEMBLE, ST_INPUT, ST_REACH
@@ -72,14 +72,8 @@ def platform_pose_k(ux, uy, uz, llb, rb, pose, info):
     info[0], info[1], info[2] = kk, 1.0 if reach else 0.0, rho
 
 
-@batch_kernel
+@batch_kernel(rows="u pose info", min_parallel=64)
 def platform_pose_b(u, llb, rb, pose, info):
-    for j in prange(u.shape[0]):
-        platform_pose_k(u[j, 0], u[j, 1], u[j, 2], llb, rb, pose[j], info[j])
-
-
-@kernel
-def platform_pose_s(u, llb, rb, pose, info):
     for j in range(u.shape[0]):
         platform_pose_k(u[j, 0], u[j, 1], u[j, 2], llb, rb, pose[j], info[j])
 
@@ -242,15 +236,8 @@ def foot_ik_k(ux, uy, uz, sv, combos, b1, b2, s, limits_only, axis_ok, near, mot
     return ST_ASSEMBLE
 
 
-@batch_kernel
+@batch_kernel(rows="u near motors pose ok", min_parallel=64)
 def foot_ik_b(u, sv, combos, b1, b2, s, limits_only, axis_ok, near, motors, pose, ok):
-    for j in prange(u.shape[0]):
-        ok[j] = foot_ik_k(u[j, 0], u[j, 1], u[j, 2], sv, combos, b1, b2, s, limits_only, axis_ok, near[j],
-                          motors[j], pose[j]) == OK
-
-
-@kernel
-def foot_ik_s(u, sv, combos, b1, b2, s, limits_only, axis_ok, near, motors, pose, ok):
     for j in range(u.shape[0]):
         ok[j] = foot_ik_k(u[j, 0], u[j, 1], u[j, 2], sv, combos, b1, b2, s, limits_only, axis_ok, near[j],
                           motors[j], pose[j]) == OK
@@ -312,13 +299,7 @@ def ik_all_out_k(ux, uy, uz, sv, motors, pose, mask, asm, within, valid):
     return math.isfinite(ux) and math.isfinite(uy) and math.isfinite(uz)
 
 
-@batch_kernel
+@batch_kernel(rows="u motors pose mask asm within valid", min_parallel=32)
 def ik_all_b(u, sv, motors, pose, mask, asm, within, valid):
-    for j in prange(u.shape[0]):
-        ik_all_out_k(u[j, 0], u[j, 1], u[j, 2], sv, motors[j], pose[j], mask[j], asm[j], within[j], valid[j])
-
-
-@kernel
-def ik_all_s(u, sv, motors, pose, mask, asm, within, valid):
     for j in range(u.shape[0]):
         ik_all_out_k(u[j, 0], u[j, 1], u[j, 2], sv, motors[j], pose[j], mask[j], asm[j], within[j], valid[j])

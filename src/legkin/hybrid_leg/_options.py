@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import replace
-from typing import Callable, Final
+from typing import Final
 
 import numpy as np
 
@@ -25,8 +25,6 @@ ST_SINGULAR: Final = 5  # N singular / reach boundary
 
 #: Scalar types a single-call fast path passes straight to a kernel (anything else takes the checked path).
 SCALARS = (float, np.float64)
-#: Batches smaller than this run the serial loop: starting numba's threads costs more than they save.
-PARALLEL_MIN = 64
 
 
 class Unset:
@@ -37,11 +35,6 @@ class Unset:
 
 
 UNSET: Final = Unset()
-
-
-def loop(parallel: Callable[..., object], serial: Callable[..., object], n: int) -> Callable[..., object]:
-    """The compiled batch loop to run for n items: the prange one (parallel) or the plain one (serial)."""
-    return parallel if n >= PARALLEL_MIN else serial
 
 
 def flat(a: np.ndarray) -> np.ndarray:

@@ -8,8 +8,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_input
-from .._kernels import batch_kernel, kernel, prange
-from ._options import SCALARS, UNSET, Unset, fast_geometry, flat, loop, resolve
+from .._kernels import batch_kernel, kernel
+from ._options import SCALARS, UNSET, Unset, fast_geometry, flat, resolve
 from .geometry import RATIO, Geometry
 
 __all__ = ["ll_angle", "extension_motor_angle"]
@@ -27,35 +27,23 @@ def theta0_k(tll, sv):
     return (sv - tll) / RATIO
 
 
-@batch_kernel
+@batch_kernel(rows="t out", min_parallel=8192)
 def _ll_b(t, sv, out):
-    for j in prange(t.shape[0]):
-        out[j] = ll_k(t[j], sv)
-
-
-@kernel
-def _ll_s(t, sv, out):
     for j in range(t.shape[0]):
         out[j] = ll_k(t[j], sv)
 
 
-@batch_kernel
+@batch_kernel(rows="t out", min_parallel=8192)
 def _theta0_b(t, sv, out):
-    for j in prange(t.shape[0]):
-        out[j] = theta0_k(t[j], sv)
-
-
-@kernel
-def _theta0_s(t, sv, out):
     for j in range(t.shape[0]):
         out[j] = theta0_k(t[j], sv)
 
 
-def _apply(x: ArrayLike, name: str, sv: float, parallel: Callable[..., object], serial: Callable[..., object]
+def _apply(x: ArrayLike, name: str, sv: float, batch: Callable[..., object]
            ) -> np.ndarray | float:
     a = as_input(x, name)
     out = np.empty(a.size)
-    loop(parallel, serial, a.size)(flat(a), sv, out)
+    batch(flat(a), sv, out)
     return out.reshape(a.shape) if a.ndim else np.float64(out[0])
 
 
@@ -81,7 +69,7 @@ def ll_angle(theta0: ArrayLike, starting_value: float | Unset = UNSET, *,
     if type(theta0) in SCALARS and starting_value is UNSET and g is not None:
         return np.float64(ll_k(theta0, g.starting_value))
     g = resolve(geometry, starting_value)
-    return _apply(theta0, "theta0", g.starting_value, _ll_b, _ll_s)
+    return _apply(theta0, "theta0", g.starting_value, _ll_b)
 
 
 def extension_motor_angle(theta_ll: ArrayLike, starting_value: float | Unset = UNSET, *,
@@ -94,4 +82,4 @@ def extension_motor_angle(theta_ll: ArrayLike, starting_value: float | Unset = U
     if type(theta_ll) in SCALARS and starting_value is UNSET and g is not None:
         return np.float64(theta0_k(theta_ll, g.starting_value))
     g = resolve(geometry, starting_value)
-    return _apply(theta_ll, "theta_ll", g.starting_value, _theta0_b, _theta0_s)
+    return _apply(theta_ll, "theta_ll", g.starting_value, _theta0_b)

@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_angles, as_input, finish
-from .._kernels import OK, batch_kernel, kernel, prange
+from .._kernels import OK, batch_kernel, kernel
 from ..errors import ConvergenceError, SingularityError
 from ._options import (
     SCALARS,
@@ -28,7 +28,6 @@ from ._options import (
     fast_sign,
     flag,
     flat,
-    loop,
     resolve,
 )
 from .chains import CX, CY, CZ, OX, OZ, rod_rates_k, tips_k
@@ -56,14 +55,8 @@ def foot_k(r, p, t, out):
     return OK
 
 
-@batch_kernel
+@batch_kernel(rows="r p t out", min_parallel=8192)
 def _foot_b(r, p, t, out):
-    for j in prange(r.shape[0]):
-        foot_k(r[j], p[j], t[j], out[j])
-
-
-@kernel
-def _foot_s(r, p, t, out):
     for j in range(r.shape[0]):
         foot_k(r[j], p[j], t[j], out[j])
 
@@ -135,14 +128,8 @@ def foot_position_k(t1, t2, t0, sv, b1, b2, s, out, aux):
     return foot_k(x[0], x[1], tll, out)
 
 
-@batch_kernel
+@batch_kernel(rows="q out aux st", min_parallel=64)
 def _fk_b(q, sv, b1, b2, s, out, aux, st):
-    for j in prange(q.shape[0]):
-        st[j] = foot_position_k(q[j, 0], q[j, 1], q[j, 2], sv, b1, b2, s, out[j], aux[j])
-
-
-@kernel
-def _fk_s(q, sv, b1, b2, s, out, aux, st):
     for j in range(q.shape[0]):
         st[j] = foot_position_k(q[j, 0], q[j, 1], q[j, 2], sv, b1, b2, s, out[j], aux[j])
 
@@ -195,14 +182,8 @@ def foot_jacobian_k(t1, t2, t0, sv, b1, b2, s, jac):
     return OK
 
 
-@batch_kernel
+@batch_kernel(rows="q jac st", min_parallel=64)
 def _jacobian_b(q, sv, b1, b2, s, jac, st):
-    for j in prange(q.shape[0]):
-        st[j] = foot_jacobian_k(q[j, 0], q[j, 1], q[j, 2], sv, b1, b2, s, jac[j])
-
-
-@kernel
-def _jacobian_s(q, sv, b1, b2, s, jac, st):
     for j in range(q.shape[0]):
         st[j] = foot_jacobian_k(q[j, 0], q[j, 1], q[j, 2], sv, b1, b2, s, jac[j])
 
@@ -223,7 +204,7 @@ def foot_position_from_platform(roll: ArrayLike, pitch: ArrayLike, theta_ll: Arr
     resolve(geometry)
     r, p, t = as_angles(roll, pitch, theta_ll, names=("roll", "pitch", "theta_ll"))
     out = np.empty((r.size, 3))
-    loop(_foot_b, _foot_s, r.size)(flat(r), flat(p), flat(t), out)
+    _foot_b(flat(r), flat(p), flat(t), out)
     return out.reshape(r.shape + (3,))
 
 
@@ -285,7 +266,7 @@ def fk(q: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, geometry: Ge
     g, qq, b, s, shape, rows = _checked_motors(q, branch, assembly, geometry, return_mask, "fk")
     n = len(rows)
     p, aux, st = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.int64)
-    loop(_fk_b, _fk_s, n)(rows, g.starting_value, float(b[0]), float(b[1]), s, p, aux, st)
+    _fk_b(rows, g.starting_value, float(b[0]), float(b[1]), s, p, aux, st)
 
     def error() -> Exception:
         if st[0] == ST_ASSEMBLE:
@@ -324,7 +305,7 @@ def jacobian(q: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, geomet
     g, qq, b, s, shape, rows = _checked_motors(q, branch, assembly, geometry, return_mask, "jacobian")
     n = len(rows)
     jac, st = np.empty((n, 3, 3)), np.empty(n, dtype=np.int64)
-    loop(_jacobian_b, _jacobian_s, n)(rows, g.starting_value, float(b[0]), float(b[1]), s, jac, st)
+    _jacobian_b(rows, g.starting_value, float(b[0]), float(b[1]), s, jac, st)
 
     def error() -> Exception:
         if st[0] == ST_ASSEMBLE:

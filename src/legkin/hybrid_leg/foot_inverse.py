@@ -15,12 +15,9 @@ from ._ik_errors import arc_error, axis_error, ik_error, platform_pose
 from ._ik_kernels import (
     foot_ik_b,
     foot_ik_k,
-    foot_ik_s,
     ik_all_b,
     ik_all_out_k,
-    ik_all_s,
     platform_pose_b,
-    platform_pose_s,
 )
 from ._options import (
     UNSET,
@@ -34,7 +31,6 @@ from ._options import (
     fast_sign,
     flag,
     fmt,
-    loop,
     resolve,
 )
 from .chains import CX, CY, CZ
@@ -58,7 +54,7 @@ def _search(u: np.ndarray, sv: float, combos: list, b: np.ndarray, s: float, lim
     n = len(u)
     motors, pose, ok = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.bool_)
     nr = np.broadcast_to(_NO_NEAR, (n, 3)) if near is None else near
-    loop(foot_ik_b, foot_ik_s, n)(np.ascontiguousarray(u, dtype=np.float64), float(sv),
+    foot_ik_b(np.ascontiguousarray(u, dtype=np.float64), float(sv),
                                   np.array(combos, dtype=np.float64).reshape(-1, 2), float(b[0]), float(b[1]),
                                   float(s), bool(limits_only), bool(axis_ok), np.ascontiguousarray(nr), motors, pose,
                                   ok)
@@ -127,7 +123,7 @@ def foot_platform_ik(p: ArrayLike, *, ll_branch: int | None = None, roll_branch:
     if (llb is not None or rb is not None) and not moded:
         n = len(u)
         out, info = np.empty((n, 3)), np.empty((n, 3))
-        loop(platform_pose_b, platform_pose_s, n)(np.ascontiguousarray(u), -1.0 if llb is None else llb,
+        platform_pose_b(np.ascontiguousarray(u), -1.0 if llb is None else llb,
                                                   1.0 if rb is None else rb, out, info)
         ok = (info[:, 1] == 1.0) & (info[:, 2] > 0.0)
         out = np.where(ok[:, None], out, np.nan)
@@ -246,7 +242,7 @@ def ik_all(p: ArrayLike, *, geometry: Geometry | None = None) -> FootIKSolutions
     _, u, shape = _targets(p)
     n = len(u)
     out = _all_outputs((n,))
-    loop(ik_all_b, ik_all_s, n)(np.ascontiguousarray(u), g.starting_value, *out)
+    ik_all_b(np.ascontiguousarray(u), g.starting_value, *out)
     return FootIKSolutions(*(a.reshape(shape + a.shape[1:]) for a in out))
 
 

@@ -10,7 +10,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_angles, as_input, finish
-from .._kernels import OK, batch_kernel, kernel, prange
+from .._kernels import OK, batch_kernel, kernel
 from .._rotations import wrap_k
 from ..errors import ConvergenceError, InvalidInputError
 from ._options import (
@@ -27,7 +27,6 @@ from ._options import (
     fast_sign,
     flag,
     flat,
-    loop,
     mode_text,
     real,
     resolve,
@@ -65,14 +64,8 @@ def fk_select_k(t1, t2, b1, b2, s, tol, max_iter, x):
     return OK if best < math.inf else ST_ASSEMBLE
 
 
-@batch_kernel
+@batch_kernel(rows="t1 t2 b1 b2 s x ok", min_parallel=64)
 def _fk_select_b(t1, t2, b1, b2, s, tol, max_iter, x, ok):
-    for j in prange(t1.shape[0]):
-        ok[j] = fk_select_k(t1[j], t2[j], b1[j], b2[j], s[j], tol, max_iter, x[j]) == OK
-
-
-@kernel
-def _fk_select_s(t1, t2, b1, b2, s, tol, max_iter, x, ok):
     for j in range(t1.shape[0]):
         ok[j] = fk_select_k(t1[j], t2[j], b1[j], b2[j], s[j], tol, max_iter, x[j]) == OK
 
@@ -115,14 +108,8 @@ def poses_k(t1, t2, tol, max_iter, x, br, asm):
     return cnt
 
 
-@batch_kernel
+@batch_kernel(rows="t1 t2 x br asm", min_parallel=64)
 def _poses_b(t1, t2, tol, max_iter, x, br, asm):
-    for j in prange(t1.shape[0]):
-        poses_k(t1[j], t2[j], tol, max_iter, x[j], br[j], asm[j])
-
-
-@kernel
-def _poses_s(t1, t2, tol, max_iter, x, br, asm):
     for j in range(t1.shape[0]):
         poses_k(t1[j], t2[j], tol, max_iter, x[j], br[j], asm[j])
 
@@ -151,17 +138,10 @@ def fk_guess_k(t1, t2, g0, g1, b1, b2, tol, max_iter, x):
     return ST_ASSEMBLE
 
 
-@batch_kernel
+@batch_kernel(rows="t1 t2 g x ok", min_parallel=64)
 def _fk_guess_b(t1, t2, g, b1, b2, tol, max_iter, x, ok):
-    for j in prange(t1.shape[0]):
-        ok[j] = fk_guess_k(t1[j], t2[j], g[j, 0], g[j, 1], b1, b2, tol, max_iter, x[j]) == OK
-
-
-@kernel
-def _fk_guess_s(t1, t2, g, b1, b2, tol, max_iter, x, ok):
     for j in range(t1.shape[0]):
         ok[j] = fk_guess_k(t1[j], t2[j], g[j, 0], g[j, 1], b1, b2, tol, max_iter, x[j]) == OK
-
 
 
 # ----------------------------------------------------------------------------- wrappers
@@ -201,7 +181,7 @@ def platform_poses(theta1: ArrayLike, theta2: ArrayLike, *, tol: float = 1e-12, 
     x = np.empty((n, 8, 2))
     bran = np.empty((n, 8, 2), dtype=np.int64)
     asm = np.empty((n, 8), dtype=np.int64)
-    loop(_poses_b, _poses_s, n)(flat(t1), flat(t2), tol, max_iter, x, bran, asm)
+    _poses_b(flat(t1), flat(t2), tol, max_iter, x, bran, asm)
     mask = np.isfinite(x[..., 0])
     return PlatformPoses(x.reshape(shape + (8, 2)), bran.reshape(shape + (8, 2)), asm.reshape(shape + (8,)),
                          mask.reshape(shape + (8,)))
@@ -308,11 +288,11 @@ def platform_orientation(
             g = np.broadcast_to(g, shape + (2,)).reshape(-1, 2)
         except ValueError:
             raise InvalidInputError(f"q_start must broadcast to shape {shape + (2,)}, got shape {g.shape}") from None
-        loop(_fk_guess_b, _fk_guess_s, n)(flat(t1), flat(t2), np.array(g, dtype=np.float64), float(b[0]),
+        _fk_guess_b(flat(t1), flat(t2), np.array(g, dtype=np.float64), float(b[0]),
                                          float(b[1]), tol, max_iter, x, ok)
     else:
         b1, b2, ss = np.full(n, b[0]), np.full(n, b[1]), np.full(n, s)
-        loop(_fk_select_b, _fk_select_s, n)(flat(t1), flat(t2), b1, b2, ss, tol, max_iter, x, ok)
+        _fk_select_b(flat(t1), flat(t2), b1, b2, ss, tol, max_iter, x, ok)
     guessed = q_start is not None
     return finish(np.where(ok[:, None], x, np.nan).reshape(shape + (2,)), ok.reshape(shape), t1.ndim == 0, return_mask,
                   lambda: ConvergenceError(fk_failure(float(t1), float(t2), b, s, guessed)))

@@ -16,7 +16,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_angles, finish
-from .._kernels import OK, batch_kernel, kernel, prange
+from .._kernels import OK, batch_kernel, kernel
 from ..errors import SingularityError
 from ._options import (
     SCALARS,
@@ -26,7 +26,6 @@ from ._options import (
     fast_branch,
     flag,
     flat,
-    loop,
     resolve,
     unreachable,
 )
@@ -55,14 +54,8 @@ Branch = Sequence[int]
 
 
 # ----------------------------------------------------------------------------- kernels
-@batch_kernel
+@batch_kernel(rows="r p out", min_parallel=8192)
 def _rot_b(r, p, out):
-    for j in prange(r.shape[0]):
-        rot_k(r[j], p[j], out[j])
-
-
-@kernel
-def _rot_s(r, p, out):
     for j in range(r.shape[0]):
         rot_k(r[j], p[j], out[j])
 
@@ -83,26 +76,14 @@ def spans_k(t1, t2, r, p, out):
         out[i] = math.sqrt(dx * dx + dy * dy + dz * dz)
 
 
-@batch_kernel
+@batch_kernel(rows="t1 t2 r p out", min_parallel=8192)
 def _spans_b(t1, t2, r, p, out):
-    for j in prange(t1.shape[0]):
-        spans_k(t1[j], t2[j], r[j], p[j], out[j])
-
-
-@kernel
-def _spans_s(t1, t2, r, p, out):
     for j in range(t1.shape[0]):
         spans_k(t1[j], t2[j], r[j], p[j], out[j])
 
 
-@batch_kernel
+@batch_kernel(rows="r p theta kout ok", min_parallel=4096)
 def _motor_angles_b(r, p, b1, b2, theta, kout, ok):
-    for j in prange(r.shape[0]):
-        ok[j] = motor_angles_k(r[j], p[j], b1, b2, theta[j], kout[j]) == OK
-
-
-@kernel
-def _motor_angles_s(r, p, b1, b2, theta, kout, ok):
     for j in range(r.shape[0]):
         ok[j] = motor_angles_k(r[j], p[j], b1, b2, theta[j], kout[j]) == OK
 
@@ -139,14 +120,8 @@ def motor_jacobian_k(r, p, b1, b2, jac, kout, mode):
     return OK
 
 
-@batch_kernel
+@batch_kernel(rows="r p jac kout mode st", min_parallel=4096)
 def _motor_jacobian_b(r, p, b1, b2, jac, kout, mode, st):
-    for j in prange(r.shape[0]):
-        st[j] = motor_jacobian_k(r[j], p[j], b1, b2, jac[j], kout[j], mode[j])
-
-
-@kernel
-def _motor_jacobian_s(r, p, b1, b2, jac, kout, mode, st):
     for j in range(r.shape[0]):
         st[j] = motor_jacobian_k(r[j], p[j], b1, b2, jac[j], kout[j], mode[j])
 
@@ -169,7 +144,7 @@ def platform_rotation(roll: ArrayLike, pitch: ArrayLike, *, geometry: Geometry |
     resolve(geometry)
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
     out = np.empty((r.size, 3, 3))
-    loop(_rot_b, _rot_s, r.size)(flat(r), flat(p), out)
+    _rot_b(flat(r), flat(p), out)
     return out.reshape(r.shape + (3, 3))
 
 
@@ -188,7 +163,7 @@ def rod_spans(theta1: ArrayLike, theta2: ArrayLike, roll: ArrayLike = 0.0, pitch
     resolve(geometry)
     t1, t2, r, p = as_angles(theta1, theta2, roll, pitch, names=("theta1", "theta2", "roll", "pitch"))
     out = np.empty((t1.size, 2))
-    loop(_spans_b, _spans_s, t1.size)(flat(t1), flat(t2), flat(r), flat(p), out)
+    _spans_b(flat(t1), flat(t2), flat(r), flat(p), out)
     return out.reshape(t1.shape + (2,))
 
 
@@ -221,7 +196,7 @@ def motor_angles(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *, 
     flag(return_mask, "return_mask")
     n = r.size
     theta, k, ok = np.empty((n, 2)), np.empty((n, 2)), np.empty(n, dtype=np.bool_)
-    loop(_motor_angles_b, _motor_angles_s, n)(flat(r), flat(p), float(b[0]), float(b[1]), theta, k, ok)
+    _motor_angles_b(flat(r), flat(p), float(b[0]), float(b[1]), theta, k, ok)
     return finish(theta.reshape(r.shape + (2,)), ok.reshape(r.shape), r.ndim == 0, return_mask,
                   lambda: unreachable(_pose_text(r, p), k[0]))
 
@@ -232,7 +207,7 @@ def _jacobian_and_mode(r: np.ndarray, p: np.ndarray, b: np.ndarray
     status (...), mode (...)."""
     n = r.size
     jac, k, mode, st = np.empty((n, 2, 2)), np.empty((n, 2)), np.empty((n, 1)), np.empty(n, dtype=np.int64)
-    loop(_motor_jacobian_b, _motor_jacobian_s, n)(flat(r), flat(p), float(b[0]), float(b[1]), jac, k, mode, st)
+    _motor_jacobian_b(flat(r), flat(p), float(b[0]), float(b[1]), jac, k, mode, st)
     sh = r.shape
     return jac.reshape(sh + (2, 2)), k.reshape(sh + (2,)), st.reshape(sh), mode.reshape(sh)
 

@@ -15,9 +15,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_input, finish
-from .._kernels import OK, batch_kernel, kernel, prange
+from .._kernels import OK, batch_kernel, kernel
 from ..errors import InvalidInputError
-from ._options import ST_INPUT, check_branch, fast_branch, flag, loop, resolve, unreachable
+from ._options import ST_INPUT, check_branch, fast_branch, flag, resolve, unreachable
 from .chains import AX0, AX1, AY0, AY1, AZ0, AZ1, CX, CY, CZ, L, chains_k, is_rotation_k, rotation_error_k, tips_k
 from .geometry import BETA, K_TOL, Geometry
 
@@ -90,47 +90,29 @@ def free_axis_k(m, b1, b2, out, kout):
     return OK
 
 
-@batch_kernel
+@batch_kernel(rows="m out kout st", min_parallel=4096)
 def _rot_angles_b(m, b1, b2, out, kout, st):
-    for j in prange(m.shape[0]):
-        st[j] = rot_angles_k(m[j], b1, b2, out[j], kout[j])
-
-
-@kernel
-def _rot_angles_s(m, b1, b2, out, kout, st):
     for j in range(m.shape[0]):
         st[j] = rot_angles_k(m[j], b1, b2, out[j], kout[j])
 
 
-@batch_kernel
+@batch_kernel(rows="m out kout st", min_parallel=4096)
 def _sphere_b(m, b1, b2, out, kout, st):
-    for j in prange(m.shape[0]):
-        st[j] = sphere_k(m[j], b1, b2, out[j], kout[j])
-
-
-@kernel
-def _sphere_s(m, b1, b2, out, kout, st):
     for j in range(m.shape[0]):
         st[j] = sphere_k(m[j], b1, b2, out[j], kout[j])
 
 
-@batch_kernel
+@batch_kernel(rows="m out kout st", min_parallel=4096)
 def _free_axis_b(m, b1, b2, out, kout, st):
-    for j in prange(m.shape[0]):
-        st[j] = free_axis_k(m[j], b1, b2, out[j], kout[j])
-
-
-@kernel
-def _free_axis_s(m, b1, b2, out, kout, st):
     for j in range(m.shape[0]):
         st[j] = free_axis_k(m[j], b1, b2, out[j], kout[j])
 
 
-def _rotation_call(kernels: tuple[Callable[..., object], Callable[..., object]], core: tuple[int, ...],
+def _rotation_call(kernels: Callable[..., object], core: tuple[int, ...],
                    rotation: ArrayLike, branch: Branch, return_mask: bool, geometry: Geometry | None
                    ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """The three functions of a platform rotation (motor angles, sphere joint angles, free axis) on their batch
-    kernels (parallel, serial): rotations checked (InvalidInputError unless orthonormal with det +1 within 1e-9)."""
+    loop: rotations checked (InvalidInputError unless orthonormal with det +1 within 1e-9)."""
     resolve(geometry)
     rot = as_input(rotation, "rotation", (3, 3))
     b = check_branch(branch)
@@ -139,7 +121,7 @@ def _rotation_call(kernels: tuple[Callable[..., object], Callable[..., object]],
     m = np.ascontiguousarray(rot.reshape(-1, 3, 3))
     n = len(m)
     out, k, st = np.empty((n,) + core), np.empty((n, 2)), np.empty(n, dtype=np.int64)
-    loop(*kernels, n)(m, float(b[0]), float(b[1]), out, k, st)
+    kernels(m, float(b[0]), float(b[1]), out, k, st)
     if np.any(st == ST_INPUT):
         worst = max(rotation_error_k(mj) for mj in m[st == ST_INPUT])
         raise InvalidInputError(f"rotation must be rotation matrices (orthonormal, det +1 within 1e-9); worst "
@@ -183,7 +165,7 @@ def motor_angles_from_rotation(rotation: ArrayLike, branch: Branch = (1, 1), *, 
         theta, k = np.empty(2), np.empty(2)
         if rot_angles_k(rotation, fb[0], fb[1], theta, k) == OK:
             return theta
-    return _rotation_call((_rot_angles_b, _rot_angles_s), (2,), rotation, branch, return_mask, geometry)  # type: ignore[no-any-return]
+    return _rotation_call(_rot_angles_b, (2,), rotation, branch, return_mask, geometry)  # type: ignore[no-any-return]
 
 
 @overload
@@ -212,7 +194,7 @@ def sphere_joint_angles(rotation: ArrayLike, branch: Branch = (1, 1), *, geometr
         out, k = np.empty((2, 3)), np.empty(2)
         if sphere_k(rotation, fb[0], fb[1], out, k) == OK:
             return out
-    return _rotation_call((_sphere_b, _sphere_s), (2, 3), rotation, branch, return_mask, geometry)  # type: ignore[no-any-return]
+    return _rotation_call(_sphere_b, (2, 3), rotation, branch, return_mask, geometry)  # type: ignore[no-any-return]
 
 
 @overload
@@ -238,4 +220,4 @@ def spherical_free_axis(rotation: ArrayLike, branch: Branch = (1, 1), *, geometr
         out, k = np.empty(3), np.empty(2)
         if free_axis_k(rotation, fb[0], fb[1], out, k) == OK:
             return out
-    return _rotation_call((_free_axis_b, _free_axis_s), (3,), rotation, branch, return_mask, geometry)  # type: ignore[no-any-return]
+    return _rotation_call(_free_axis_b, (3,), rotation, branch, return_mask, geometry)  # type: ignore[no-any-return]

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from .._kernels import OK, SERIAL_BELOW, batch_kernel, kernel, prange
+from .._kernels import OK, batch_kernel, kernel, prange
 from ._layout import _A1, _A2, _A3, _BAD_INPUT, _O, _V3F, _V21, _V32
 
 
@@ -88,25 +88,17 @@ def _jacobian_k(q, g, out) -> int:
     return OK
 
 
-@batch_kernel
+@batch_kernel(rows="q out", min_parallel=256, parfor=True)
 def _fk_batch(q, g, out) -> int:
     n, bad = q.shape[0], 0
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            bad += _fk_k(q[i], g, out[i]) != OK
-    else:
-        for i in prange(n):
-            bad += _fk_k(q[i], g, out[i]) != OK
+    for i in prange(n):
+        bad += _fk_k(q[i], g, out[i]) != OK
     return bad
 
 
-@batch_kernel
+@batch_kernel(rows="q out", min_parallel=256, parfor=True)
 def _jacobian_batch(q, g, out) -> int:
     n, bad = q.shape[0], 0
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            bad += _jacobian_k(q[i], g, out[i]) != OK
-    else:
-        for i in prange(n):
-            bad += _jacobian_k(q[i], g, out[i]) != OK
+    for i in prange(n):
+        bad += _jacobian_k(q[i], g, out[i]) != OK
     return bad

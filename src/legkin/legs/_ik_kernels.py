@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from .._kernels import OK, SERIAL_BELOW, batch_kernel, kernel, prange
+from .._kernels import OK, batch_kernel, kernel
 from ._fk_kernels import _finite3, _fk3_k, _jac3_k
 from ._layout import (
     _BAD_INPUT,
@@ -248,24 +248,16 @@ def _ik_k(p, g, ref, out, info) -> int:
     return OK
 
 
-@batch_kernel
+@batch_kernel(rows="p ref out status info", min_parallel=4096)
 def _ik_all_batch(p, g, ref, out, status, info) -> None:
     # ref: one row for all targets (m = 1) or one per target; ``i - i`` keeps the index type of prange's i
     n, m = p.shape[0], ref.shape[0]
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            status[i] = _ik_all_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])
-    else:
-        for i in prange(n):
-            status[i] = _ik_all_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])
+    for i in range(n):
+        status[i] = _ik_all_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])
 
 
-@batch_kernel
+@batch_kernel(rows="p ref out status info", min_parallel=4096)
 def _ik_batch(p, g, ref, out, status, info) -> None:
     n, m = p.shape[0], ref.shape[0]
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            status[i] = _ik_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])
-    else:
-        for i in prange(n):
-            status[i] = _ik_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])
+    for i in range(n):
+        status[i] = _ik_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])

@@ -19,7 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .._batch import check_flag
-from .._kernels import OK, SERIAL_BELOW, as_rows, batch_kernel, kernel, prange
+from .._kernels import OK, as_rows, batch_kernel, kernel, prange
 from ..errors import UnreachableError
 from ._common import F64, LEG_INDEX, S3, S43, foot_z_of, leg_index, raise_bad, rows
 from .constants import (
@@ -155,20 +155,14 @@ def _ik_all_k(p, li, foot_z, out) -> int:
     return _ik_all_core(p, li, foot_z, l2, offset, co, so, out)
 
 
-@batch_kernel
+@batch_kernel(rows="p out ok", min_parallel=256, parfor=True)
 def _ik_all_batch(p, li, foot_z, out, ok) -> int:
     n, bad = p.shape[0], 0
     l2, offset, co, so = _leg_plane_k(foot_z)
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            s = _ik_all_core(p[i], li, foot_z, l2, offset, co, so, out[i])
-            ok[i] = s == OK
-            bad += s == BAD_INPUT
-    else:
-        for i in prange(n):
-            s = _ik_all_core(p[i], li, foot_z, l2, offset, co, so, out[i])
-            ok[i] = s == OK
-            bad += s == BAD_INPUT
+    for i in prange(n):
+        s = _ik_all_core(p[i], li, foot_z, l2, offset, co, so, out[i])
+        ok[i] = s == OK
+        bad += s == BAD_INPUT
     return bad
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import numpy.typing as npt
 
-from .._kernels import OK, SERIAL_BELOW, as_rows, batch_kernel, kernel, prange
+from .._kernels import OK, as_rows, batch_kernel, kernel, prange
 from ._common import F64, LEG_INDEX, S3, S33, foot_z_of, leg_index, raise_bad, rows
 from .constants import BAD_INPUT, SX, SY, X01, X23, X34, Y01, Y12, Z01, Z23
 from .geometry import Geometry
@@ -91,27 +91,19 @@ def _jac_k(q, li, foot_z, out) -> int:
     return OK
 
 
-@batch_kernel
+@batch_kernel(rows="q out", min_parallel=256, parfor=True)
 def _fk_batch(q, li, foot_z, out) -> int:
     n, bad = q.shape[0], 0
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            bad += _fk_k(q[i], li, foot_z, out[i]) != OK
-    else:
-        for i in prange(n):
-            bad += _fk_k(q[i], li, foot_z, out[i]) != OK
+    for i in prange(n):
+        bad += _fk_k(q[i], li, foot_z, out[i]) != OK
     return bad
 
 
-@batch_kernel
+@batch_kernel(rows="q out", min_parallel=256, parfor=True)
 def _jac_batch(q, li, foot_z, out) -> int:
     n, bad = q.shape[0], 0
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            bad += _jac_k(q[i], li, foot_z, out[i]) != OK
-    else:
-        for i in prange(n):
-            bad += _jac_k(q[i], li, foot_z, out[i]) != OK
+    for i in prange(n):
+        bad += _jac_k(q[i], li, foot_z, out[i]) != OK
     return bad
 
 
@@ -121,7 +113,7 @@ def _hip_position_k(li, out) -> int:
     return OK
 
 
-@batch_kernel
+@batch_kernel(rows="q3 out", min_parallel=256, parfor=True)
 def _knee_batch(q3, foot_z, out) -> None:
     for i in prange(q3.shape[0]):
         out[i, 0], out[i, 1] = _knee_k(q3[i], foot_z)

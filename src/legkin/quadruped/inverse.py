@@ -9,7 +9,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .._batch import as_input, check_flag
-from .._kernels import OK, SERIAL_BELOW, as_rows, batch_kernel, kernel, prange
+from .._kernels import OK, as_rows, batch_kernel, kernel, prange
 from .._rotations import wrap_k
 from ..errors import InvalidInputError, JointLimitError, UnreachableError
 from ._common import F64, LEG_INDEX, S3, foot_z_of, leg_index, rows
@@ -103,22 +103,16 @@ def _ik_noref_k(p, li, foot_z, out) -> int:
     return _ik_core(p, li, foot_z, l2, offset, co, so, False, p, out)
 
 
-@batch_kernel
+@batch_kernel(rows="p q_near out ok", min_parallel=256, parfor=True)
 def _ik_batch(p, li, foot_z, has_ref, q_near, out, ok) -> int:
     """:func:`_ik_k` over rows ``p`` (n, 3), ``q_near`` (n, 3) (ignored unless ``has_ref``); returns the
     number of rows with a NaN/inf entry."""
     n, bad = p.shape[0], 0
     l2, offset, co, so = _leg_plane_k(foot_z)
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            s = _ik_core(p[i], li, foot_z, l2, offset, co, so, has_ref, q_near[i], out[i])
-            ok[i] = s == OK
-            bad += s >= BAD_INPUT
-    else:
-        for i in prange(n):
-            s = _ik_core(p[i], li, foot_z, l2, offset, co, so, has_ref, q_near[i], out[i])
-            ok[i] = s == OK
-            bad += s >= BAD_INPUT
+    for i in prange(n):
+        s = _ik_core(p[i], li, foot_z, l2, offset, co, so, has_ref, q_near[i], out[i])
+        ok[i] = s == OK
+        bad += s >= BAD_INPUT
     return bad
 
 

@@ -6,7 +6,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .._batch import check_number
-from .._kernels import SERIAL_BELOW, as_rows, batch_kernel, kernel, prange
+from .._kernels import as_rows, batch_kernel, kernel, prange
 from ._common import foot_z_of, rows
 from .constants import HI, LIMIT_TOL, LO, TWO_PI
 from .geometry import Geometry
@@ -24,15 +24,11 @@ def _within_limits_k(q, tol) -> bool:
     )
 
 
-@batch_kernel
+@batch_kernel(rows="q out", min_parallel=256, parfor=True)
 def _within_limits_batch(q, tol, out) -> None:
     n = q.shape[0]
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            out[i] = _within_limits_k(q[i], tol)
-    else:
-        for i in prange(n):
-            out[i] = _within_limits_k(q[i], tol)
+    for i in prange(n):
+        out[i] = _within_limits_k(q[i], tol)
 
 
 @kernel

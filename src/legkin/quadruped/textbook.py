@@ -13,7 +13,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .._batch import check_flag, check_number
-from .._kernels import OK, SERIAL_BELOW, as_rows, batch_kernel, kernel, prange
+from .._kernels import OK, as_rows, batch_kernel, kernel, prange
 from .._rotations import wrap_k
 from ._common import foot_z_of, leg_index, raise_bad, rows
 from .constants import BAD_INPUT, KNEE_OFFSET, PI, SX, SY, X01, X34, Y01, Z01
@@ -33,15 +33,11 @@ def _textbook_frame_k(p, li, out) -> int:
     return OK
 
 
-@batch_kernel
+@batch_kernel(rows="p out", min_parallel=256, parfor=True)
 def _textbook_frame_batch(p, li, out) -> int:
     n, bad = p.shape[0], 0
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            bad += _textbook_frame_k(p[i], li, out[i]) != OK
-    else:
-        for i in prange(n):
-            bad += _textbook_frame_k(p[i], li, out[i]) != OK
+    for i in prange(n):
+        bad += _textbook_frame_k(p[i], li, out[i]) != OK
     return bad
 
 
@@ -82,15 +78,11 @@ def _textbook_ik_k(p, a, b, c, literal, out) -> int:
     return OK
 
 
-@batch_kernel
+@batch_kernel(rows="p out", min_parallel=256, parfor=True)
 def _textbook_ik_batch(p, a, b, c, literal, out) -> int:
     n, bad = p.shape[0], 0
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            bad += _textbook_ik_k(p[i], a, b, c, literal, out[i]) != OK
-    else:
-        for i in prange(n):
-            bad += _textbook_ik_k(p[i], a, b, c, literal, out[i]) != OK
+    for i in prange(n):
+        bad += _textbook_ik_k(p[i], a, b, c, literal, out[i]) != OK
     return bad
 
 
@@ -141,15 +133,11 @@ def _textbook_to_joints_k(theta, beta, out) -> int:
     return OK
 
 
-@batch_kernel
+@batch_kernel(rows="theta out", min_parallel=256, parfor=True)
 def _textbook_to_joints_batch(theta, beta, out) -> None:
     n = theta.shape[0]
-    if n < SERIAL_BELOW:
-        for i in range(n):
-            _textbook_to_joints_k(theta[i], beta, out[i])
-    else:
-        for i in prange(n):
-            _textbook_to_joints_k(theta[i], beta, out[i])
+    for i in prange(n):
+        _textbook_to_joints_k(theta[i], beta, out[i])
 
 
 def textbook_to_joints(theta: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None) -> np.ndarray:

@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import types
 import warnings
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 from .._batch import check_choice, check_flag
-from .._kernels import kernel
 from ..errors import InvalidInputError, InvalidParameterError
 from .geometry import DEFAULT, Geometry
 
@@ -58,27 +56,6 @@ def modes_sel(mode: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         return MODE_HOME, MODE_E, MODE_S
     j = MODE_INDEX[mode]
     return MODE_HOME[j:j + 1], MODE_E[j:j + 1], MODE_S[j:j + 1]
-
-
-# ------------------------------------------------------------------------------------------ serial / parallel
-def serial(fn: Callable[..., Any]) -> Callable[..., Any]:
-    """The serial twin of a batch loop (the same loop compiled without threads, ``prange`` as ``range``): the wrappers
-    use it below :data:`PARALLEL_MIN` items, where waking numba's thread pool costs more than the loop."""
-    twin = types.FunctionType(fn.__code__, fn.__globals__, fn.__name__ + "_serial", fn.__defaults__, fn.__closure__)
-    twin.__qualname__ = fn.__qualname__ + "_serial"
-    twin.__doc__ = fn.__doc__
-    return kernel(twin)
-
-
-#: Batches smaller than this (items x modes, per function) run the serial twin of the batch loop. Chosen on a busy
-#: 2-core machine, where waking the pool costs up to ~10 ms: fk (~3 us an item) from 4096 items, the closed forms
-#: (~0.1-1 us an item) from 50000.
-PARALLEL_MIN = {"fk": 4096, "ik": 50000, "jac": 50000, "closed": 50000}
-
-
-def pick(pair: tuple[Callable[..., Any], Callable[..., Any]], n: int, kind: str) -> Callable[..., Any]:
-    """The parallel loop of ``pair = (parallel, serial)`` for n >= PARALLEL_MIN[kind] items, else its serial twin."""
-    return pair[0] if n >= PARALLEL_MIN[kind] else pair[1]
 
 
 # ------------------------------------------------------------------------------------------ arguments

@@ -17,8 +17,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._kernels import OK, batch_kernel, kernel, prange
-from ._common import BOUNDARY_TOL, DET_GUARD, GAIN_GUARD, SINGULAR_TOL, ST_FAIL, ST_NONFINITE, serial
+from .._kernels import OK, batch_kernel, kernel
+from ._common import BOUNDARY_TOL, DET_GUARD, GAIN_GUARD, SINGULAR_TOL, ST_FAIL, ST_NONFINITE
 from .geometry import G_CA, G_CE, G_D, G_DSA, G_K, G_K2, G_ML, G_OPC, G_SA, G_SE, G_TH, G_W
 from .platform import _k_one_plus_cc
 
@@ -300,23 +300,23 @@ def _ik_loop(ay, az, G, homes, es, ss, q, aux, status):  # type: ignore[no-untyp
     """ik over orientations (n,) in the modes given (homes (m,), es (m,), ss (m, 3)): q (n, m, 12), aux (n, m, 6),
     status (n, m)."""
     n, m = ay.shape[0], homes.shape[0]
-    for i in prange(n):
+    for i in range(n):
         for j in range(m):
             status[i, j] = _k_ik(ay[i], az[i], G, homes[j], es[j], ss[j], q[i, j], aux[i, j])
 
 
 def _ik_all_loop(ay, az, G, q, ok, status):  # type: ignore[no-untyped-def]
     """ik in every mode over orientations (n,): q (n, 16, 12 or 3), ok (n, 16), status (n,)."""
-    for i in prange(ay.shape[0]):
+    for i in range(ay.shape[0]):
         status[i] = _k_ik_all(ay[i], az[i], G, q[i], ok[i])
 
 
 def _jacobian_loop(ay, az, G, home, e, s, a, aux, status):  # type: ignore[no-untyped-def]
     """A_u over orientations (n,): a (n, 3, 2), aux (n, 4), status (n,)."""
-    for i in prange(ay.shape[0]):
+    for i in range(ay.shape[0]):
         status[i] = _k_actuation_jacobian(ay[i], az[i], G, home, e, s, a[i], aux[i])
 
 
-IK_LOOP = (batch_kernel(_ik_loop), serial(_ik_loop))
-IK_ALL_LOOP = (batch_kernel(_ik_all_loop), serial(_ik_all_loop))
-JACOBIAN_LOOP = (batch_kernel(_jacobian_loop), serial(_jacobian_loop))
+IK_LOOP = batch_kernel(rows="ay az q aux status", min_parallel=1024)(_ik_loop)
+IK_ALL_LOOP = batch_kernel(rows="ay az q ok status", min_parallel=256)(_ik_all_loop)
+JACOBIAN_LOOP = batch_kernel(rows="ay az a aux status", min_parallel=4096)(_jacobian_loop)

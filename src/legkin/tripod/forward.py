@@ -30,7 +30,6 @@ from ._common import (
     flag,
     geometry_of,
     modes_sel,
-    pick,
     split_legacy,
 )
 from .forward_kernels import FK_LOOP, _k_fk, _k_initial_guess
@@ -169,7 +168,7 @@ def _batch(
     homes, es, ss = modes_sel(mode)
     n, m = rows.shape[0], homes.shape[0]
     out, status = np.empty((n, m, 3)), np.empty((n, m), dtype=np.int64)
-    pick(FK_LOOP, n * m, "fk")(rows, g._vector, homes, es, ss, tol, max_iter, max_inc, out, status)
+    FK_LOOP(rows, g._vector, homes, es, ss, tol, max_iter, max_inc, out, status)
     ok = status == OK
     if mode == "all":
         return out.reshape(shape + (m, 3)), ok.reshape(shape + (m,))

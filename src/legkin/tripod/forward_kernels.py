@@ -30,7 +30,7 @@ import math
 
 import numpy as np
 
-from .._kernels import OK, batch_kernel, kernel, prange
+from .._kernels import OK, batch_kernel, kernel
 from .._rotations import wrap_k
 from ._common import (
     DET_GUARD,
@@ -42,7 +42,6 @@ from ._common import (
     ST_NOT_CONVERGED,
     ST_OUTSIDE,
     ST_SINGULAR_PLANES,
-    serial,
 )
 from .closure import _k_inside, _k_jac, _k_pose
 from .geometry import G_CE, G_K, G_SE, G_W
@@ -274,11 +273,11 @@ def _fk_loop(qm, G, homes, es, ss, tol, max_iter, max_inc, out, status):  # type
     """fk over motors (n, 3) in the modes given (homes (m,), es (m,), ss (m, 3)): out (n, m, 3), status (n, m);
     NaN where an item fails."""
     n, m = qm.shape[0], homes.shape[0]
-    for i in prange(n):
+    for i in range(n):
         for j in range(m):
             st = _k_fk(qm[i, 0], qm[i, 1], qm[i, 2], G, homes[j], es[j], ss[j], tol, max_iter, max_inc, out[i, j])
             status[i, j] = st
             if st != OK:
                 out[i, j, 0] = out[i, j, 1] = out[i, j, 2] = np.nan
 
-FK_LOOP = (batch_kernel(_fk_loop), serial(_fk_loop))
+FK_LOOP = batch_kernel(rows="qm out status", min_parallel=256)(_fk_loop)

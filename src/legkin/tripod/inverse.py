@@ -26,7 +26,6 @@ from ._common import (
     flag,
     geometry_of,
     modes_sel,
-    pick,
     split_legacy,
 )
 from .closure import IK_ALL_LOOP, IK_LOOP, JACOBIAN_LOOP, _k_actuation_jacobian, _k_ik, _k_ik_all
@@ -118,7 +117,7 @@ def _run(ay: np.ndarray, az: np.ndarray, G: np.ndarray, mode: str,
     homes, es, ss = modes_sel(mode)
     n, m = y.shape[0], homes.shape[0]
     q, aux, status = np.empty((n, m, width)), np.empty((n, m, 6)), np.empty((n, m), dtype=np.int64)
-    pick(IK_LOOP, n * m, "ik")(y, z, G, homes, es, ss, q, aux, status)
+    IK_LOOP(y, z, G, homes, es, ss, q, aux, status)
     return q.reshape(shape + (m, width)), aux.reshape(shape + (m, 6)), status.reshape(shape + (m,))
 
 
@@ -148,7 +147,7 @@ def _all_modes(ay: Any, az: Any, scalar: bool, G: np.ndarray, return_mask: bool,
     z = np.ascontiguousarray(az, dtype=np.float64).reshape(-1)
     n = y.shape[0]
     q, ok, status = np.empty((n, 16, w)), np.empty((n, 16), dtype=np.bool_), np.empty(n, dtype=np.int64)
-    pick(IK_ALL_LOOP, n * 16, "ik")(y, z, G, q, ok, status)
+    IK_ALL_LOOP(y, z, G, q, ok, status)
     q, ok = q.reshape(shape + (16, w)), ok.reshape(shape + (16,))
     return (q, ok) if return_mask else q
 
@@ -340,7 +339,7 @@ def _jacobian(ay: Any, az: Any, scalar: bool, g: Geometry, mode: str, return_mas
         y, z = np.ascontiguousarray(ay).reshape(-1), np.ascontiguousarray(az).reshape(-1)
         n = y.shape[0]
         ab, auxb, status = np.empty((n, 3, 2)), np.empty((n, 4)), np.empty(n, dtype=np.int64)
-        pick(JACOBIAN_LOOP, n, "jac")(y, z, G, home, e, s, ab, auxb, status)
+        JACOBIAN_LOOP(y, z, G, home, e, s, ab, auxb, status)
         ab, ok = ab.reshape(shape + (3, 2)), (status == OK).reshape(shape)
         return (ab, ok) if return_mask else ab
     a, aux = np.empty((3, 2)), np.empty(4)

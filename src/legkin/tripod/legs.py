@@ -14,9 +14,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_input, check_choice, real_number
-from .._kernels import OK, batch_kernel, kernel, prange
+from .._kernels import OK, batch_kernel, kernel
 from .._rotations import rot_k
-from ._common import LEGS, ST_NONFINITE, deprecated, geometry_of, pick, serial
+from ._common import LEGS, ST_NONFINITE, deprecated, geometry_of
 from .geometry import G_CA, G_D, G_SA, Geometry
 
 __all__ = ["leg_transform", "leg_transform_cv"]
@@ -91,18 +91,18 @@ def _k_leg_transform_cv(q1, q2, eta, G, T):  # type: ignore[no-untyped-def]
 
 def _leg_transform_loop(q, eta, alpha, G, T):  # type: ignore[no-untyped-def]
     """leg_transform over joint vectors (n, 4): T (n, 4, 4)."""
-    for i in prange(q.shape[0]):
+    for i in range(q.shape[0]):
         _k_leg_transform(q[i, 0], q[i, 1], q[i, 2], q[i, 3], eta, alpha, G, T[i])
 
 
 def _leg_transform_cv_loop(q, eta, G, T):  # type: ignore[no-untyped-def]
     """leg_transform_cv over (n, 2) joint pairs: T (n, 4, 4)."""
-    for i in prange(q.shape[0]):
+    for i in range(q.shape[0]):
         _k_leg_transform_cv(q[i, 0], q[i, 1], eta, G, T[i])
 
 
-_LEG_TRANSFORM = (batch_kernel(_leg_transform_loop), serial(_leg_transform_loop))
-_LEG_TRANSFORM_CV = (batch_kernel(_leg_transform_cv_loop), serial(_leg_transform_cv_loop))
+_LEG_TRANSFORM = batch_kernel(rows="q T", min_parallel=4096)(_leg_transform_loop)
+_LEG_TRANSFORM_CV = batch_kernel(rows="q T", min_parallel=4096)(_leg_transform_cv_loop)
 
 
 # ------------------------------------------------------------------------------------------ arguments
@@ -172,7 +172,7 @@ def leg_transform(
     shape = qa.shape[:-1]
     rows = np.ascontiguousarray(qa.reshape(-1, 4))
     T = np.empty((rows.shape[0], 4, 4))
-    pick(_LEG_TRANSFORM, rows.shape[0], "closed")(rows, eta, g.alpha, G, T)
+    _LEG_TRANSFORM(rows, eta, g.alpha, G, T)
     return T.reshape(shape + (4, 4))
 
 
@@ -215,5 +215,5 @@ def leg_transform_cv(q: ArrayLike, *args: Any, geometry: Geometry | None = None,
     shape = qa.shape[:-1]
     rows = np.ascontiguousarray(qa.reshape(-1, 2))
     T = np.empty((rows.shape[0], 4, 4))
-    pick(_LEG_TRANSFORM_CV, rows.shape[0], "closed")(rows, eta, g._vector, T)
+    _LEG_TRANSFORM_CV(rows, eta, g._vector, T)
     return T.reshape(shape + (4, 4))

@@ -11,9 +11,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_angles, as_input
-from .._kernels import OK, batch_kernel, kernel, prange
+from .._kernels import OK, batch_kernel, kernel
 from ..errors import InvalidInputError
-from ._common import SINGULAR_TOL, ST_FAIL, ST_NONFINITE, geometry_of, pick, serial
+from ._common import SINGULAR_TOL, ST_FAIL, ST_NONFINITE, geometry_of
 from .geometry import G_ML, Geometry
 
 __all__ = ["alpha_x", "platform_rotation", "platform_position", "platform_axis", "orientation_from_axis"]
@@ -91,7 +91,7 @@ def _k_orientation_from_axis(r0, r1, r2):  # type: ignore[no-untyped-def]
 def _uv_loop(kind, ay, az, G, out):  # type: ignore[no-untyped-def]
     """The per-orientation closed forms over (n,) orientations: kind 1 platform_axis (out (n, 3)), 2
     platform_position (n, 3), 3 platform_rotation (n, 3, 3) (out flattened to (n, 9))."""
-    for i in prange(ay.shape[0]):
+    for i in range(ay.shape[0]):
         if kind == 1:
             _k_platform_axis(ay[i], az[i], out[i])
         elif kind == 2:
@@ -102,19 +102,19 @@ def _uv_loop(kind, ay, az, G, out):  # type: ignore[no-untyped-def]
 
 def _alpha_x_loop(ay, az, out):  # type: ignore[no-untyped-def]
     """alpha_x over (n,) orientations into out (n,)."""
-    for i in prange(ay.shape[0]):
+    for i in range(ay.shape[0]):
         out[i] = _k_alpha_x(ay[i], az[i])
 
 
 def _axis_loop(r, out, status):  # type: ignore[no-untyped-def]
     """orientation_from_axis over axes (n, 3): out (n, 2), status (n,)."""
-    for i in prange(r.shape[0]):
+    for i in range(r.shape[0]):
         status[i], out[i, 0], out[i, 1] = _k_orientation_from_axis(r[i, 0], r[i, 1], r[i, 2])
 
 
-_UV = (batch_kernel(_uv_loop), serial(_uv_loop))
-_ALPHA_X = (batch_kernel(_alpha_x_loop), serial(_alpha_x_loop))
-_AXIS = (batch_kernel(_axis_loop), serial(_axis_loop))
+_UV = batch_kernel(rows="ay az out", min_parallel=8192)(_uv_loop)
+_ALPHA_X = batch_kernel(rows="ay az out", min_parallel=8192)(_alpha_x_loop)
+_AXIS = batch_kernel(rows="r out status", min_parallel=8192)(_axis_loop)
 _NO_GEOMETRY = np.zeros(18)
 
 
@@ -140,7 +140,7 @@ def _uv_closed(kind: int, alpha_y: ArrayLike, alpha_z: ArrayLike, core: tuple[in
     shape = y_.shape
     y, z = np.ascontiguousarray(y_).reshape(-1), np.ascontiguousarray(z_).reshape(-1)
     out = np.empty((y.shape[0], int(np.prod(core))))
-    pick(_UV, y.shape[0], "closed")(kind, y, z, G, out)
+    _UV(kind, y, z, G, out)
     return out.reshape(shape + core)
 
 
@@ -166,7 +166,7 @@ def alpha_x(alpha_y: ArrayLike, alpha_z: ArrayLike, *, geometry: Geometry | None
     if not ay.ndim:
         return np.float64(_k_alpha_x(float(ay), float(az)))  # type: ignore[no-any-return]
     out = np.empty(ay.size)
-    pick(_ALPHA_X, ay.size, "closed")(np.ascontiguousarray(ay).reshape(-1), np.ascontiguousarray(az).reshape(-1), out)
+    _ALPHA_X(np.ascontiguousarray(ay).reshape(-1), np.ascontiguousarray(az).reshape(-1), out)
     return out.reshape(ay.shape)
 
 
@@ -203,7 +203,7 @@ def orientation_from_axis(axis: ArrayLike, *, geometry: Geometry | None = None) 
     shape = r.shape[:-1]
     rows = np.ascontiguousarray(r.reshape(-1, 3))
     out, status = np.empty((rows.shape[0], 2)), np.empty(rows.shape[0], dtype=np.int64)
-    pick(_AXIS, rows.shape[0], "closed")(rows, out, status)
+    _AXIS(rows, out, status)
     if not (status == OK).all():
         raise InvalidInputError("axis must be a nonzero vector (every row)")
     if not shape:

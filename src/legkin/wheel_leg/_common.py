@@ -1,5 +1,4 @@
-"""Helpers shared by the wheel-leg kinematics files: the serial/parallel batch loop, input range checks and
-small float kernels."""
+"""Helpers shared by the wheel-leg kinematics files: input range checks and small float kernels."""
 
 from __future__ import annotations
 
@@ -10,30 +9,9 @@ from typing import Literal, Union
 import numpy as np
 
 from .._batch import check_choice
-from .._kernels import batch_kernel, kernel
+from .._kernels import kernel
 from ..errors import InvalidInputError
 from .geometry import THETA_MAX, THETA_MIN, Geometry
-
-
-class _Loop:
-    """A batch loop compiled from one body twice: serially (:func:`kernel`, ``prange`` runs as ``range``) for
-    fewer than ``min_parallel`` items, where starting numba's threads costs more than the loop, and in
-    parallel (:func:`batch_kernel`) from there on. Called like the body; the first argument's length is the
-    item count."""
-
-    def __init__(self, fn, min_parallel: int):
-        self.serial = kernel(fn)
-        self.parallel = batch_kernel(fn)
-        self.min_parallel = min_parallel
-        self.__doc__, self.__name__ = fn.__doc__, fn.__name__
-
-    def __call__(self, *args):
-        return (self.parallel if args[0].shape[0] >= self.min_parallel else self.serial)(*args)
-
-
-def _loop(min_parallel: int):
-    return lambda fn: _Loop(fn, min_parallel)
-
 
 
 def _check_theta(theta: np.ndarray, name: str = "theta") -> None:
@@ -58,7 +36,6 @@ def _check_w(w: np.ndarray, geo: Geometry) -> None:
     if np.any(bad):
         v = float(w[bad].ravel()[0])
         raise InvalidInputError(f"w={v!r} m is out of range: must be in [-T/2, T/2] = [{-geo.T / 2:g}, {geo.T / 2:g}]")
-
 
 
 @kernel
@@ -87,11 +64,9 @@ def _k_min(a, b):
     return a if a <= b else b
 
 
-
 @kernel
 def _k_phase(z):
     return math.atan2(z.imag, z.real)
-
 
 
 _SCALARS = (float, int)

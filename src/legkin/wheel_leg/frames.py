@@ -12,9 +12,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_input, check_choice, check_flag, check_number, finish
-from .._kernels import OK, as_rows, kernel, prange
+from .._kernels import OK, as_rows, batch_kernel, kernel
 from ..errors import InvalidInputError
-from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, _loop, legacy_geometry, rim_name
+from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, legacy_geometry, rim_name
 from .geometry import _DEFAULT_GEOMETRY, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry, _leg
 from .linkage import _Const, _constants, _kconst
 from .rim import _k_plane, _k_select, _Sel, _select
@@ -28,7 +28,6 @@ _R_0 = {  # columns: x_M, y_M, z_M in {R} at gamma = 0
     "L": np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
     "R": np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]),
 }
-
 
 
 def module_origin(leg: Leg, *args: Geometry | None, geometry: Geometry | None = None) -> np.ndarray:
@@ -78,10 +77,10 @@ def _k_frame(p, gamma, RLM, R0, dwheel, o, out):
         out[i] = o[i] + R0[i, 0] * r0 + R0[i, 1] * r1 + R0[i, 2] * r2
 
 
-@_loop(32768)
+@batch_kernel(rows="p gamma out", min_parallel=32768)
 def _k_frame_batch(p, gamma, RLM, R0, dwheel, o, out):
     """:func:`_k_frame` over p (n, 3), gamma (n,) into out (n, 3)."""
-    for i in prange(p.shape[0]):
+    for i in range(p.shape[0]):
         _k_frame(p[i], gamma[i], RLM, R0, dwheel, o, out[i])
 
 
@@ -170,7 +169,7 @@ def _fk(q: np.ndarray, ctx: _Ctx, want_jac: bool):
     P = np.empty((n, 3))
     J = np.empty((n, 9) if want_jac else (n, 0))
     o = ctx.origin
-    _k_fk_batch.serial(flat, items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128), a,
+    _k_fk_batch.kernel(flat, items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128), a,
                 ctx.seed, K, KC, ctx.s, float(o[0]), float(o[1]), float(o[2]), bool(want_jac), P, J)
     p = P.reshape(shape + (3,))
     return p, (J.reshape(shape + (3, 3)) if want_jac else None)
@@ -213,9 +212,6 @@ def _kctx(leg, rim, radius, geo: Geometry):
     except TypeError:  # unhashable: let the checks name it
         _context(np.zeros(()), 0.0, leg, rim, geo, radius)
         raise
-
-
-
 
 
 def _contact_call(q, alpha, w, leg, rim, radius, geometry, want_jac, return_mask=False):
@@ -378,18 +374,18 @@ def _k_contact(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, wan
     return _k_fk(theta, q[1], q[2], upper, right, e, seed, K, KC, s, dwheel + s * w, o0, o1, o2, want_jac, p, J)
 
 
-@_loop(32768)
+@batch_kernel(rows="q alpha w P J status", min_parallel=32768)
 def _k_contact_batch(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac, P, J, status):
     """:func:`_k_contact` over q (n, 3), alpha, w (n,) into P (n, 3), J (n, 9), status (n,)."""
-    for i in prange(q.shape[0]):
+    for i in range(q.shape[0]):
         status[i] = _k_contact(q[i], alpha[i], w[i], seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac,
                                P[i], J[i])
 
 
-@_loop(32768)
+@batch_kernel(rows="q upper right e a P J", min_parallel=32768)
 def _k_fk_batch(q, upper, right, e, a, seed, K, KC, s, o0, o1, o2, want_jac, P, J):
     """:func:`_k_fk` over q (n, 3) and the prepared arc choice (:class:`_Sel`) into P (n, 3), J (n, 9)."""
-    for i in prange(q.shape[0]):
+    for i in range(q.shape[0]):
         _k_fk(q[i, 0], q[i, 1], q[i, 2], upper[i], right[i], e[i], seed, K, KC, s, a[i], o0, o1, o2, want_jac,
               P[i], J[i])
 

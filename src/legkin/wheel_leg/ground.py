@@ -35,9 +35,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_input, check_flag
-from .._kernels import OK, as_rows, kernel, prange
+from .._kernels import OK, as_rows, batch_kernel, kernel
 from ..errors import InvalidInputError
-from ._common import Leg, _check_theta, _loop
+from ._common import Leg, _check_theta
 from .frames import _R_0, _R_LM, _k_fk, _origin
 from .geometry import _DEFAULT_GEOMETRY, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry, _leg
 from .linkage import _IF, _IG, _IL, _IU, _k_closed, _kconst
@@ -159,9 +159,9 @@ def _k_ground(q, n, r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, p, J, info
     return status
 
 
-@_loop(256)
+@batch_kernel(rows="q n P J info status", min_parallel=256)
 def _k_ground_batch(q, n, r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, P, J, info, status):
-    for i in prange(q.shape[0]):
+    for i in range(q.shape[0]):
         status[i] = _k_ground(q[i], n[i], r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, P[i], J[i], info[i])
 
 

@@ -15,9 +15,9 @@ import math
 
 import numpy as np
 
-from .._kernels import as_rows, kernel, prange
+from .._kernels import as_rows, batch_kernel, kernel
 from .._rotations import wrap_k
-from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip, _loop
+from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip
 from .frames import _Ctx, _k_fk
 from .geometry import _LIMIT_ROUNDING, ABAD_LIMIT, THETA_MAX, THETA_MIN, TYRE_THICKNESS
 from .ik_radial import _arc_table
@@ -235,8 +235,6 @@ def _k_ik_damped(q, tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, tol, ma
     return it, err, ev
 
 
-
-
 @kernel
 def _k_ik_iterative(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, table, method, count, tol, max_iter,
                     delta, q_start, use_start, limits, q):
@@ -287,12 +285,12 @@ def _k_ik_iterative(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, t
     return its, err, reason, ev
 
 
-@_loop(256)
+@batch_kernel(rows="tgt upper right e a q_start q its err reason ev", min_parallel=256)
 def _k_ik_iterative_batch(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, table, method, count, tol,
                           max_iter, delta, q_start, use_start, limits, q, its, err, reason, ev):
     """:func:`_k_ik_iterative` over targets (n, 3) (``q_start`` (n, 3), or (1, 3) unused) into q (n, 3),
     its, err, reason, ev (n,)."""
-    for i in prange(tgt.shape[0]):
+    for i in range(tgt.shape[0]):
         i0 = i if use_start else i - i  # (same integer type as i)
         its[i], err[i], reason[i], ev[i] = _k_ik_iterative(
             tgt[i], upper[i], right[i], e[i], a[i], seed, K, KC, s, o0, o1, o2, grid, table, method, count, tol,

@@ -7,9 +7,9 @@ from functools import lru_cache
 
 import numpy as np
 
-from .._kernels import as_rows, kernel, prange
+from .._kernels import as_rows, batch_kernel, kernel
 from .._rotations import wrap_k
-from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip, _k_max, _k_min, _k_phase, _loop
+from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip, _k_max, _k_min, _k_phase
 from .frames import _k_fk
 from .geometry import _LIMIT_ROUNDING, ABAD_LIMIT, THETA_MAX, THETA_MIN, TYRE_THICKNESS
 from .linkage import _closed_form, _constants, _kconst
@@ -59,7 +59,6 @@ def _arc_terms(theta: np.ndarray, R: float, seed: bool) -> np.ndarray:
     return np.array(rows)
 
 
-
 #: Nodes of the theta grid that brackets the roots of the radial equation (8.9 deg cells).
 _RADIAL_NODES = 17
 #: Sub-cells per cell of the fine coefficient table that refines the Newton start (0.14 deg).
@@ -94,8 +93,6 @@ def _radial_table(R: float, seed: bool):
 
 #: Most roots of one target kept by the radial kernel (16 cells, two per split cell, the ends, doubles).
 _RADIAL_CAP = 64
-
-
 
 
 @kernel
@@ -320,12 +317,12 @@ def _k_ik_radial(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, tabl
     return its, err, reason, nr, nsol
 
 
-@_loop(256)
+@batch_kernel(rows="tgt upper right e a q0 q sols its err reason nsol", min_parallel=256)
 def _k_ik_radial_batch(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, table, m2, fine, fine_rows, tol,
                        max_iter, q0, use_q0, limits, q, sols, its, err, reason, nsol):
     """:func:`_k_ik_radial` over targets (n, 3) (q0 (n, 3) or (1, 3) unused) into q, sols, its, err, reason,
     nsol (solutions found per target, possibly more than sols holds)."""
-    for i in prange(tgt.shape[0]):
+    for i in range(tgt.shape[0]):
         iq0 = i if use_q0 else i - i  # (same integer type as i)
         its[i], err[i], reason[i], _nr, nsol[i] = _k_ik_radial(
             tgt[i], upper[i], right[i], e[i], a[i], seed, K, KC, s, o0, o1, o2, grid, table, m2, fine, fine_rows,

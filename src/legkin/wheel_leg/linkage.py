@@ -12,8 +12,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_angles
-from .._kernels import as_rows, kernel, prange
-from ._common import _SCALARS, _check_theta, _loop, legacy_geometry
+from .._kernels import as_rows, batch_kernel, kernel
+from ._common import _SCALARS, _check_theta, legacy_geometry
 from .geometry import (
     _ARC_BC,
     _ARC_HF,
@@ -194,10 +194,10 @@ def _k_closed(theta, K, KC, want_der):
     return pts, (dA, dB, dC, dD, complex(dE, 0.0), dF, dG, dU, dL, dH, dG, dJ)
 
 
-@_loop(32768)
+@batch_kernel(rows="theta P DP", min_parallel=32768)
 def _k_closed_batch(theta, K, KC, want_der, P, DP):
     """:func:`_k_closed` over theta (n,) into P, DP (n, 12)."""
-    for i in prange(theta.shape[0]):
+    for i in range(theta.shape[0]):
         pts, der = _k_closed(theta[i], K, KC, want_der)
         for j in range(12):
             P[i, j] = pts[j]
@@ -224,7 +224,6 @@ def _closed_form(theta: np.ndarray, c: _Const, foot_radius: float, want_der: boo
     if not want_der:
         return pts, None
     return pts, {"O": zero, **{k: DP[:, j].reshape(theta.shape) for j, k in enumerate(names)}}
-
 
 
 #: For each name of :data:`POINTS`: (index in :data:`_CF_NAMES` or -1 for O, conjugated: right half).
@@ -257,10 +256,10 @@ def _k_linkage(theta, beta, K, KC, idx, conj, out):
         out[j, 0], out[j, 1], out[j, 2] = v.real, v.imag, 0.0
 
 
-@_loop(32768)
+@batch_kernel(rows="theta beta out", min_parallel=32768)
 def _k_linkage_batch(theta, beta, K, KC, idx, conj, out):
     """:func:`_k_linkage` over theta, beta (n,) into out (n, 22, 3)."""
-    for i in prange(theta.shape[0]):
+    for i in range(theta.shape[0]):
         _k_linkage(theta[i], beta[i], K, KC, idx, conj, out[i])
 
 
@@ -294,10 +293,10 @@ def _k_passive(theta, beta, K, KC, KR, out):
     out[6], out[7], out[8], out[9] = hD, -hD, hF, -hF
 
 
-@_loop(32768)
+@batch_kernel(rows="theta beta out", min_parallel=32768)
 def _k_passive_batch(theta, beta, K, KC, KR, out):
     """:func:`_k_passive` over theta, beta (n,) into out (n, 10)."""
-    for i in prange(theta.shape[0]):
+    for i in range(theta.shape[0]):
         _k_passive(theta[i], beta[i], K, KC, KR, out[i])
 
 
@@ -401,10 +400,10 @@ def _k_theta_beta(phi_L, phi_R):
     return (phi_L - phi_R) / 2 + THETA0, (phi_L + phi_R) / 2
 
 
-@_loop(32768)
+@batch_kernel(rows="x y u v", min_parallel=32768)
 def _k_pair_batch(x, y, inverse, u, v):
     """:func:`_k_motor_angles` (or, ``inverse``, :func:`_k_theta_beta`) over x, y (n,) into u, v (n,)."""
-    for i in prange(x.shape[0]):
+    for i in range(x.shape[0]):
         if inverse:
             u[i], v[i] = _k_theta_beta(x[i], y[i])
         else:

@@ -9,8 +9,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_angles, as_input, check_number
-from .._kernels import as_rows, kernel, prange
-from ._common import _SCALARS, _check_alpha, _check_theta, _check_w, _loop
+from .._kernels import as_rows, batch_kernel, kernel
+from ._common import _SCALARS, _check_alpha, _check_theta, _check_w
 from .geometry import _ARC_FG, _DEFAULT_GEOMETRY, PSI_FG, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry
 from .linkage import _IF, _IG, _IJ, _IL, _IOR, _IU, _k_closed, _kconst
 
@@ -43,10 +43,10 @@ def _k_segment(alpha):
     return 2 if alpha <= _ARC_FG else 3
 
 
-@_loop(32768)
+@batch_kernel(rows="alpha out", min_parallel=32768)
 def _k_segment_batch(alpha, out):
     """:func:`_k_segment` over alpha (n,) into out (n,)."""
-    for i in prange(alpha.shape[0]):
+    for i in range(alpha.shape[0]):
         out[i] = _k_segment(alpha[i])
 
 
@@ -119,10 +119,10 @@ def _k_plane(theta, upper, right, e, seed, K, KC, want_der, conj):
     return y, dy
 
 
-@_loop(32768)
+@batch_kernel(rows="alpha upper right e", min_parallel=32768)
 def _k_select_batch(alpha, seed, rho, R, upper, right, e):
     """:func:`_k_select` over alpha (n,) into upper, right, e (n,)."""
-    for i in prange(alpha.shape[0]):
+    for i in range(alpha.shape[0]):
         upper[i], right[i], e[i] = _k_select(alpha[i], seed, rho, R)
 
 
@@ -147,10 +147,10 @@ def _k_rim(theta, beta, alpha, w, seed, rho, K, KC, out):
     out[0], out[1], out[2] = z.real, z.imag, w
 
 
-@_loop(32768)
+@batch_kernel(rows="theta beta alpha w out", min_parallel=32768)
 def _k_rim_batch(theta, beta, alpha, w, seed, rho, K, KC, out):
     """:func:`_k_rim` over theta, beta, alpha, w (n,) into out (n, 3)."""
-    for i in prange(theta.shape[0]):
+    for i in range(theta.shape[0]):
         _k_rim(theta[i], beta[i], alpha[i], w[i], seed, rho, K, KC, out[i])
 
 
@@ -168,10 +168,10 @@ def _k_jump(theta, rho, K, KC):
     return abs(rot * z2 - rot * z1)
 
 
-@_loop(32768)
+@batch_kernel(rows="theta out", min_parallel=32768)
 def _k_jump_batch(theta, rho, K, KC, out):
     """:func:`_k_jump` over theta (n,) into out (n,)."""
-    for i in prange(theta.shape[0]):
+    for i in range(theta.shape[0]):
         out[i] = _k_jump(theta[i], rho, K, KC)
 
 

@@ -33,10 +33,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_input, check_flag
-from .._kernels import as_rows, kernel, prange
+from .._kernels import as_rows, batch_kernel, kernel
 from .._rotations import wrap_k
 from ..errors import InvalidInputError, JointLimitError, UnreachableError
-from ._common import Leg, _loop
+from ._common import Leg
 from .geometry import _DEFAULT_GEOMETRY, ABAD_LIMIT, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry, _leg
 from .ground import _ZERO, _k_ground, _k_normal_leg, _leg_consts, _normals
 from .linkage import _IF, _IG, _IH, _IL, _IU, _k_closed, _kconst, linkage_points
@@ -339,15 +339,15 @@ def _k_stance(t, n, TH, TAB, RUNS, NRUN, K, KC, gargs, limits, near, has_near, q
     return 0
 
 
-@_loop(4)
+@batch_kernel(rows="t n out count", min_parallel=4)
 def _k_stance_all_batch(t, n, TH, TAB, RUNS, NRUN, K, KC, gargs, limits, out, count):
-    for i in prange(t.shape[0]):
+    for i in range(t.shape[0]):
         count[i] = _k_stance_all(t[i], n[i], TH, TAB, RUNS, NRUN, K, KC, gargs, limits, out[i])
 
 
-@_loop(4)
+@batch_kernel(rows="t n near q status", min_parallel=4)
 def _k_stance_batch(t, n, TH, TAB, RUNS, NRUN, K, KC, gargs, limits, near, has_near, q, status):
-    for i in prange(t.shape[0]):
+    for i in range(t.shape[0]):
         status[i] = _k_stance(t[i], n[i], TH, TAB, RUNS, NRUN, K, KC, gargs, limits, near[i], has_near, q[i])
 
 

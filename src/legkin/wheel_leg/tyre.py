@@ -38,10 +38,10 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_angles, check_number
-from .._kernels import as_rows, kernel, prange
+from .._kernels import as_rows, batch_kernel, kernel
 from .._rotations import wrap_k
 from ..errors import InvalidInputError
-from ._common import _check_theta, _loop
+from ._common import _check_theta
 from .geometry import _DEFAULT_GEOMETRY, TYRE_THICKNESS, Geometry, _geometry
 from .linkage import _IF, _IG, _IH, _IL, _IU, _k_closed, _kconst
 
@@ -198,15 +198,15 @@ def _k_tyre_point(theta, beta, s, w, r, K, KC, out):
     out[0], out[1], out[2] = z.real, z.imag, w
 
 
-@_loop(256)
+@batch_kernel(rows="theta beta s w out", min_parallel=256)
 def _k_tyre_point_batch(theta, beta, s, w, r, K, KC, out):
-    for i in prange(theta.shape[0]):
+    for i in range(theta.shape[0]):
         _k_tyre_point(theta[i], beta[i], s[i], w[i], r, K, KC, out[i])
 
 
-@_loop(256)
+@batch_kernel(rows="theta C RAD A0 SPAN CUM", min_parallel=256)
 def _k_pieces_batch(theta, r, K, KC, C, RAD, A0, SPAN, CUM):
-    for i in prange(theta.shape[0]):
+    for i in range(theta.shape[0]):
         _k_pieces(theta[i], r, K, KC, C[i], RAD[i], A0[i], SPAN[i])
         _k_cumulative(RAD[i], SPAN[i], CUM[i])
 

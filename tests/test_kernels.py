@@ -1,0 +1,105 @@
+"""legkin._kernels: the batch loops' thread chunks and the kernels' dispatcher (issue 16)."""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+import pytest
+
+from legkin._kernels import BatchLoop, KernelDispatcher, batch_kernel, kernel
+
+
+@kernel
+def _axis_value(axis, x):
+    if axis == 0:
+        return x
+    if axis == 1:
+        return 2.0 * x
+    return -x
+
+
+@kernel
+def _calls_with_literals(x):
+    return _axis_value(0, x) + _axis_value(1, x) + _axis_value(2, x)
+
+
+@kernel
+def _item(x, shared, out):
+    out[0] = x[0] * shared[0] + x[1]
+    out[1] = x[0] - x[1] * shared[1]
+    return 1 if x[0] > 0.5 else 0
+
+
+@batch_kernel(rows="x ref out", min_parallel=8)
+def _loop(x, shared, ref, out):
+    count = 0
+    m = ref.shape[0]
+    for i in range(x.shape[0]):
+        count += _item(x[i], shared, out[i])
+        out[i, 2] = ref[i if m > 1 else 0, 0]
+    return count
+
+
+@pytest.fixture
+def two_threads():
+    before = numba.get_num_threads()
+    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+    yield numba.get_num_threads()
+    numba.set_num_threads(before)
+
+
+def test_literal_arguments_compile_one_version():
+    """Calls with the constants 0, 1, 2 share one compiled version of the callee (numba alone compiles three,
+    each with its call tree): the dispatcher types calls on non-literal arguments."""
+    assert isinstance(_axis_value, KernelDispatcher)
+    assert _calls_with_literals(1.5) == pytest.approx(1.5 + 3.0 - 1.5)
+    assert len(_axis_value.signatures) == 1
+    assert _axis_value(1, 2.0) == 4.0  # the call from Python reuses it
+    assert len(_axis_value.signatures) == 1
+
+
+@pytest.mark.parametrize("n", [1, 7, 8, 9, 1000])
+@pytest.mark.parametrize("shared_ref", [False, True])
+def test_chunks_are_the_serial_loop_bit_for_bit(n, shared_ref, two_threads):
+    """From min_parallel items the rows are split among the threads: the outputs are the serial loop's, bit for
+    bit; the int return (a count) is summed over the chunks; a one-row argument is shared by all items."""
+    rng = np.random.default_rng(n)
+    x = rng.uniform(0, 1, (n, 2))
+    shared = np.array([0.3, 1.7])
+    ref = rng.uniform(0, 1, (1 if shared_ref else n, 1))
+    out = np.full((n, 3), np.nan)
+    count = _loop(x, shared, ref, out)
+    serial = np.full((n, 3), np.nan)
+    assert count == _loop.kernel(x, shared, ref, serial)  # the compiled loop itself: one thread
+    np.testing.assert_array_equal(out, serial)
+    assert count == int(np.sum(x[:, 0] > 0.5))
+    np.testing.assert_array_equal(out[:, 2], np.broadcast_to(ref[:, 0], (n,)))
+
+
+def test_chunks_run_on_several_threads(two_threads):
+    """A large batch hands chunks to worker threads (numba's thread count): the loop runs outside the GIL."""
+    if two_threads < 2:
+        pytest.skip("numba has one thread here")
+    import threading
+
+    seen = set()
+    real = _loop.kernel
+
+    def spy(*args):
+        seen.add(threading.get_ident())
+        return real(*args)
+
+    loop = BatchLoop(_loop.__wrapped__, "x ref out", 8)
+    loop.kernel = spy
+    n = 64
+    loop(np.zeros((n, 2)), np.ones(2), np.zeros((n, 1)), np.empty((n, 3)))
+    assert len(seen) == 2
+    numba.set_num_threads(1)
+    seen.clear()
+    loop(np.zeros((n, 2)), np.ones(2), np.zeros((n, 1)), np.empty((n, 3)))
+    assert seen == {threading.get_ident()}
+
+
+def test_row_names_are_checked():
+    with pytest.raises(TypeError, match="no argument 'y'"):
+        batch_kernel(rows="x y", min_parallel=8)(_loop.__wrapped__)

@@ -369,17 +369,17 @@ def test_big_batch_equals_single_calls_and_shapes(fl):
     from legkin.legs._ik_kernels import _ik_batch
 
     rng = np.random.default_rng(3)
-    n = max(_ik_batch.min_parallel, _fk_batch.min_parallel) + 3  # the parallel loops
+    n = 1000 * ((max(_ik_batch.min_parallel, _fk_batch.min_parallel) + 999) // 1000)  # the parallel loops
     q = rng.uniform(fl.lower, fl.upper, (n, 3))
     p = fl.fk(q)
     sol = fl.ik(p)
     for i in range(0, n, 397):
         np.testing.assert_array_equal(fl.ik(p[i]), sol[i])
-    assert fl.fk(q.reshape(10, 100, 3)).shape == (10, 100, 3)
-    assert fl.jacobian(q.reshape(10, 100, 3)).shape == (10, 100, 3, 3)
-    s, ok = fl.ik(p.reshape(10, 100, 3), return_mask=True)
+    assert fl.fk(q[:1000].reshape(10, 100, 3)).shape == (10, 100, 3)
+    assert fl.jacobian(q[:1000].reshape(10, 100, 3)).shape == (10, 100, 3, 3)
+    s, ok = fl.ik(p[:1000].reshape(10, 100, 3), return_mask=True)
     assert s.shape == (10, 100, 3) and ok.shape == (10, 100)
-    a, m = fl.ik_all(p.reshape(10, 100, 3))
+    a, m = fl.ik_all(p[:1000].reshape(10, 100, 3))
     assert a.shape == (10, 100, 4, 3) and m.shape == (10, 100, 4)
     assert fl.ik(np.empty((0, 3))).shape == (0, 3)
     one, ok1 = fl.ik(p[0], return_mask=True)

@@ -6,11 +6,10 @@ import numba
 import numpy as np
 import pytest
 
-from legkin._kernels import BatchLoop, KernelDispatcher, batch_kernel, kernel
+from legkin._kernels import BatchLoop, KernelDispatcher, _njit, batch_kernel, kernel  # noqa: F401
 
 
-@kernel
-def _axis_value(axis, x):
+def _axis_value_py(axis, x):
     if axis == 0:
         return x
     if axis == 1:
@@ -18,9 +17,14 @@ def _axis_value(axis, x):
     return -x
 
 
-@kernel
-def _calls_with_literals(x):
+_axis_value = _njit(_axis_value_py, cache=False)  # not cached: compiled in every test run
+
+
+def _calls_with_literals_py(x):
     return _axis_value(0, x) + _axis_value(1, x) + _axis_value(2, x)
+
+
+_calls_with_literals = _njit(_calls_with_literals_py, cache=False)
 
 
 @kernel

@@ -57,10 +57,12 @@ def as_angles(*xs, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
     """Check scalar-per-item inputs (angles) and broadcast them together."""
     arrs = [as_input(x, n) for x, n in zip(xs, names)]
     try:
-        return tuple(np.broadcast_arrays(*arrs))
+        shape = np.broadcast_shapes(*(a.shape for a in arrs))
     except ValueError as exc:
         shapes = ", ".join(f"{n}{a.shape}" for n, a in zip(names, arrs))
         raise InvalidInputError(f"inputs do not broadcast together: {shapes}") from exc
+    # writeable arrays (a copy where one is broadcast): numba types read-only arrays apart (a second compilation)
+    return tuple(a if a.shape == shape else np.broadcast_to(a, shape).copy() for a in arrs)
 
 
 def finish(

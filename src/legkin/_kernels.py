@@ -41,7 +41,7 @@ import numpy as np
 from numba.core import config, types
 from numba.core.registry import CPUDispatcher
 
-__all__ = ["kernel", "batch_kernel", "BatchLoop", "OK", "as_rows", "prange", "threads"]
+__all__ = ["kernel", "batch_kernel", "BatchLoop", "OK", "as_items", "as_rows", "prange", "threads"]
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -61,13 +61,14 @@ class KernelDispatcher(CPUDispatcher):
         return super().get_call_template(args, kws)
 
 
-def _njit(fn: Callable[..., Any], **options: Any) -> Any:
-    """``numba.njit(cache=True, error_model="numpy", **options)(fn)`` on a :class:`KernelDispatcher`."""
+def _njit(fn: Callable[..., Any], *, cache: bool = True, **options: Any) -> Any:
+    """``numba.njit(cache=cache, error_model="numpy", **options)(fn)`` on a :class:`KernelDispatcher`."""
     if config.DISABLE_JIT:
         return fn
     disp = KernelDispatcher(py_func=fn, locals={},
                             targetoptions={"nopython": True, "boundscheck": None, "error_model": "numpy", **options})
-    disp.enable_caching()
+    if cache:
+        disp.enable_caching()
     return disp
 
 
@@ -161,5 +162,15 @@ def batch_kernel(rows: str, min_parallel: int, parfor: bool = False) -> Callable
 
 
 def as_rows(x: np.ndarray, core: int) -> np.ndarray:
-    """``x`` (..., core) as a C-contiguous float64 (n, core) array (a view when it already is one)."""
-    return np.ascontiguousarray(x.reshape(-1, core), dtype=np.float64)
+    """``x`` (..., core) as a C-contiguous, writeable float64 (n, core) array (a view when it already is one).
+
+    Writeable always (a read-only view, e.g. of ``np.broadcast_to``, is copied): numba types read-only arrays
+    apart, and a kernel called with both would be compiled twice, with its whole call tree."""
+    rows = np.ascontiguousarray(x.reshape(-1, core), dtype=np.float64)
+    return rows if rows.flags.writeable else rows.copy()
+
+
+def as_items(x: Any, n: int, dtype: Any = np.float64) -> np.ndarray:
+    """``x`` broadcast to (n,) as a C-contiguous, writeable array of ``dtype`` (see :func:`as_rows`)."""
+    items = np.ascontiguousarray(np.broadcast_to(x, (n,)), dtype=dtype)
+    return items if items.flags.writeable else items.copy()

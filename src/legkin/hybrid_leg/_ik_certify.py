@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from .._kernels import kernel
@@ -48,7 +47,7 @@ NOT_NEARER = 0
 SELF = 1
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@kernel
 def bernstein_k(c, lo, hi, b, d):
     """Bernstein coefficients b (9,) on [lo, hi] of the degree-8 polynomial c (9,) (ascending); d (9,) work."""
     for k in range(_N + 1):
@@ -68,7 +67,7 @@ def bernstein_k(c, lo, hi, b, d):
         b[i] = s
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@kernel
 def _split_k(b, left, right, w):
     """de Casteljau at the midpoint: the Bernstein coefficients of both halves; w (9,) work."""
     for i in range(_N + 1):
@@ -80,7 +79,7 @@ def _split_k(b, left, right, w):
         left[r], right[_N - r] = w[0], w[_N - r]
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@kernel
 def _signs_k(b, eps):
     """+1 / -1 where every entry of b exceeds eps / is below -eps, else 0."""
     pos = True
@@ -91,7 +90,7 @@ def _signs_k(b, eps):
     return 1 if pos else (-1 if neg else 0)
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@kernel
 def _slope_k(b, eps):
     """The sign of the polynomial's slope where its Bernstein coefficients b are strictly monotone, else 0."""
     up = True
@@ -103,7 +102,7 @@ def _slope_k(b, eps):
     return 1 if up else (-1 if down else 0)
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@kernel
 def _horner_k(c, t):
     """(c(t), c'(t)) of the polynomial c (9,) (ascending)."""
     p = c[_N]
@@ -135,7 +134,7 @@ def _root_k(c, a, b, fa):
     return x
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@kernel
 def classify_k(t, tip, dtip, al, be, ga, pose, b1, b2, s, rc, work):
     """What the pose at the root t = tan(roll / 2) is to the candidate pose (3,) (theta_LL, roll, pitch) of mode
     (b1, b2), s at distance rc from R_P = I: SELF, NOT_NEARER (outside the limits, farther, or in another mode) or
@@ -183,7 +182,7 @@ _STACK = 78
 CERTIFY_WORK = _STACK + _S * (_N + 4)
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")
+@kernel
 def certify_k(pose, motors, b1, b2, s, work):
     """True if the forward kinematics of the candidate's motors (3,) in mode (b1, b2), s surely returns the
     candidate's pose (3,) (theta_LL, roll, pitch); False if it cannot tell (then ask the forward kinematics).

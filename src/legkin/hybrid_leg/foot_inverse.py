@@ -53,7 +53,7 @@ def _search(u: np.ndarray, sv: float, combos: list, b: np.ndarray, s: float, lim
     motors, pose, ok (the batch kernel :func:`foot_ik_b`)."""
     n = len(u)
     motors, pose, ok = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.bool_)
-    nr = np.broadcast_to(_NO_NEAR, (n, 3)) if near is None else near
+    nr = np.full((n, 3), np.nan) if near is None else near
     foot_ik_b(np.ascontiguousarray(u, dtype=np.float64), float(sv),
                                   np.array(combos, dtype=np.float64).reshape(-1, 2), float(b[0]), float(b[1]),
                                   float(s), bool(limits_only), bool(axis_ok), np.ascontiguousarray(nr), motors, pose,

@@ -224,7 +224,7 @@ def rod_newton_k(x, tip, max_iter, keep_sign):
                     acc = True
                     x[0], x[1], cur = xt0, xt1, ct
                     g[0], g[1] = gt[0], gt[1]
-                    nm[:, :] = nt
+                    nm[0, 0], nm[0, 1], nm[1, 0], nm[1, 1] = nt[0, 0], nt[0, 1], nt[1, 0], nt[1, 1]
                     break
                 lam *= 0.5
         if not acc or smax * lam <= 1e-16:

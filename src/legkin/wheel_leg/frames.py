@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_input, check_choice, check_flag, check_number, finish
-from .._kernels import OK, as_rows, batch_kernel, kernel
+from .._kernels import OK, as_items, as_rows, batch_kernel, kernel
 from ..errors import InvalidInputError
 from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, legacy_geometry, rim_name
 from .geometry import _DEFAULT_GEOMETRY, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry, _leg
@@ -161,7 +161,7 @@ def _fk(q: np.ndarray, ctx: _Ctx, want_jac: bool):
     n = flat.shape[0]
 
     def items(x, dtype):
-        return np.ascontiguousarray(np.broadcast_to(x, shape).reshape(n), dtype=dtype)
+        return as_items(np.broadcast_to(x, shape).reshape(n), n, dtype)
 
     sel = ctx.sel
     a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)

@@ -122,7 +122,7 @@ def _k_support(C, RAD, A0, SPAN, d):
 
 
 @kernel
-def _k_ground(q, n, r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, p, J, info, want_jac=True):
+def _k_ground(q, n, r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, p, J, info, want_jac):
     """:func:`ground_contact` for one item: point p (3,), Jacobian J (9,) (when ``want_jac``), info (4,) =
     (piece, s, w, link)."""
     theta, beta, gamma = q[0], q[1], q[2]
@@ -162,7 +162,8 @@ def _k_ground(q, n, r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, p, J, info
 @batch_kernel(rows="q n P J info status", min_parallel=256)
 def _k_ground_batch(q, n, r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, P, J, info, status):
     for i in range(q.shape[0]):
-        status[i] = _k_ground(q[i], n[i], r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, P[i], J[i], info[i])
+        status[i] = _k_ground(q[i], n[i], r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, P[i], J[i], info[i],
+                              True)
 
 
 def _normals(normal) -> np.ndarray:
@@ -190,8 +191,7 @@ def _kernel_args(leg, r, geometry) -> tuple[Any, ...]:
 
 
 _Z = (0.0, 0.0, 1.0)
-_Z_ARRAY = np.array(_Z)
-_Z_ARRAY.setflags(write=False)
+_Z_ARRAY = np.array(_Z)  # writeable, like the batch rows: one compiled version of the kernels (never written)
 
 
 def _single(q: np.ndarray, leg, r, geometry) -> GroundContact | None:
@@ -203,7 +203,7 @@ def _single(q: np.ndarray, leg, r, geometry) -> GroundContact | None:
     except Exception:  # noqa: BLE001 - the full checks raise the documented error
         return None
     P, Jm, info = np.empty(3), np.empty(9), np.empty(4)
-    if _k_ground(q, _Z_ARRAY, *args, P, Jm, info) != OK:  # type: ignore[call-arg]
+    if _k_ground(q, _Z_ARRAY, *args, P, Jm, info, True) != OK:  # type: ignore[call-arg]
         return None
     return GroundContact(P, np.asarray(int(info[0])), np.asarray(info[1]), np.asarray(info[2]), Jm.reshape(3, 3),
                          np.asarray(int(info[3])))
@@ -258,7 +258,7 @@ def ground_contact(q: ArrayLike, leg: Leg, normal: ArrayLike = _Z, *, r: float =
     P, Jm, info, status = np.empty((m, 3)), np.empty((m, 9)), np.empty((m, 4)), np.empty(m, dtype=np.int64)
     args = (rho, K, KC, sl, geo.d_wheel, geo.T / 2, float(o[0]), float(o[1]), float(o[2]), RLM, R0)
     if shape == ():
-        status[0] = _k_ground(qr[0], nr[0], *args, P[0], Jm[0], info[0])
+        status[0] = _k_ground(qr[0], nr[0], *args, P[0], Jm[0], info[0], True)
     else:
         _k_ground_batch(qr, nr, *args, P, Jm, info, status)
     ok = status == OK

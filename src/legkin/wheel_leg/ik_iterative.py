@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from .._kernels import as_rows, batch_kernel, kernel
+from .._kernels import as_items, as_rows, batch_kernel, kernel
 from .._rotations import wrap_k
 from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip
 from .frames import _Ctx, _k_fk
@@ -311,7 +311,7 @@ def starts(target: np.ndarray, ctx: _Ctx, count: int = 1, branch: float = -1.0) 
     sel = ctx.sel
 
     def items(x, dtype):
-        return np.ascontiguousarray(np.broadcast_to(x, (n,)), dtype=dtype)
+        return as_items(x, n, dtype)
 
     upper, right, e = items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128)
     a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)
@@ -333,7 +333,7 @@ def solve(target, ctx: _Ctx, q_start, method: str, tol: float, max_iter: int | N
     sel = ctx.sel
 
     def items(x, dtype):
-        return np.ascontiguousarray(np.broadcast_to(x, (n,)), dtype=dtype)
+        return as_items(x, n, dtype)
 
     upper, right, e = items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128)
     a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)

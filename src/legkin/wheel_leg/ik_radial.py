@@ -7,7 +7,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .._kernels import as_rows, batch_kernel, kernel
+from .._kernels import as_items, as_rows, batch_kernel, kernel
 from .._rotations import wrap_k
 from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip, _k_max, _k_min, _k_phase
 from .frames import _k_fk
@@ -152,12 +152,11 @@ def _k_radial_brackets(grid, f, g, m2, kind, ee, ea, ftol, upper, right, e, seed
                     row[0], row[1], row[2], row[3] = th_e, grid[k + 1], f_e, f[k + 1]
                     row[4], row[5], row[6], row[7] = g_e, g[k + 1], M, th_e + _k_max(dd1, dd2)
                     ns += 1
-    for i in range(ns):
-        jobs[nj] = split_lo[i]
-        nj += 1
-    for i in range(ns):
-        jobs[nj] = split_hi[i]
-        nj += 1
+    for half in (split_lo, split_hi):  # element by element: a row assignment compiles numba's shape-error text
+        for i in range(ns):
+            for c in range(8):
+                jobs[nj, c] = half[i, c]
+            nj += 1
     return nj, nx, ns, its
 
 
@@ -378,7 +377,7 @@ def _ik_radial(target, ctx, tol, max_iter, q0, limits=True):
     sel = ctx.sel
 
     def items(x, dtype):
-        return np.ascontiguousarray(np.broadcast_to(x, (n,)), dtype=dtype)
+        return as_items(x, n, dtype)
 
     upper, right, e = items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128)
     a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)

@@ -375,17 +375,15 @@ def _consts(leg, r, geometry) -> tuple[Any, ...]:
 
 
 _Z = (0.0, 0.0, 1.0)
-_Z_ARRAY = np.array(_Z)
-_Z_ARRAY.setflags(write=False)
-_NO_NEAR = np.zeros((1, 3))
-_NO_NEAR.setflags(write=False)
+_Z_ARRAY = np.array(_Z)  # writeable, like the batch rows: one compiled version of the kernels (never written)
+_NO_NEAR = np.zeros((1, 3))  # writeable, like the batch rows (one compiled version; never written)
 
 
 def _targets(target, normal):
     t = as_input(target, "target", (3,))
     if normal is _Z:  # the default normal: no checks, one row for all
         rows = as_rows(t, 3)
-        return rows, np.broadcast_to(_Z_ARRAY, rows.shape), t.shape[:-1]
+        return rows, np.tile(_Z_ARRAY, (rows.shape[0], 1)), t.shape[:-1]
     n = _normals(normal)
     try:
         shape = np.broadcast_shapes(t.shape[:-1], n.shape[:-1])
@@ -471,7 +469,7 @@ def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = _Z, q_near: Ar
         t, n, shape = _targets(target, normal)
         m = t.shape[0]
         if q_near is None:
-            near, has_near = np.broadcast_to(_NO_NEAR, (m, 3)), False
+            near, has_near = np.zeros((m, 3)), False
         else:
             near = as_rows(np.broadcast_to(as_input(q_near, "q_near", (3,)), shape + (3,)), 3)
             has_near = True

@@ -246,3 +246,34 @@ def test_view_floating_stands_on_the_ground(tmp_path, capsys):
     assert page.stat().st_size > 10_000
     assert main(["view", "tripod", "--floating", "--html", str(tmp_path / "t.html")]) == 2
     assert "fixed-base" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------------------------------- worker processes
+def test_check_jobs_default_and_option(monkeypatch):
+    seen = _capture_run_checks(monkeypatch)
+    assert main(["check", "tripod", "--samples", "5"]) == 0
+    cpus = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    assert seen["jobs"] == min(4, cpus)
+    assert main(["check", "tripod", "--samples", "5", "--jobs", "1"]) == 0 and seen["jobs"] == 1
+    assert main(["check", "-j", "3"]) == 0 and seen["jobs"] == 3
+    assert main(["check", "--jobs", "0"]) == 2
+
+
+def test_run_checks_in_worker_processes_gives_the_same_rows():
+    """jobs=2: the models run in two spawned processes (the external robots in one group), same rows and order."""
+    models = ["quadruped", "a1", "go1"]
+    serial = validation.run_checks(models, samples=30, seed=4, ik_targets=40)
+    parallel = validation.run_checks(models, samples=30, seed=4, ik_targets=40, jobs=2)
+    assert list(parallel) == models
+    for name in models:
+        a, b = serial[name][0], parallel[name][0]
+        assert [r.as_dict() for r in a] == [r.as_dict() for r in b]
+    assert validation._groups(models) == [["a1", "go1"], ["quadruped"]]
+
+
+@pytest.mark.parametrize("jobs", [0, -1, 1.5, True, "2"])
+def test_run_checks_rejects_bad_jobs(jobs):
+    from legkin.errors import InvalidArgumentError
+
+    with pytest.raises(InvalidArgumentError, match="jobs"):
+        validation.run_checks(["quadruped"], samples=5, jobs=jobs)

@@ -63,10 +63,11 @@ class KernelDispatcher(CPUDispatcher):
 
 def _njit(fn: Callable[..., Any], *, cache: bool = True, **options: Any) -> Any:
     """``numba.njit(cache=cache, error_model="numpy", **options)(fn)`` on a :class:`KernelDispatcher`."""
-    if config.DISABLE_JIT:
+    if config.DISABLE_JIT:  # type: ignore[attr-defined]
         return fn
-    disp = KernelDispatcher(py_func=fn, locals={},
-                            targetoptions={"nopython": True, "boundscheck": None, "error_model": "numpy", **options})
+    # no_cfunc_wrapper: the C-callable wrapper serves numba's first-class functions, which legkin does not use
+    targetoptions = {"nopython": True, "boundscheck": None, "error_model": "numpy", "no_cfunc_wrapper": True}
+    disp = KernelDispatcher(py_func=fn, locals={}, targetoptions={**targetoptions, **options})
     if cache:
         disp.enable_caching()
     return disp

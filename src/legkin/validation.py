@@ -145,7 +145,7 @@ def run_checks(
         raise InvalidArgumentError(f"jobs={jobs!r} must be an integer >= 1")
     modules = [_checks_module(spec) for spec in specs]
     steps = {name: 2 if hasattr(m, "ik_robustness") else 1 for name, m in zip(names, modules)}
-    options = dict(samples=samples, seed=seed, ik_targets=ik_targets, classify=classify)
+    options: dict[str, Any] = dict(samples=samples, seed=seed, ik_targets=ik_targets, classify=classify)
     groups = _groups(names)
     out: dict[str, tuple[list[CheckResult], float]] = {}
     with progress_bar(sum(steps.values()), "legkin check", enabled=progress) as bar:

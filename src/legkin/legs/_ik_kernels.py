@@ -250,7 +250,7 @@ def _ik_k(p, g, ref, out, info) -> int:
 
 @batch_kernel(rows="p ref out status info", min_parallel=4096)
 def _ik_all_batch(p, g, ref, out, status, info) -> None:
-    # ref: one row for all targets (m = 1) or one per target; ``i - i`` keeps the index type of prange's i
+    # ref: one row for all targets (m = 1) or one per target; ``i - i`` keeps the index type of i
     n, m = p.shape[0], ref.shape[0]
     for i in range(n):
         status[i] = _ik_all_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])

@@ -23,8 +23,8 @@ and ``q_near``) their leading shapes broadcast, and the call is a single one onl
 
 Implementation (issue 16, see :mod:`legkin._kernels`): every function is a compiled numba kernel,
 written once beside its seed equations; a batch is a compiled loop over the same kernel (``prange``, threads:
-``numba.set_num_threads`` or ``NUMBA_NUM_THREADS``; batches below :data:`legkin._kernels.SERIAL_BELOW`
-items run on the calling thread). The Python wrappers only check the inputs and apply the single/batch rule.
+``numba.set_num_threads`` or ``NUMBA_NUM_THREADS``; batches below the loop's ``min_parallel`` (256) items run
+on the calling thread). The Python wrappers only check the inputs and apply the single/batch rule.
 
 Inputs are checked at every public function: arrays as by :func:`legkin._batch.as_input` (wrong shape,
 NaN/inf, complex, strings, ragged: ``InvalidInputError``; a float64 array of the right shape goes straight to

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
 from .._kernels import kernel
@@ -47,7 +48,7 @@ NOT_NEARER = 0
 SELF = 1
 
 
-@kernel
+@numba.njit(cache=True, error_model="numpy", inline="always")  # small and hot: inlined
 def bernstein_k(c, lo, hi, b, d):
     """Bernstein coefficients b (9,) on [lo, hi] of the degree-8 polynomial c (9,) (ascending); d (9,) work."""
     for k in range(_N + 1):
@@ -67,7 +68,7 @@ def bernstein_k(c, lo, hi, b, d):
         b[i] = s
 
 
-@kernel
+@numba.njit(cache=True, error_model="numpy", inline="always")  # small and hot: inlined
 def _split_k(b, left, right, w):
     """de Casteljau at the midpoint: the Bernstein coefficients of both halves; w (9,) work."""
     for i in range(_N + 1):
@@ -79,7 +80,7 @@ def _split_k(b, left, right, w):
         left[r], right[_N - r] = w[0], w[_N - r]
 
 
-@kernel
+@numba.njit(cache=True, error_model="numpy", inline="always")  # small and hot: inlined
 def _signs_k(b, eps):
     """+1 / -1 where every entry of b exceeds eps / is below -eps, else 0."""
     pos = True
@@ -90,7 +91,7 @@ def _signs_k(b, eps):
     return 1 if pos else (-1 if neg else 0)
 
 
-@kernel
+@numba.njit(cache=True, error_model="numpy", inline="always")  # small and hot: inlined
 def _slope_k(b, eps):
     """The sign of the polynomial's slope where its Bernstein coefficients b are strictly monotone, else 0."""
     up = True
@@ -102,7 +103,7 @@ def _slope_k(b, eps):
     return 1 if up else (-1 if down else 0)
 
 
-@kernel
+@numba.njit(cache=True, error_model="numpy", inline="always")  # small and hot: inlined
 def _horner_k(c, t):
     """(c(t), c'(t)) of the polynomial c (9,) (ascending)."""
     p = c[_N]

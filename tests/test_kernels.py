@@ -107,3 +107,14 @@ def test_chunks_run_on_several_threads(two_threads):
 def test_row_names_are_checked():
     with pytest.raises(TypeError, match="no argument 'y'"):
         batch_kernel(rows="x y", min_parallel=8)(_loop.__wrapped__)
+
+
+def test_parfor_twin_has_its_own_cache_files():
+    """numba's cache keys on the qualified name and the signature, not on parallel=True: the serial loop and its
+    parallel twin must not share cache files (a process would load whichever was cached first: the parallel loop
+    for a batch of 8 cost 10 us of thread start-up)."""
+    from legkin.quadruped.inverse import _ik_batch
+
+    assert _ik_batch.parfor is not None
+    assert _ik_batch.kernel._cache._cache_file._index_path != _ik_batch.parfor._cache._cache_file._index_path
+    assert _ik_batch.parfor.py_func.__code__ is _ik_batch.kernel.py_func.__code__

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import inspect
 import threading
+import types as pytypes
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, TypeVar
 
@@ -125,7 +126,7 @@ class BatchLoop:
         self.kernel = _njit(fn, nogil=True)
         self.rows = tuple(names.index(r) for r in rows.split())
         self.min_parallel = int(min_parallel)
-        self.parfor = _njit(fn, parallel=True) if parfor else None
+        self.parfor = _njit(_renamed(fn, "_parfor"), parallel=True) if parfor else None
         self.__name__, self.__qualname__, self.__doc__ = fn.__name__, fn.__qualname__, fn.__doc__
         self.__module__, self.__wrapped__ = fn.__module__, fn
 
@@ -151,6 +152,15 @@ class BatchLoop:
         first = self.kernel(*chunks[0])
         rest = [f.result() for f in futures]
         return first if first is None else first + sum(rest)
+
+
+def _renamed(fn: Callable[..., Any], suffix: str) -> Callable[..., Any]:
+    """A copy of ``fn`` whose qualified name ends in ``suffix``: numba keys its cache files on the qualified name and
+    the signature, not on the compile options, so the parallel compilation of a loop needs a name of its own
+    (otherwise each process loads whichever of the two was cached first)."""
+    twin = pytypes.FunctionType(fn.__code__, fn.__globals__, fn.__name__, fn.__defaults__, fn.__closure__)
+    twin.__qualname__, twin.__doc__, twin.__module__ = fn.__qualname__ + suffix, fn.__doc__, fn.__module__
+    return twin
 
 
 def batch_kernel(rows: str, min_parallel: int, parfor: bool = False) -> Callable[[Callable[..., Any]], BatchLoop]:

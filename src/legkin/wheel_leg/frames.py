@@ -129,6 +129,17 @@ class _Ctx(NamedTuple):
     def take(self, idx) -> "_Ctx":
         return self._replace(sel=self.sel.take(idx), w=self.w[idx])
 
+    def items(self, shape: tuple[int, ...]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The kernels' per-item inputs besides q, broadcast to ``shape`` and flattened (writeable, contiguous):
+        the rim selection (upper, right, e) and the wheel's lateral offset a = d_wheel + s w."""
+        n = int(np.prod(shape, dtype=int))
+
+        def flat(x, dtype):
+            return as_items(np.broadcast_to(x, shape).reshape(n), n, dtype)
+
+        return (flat(self.sel.upper, np.bool_), flat(self.sel.right, np.bool_), flat(self.sel.e, np.complex128),
+                flat(self.geo.d_wheel + self.s * self.w, np.float64))
+
 
 def _rim_kind(rim: str) -> bool:
     """True for the three-arc rim (``rim`` already normalised by :func:`rim_name`)."""
@@ -159,18 +170,13 @@ def _fk(q: np.ndarray, ctx: _Ctx, want_jac: bool):
     shape = np.broadcast_shapes(q.shape[:-1], ctx.sel.e.shape, ctx.w.shape)
     flat = as_rows(np.broadcast_to(q, shape + (3,)), 3)
     n = flat.shape[0]
-
-    def items(x, dtype):
-        return as_items(np.broadcast_to(x, shape).reshape(n), n, dtype)
-
-    sel = ctx.sel
-    a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)
+    upper, right, e, a = ctx.items(shape)
     K, KC = _kconst(ctx.c.R, ctx.geo.R + TYRE_THICKNESS)
     P = np.empty((n, 3))
     J = np.empty((n, 9) if want_jac else (n, 0))
     o = ctx.origin
-    _k_fk_batch.kernel(flat, items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128), a,
-                ctx.seed, K, KC, ctx.s, float(o[0]), float(o[1]), float(o[2]), bool(want_jac), P, J)
+    _k_fk_batch.kernel(flat, upper, right, e, a, ctx.seed, K, KC, ctx.s, float(o[0]), float(o[1]), float(o[2]),
+                       bool(want_jac), P, J)
     p = P.reshape(shape + (3,))
     return p, (J.reshape(shape + (3, 3)) if want_jac else None)
 

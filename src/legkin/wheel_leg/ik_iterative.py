@@ -15,7 +15,7 @@ import math
 
 import numpy as np
 
-from .._kernels import as_items, as_rows, batch_kernel, kernel
+from .._kernels import as_rows, batch_kernel, kernel
 from .._rotations import wrap_k
 from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip
 from .frames import _Ctx, _k_fk
@@ -308,13 +308,7 @@ def guess_table(R: float, three_arc: bool) -> tuple[np.ndarray, np.ndarray]:
 def starts(target: np.ndarray, ctx: _Ctx, count: int = 1, branch: float = -1.0) -> np.ndarray:
     """(count, n, 3) geometric starts of the targets (n, 3) on one out-of-plane branch (:func:`_k_starts`)."""
     n = target.shape[0]
-    sel = ctx.sel
-
-    def items(x, dtype):
-        return as_items(x, n, dtype)
-
-    upper, right, e = items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128)
-    a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)
+    upper, right, e, a = ctx.items((n,))
     K, KC = _kconst(ctx.c.R, ctx.geo.R + TYRE_THICKNESS)
     grid, table = guess_table(ctx.geo.R, ctx.seed)
     o = ctx.origin
@@ -330,13 +324,7 @@ def solve(target, ctx: _Ctx, q_start, method: str, tol: float, max_iter: int | N
     """The iterative methods on a batch (n, 3): :func:`_k_ik_iterative` per target (compiled loop).
     Returns (q, iterations, error, solved, reason, evaluations)."""
     n = target.shape[0]
-    sel = ctx.sel
-
-    def items(x, dtype):
-        return as_items(x, n, dtype)
-
-    upper, right, e = items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128)
-    a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)
+    upper, right, e, a = ctx.items((n,))
     K, KC = _kconst(ctx.c.R, ctx.geo.R + TYRE_THICKNESS)
     grid, table = guess_table(ctx.geo.R, ctx.seed)
     o = ctx.origin

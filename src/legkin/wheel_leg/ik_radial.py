@@ -7,7 +7,7 @@ from functools import lru_cache
 
 import numpy as np
 
-from .._kernels import as_items, as_rows, batch_kernel, kernel
+from .._kernels import as_rows, batch_kernel, kernel
 from .._rotations import wrap_k
 from ._common import _LIMITS, _SOLVED, _UNREACHABLE, _k_clip, _k_max, _k_min, _k_phase
 from .frames import _k_fk
@@ -374,13 +374,7 @@ def _ik_radial(target, ctx, tol, max_iter, q0, limits=True):
     n = target.shape[0]
     grid, table, m2, fine, fine_rows = _radial_table(ctx.geo.R, ctx.seed)
     K, KC = _kconst(ctx.c.R, ctx.geo.R + TYRE_THICKNESS)
-    sel = ctx.sel
-
-    def items(x, dtype):
-        return as_items(x, n, dtype)
-
-    upper, right, e = items(sel.upper, np.bool_), items(sel.right, np.bool_), items(sel.e, np.complex128)
-    a = items(ctx.geo.d_wheel + ctx.s * ctx.w, np.float64)
+    upper, right, e, a = ctx.items((n,))
     tgt = as_rows(target, 3)
     q0a = _NO_Q0 if q0 is None else as_rows(q0, 3)
     o = ctx.origin

@@ -150,8 +150,7 @@ def run_checks(
     out: dict[str, tuple[list[CheckResult], float]] = {}
     with progress_bar(sum(steps.values()), "legkin check", enabled=progress) as bar:
         if jobs == 1 or len(groups) == 1:
-            for name in names:
-                out.update(_run_models([name], bar=bar, **options))
+            out = _run_models(names, bar=bar, **options)
         else:
             import multiprocessing
             from concurrent.futures import ProcessPoolExecutor, as_completed
@@ -184,25 +183,24 @@ def _groups(names: list[str]) -> list[list[str]]:
 
 def _run_models(names: list[str], *, samples: int, seed: int, ik_targets: int | None, classify: int | None,
                 bar: Any = None) -> dict[str, tuple[list[CheckResult], float]]:
-    """The rows of each model (``bar``: a progress bar to advance per model and stage)."""
+    """The rows of each model, advancing ``bar`` per model and stage (None, in a worker process: no bar)."""
+    if bar is None:
+        with progress_bar(0, "", enabled=False) as bar:
+            return _run_models(names, samples=samples, seed=seed, ik_targets=ik_targets, classify=classify, bar=bar)
     out = {}
     for name in names:
         module = _checks_module(get_spec(name))
         rng = np.random.default_rng(seed)
         t0 = time.perf_counter()
-        if bar is not None:
-            bar.set_postfix_str(f"{name}: checks ({samples} samples)")
+        bar.set_postfix_str(f"{name}: checks ({samples} samples)")
         rows = list(module.run(samples, rng))
         rows += _mujoco_rows(name, samples, seed)
-        if bar is not None:
-            bar.update(1)
+        bar.update(1)
         if hasattr(module, "ik_robustness"):
             n = samples if ik_targets is None else ik_targets
-            if bar is not None:
-                bar.set_postfix_str(f"{name}: IK robustness ({n} targets)")
+            bar.set_postfix_str(f"{name}: IK robustness ({n} targets)")
             rows.append(module.ik_robustness(n, np.random.default_rng(seed + 1), classify=classify))
-            if bar is not None:
-                bar.update(1)
+            bar.update(1)
         out[name] = (rows, time.perf_counter() - t0)
     return out
 

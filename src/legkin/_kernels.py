@@ -35,7 +35,7 @@ import inspect
 import threading
 import types as pytypes
 from concurrent.futures import ThreadPoolExecutor
-from typing import Any, Callable, TypeVar
+from typing import Any, Callable, TypeVar, overload
 
 import numba
 import numpy as np
@@ -62,23 +62,66 @@ class KernelDispatcher(CPUDispatcher):
         return super().get_call_template(args, kws)
 
 
-def _njit(fn: Callable[..., Any], *, cache: bool = True, **options: Any) -> Any:
-    """``numba.njit(cache=cache, error_model="numpy", **options)(fn)`` on a :class:`KernelDispatcher`."""
+class InternalKernel(KernelDispatcher):
+    """A kernel that only other kernels call (:func:`kernel`'s default): compiled without numba's CPython wrapper.
+
+    numba compiles each kernel with its whole call tree (every kernel it calls is linked in, optimized and turned
+    into machine code again), and with a wrapper that unboxes Python arguments; for a kernel that only compiled
+    code calls, the wrapper is never used. A call from Python still works: it compiles, once, a Python-callable
+    twin of the kernel (its own cache entry, see :func:`_renamed`), listed in :data:`python_twins`. The library
+    calls kernels from Python only through ``kernel(entry=True)`` kernels and batch loops."""
+
+    _twin: KernelDispatcher | None = None
+
+    def __call__(self, *args: Any, **kws: Any) -> Any:
+        twin = self._twin
+        if twin is None:
+            options = {k: v for k, v in self.targetoptions.items() if k not in ("no_cpython_wrapper", "inline")}
+            twin = self._twin = _njit(_renamed(self.py_func, "_py"), cache=self._cache_enabled, **options)
+            python_twins.append(f"{self.py_func.__module__}.{self.py_func.__qualname__}")
+        return twin(*args, **kws)
+
+
+#: Internal kernels called from Python in this process (each compiled a Python-callable twin; see
+#: :class:`InternalKernel`). The checks and the public functions call none.
+python_twins: list[str] = []
+
+
+def _njit(fn: Callable[..., Any], *, cache: bool = True, entry: bool = True, **options: Any) -> Any:
+    """``numba.njit(cache=cache, error_model="numpy", **options)(fn)`` on a :class:`KernelDispatcher`
+    (``entry=False``: an :class:`InternalKernel`, without the CPython wrapper)."""
     if config.DISABLE_JIT:  # type: ignore[attr-defined]
         return fn
     # no_cfunc_wrapper: the C-callable wrapper serves numba's first-class functions, which legkin does not use
     targetoptions = {"nopython": True, "boundscheck": None, "error_model": "numpy", "no_cfunc_wrapper": True}
-    disp = KernelDispatcher(py_func=fn, locals={}, targetoptions={**targetoptions, **options})
+    if not entry:
+        targetoptions["no_cpython_wrapper"] = True
+    cls = KernelDispatcher if entry else InternalKernel
+    disp = cls(py_func=fn, locals={}, targetoptions={**targetoptions, **options})
+    disp._cache_enabled = cache
     if cache:
         disp.enable_caching()
     return disp
 
 
-def kernel(fn: F) -> F:
+@overload
+def kernel(fn: F, /) -> F: ...
+@overload
+def kernel(*, entry: bool = False, inline: bool = False) -> Callable[[F], F]: ...
+def kernel(fn: F | None = None, /, *, entry: bool = False, inline: bool = False) -> F | Callable[[F], F]:
     """Compile a scalar kernel: ``numba.njit(cache=True, error_model="numpy")`` (no ZeroDivisionError: IEEE
     semantics, NaN/inf propagate and the kernel's status reports them), typed on non-literal arguments
-    (:class:`KernelDispatcher`)."""
-    return _njit(fn)  # type: ignore[no-any-return]
+    (:class:`KernelDispatcher`).
+
+    ``@kernel``: a kernel that other kernels call (an :class:`InternalKernel`, without numba's CPython wrapper).
+    ``@kernel(entry=True)``: also called from Python (a single call of a public function).
+    ``@kernel(inline=True)``: inlined into each kernel that calls it (numba's ``inline="always"``), for a thin
+    wrapper or a helper with a single caller: numba then types it inside its caller instead of compiling it, with
+    its whole call tree, on its own (see CONTRIBUTING.md, "first-run compile")."""
+    def wrap(f: F) -> F:
+        options = {"inline": "always"} if inline else {}
+        return _njit(f, entry=entry, **options)  # type: ignore[no-any-return]
+    return wrap if fn is None else wrap(fn)
 
 
 _pool: ThreadPoolExecutor | None = None

@@ -114,7 +114,7 @@ def _horner_k(c, t):
     return p, dp
 
 
-@kernel
+@kernel(inline=True)
 def _root_k(c, a, b, fa):
     """The root of c in [a, b] where c is monotone and changes sign (fa = c(a)): Newton, bisection-safeguarded."""
     x = 0.5 * (a + b)

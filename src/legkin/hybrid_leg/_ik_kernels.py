@@ -43,7 +43,7 @@ from .geometry import (
 BRANCHES = np.array(FOOT_IK_BRANCHES, dtype=np.float64)
 
 
-@kernel
+@kernel(entry=True)
 def platform_pose_k(ux, uy, uz, llb, rb, pose, info):
     """(theta_LL, roll, pitch) (3,) placing the foot at u = p - CENTER, wrapped, for one (ll_branch, roll_branch).
 
@@ -162,7 +162,7 @@ def ik_candidate_k(ux, uy, uz, sv, llb, rb, b1, b2, pose, motors, info):
     return OK if exists else ST_REACH
 
 
-@kernel
+@kernel(inline=True)
 def reproduced_k(pose, motors, b1, b2, s, work):
     """The forward kinematics of the candidate's motors in mode (b1, b2), s returns its pose. The neutral aspect
     (branch (1, 1), mode +1, pitch < PITCH_SPLIT) is one-to-one and nearer R_P = I than the other region of that
@@ -179,7 +179,7 @@ def reproduced_k(pose, motors, b1, b2, s, work):
     return max(abs(xf[0] - pose[1]), abs(xf[1] - pose[2])) <= 1e-7
 
 
-@kernel
+@kernel(inline=True)
 def accepted_k(pose, motors, info, b1, b2, s, work):
     """The mode-checked IK keeps the candidate: inside the limits, in mode (b1, b2), s, off the forward-singularity
     band, and reproduced by the forward kinematics (:func:`reproduced_k`)."""
@@ -188,7 +188,7 @@ def accepted_k(pose, motors, info, b1, b2, s, work):
     return reproduced_k(pose, motors, b1, b2, s, work)
 
 
-@kernel
+@kernel(inline=True)
 def _joint_distance(motors, near):
     """Distance in the joints (MCS1, MCS2, LL): wrapped motor differences and the LL difference (RATIO dtheta0)."""
     d0 = wrap_k(motors[0] - near[0])
@@ -197,7 +197,7 @@ def _joint_distance(motors, near):
     return math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
 
 
-@kernel
+@kernel(inline=True)
 def foot_ik_k(ux, uy, uz, sv, combos, b1, b2, s, limits_only, axis_ok, near, motors, pose):
     """The mode-checked foot IK of one target u = p - CENTER: the first candidate, in the order combos (k, 2) of
     (ll_branch, roll_branch), that :func:`accepted_k` keeps (limits_only: that reaches the LL arc inside the joint
@@ -243,7 +243,7 @@ def foot_ik_b(u, sv, combos, b1, b2, s, limits_only, axis_ok, near, motors, pose
                           motors[j], pose[j]) == OK
 
 
-@kernel
+@kernel(entry=True)
 def ik_all_k(ux, uy, uz, sv, fk_in_band, motors, pose, info, fk):
     """Every closed-form branch (BRANCHES order) of one target u = p - CENTER: motors (16, 3), pose (16, 3), info
     (16, 7) (:func:`ik_candidate_k`) and fk (16,): the branch exists inside the limits in a mode (+-1) and the
@@ -281,7 +281,7 @@ def ik_all_k(ux, uy, uz, sv, fk_in_band, motors, pose, info, fk):
             fk[j] = live and reproduced_k(pose[j], motors[j], b1, b2, info[j, 2], work)
 
 
-@kernel
+@kernel(inline=True)
 def ik_all_out_k(ux, uy, uz, sv, motors, pose, mask, asm, within, valid):
     """:func:`ik_all` of one target: motors, pose (16, 3) (NaN where the branch does not exist), mask (exists),
     asm (assembly mode, int), within (inside the limits, and exists), valid (fk reproduces it, off the band).

@@ -28,7 +28,7 @@ OX, OZ = float(LL_ORIGIN[0]), float(LL_ORIGIN[2])
 L = ROD_LENGTH
 
 
-@kernel
+@kernel(entry=True)
 def rot_k(r, p, m):
     """m (3, 3) = Rx(r) Ry(p), the universal centre (seed eq 2 with the universal joint)."""
     rot_cs_k(math.cos(r), math.sin(r), math.cos(p), math.sin(p), m)
@@ -42,7 +42,7 @@ def rot_cs_k(cr, sr, cp, sp, m):
     m[2, 0], m[2, 1], m[2, 2] = -cr * sp, sr, cr * cp
 
 
-@kernel
+@kernel(entry=True)
 def rotation_error_k(m):
     """max |R^T R - I| of m (3, 3); inf if m has a non-finite entry or det m < 0 (not a rotation)."""
     err = 0.0
@@ -57,7 +57,7 @@ def rotation_error_k(m):
     return err if det >= 0.0 else math.inf
 
 
-@kernel
+@kernel(inline=True)
 def is_rotation_k(m):
     """m is a rotation within 1e-9 (|R^T R - I| <= 1e-9, det >= 0), as the wrappers require."""
     return rotation_error_k(m) <= 1e-9
@@ -91,7 +91,7 @@ def chain_k(m, i, bi, tol, theta, kout):
     return True
 
 
-@kernel
+@kernel(entry=True)
 def chains_k(m, b1, b2, tol, theta, kout):
     """Both chains (:func:`motor_angles_from_rotation`); returns _OK or ST_REACH (theta NaN then)."""
     ok1 = chain_k(m, 0, b1, tol, theta, kout)
@@ -103,7 +103,7 @@ def chains_k(m, b1, b2, tol, theta, kout):
     return ST_REACH
 
 
-@kernel
+@kernel(entry=True)
 def motor_angles_k(r, p, b1, b2, theta, kout):
     """:func:`motor_angles`: the chains at R_P = Rx(r) Ry(p)."""
     if not (math.isfinite(r) and math.isfinite(p)):
@@ -197,7 +197,7 @@ def rod_system_rates_cs_k(cr, sr, cp, sp, tip, dtip, g, nm, dd):
                  + (CZ + rz - tip[i, 2]) * dtip[i, 2])
 
 
-@kernel
+@kernel(entry=True)
 def ref_sign_k(b1, b2):
     """Sign of det N at the neutral pose R_P = I on motor branch (b1, b2) (the reference of assembly +1)."""
     rot = np.eye(3)

@@ -15,13 +15,13 @@ from .geometry import RATIO, Geometry
 __all__ = ["ll_angle", "extension_motor_angle"]
 
 
-@kernel
+@kernel(entry=True)
 def ll_k(t0, sv):
     """Eq 19 (OCR artefact removed): ``theta_LL = -theta0 * 0.07 / (2 pi 1.5) + starting_value``."""
     return -RATIO * t0 + sv
 
 
-@kernel
+@kernel(entry=True)
 def theta0_k(tll, sv):
     """Eq 19 solved for theta0: ``(starting_value - theta_LL) / RATIO`` (inf beyond |theta_LL| ~ 1e306)."""
     return (sv - tll) / RATIO

@@ -40,7 +40,7 @@ __all__ = ["foot_position_from_platform", "fk", "jacobian", "foot_position", "fo
 Branch = Sequence[int]
 
 
-@kernel
+@kernel(entry=True)
 def foot_k(r, p, t, out):
     """Foot FCS in CCS (seed eqs 1, 17, 18, 20): ``CENTER + R_P (o_LL + Ry(t) (FOOT_X, 0, 0))``."""
     if not (math.isfinite(r) and math.isfinite(p) and math.isfinite(t)):
@@ -64,7 +64,7 @@ def _foot_b(r, p, t, out):
 # --- forward kinematics of the closed sub-chain (the polynomial in tan(roll / 2), see the comment above
 
 
-@kernel
+@kernel(inline=True)
 def gain_k(r, p, tll, tip, dtip):
     """Spectral norm of d(foot)/d(theta1, theta2) (m/rad) at the pose (r, p) closed by the lever tips tip:
     ``dx/dtheta = N^-1 diag(D)``, ``dp/dx = [e_x x R f, (Rx(roll) e_y) x R f]``; inf on det N = 0."""
@@ -74,7 +74,7 @@ def gain_k(r, p, tll, tip, dtip):
     return gain_of_rates_k(r, p, tll, nm, dd)
 
 
-@kernel
+@kernel(inline=True)
 def gain_of_rates_k(r, p, tll, nm, dd):
     """:func:`gain_k` from the rod system's Jacobian nm (2, 2) and rates dd (2,) (:func:`.chains.rod_rates_k`)."""
     return gain_cs_k(math.cos(r), math.sin(r), math.cos(p), math.sin(p), math.cos(tll), math.sin(tll), nm, dd)
@@ -104,7 +104,7 @@ def gain_cs_k(cr, sr, cp, sp, ct, st, nm, dd):
     return gain if math.isfinite(gain) else math.inf
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def foot_position_k(t1, t2, t0, sv, b1, b2, s, out, aux):
     """:func:`fk`: the FK pose in mode (b1, b2), s, the band check, the foot. aux = (roll, pitch,
     gain). Returns OK, ST_INPUT, ST_ASSEMBLE or ST_BAND (out NaN then)."""
@@ -134,7 +134,7 @@ def _fk_b(q, sv, b1, b2, s, out, aux, st):
         st[j] = foot_position_k(q[j, 0], q[j, 1], q[j, 2], sv, b1, b2, s, out[j], aux[j])
 
 
-@kernel
+@kernel(entry=True)
 def foot_jacobian_k(t1, t2, t0, sv, b1, b2, s, jac):
     """:func:`jacobian`: d(foot)/d(theta1, theta2, theta0) (3, 3) at the FK pose in mode (b1, b2), s.
 

@@ -3,20 +3,18 @@ angles in the mode asked for (:func:`ik`), and every closed-form branch with its
 
 from __future__ import annotations
 
+import math
 from typing import Literal, NamedTuple, Sequence, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_input, finish
-from .._kernels import OK
 from ..errors import InvalidInputError, UnreachableError
 from ._ik_errors import arc_error, axis_error, ik_error, platform_pose
 from ._ik_kernels import (
     foot_ik_b,
-    foot_ik_k,
     ik_all_b,
-    ik_all_out_k,
     platform_pose_b,
 )
 from ._options import (
@@ -33,14 +31,13 @@ from ._options import (
     fmt,
     resolve,
 )
-from .chains import CX, CY, CZ
 from .geometry import CENTER, FOOT_IK_ORDER, Geometry
 
 __all__ = ["foot_platform_ik", "ik", "ik_all", "FootIKSolutions", "foot_ik", "foot_ik_solutions"]
 
 Branch = Sequence[int]
 _COMBOS = np.array(FOOT_IK_ORDER, dtype=np.float64)
-_NO_NEAR = np.full(3, np.nan)
+_NO_NEAR = np.full((1, 3), np.nan)  # the near row of a single call (none)
 
 
 def _combos(llb: float | None, rb: float | None) -> list:
@@ -108,10 +105,10 @@ def foot_platform_ik(p: ArrayLike, *, ll_branch: int | None = None, roll_branch:
     """
     if (ll_branch is None and roll_branch is None and branch is None and assembly is None and return_mask is False
             and geometry is None and type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64):
-        motors, pose = np.empty(3), np.empty(3)
-        if foot_ik_k(p[0] - CX, p[1] - CY, p[2] - CZ, 0.0, _COMBOS, 1.0, 1.0, 1.0, True, False, _NO_NEAR, motors,
-                     pose) == OK:
-            return pose
+        u, out, ok = (p - CENTER).reshape(1, 3), np.empty((2, 1, 3)), np.empty(1, dtype=np.bool_)
+        foot_ik_b.kernel(u, 0.0, _COMBOS, 1.0, 1.0, 1.0, True, False, _NO_NEAR, out[0], out[1], ok)
+        if ok[0]:
+            return out[1, 0]
     resolve(geometry)
     pp, u, shape = _targets(p)
     llb = check_sign(ll_branch, "ll_branch", allow_none=True)
@@ -180,10 +177,11 @@ def ik(p: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, ll_branch: i
             and type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64):
         fb, fs, g = fast_branch(branch), fast_sign(assembly), fast_geometry(geometry)
         if fb is not None and fs is not None and g is not None and g.center == "universal":
-            motors, pose = np.empty(3), np.empty(3)
-            if foot_ik_k(p[0] - CX, p[1] - CY, p[2] - CZ, g.starting_value, _COMBOS, fb[0], fb[1], fs, False, True,
-                         _NO_NEAR, motors, pose) == OK:
-                return motors
+            u, out, ok = (p - CENTER).reshape(1, 3), np.empty((2, 1, 3)), np.empty(1, dtype=np.bool_)
+            foot_ik_b.kernel(u, g.starting_value, _COMBOS, fb[0], fb[1], fs, False, True, _NO_NEAR, out[0], out[1],
+                             ok)
+            if ok[0]:
+                return out[0, 0]
     g = resolve(geometry, universal="ik")
     pp, u, shape = _targets(p)
     llb = check_sign(ll_branch, "ll_branch", allow_none=True)
@@ -235,9 +233,10 @@ def ik_all(p: ArrayLike, *, geometry: Geometry | None = None) -> FootIKSolutions
     g = fast_geometry(geometry)
     if (type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64 and g is not None
             and g.center == "universal"):
-        out = _all_outputs(())
-        if ik_all_out_k(p[0] - CX, p[1] - CY, p[2] - CZ, g.starting_value, *out):
-            return FootIKSolutions(*out)
+        if math.isfinite(p[0] + p[1] + p[2]):  # (the kernel gives a non-finite target no branch; as_input raises)
+            out = _all_outputs((1,))
+            ik_all_b.kernel((p - CENTER).reshape(1, 3), g.starting_value, *out)
+            return FootIKSolutions(*(a[0] for a in out))
     g = resolve(geometry, universal="ik_all")
     _, u, shape = _targets(p)
     n = len(u)

@@ -40,7 +40,7 @@ __all__ = ["platform_orientation", "platform_poses", "PlatformPoses"]
 Branch = Sequence[int]
 
 
-@kernel
+@kernel(entry=True)
 def fk_select_k(t1, t2, b1, b2, s, tol, max_iter, x):
     """The pose x (2,) of motors (t1, t2) in mode (b1, b2), s within the limits nearest R_P = I (the numpy
     ``_fk_select``). Returns _OK, ST_INPUT (non-finite motors) or ST_ASSEMBLE (x NaN)."""
@@ -70,7 +70,7 @@ def _fk_select_b(t1, t2, b1, b2, s, tol, max_iter, x, ok):
         ok[j] = fk_select_k(t1[j], t2[j], b1[j], b2[j], s[j], tol, max_iter, x[j]) == OK
 
 
-@kernel
+@kernel(entry=True)
 def poses_k(t1, t2, tol, max_iter, x, br, asm):
     """:func:`platform_poses` for one motor pair: every pose (nearest R_P = I first, duplicates - the same pose
     with the same sign of det N - dropped), its motor branch and assembly mode, into x (8, 2), br (8, 2),

@@ -60,7 +60,7 @@ def _rot_b(r, p, out):
         rot_k(r[j], p[j], out[j])
 
 
-@kernel
+@kernel(entry=True)
 def spans_k(t1, t2, r, p, out):
     """|A_i - S_i| (2,): lever tips of eqs 7, 14 to the platform points of eqs 9, 16 at R_P = Rx(r) Ry(p)."""
     tip = np.empty((2, 3))
@@ -88,7 +88,7 @@ def _motor_angles_b(r, p, b1, b2, theta, kout, ok):
         ok[j] = motor_angles_k(r[j], p[j], b1, b2, theta[j], kout[j]) == OK
 
 
-@kernel
+@kernel(entry=True)
 def motor_jacobian_k(r, p, b1, b2, jac, kout, mode):
     """:func:`motor_jacobian` jac (2, 2) = d(theta1, theta2)/d(roll, pitch) = D^-1 N and :func:`assembly_mode`
     mode (1,) = sign(det N) x its sign at R_P = I on (b1, b2), at the pose (r, p). Returns OK, ST_INPUT,

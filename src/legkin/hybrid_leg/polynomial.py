@@ -66,7 +66,7 @@ def roll_poly_k(tip, poly, al, be, ga):
         poly[k] = _rows_conv_k(w, 1, w, 1, 5, k) + _rows_conv_k(w, 2, w, 2, 5, k) - _rows_conv_k(w, 0, w, 0, 5, k)
 
 
-@kernel
+@kernel(inline=True)
 def _rows_conv_k(a, ra, b, rb, n, k):
     """Coefficient k of the product of the polynomials a[ra], b[rb] (n ascending coefficients each), summed over
     ascending i (rows indexed in place: no array views)."""
@@ -78,7 +78,7 @@ def _rows_conv_k(a, ra, b, rb, n, k):
     return s
 
 
-@kernel
+@kernel(inline=True)
 def roots_k(c, z):
     """Complex roots z (8,) of the polynomial c (9,) (ascending), NaN-padded: Aberth-Ehrlich iteration.
 
@@ -234,7 +234,7 @@ def rod_newton_k(x, tip, max_iter, keep_sign):
     return err if math.isfinite(err) else math.inf
 
 
-@kernel
+@kernel(inline=True)
 def null_k(nm, v):
     """Singular values (s_max, s_min) of N (2, 2) and the right singular vector v (2,) of s_min."""
     a = nm[0, 0] * nm[0, 0] + nm[1, 0] * nm[1, 0]
@@ -409,7 +409,7 @@ def label_k(tip, dtip, x, err, m, tol, xs, bl, sdet):
 
 
 
-@kernel
+@kernel(inline=True)
 def solutions_k(t1, t2, tol, max_iter, xs, bl, sdet):
     """Every platform pose within the joint limits closing both rods for motors (t1, t2): xs (m, 2), motor
     branch bl (m, 2) (0 on a chain's reach boundary), sign det N sdet (m,). Returns m (duplicates possible).

@@ -26,7 +26,7 @@ __all__ = ["motor_angles_from_rotation", "sphere_joint_angles", "spherical_free_
 Branch = Sequence[int]
 
 
-@kernel
+@kernel(entry=True)
 def rot_angles_k(m, b1, b2, theta, kout):
     """:func:`motor_angles_from_rotation` of one matrix m (3, 3): ST_INPUT unless a rotation, else the chains."""
     if not is_rotation_k(m):
@@ -35,7 +35,7 @@ def rot_angles_k(m, b1, b2, theta, kout):
     return chains_k(m, b1, b2, K_TOL, theta, kout)
 
 
-@kernel
+@kernel(entry=True)
 def sphere_k(m, b1, b2, out, kout):
     """:func:`sphere_joint_angles` out (2, 3) of one rotation m: ``u = Rz(phi_i)^T (A_i - S_i) / L``,
     ``alpha = atan2(u_y, u_x)``, ``beta = -asin(u_z)``, ``gamma = 0``. Returns a status (out NaN unless OK)."""
@@ -61,7 +61,7 @@ def sphere_k(m, b1, b2, out, kout):
     return OK
 
 
-@kernel
+@kernel(entry=True)
 def free_axis_k(m, b1, b2, out, kout):
     """:func:`spherical_free_axis` out (3,) of one rotation m: ``g_1 x g_2`` normalised, ``g_i = (R a_i) x d_i``,
     positive z. Returns a status (out NaN unless OK)."""

@@ -28,7 +28,7 @@ def _rot_k(g, ia, c, s, vx, vy, vz):
     )
 
 
-@kernel
+@kernel(inline=True)
 def _cross_k(g, ia, vx, vy, vz):
     """``a x v`` with ``a = g[ia:ia + 3]``."""
     ax, ay, az = g[ia], g[ia + 1], g[ia + 2]
@@ -50,7 +50,7 @@ def _fk3_k(q0, q1, q2, g):
     return g[_O] + px, g[_O + 1] + py, g[_O + 2] + pz
 
 
-@kernel
+@kernel(entry=True)
 def _fk_k(q, g, out) -> int:
     """Foot position: :func:`_fk3_k`,
     ``p = o1 + R(a1, q1) [(o2 - o1) + R(a2, q2) ((o3 - o2) + R(a3, q3) (f - o3))]``."""
@@ -79,7 +79,7 @@ def _jac3_k(q0, q1, q2, g, out) -> None:
     out[0, 2], out[1, 2], out[2, 2] = _rot_k(g, _A1, c1, s1, x, y, z)
 
 
-@kernel
+@kernel(entry=True)
 def _jacobian_k(q, g, out) -> int:
     """Foot Jacobian ``dp/dq`` (3, 3): :func:`_jac3_k`."""
     if not _finite3(q):

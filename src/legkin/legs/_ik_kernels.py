@@ -195,7 +195,7 @@ def _ik_all_k(p, g, ref, out, info) -> int:
     return OK
 
 
-@kernel
+@kernel(inline=True)
 def _in_limits_k(a, r, lo, hi):
     """The representative ``a + 2 pi n`` inside ``[lo, hi]`` (slack :data:`LIMIT_TOL`, then clipped) nearest ``r``;
     NaN if none. Also returns the distance to the limits of the nearest representative (0 when inside)."""
@@ -214,7 +214,7 @@ def _in_limits_k(a, r, lo, hi):
     return best, miss
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _ik_k(p, g, ref, out, info) -> int:
     """The branch of :func:`_ik_all_k` inside the limits nearest ``ref`` (least sum of squared joint differences;
     ties to the earlier branch). ``info``: the miss (m) and reason, or the least limit violation (rad) and the

@@ -126,13 +126,13 @@ def _hip_k(dx, rho, s_u, vx, vz):
     return np.arctan2(uz * vx - dx * vz, dx * vx + uz * vz)
 
 
-@kernel
+@kernel(inline=True)
 def _branch_k(dx, dy, dz, rho, s_u, vx, vz, li):
     """Steps 2 and 4: q1 and q2 of abduction branch ``s_u`` for a knee vector ``v``."""
     return _abduction_k(dy, dz, rho, s_u, li), _hip_k(dx, rho, s_u, vx, vz)
 
 
-@kernel
+@kernel(inline=True)
 def _ik_all_core(p, li, foot_z, l2, offset, co, so, out) -> int:
     """Every branch of :func:`ik_all` for one target ``p`` (3,) into ``out`` (4, 3) (NaN if unreachable)."""
     if not _finite3(p):
@@ -149,7 +149,7 @@ def _ik_all_core(p, li, foot_z, l2, offset, co, so, out) -> int:
     return OK
 
 
-@kernel
+@kernel(entry=True)
 def _ik_all_k(p, li, foot_z, out) -> int:
     l2, offset, co, so = _leg_plane_k(foot_z)
     return _ik_all_core(p, li, foot_z, l2, offset, co, so, out)

@@ -25,7 +25,7 @@ def _finite3(x) -> bool:
     return np.isfinite(x[0]) and np.isfinite(x[1]) and np.isfinite(x[2])
 
 
-@kernel
+@kernel(inline=True)
 def _knee_k(q3, foot_z):
     """``v = t23 + Ry(q3) t34`` in the thigh's x-z plane (foot from the shoulder, before q2)."""
     c3, s3 = np.cos(q3), np.sin(q3)
@@ -73,7 +73,7 @@ def _jacobian_k(q1, q2, q3, li, foot_z, jac):
     jac[2, 2] = c1 * duz3
 
 
-@kernel
+@kernel(entry=True)
 def _fk_k(q, li, foot_z, out) -> int:
     """:func:`fk` of one joint vector ``q`` (3,) into ``out`` (3,)."""
     if not _finite3(q):
@@ -82,7 +82,7 @@ def _fk_k(q, li, foot_z, out) -> int:
     return OK
 
 
-@kernel
+@kernel(entry=True)
 def _jac_k(q, li, foot_z, out) -> int:
     """:func:`jacobian` of one joint vector ``q`` (3,) into ``out`` (3, 3)."""
     if not _finite3(q):
@@ -107,7 +107,7 @@ def _jac_batch(q, li, foot_z, out) -> int:
     return bad
 
 
-@kernel
+@kernel(entry=True)
 def _hip_position_k(li, out) -> int:
     out[0], out[1], out[2] = SX[li] * X01, SY[li] * Y01, Z01
     return OK

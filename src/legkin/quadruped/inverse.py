@@ -44,7 +44,7 @@ from .repair import _clipped_k
 __all__ = ["ik"]
 
 
-@kernel
+@kernel(inline=True)
 def _ik_core(p, li, foot_z, l2, offset, co, so, has_ref, q_near, out) -> int:
     """:func:`ik` of one target ``p`` (3,) into ``out`` (3,): the branch inside the limits (nearest ``q_near``
     when ``has_ref``), or NaN and the failure code (unreachable, or only outside the limits).
@@ -90,13 +90,13 @@ def _ik_core(p, li, foot_z, l2, offset, co, so, has_ref, q_near, out) -> int:
     return OK if best < np.inf else JOINT_LIMIT
 
 
-@kernel
+@kernel(entry=True)
 def _ik_k(p, li, foot_z, has_ref, q_near, out) -> int:
     l2, offset, co, so = _leg_plane_k(foot_z)
     return _ik_core(p, li, foot_z, l2, offset, co, so, has_ref, q_near, out)
 
 
-@kernel
+@kernel(entry=True)
 def _ik_noref_k(p, li, foot_z, out) -> int:
     """:func:`_ik_k` without ``q_near`` (fewer arguments: a cheaper single call)."""
     l2, offset, co, so = _leg_plane_k(foot_z)

@@ -14,7 +14,7 @@ from .geometry import Geometry
 __all__ = ["within_limits"]
 
 
-@kernel
+@kernel(entry=True)
 def _within_limits_k(q, tol) -> bool:
     """Whether ``q`` (3,) lies inside :data:`JOINT_LIMITS` with slack ``tol`` (NaN: outside)."""
     return (
@@ -31,7 +31,7 @@ def _within_limits_batch(q, tol, out) -> None:
         out[i] = _within_limits_k(q[i], tol)
 
 
-@kernel
+@kernel(inline=True)
 def _toward_limits_k(x, row):
     """The representative of angle ``x`` (mod 2 pi) inside the limits of joint ``row`` when one is.
 
@@ -45,13 +45,13 @@ def _toward_limits_k(x, row):
     return x
 
 
-@kernel
+@kernel(inline=True)
 def _strictly_inside_k(q1, q2, q3) -> bool:
     """Inside :data:`JOINT_LIMITS` with no slack."""
     return q1 >= LO[0] and q1 <= HI[0] and q2 >= LO[1] and q2 <= HI[1] and q3 >= LO[2] and q3 <= HI[2]
 
 
-@kernel
+@kernel(inline=True)
 def _inside_by_k(q1, q2, q3, slack) -> bool:
     """Inside :data:`JOINT_LIMITS` widened by ``slack`` (rad)."""
     return (

@@ -100,7 +100,7 @@ def _clip_repair_k(qc, q, p, li, foot_z, best) -> bool:
     return best_err <= CLIP_TOL
 
 
-@kernel
+@kernel(inline=True)
 def _clipped_k(q1, q2, q3, p, li, foot_z):
     """A branch a hair outside the limits, clipped into them and repaired (:func:`_clip_repair_k`):
     (kept, q1, q2, q3). The rare path: its scratch arrays are allocated here."""

@@ -23,7 +23,7 @@ from .geometry import Geometry
 __all__ = ["textbook_ik", "textbook_frame", "textbook_to_joints"]
 
 
-@kernel
+@kernel(entry=True)
 def _textbook_frame_k(p, li, out) -> int:
     """``(x_f, y_f, z_f) = (s_y d_y, d_x, -d_z)`` with ``d = p - h``."""
     if not _finite3(p):
@@ -63,7 +63,7 @@ def textbook_frame(p: npt.ArrayLike, leg: str, *, geometry: Geometry | None = No
     return out
 
 
-@kernel
+@kernel(entry=True)
 def _textbook_ik_k(p, a, b, c, literal, out) -> int:
     """Seed 002's law of cosines for one target ``p`` (3,) in its frame (NaN where acos/asin are out of range)."""
     if not _finite3(p):
@@ -124,7 +124,7 @@ def textbook_ik(p: npt.ArrayLike, a: float, b: float, c: float, *, literal: bool
     return out
 
 
-@kernel
+@kernel(entry=True)
 def _textbook_to_joints_k(theta, beta, out) -> int:
     """``q = wrap(theta - (pi/2, KNEE_OFFSET, KNEE_OFFSET - beta))`` (NaN maps to NaN)."""
     out[0] = wrap_k(theta[0] - PI / 2)

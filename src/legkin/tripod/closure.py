@@ -129,7 +129,7 @@ def _k_pose(cy, sy, cz, sz, G, home, e, s, q1, c2, s2, sn, cn):  # type: ignore[
     return nb2
 
 
-@kernel
+@kernel(inline=True)
 def _k_jac(cy, sy, cz, sz, c2, s2, nb2, G, home, e, a1, a2):  # type: ignore[no-untyped-def]
     """Both columns of A_u (3,) each, in place."""
     for K in range(3):
@@ -139,7 +139,7 @@ def _k_jac(cy, sy, cz, sz, c2, s2, nb2, G, home, e, a1, a2):  # type: ignore[no-
             a1[K], a2[K] = _k_jac_general(K, cy, sy, cz, sz, c2[K], s2[K], nb2, G, e)
 
 
-@kernel
+@kernel(inline=True)
 def _k_det_planes(sa_, sb_, sc_, ca_, cb_, cc_, G):  # type: ignore[no-untyped-def]
     """det M of the motor planes' unit normals ``n_K = (s_K1, -c_K1 c_K, -c_K1 s_K)`` from sin / cos of the three
     motors: the triple product ``n_A . (n_B x n_C)`` (the mean of its three cyclic forms)."""
@@ -156,7 +156,7 @@ def _k_det_planes(sa_, sb_, sc_, ca_, cb_, cc_, G):  # type: ignore[no-untyped-d
     return tot / 3.0
 
 
-@kernel
+@kernel(entry=True)
 def _k_ik(ay, az, G, home, e, s, q, aux):  # type: ignore[no-untyped-def]
     """ik of one orientation in one assembly mode (seed eqs (98), (102)): writes the 12 joints into ``q`` (NaN
     unless ok) and (cos q_A2, cos q_B2, cos q_C2, 1 + c_y c_z, det M, |A_u|_F) into ``aux`` (6,); the motor gain
@@ -198,7 +198,7 @@ def _k_ik(ay, az, G, home, e, s, q, aux):  # type: ignore[no-untyped-def]
     return ST_FAIL
 
 
-@kernel
+@kernel(inline=True)
 def _k_write(q, q1a, q2a, q1b, q2b, q1c, q2c):  # type: ignore[no-untyped-def]
     """The solution into ``q``: every joint (12,) (q_K3 = q_K2, q_K4 = q_K1) or the motors (3,)."""
     if q.shape[0] == 12:
@@ -209,7 +209,7 @@ def _k_write(q, q1a, q2a, q1b, q2b, q1c, q2c):  # type: ignore[no-untyped-def]
         q[0], q[1], q[2] = q1a, q1b, q1c
 
 
-@kernel
+@kernel(entry=True)
 def _k_ik_all(ay, az, G, q, ok):  # type: ignore[no-untyped-def]
     """ik of one orientation in every assembly mode at once (:data:`legkin.tripod.MODES` order): writes each
     mode's joints into ``q[j]`` ((16, 12) every joint or (16, 3) the motors; NaN unless ok) and its success
@@ -272,7 +272,7 @@ def _k_ik_all(ay, az, G, q, ok):  # type: ignore[no-untyped-def]
     return OK if found else ST_FAIL
 
 
-@kernel
+@kernel(entry=True)
 def _k_actuation_jacobian(ay, az, G, home, e, s, a, aux):  # type: ignore[no-untyped-def]
     """A_u (3, 2) of one orientation in one mode into ``a`` (NaN unless inside the workspace), (cos q_K2 (3),
     1 + c_y c_z) into ``aux``; returns OK, ST_FAIL or ST_NONFINITE (see :func:`legkin.tripod.jacobian`)."""

@@ -55,7 +55,7 @@ STEP_RCOND = 1e-12
 ROUNDING_FLOOR = 4.0 * math.pi * 2.0**-52
 
 
-@kernel
+@kernel(entry=True)
 def _k_initial_guess(qa, qb, qc, G):  # type: ignore[no-untyped-def]
     """Closed-form start of fk from the motors (the motor planes' adjugate intersection, see the module docstring):
     (alpha_y, alpha_z, det M). With ``1 - c_alpha = 0`` (E = 0) the start is the home direction."""
@@ -110,7 +110,7 @@ def _k_gn_step(a1, a2, r):  # type: ignore[no-untyped-def]
     return s0, s1
 
 
-@kernel
+@kernel(inline=True)
 def _k_normal_residual(a1, a2, r):  # type: ignore[no-untyped-def]
     """|r - A A^+ r| and |A|_F for A = [a1 a2] (the part of r off the range of A: rank 2 ``|r . n| / |n|``,
     n = a1 x a2; rank-1 projection where ``sigma_2 <= STEP_RCOND sigma_1``)."""
@@ -139,7 +139,7 @@ def _k_normal_residual(a1, a2, r):  # type: ignore[no-untyped-def]
     return out, np.sqrt(f)
 
 
-@kernel
+@kernel(inline=True)
 def _k_shrunk(ay, az, f):  # type: ignore[no-untyped-def]
     """The orientation of tilt (1 - f) theta in the direction of (ay, az) (towards home)."""
     cy = np.cos(ay)
@@ -169,7 +169,7 @@ def _k_fk_report(ay, az, qm, G, home, e, s, a1, a2, q1, c2, s2, sn, cn, r, last)
     return ay, az, inc, _k_inside(c2[0], c2[1], c2[2], nb2), ROUNDING_FLOOR * norm_a
 
 
-@kernel
+@kernel(entry=True)
 def _k_fk(qa, qb, qc, G, home, e, s, tol, max_iter, max_inc, out):  # type: ignore[no-untyped-def]
     """fk of one motor triple in one assembly mode: writes (alpha_y, alpha_z, inconsistency) into ``out`` (3,)
     and returns the status (0 ok, else the ST_ codes of :mod:`legkin.tripod._common`; :data:`ST_NONFINITE` for

@@ -23,7 +23,7 @@ __all__ = ["leg_transform", "leg_transform_cv"]
 
 
 # ------------------------------------------------------------------------------------------ kernels
-@kernel
+@kernel(inline=True)
 def _k_matmul3(A, B):  # type: ignore[no-untyped-def]
     """A @ B for 3 x 3 matrices given as row-major 9-tuples (no heap arrays)."""
     return (
@@ -50,7 +50,7 @@ def _k_leg_position(q1, q2, eta, G, T):  # type: ignore[no-untyped-def]
     T[3, 0], T[3, 1], T[3, 2], T[3, 3] = 0.0, 0.0, 0.0, 1.0
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_leg_transform(q1, q2, q3, q4, eta, alpha, G, T):  # type: ignore[no-untyped-def]
     """:func:`leg_transform` of one joint vector into T (4, 4); returns OK or ST_NONFINITE (T not written)."""
     if not (np.isfinite(q1) and np.isfinite(q2) and np.isfinite(q3) and np.isfinite(q4)):
@@ -69,7 +69,7 @@ def _k_leg_transform(q1, q2, q3, q4, eta, alpha, G, T):  # type: ignore[no-untyp
     return OK
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_leg_transform_cv(q1, q2, eta, G, T):  # type: ignore[no-untyped-def]
     """Seed eqs (10)-(12) (:func:`leg_transform_cv`, T33 sign corrected) into T (4, 4)."""
     c1, s1, c2, s2 = np.cos(q1), np.sin(q1), np.cos(q2), np.sin(q2)

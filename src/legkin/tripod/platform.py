@@ -40,13 +40,13 @@ def _k_one_plus_cc(cy, sy, cz, sz):  # type: ignore[no-untyped-def]
     return out
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_alpha_x(ay, az):  # type: ignore[no-untyped-def]
     """Seed eq (15), two-argument form (:func:`alpha_x`)."""
     return np.arctan2(np.sin(ay) * np.sin(az), np.cos(ay) + np.cos(az))
 
 
-@kernel
+@kernel(entry=True)
 def _k_platform_rotation(ay, az, R):  # type: ignore[no-untyped-def]
     """Seed eqs (5), (15): R = Rz(alpha_z) Ry(alpha_y) Rx(alpha_x) into R (3, 3)."""
     cy, sy, cz, sz = np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
@@ -57,14 +57,14 @@ def _k_platform_rotation(ay, az, R):  # type: ignore[no-untyped-def]
     R[2, 0], R[2, 1], R[2, 2] = -sy, cy * sx, cy * cx
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_platform_axis(ay, az, out):  # type: ignore[no-untyped-def]
     """R e_x = (c_z c_y, s_z c_y, -s_y) into out (3,)."""
     cy = np.cos(ay)
     out[0], out[1], out[2] = np.cos(az) * cy, np.sin(az) * cy, -np.sin(ay)
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_platform_position(ay, az, G, out):  # type: ignore[no-untyped-def]
     """E = -L b / |b| (:func:`platform_position`) into out (3,); NaN where 1 + c_y c_z <= SINGULAR_TOL."""
     cy, sy, cz, sz = np.cos(ay), np.sin(ay), np.cos(az), np.sin(az)
@@ -73,7 +73,7 @@ def _k_platform_position(ay, az, G, out):  # type: ignore[no-untyped-def]
     out[0], out[1], out[2] = nb2 * scale, sz * cy * scale, -sy * scale
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_orientation_from_axis(r0, r1, r2):  # type: ignore[no-untyped-def]
     """(status, alpha_y, alpha_z) of a platform axis (:func:`orientation_from_axis`): ST_NONFINITE, ST_FAIL
     (zero vector) or OK."""

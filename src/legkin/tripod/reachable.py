@@ -17,7 +17,7 @@ from .geometry import Geometry
 __all__ = ["workspace", "Workspace"]
 
 
-@kernel
+@kernel(inline=True)
 def _k_linspace(a, b, out):  # type: ignore[no-untyped-def]
     """np.linspace(a, b, len(out)) into out (the same operations: start + i * step, the last point exactly b)."""
     n = out.shape[0]
@@ -27,7 +27,7 @@ def _k_linspace(a, b, out):  # type: ignore[no-untyped-def]
     out[n - 1] = b
 
 
-@kernel
+@kernel(inline=True)
 def _k_tilt_curve(theta, phi, pts):  # type: ignore[no-untyped-def]
     """The curve of tilts theta (m,) in directions phi (m,) as (alpha_y, alpha_z) rows into pts (2m, 2), a NaN row
     wherever alpha_z wraps around (|jump| > pi); returns the row count."""
@@ -46,7 +46,7 @@ def _k_tilt_curve(theta, phi, pts):  # type: ignore[no-untyped-def]
     return k
 
 
-@kernel
+@kernel(entry=True)
 def _k_workspace(G, eta, ch, ay, az, cos_q2, reachable, phi, theta_k, tilt_max, curves, counts):  # type: ignore[no-untyped-def]
     """:func:`workspace` on preallocated outputs: the grid (ik's kernel, home mode: cos q_K2 and success), the
     singular curves theta_K(phi) = 2 asin(cos(alpha/2) / |sin(phi - eta_K)|), their minimum and the four curves

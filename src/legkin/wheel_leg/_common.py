@@ -56,7 +56,7 @@ def _k_max(a, b):
     return a if a >= b else b
 
 
-@kernel
+@kernel(inline=True)
 def _k_min(a, b):
     """``np.minimum`` for floats (NaN propagates)."""
     if a != a or b != b:

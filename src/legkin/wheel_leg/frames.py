@@ -64,7 +64,7 @@ def _origin(leg, geo: Geometry) -> np.ndarray:
     return o
 
 
-@kernel
+@kernel(entry=True)
 def _k_frame(p, gamma, RLM, R0, dwheel, o, out):
     """:func:`leg_frame_to_robot` for one point: ``out = o + R0 Rz(gamma) (RLM p + (d_wheel, 0, 0))``."""
     pm = np.empty(3)
@@ -363,7 +363,7 @@ def _k_fk(theta, beta, gamma, upper, right, e, seed, K, KC, s, a, o0, o1, o2, wa
     return status
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_contact(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac, p, J):
     """:func:`fk` / :func:`jacobian` for one item, inputs range-checked (status codes)."""
     theta = q[0]

@@ -121,7 +121,7 @@ def _k_support(C, RAD, A0, SPAN, d):
     return bp, bu, Y
 
 
-@kernel
+@kernel(entry=True)
 def _k_ground(q, n, r, K, KC, sl, dwheel, halfT, o0, o1, o2, RLM, R0, p, J, info, want_jac):
     """:func:`ground_contact` for one item: point p (3,), Jacobian J (9,) (when ``want_jac``), info (4,) =
     (piece, s, w, link)."""

@@ -38,7 +38,7 @@ _GUESS_NODES = 64
 _START_MARGIN = 0.5 * (THETA_MAX - THETA_MIN) / (_GUESS_NODES - 1)
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_starts(tgt, upper, right, e, a, seed, K, KC, o0, o1, o2, s, grid, table, branch, count, starts):
     """Geometric starts for one target on the out-of-plane branch ``sign(y_L) = branch``, best first, into
     ``starts`` (count, 3).
@@ -235,7 +235,7 @@ def _k_ik_damped(q, tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, tol, ma
     return it, err, ev
 
 
-@kernel
+@kernel(entry=True)
 def _k_ik_iterative(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, table, method, count, tol, max_iter,
                     delta, q_start, use_start, limits, q):
     """One target by an iterative method (0: :func:`_k_ik_gauss_newton_fd`, 1: :func:`_k_ik_damped`) into

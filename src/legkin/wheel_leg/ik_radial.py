@@ -160,7 +160,7 @@ def _k_radial_brackets(grid, f, g, m2, kind, ee, ea, ftol, upper, right, e, seed
     return nj, nx, ns, its
 
 
-@kernel
+@kernel(inline=True)
 def _k_radial_roots(jobs, nj, xth, nx, ns, coef, fine, fine_rows, upper, right, e, seed, K, KC, r2, max_iter, rth,
                     rz):
     """The roots of one target into ``rth`` (theta) and ``rz`` (its contact point before the beta rotation):
@@ -252,7 +252,7 @@ def _k_radial_pick(rth, rz, nr, tau, gamma1, gamma2, two, q0, use_q0, limits, q,
     return best, nsol
 
 
-@kernel
+@kernel(entry=True)
 def _k_ik_radial(tgt, upper, right, e, a, seed, K, KC, s, o0, o1, o2, grid, table, m2, fine, fine_rows, tol,
                  max_iter, q0, use_q0, limits, q, sols):
     """The radial IK for one target (:func:`_ik_radial` states the math) into ``q`` (3,) and ``sols``

@@ -235,7 +235,7 @@ _PT_INDEX = np.array([i for i, _ in _POINT_SOURCE], dtype=np.int64)
 _PT_CONJ = np.array([c for _, c in _POINT_SOURCE], dtype=np.bool_)
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_linkage(theta, beta, K, KC, idx, conj, out):
     """:func:`linkage_points` for one (theta, beta) into ``out`` (22, 3): the closed form (:func:`_k_closed`),
     right half = conjugates, rotated by ``exp(i (beta + pi/2))``, w = 0."""
@@ -269,14 +269,14 @@ def _k_links(pts):
     return (pts[_IA], pts[_IE] - pts[_IA], pts[_IC] - pts[_ID], pts[_IC] - pts[_IB], pts[_IG] - pts[_IF])
 
 
-@kernel
+@kernel(inline=True)
 def _k_turn(a, b):
     """``arg(u(a) conj(u(b)))``, u the unit vector: the angle from link vector b to a."""
     z = a * b.conjugate()  # (the positive scales of the unit vectors do not change the angle)
     return math.atan2(z.imag, z.real)
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_passive(theta, beta, K, KC, KR, out):
     """:func:`passive_angles` for one (theta, beta) into ``out`` (10,) in the order of :data:`PASSIVE_JOINTS`:
     the link orientations of the closed form at theta and at theta0, ``d(link) = arg(u(theta) conj(u(theta0)))``
@@ -300,7 +300,7 @@ def _k_passive_batch(theta, beta, K, KC, KR, out):
         _k_passive(theta[i], beta[i], K, KC, KR, out[i])
 
 
-@kernel
+@kernel(entry=True)
 def _k_ref_links(K, KC, out):
     pts, _d = _k_closed(THETA0, K, KC, False)
     links = _k_links(pts)
@@ -388,13 +388,13 @@ def passive_angles(theta: ArrayLike, beta: ArrayLike = 0.0, *,
     return dict(zip(PASSIVE_JOINTS, out.T.reshape((len(PASSIVE_JOINTS),) + shape)))
 
 
-@kernel
+@kernel(entry=True)
 def _k_motor_angles(theta, beta):
     """The motor mapping (reference): ``phi_L = beta + (theta - theta0)``, ``phi_R = beta - (theta - theta0)``."""
     return beta + (theta - THETA0), beta - (theta - THETA0)
 
 
-@kernel
+@kernel(entry=True)
 def _k_theta_beta(phi_L, phi_R):
     """Its inverse: ``theta = (phi_L - phi_R) / 2 + theta0``, ``beta = (phi_L + phi_R) / 2``."""
     return (phi_L - phi_R) / 2 + THETA0, (phi_L + phi_R) / 2

@@ -37,7 +37,7 @@ def _k_lower_bound(Fa, Fb, Ga, Gb, h, M):
     return _k_max(Fa + Ga * tc - M * tc * tc / 2, Fb - Gb * (h - tc) - M * (h - tc) ** 2 / 2)
 
 
-@kernel
+@kernel(inline=True)
 def _k_hermite_root(h, flo, fhi, glo, ghi):
     """Root (offset from the lower end, in [0, h]) of the cubic Hermite model of f on a bracket of width h
     (values flo, fhi of opposite signs, slopes glo, ghi): four Newton steps on the cubic from the regula
@@ -109,7 +109,7 @@ def _k_radial_extremum(lo, hi, flo, fhi, glo, ghi, M, upper, right, e, seed, K, 
     return th, f_out, g_out, status, curv, its
 
 
-@kernel
+@kernel(inline=True)
 def _k_fine_f(fine_rows, i, coef):
     """f (f' for rows kf + i) from the fine table at node i: ``fine_rows[i] . coef``."""
     acc = 0.0

@@ -33,7 +33,7 @@ def rim_segment(alpha: ArrayLike, *, geometry: Geometry | None = None) -> np.nda
     return out.reshape(a.shape)
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_segment(alpha):
     """:func:`rim_segment` for one alpha."""
     if alpha < -_ARC_FG:
@@ -68,7 +68,7 @@ class _Sel(NamedTuple):
         return _Sel(self.seed, self.upper[idx], self.right[idx], self.e[idx])
 
 
-@kernel
+@kernel(entry=True)
 def _k_select(alpha, seed, rho, R):
     """:func:`_select` for one alpha: (upper, right, e) (``e`` conjugated on the right half)."""
     if seed:
@@ -137,7 +137,7 @@ def _select(alpha: np.ndarray, seed: bool, radius: float, R: float) -> _Sel:
     return _Sel(seed, upper.reshape(alpha.shape), right.reshape(alpha.shape), e.reshape(alpha.shape))
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_rim(theta, beta, alpha, w, seed, rho, K, KC, out):
     """:func:`rim_point` (``seed=False``) / :func:`rim_point_seed` for one item into ``out`` (3,): the arc of
     :func:`_k_select`, the point of :func:`_k_plane`, rotated by ``exp(i (beta + pi/2))``."""
@@ -157,7 +157,7 @@ def _k_rim_batch(theta, beta, alpha, w, seed, rho, K, KC, out):
 _PSI_NEXT = float(np.nextafter(PSI_FG, 4.0))
 
 
-@kernel
+@kernel(entry=True)
 def _k_jump(theta, rho, K, KC):
     """:func:`rim_jump_seed` for one theta: ``|z(psi_FG+) - z(psi_FG)|`` on the seed rim (beta = 0)."""
     rot = complex(math.cos(math.pi / 2), math.sin(math.pi / 2))

@@ -107,7 +107,7 @@ def _k_centre(theta, row, K, KC):
     return pts[j], der[j]
 
 
-@kernel
+@kernel(inline=True)
 def _k_root(row, z2, lo, hi, flo, fhi, K, KC):
     """The root of ``|c_row(theta)|^2 - z2`` in the grid cell [lo, hi] (values flo, fhi of opposite signs):
     Newton's method from the secant point, a bisection step whenever Newton would leave the bracket or does not
@@ -139,7 +139,7 @@ def _k_root(row, z2, lo, hi, flo, fhi, K, KC):
     return x, 0.0
 
 
-@kernel
+@kernel(inline=True)
 def _k_bisect(row, z2, lo, hi, flo, K, KC):
     """The root of ``|c_row(theta)|^2 - z2`` in [lo, hi] by :data:`_BISECT` bisection steps (to the last bit):
     for the ill-conditioned roots (:func:`_k_root`'s derivative small, near wheel mode, where every centre
@@ -155,7 +155,7 @@ def _k_bisect(row, z2, lo, hi, flo, K, KC):
     return 0.5 * (lo + hi)
 
 
-@kernel
+@kernel(inline=True)
 def _k_arc_low(c, p1, p2, d, R):
     """Lowest height ``Re(conj(p) d)`` over the arc of radius R about c from p1 to p2 (counter-clockwise)."""
     a1 = math.atan2((p1 - c).imag, (p1 - c).real)
@@ -165,7 +165,7 @@ def _k_arc_low(c, p1, p2, d, R):
     return min((p1.conjugate() * d).real, (p2.conjugate() * d).real)
 
 
-@kernel
+@kernel(inline=True)
 def _k_pitch_low(pts, d, R):
     """Lowest height along the unit direction d (pre-rotation plane) of the pitch curve (the four rim arcs of
     radius R, H_L -> F_L -> G -> F_R -> H_R): the tyre's lowest height is this minus r (the tyre is the pitch
@@ -253,7 +253,7 @@ def _k_branch(t, n, yl, gamma, Zb, u, TH, TAB, RUNS, NRUN, K, KC, gargs, rho_big
     return nc
 
 
-@kernel
+@kernel(entry=True)
 def _k_stance_all(t, n, TH, TAB, RUNS, NRUN, K, KC, gargs, limits, out):
     """Every solution of one target t (3,) for the unit normal n (3,) into out (CAP, 3), sorted by (|gamma|,
     theta), de-duplicated; ``limits``: only |gamma| <= ABAD_LIMIT. Returns the count (-1: more than CAP)."""
@@ -313,7 +313,7 @@ def _k_stance_all(t, n, TH, TAB, RUNS, NRUN, K, KC, gargs, limits, out):
     return m
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_stance(t, n, TH, TAB, RUNS, NRUN, K, KC, gargs, limits, near, has_near, q):
     """:func:`stance_ik` for one target into q (3,): 0 solved, 1 unreachable, 2 solutions only outside the
     limits, 3 overflow (more than CAP solutions)."""

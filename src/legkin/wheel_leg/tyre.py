@@ -68,13 +68,13 @@ PIECE_LINKS = {p: (LINK_NAMES[a], LINK_NAMES[b]) for p, a, b in zip(PIECES, _LIN
 _FLAT = 1e-9
 
 
-@kernel
+@kernel(inline=True)
 def _k_wrap_pos(a):
     """An angle wrapped to [0, 2 pi)."""
     return a % (2.0 * math.pi)
 
 
-@kernel
+@kernel(inline=True)
 def _k_meet(c1, c2, rho, X):
     """The intersection of the circles (c1, rho) and (c2, rho) on the side of X of the line c1 c2 (X lies on
     their perpendicular bisector: |X - c1| = |X - c2| = R) and whether they meet."""
@@ -90,7 +90,7 @@ def _k_meet(c1, c2, rho, X):
     return m + (h if side >= 0.0 else -h) * perp, True
 
 
-@kernel
+@kernel(inline=True)
 def _k_trim(c1, c2, rho, X, a1_lo, a1_hi, a2_lo, a2_hi):
     """Trim the end (angle ``a1_hi``) of the arc (c1, rho) over [a1_lo, a1_hi] and the start (``a2_lo``) of the
     arc (c2, rho) over [a2_lo, a2_hi] at their intersection near X: (ok, P, new a1_hi, new a2_lo). ``ok`` is
@@ -172,7 +172,7 @@ def _k_cumulative(RAD, SPAN, CUM):
         CUM[p + 1] = CUM[p] + RAD[p] * abs(SPAN[p])
 
 
-@kernel
+@kernel(inline=True)
 def _k_locate(s, CUM):
     """(piece, u) of the normalised arc length s in [0, 1]: the first piece of positive length holding it."""
     ell = s * CUM[_NP]
@@ -184,7 +184,7 @@ def _k_locate(s, CUM):
     return _NP - 1, 1.0
 
 
-@kernel
+@kernel(entry=True, inline=True)
 def _k_tyre_point(theta, beta, s, w, r, K, KC, out):
     """:func:`tyre_point` for one item into out (3,)."""
     C = np.empty(_NP, dtype=np.complex128)

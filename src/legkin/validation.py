@@ -171,12 +171,18 @@ def run_checks(
 _COST = {"wheel_leg": 5, "hybrid_leg": 4, "tripod": 3, "legs": 2}
 
 
+#: Mechanisms whose checks compile another group's kernels: run in that group's process (the quadruped's checks
+#: compare against :mod:`legkin.legs`' leg IK, whose kernels the external robots use: compiled once, ~5 s).
+_SHARES = {"quadruped": "legs"}
+
+
 def _groups(names: list[str]) -> list[list[str]]:
     """The models in groups run by one worker process each, dearest first: one group per mechanism package
-    (the external robots of :mod:`legkin.legs` share their kernels: one group)."""
+    (the external robots of :mod:`legkin.legs` share their kernels: one group, with the quadruped, see
+    :data:`_SHARES`)."""
     groups: dict[str, list[str]] = {}
-    for name in names:
-        groups.setdefault("legs" if get_spec(name).external else name, []).append(name)
+    for name in sorted(names, key=lambda name: name not in _SHARES):  # a sharing mechanism first in its group
+        groups.setdefault("legs" if get_spec(name).external else _SHARES.get(name, name), []).append(name)
     order = sorted(groups, key=lambda key: -_COST.get(key, 1))
     return [groups[key] for key in order]
 

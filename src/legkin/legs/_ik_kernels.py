@@ -214,7 +214,7 @@ def _in_limits_k(a, r, lo, hi):
     return best, miss
 
 
-@kernel(entry=True, inline=True)
+@kernel(entry=True)
 def _ik_k(p, g, ref, out, info) -> int:
     """The branch of :func:`_ik_all_k` inside the limits nearest ``ref`` (least sum of squared joint differences;
     ties to the earlier branch). ``info``: the miss (m) and reason, or the least limit violation (rad) and the

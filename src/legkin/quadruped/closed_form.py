@@ -132,7 +132,7 @@ def _branch_k(dx, dy, dz, rho, s_u, vx, vz, li):
     return _abduction_k(dy, dz, rho, s_u, li), _hip_k(dx, rho, s_u, vx, vz)
 
 
-@kernel(inline=True)
+@kernel
 def _ik_all_core(p, li, foot_z, l2, offset, co, so, out) -> int:
     """Every branch of :func:`ik_all` for one target ``p`` (3,) into ``out`` (4, 3) (NaN if unreachable)."""
     if not _finite3(p):

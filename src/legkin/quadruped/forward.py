@@ -25,7 +25,7 @@ def _finite3(x) -> bool:
     return np.isfinite(x[0]) and np.isfinite(x[1]) and np.isfinite(x[2])
 
 
-@kernel(inline=True)
+@kernel
 def _knee_k(q3, foot_z):
     """``v = t23 + Ry(q3) t34`` in the thigh's x-z plane (foot from the shoulder, before q2)."""
     c3, s3 = np.cos(q3), np.sin(q3)

@@ -44,7 +44,7 @@ from .repair import _clipped_k
 __all__ = ["ik"]
 
 
-@kernel(inline=True)
+@kernel
 def _ik_core(p, li, foot_z, l2, offset, co, so, has_ref, q_near, out) -> int:
     """:func:`ik` of one target ``p`` (3,) into ``out`` (3,): the branch inside the limits (nearest ``q_near``
     when ``has_ref``), or NaN and the failure code (unreachable, or only outside the limits).

@@ -38,7 +38,7 @@ _GUESS_NODES = 64
 _START_MARGIN = 0.5 * (THETA_MAX - THETA_MIN) / (_GUESS_NODES - 1)
 
 
-@kernel(entry=True, inline=True)
+@kernel(entry=True)
 def _k_starts(tgt, upper, right, e, a, seed, K, KC, o0, o1, o2, s, grid, table, branch, count, starts):
     """Geometric starts for one target on the out-of-plane branch ``sign(y_L) = branch``, best first, into
     ``starts`` (count, 3).

@@ -160,7 +160,7 @@ def _k_radial_brackets(grid, f, g, m2, kind, ee, ea, ftol, upper, right, e, seed
     return nj, nx, ns, its
 
 
-@kernel(inline=True)
+@kernel
 def _k_radial_roots(jobs, nj, xth, nx, ns, coef, fine, fine_rows, upper, right, e, seed, K, KC, r2, max_iter, rth,
                     rz):
     """The roots of one target into ``rth`` (theta) and ``rz`` (its contact point before the beta rotation):

@@ -240,9 +240,9 @@ def certify_k(pose, motors, b1, b2, s, work):
             return False
         _split_k(b, left, right, tmp)
         m = 0.5 * (a + c)
-        stack[top, :] = right
+        for i in range(_N + 1):  # (element copies: an array assignment compiles numba's shape-error formatting)
+            stack[top, i], stack[top + 1, i] = right[i], left[i]
         lo[top], hi[top], depth[top] = m, c, dpt + 1.0
-        stack[top + 1, :] = left
         lo[top + 1], hi[top + 1], depth[top + 1] = a, m, dpt + 1.0
         top += 2
     return found_self

@@ -118,3 +118,54 @@ def test_parfor_twin_has_its_own_cache_files():
     assert _ik_batch.parfor is not None
     assert _ik_batch.kernel._cache._cache_file._index_path != _ik_batch.parfor._cache._cache_file._index_path
     assert _ik_batch.parfor.py_func.__code__ is _ik_batch.kernel.py_func.__code__
+
+
+def _thin_py(x):
+    return 3.0 * _leaf(x)
+
+
+def _leaf_py(x):
+    return x * x + 1.0
+
+
+_leaf = _njit(_leaf_py, cache=False, entry=False)
+_thin = _njit(_thin_py, cache=False, entry=False, inline="always")
+
+
+def _entry_py(x):
+    return _thin(x) + _leaf(x)
+
+
+_entry = _njit(_entry_py, cache=False)
+
+
+def test_internal_kernels_have_no_python_wrapper_and_a_python_call_compiles_a_twin():
+    """A kernel only kernels call is compiled without numba's CPython wrapper; the kernel calling it works, and a
+    call from Python goes to a Python-callable twin (compiled once, listed in python_twins), same result."""
+    from legkin import _kernels
+
+    assert isinstance(_leaf, _kernels.InternalKernel) and not isinstance(_entry, _kernels.InternalKernel)
+    assert _leaf.targetoptions["no_cpython_wrapper"] is True
+    assert "no_cpython_wrapper" not in _entry.targetoptions
+    assert _entry(2.0) == 3.0 * 5.0 + 5.0
+    assert len(_leaf.signatures) == 1 and len(_thin.signatures) == 0  # _thin: inlined into _entry, never compiled
+    before = list(_kernels.python_twins)
+    assert _leaf(2.0) == 5.0 and _leaf(3.0) == 10.0 and _thin(2.0) == 15.0
+    new = _kernels.python_twins[len(before):]
+    assert new == [f"{__name__}._leaf_py", f"{__name__}._thin_py"]  # one twin each, however many calls
+    assert _leaf._twin is not None and _leaf._twin.py_func.__qualname__ == "_leaf_py_py"  # its own cache entry
+    assert "no_cpython_wrapper" not in _leaf._twin.targetoptions and "inline" not in _thin._twin.targetoptions
+
+
+def test_checks_call_no_internal_kernel_from_python():
+    """Every kernel the checks (and the public functions they call) call from Python is an entry kernel or a batch
+    loop: a run of every model's checks, in a fresh process, compiles no Python twin (a twin is a second compile of
+    a kernel with its whole call tree)."""
+    import subprocess
+    import sys
+
+    code = ("from legkin import _kernels, validation; "
+            "validation.run_checks(samples=60, ik_targets=60, classify=60); print(_kernels.python_twins)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=1800)
+    assert out.returncode == 0, out.stderr[-2000:]
+    assert out.stdout.strip().splitlines()[-1] == "[]"

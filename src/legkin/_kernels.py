@@ -12,6 +12,10 @@ The rule (issue 16), for every analytic module:
   numba's own setting (``numba.set_num_threads(k)`` or the ``NUMBA_NUM_THREADS`` environment variable); below it
   the loop runs on the calling thread. (Not numba's ``prange``, except for the cheapest closed forms: numba's
   parallel compiler took a third of the first-run compile time of legkin's kernels; see :class:`BatchLoop`.)
+* Who calls a kernel is declared, for the first-run compile: ``@kernel`` (only kernels: no CPython wrapper,
+  :class:`InternalKernel`), ``@kernel(entry=True)`` (also the Python wrapper of a single call),
+  ``@kernel(inline=True)`` (typed inside each caller: thin wrappers and one-caller helpers). numba compiles
+  every kernel with the whole tree of kernels it calls, so each level of a call chain costs its whole tree again.
 * The Python wrapper only checks the inputs (lean: a float64 array of the core shape goes straight to the
   kernel), calls the kernel (single input) or the batch loop (leading dimensions), and applies the
   single/batch rule of :mod:`legkin._batch` (a single call raises a legkin error on failure, a batch
@@ -55,6 +59,8 @@ class KernelDispatcher(CPUDispatcher):
     its arguments: numba would compile one version of a kernel per constant it is called with
     (``rot_k(0, a)``, ``rot_k(1, a)``, ``f(..., True)``), each with its whole call tree, and one more for the calls
     from Python. A kernel's code never depends on a literal argument, so one version serves them all."""
+
+    _cache_enabled = True  # numba's on-disk cache (cache=True), also for an InternalKernel's twin
 
     def get_call_template(self, args, kws):  # noqa: D102 - numba API
         args = tuple(types.unliteral(a) for a in args)
@@ -119,7 +125,7 @@ def kernel(fn: F | None = None, /, *, entry: bool = False, inline: bool = False)
     wrapper or a helper with a single caller: numba then types it inside its caller instead of compiling it, with
     its whole call tree, on its own (see CONTRIBUTING.md, "first-run compile")."""
     def wrap(f: F) -> F:
-        options = {"inline": "always"} if inline else {}
+        options: dict[str, Any] = {"inline": "always"} if inline else {}
         return _njit(f, entry=entry, **options)  # type: ignore[no-any-return]
     return wrap if fn is None else wrap(fn)
 

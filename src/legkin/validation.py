@@ -177,21 +177,15 @@ def _one_thread() -> None:
 #: The order in which the worker processes take the groups: dearest first by the first-run time of their checks
 #: (compiling the kernels dominates; measured on 2 cores: wheel_leg ~58 s, hybrid_leg ~38 s, tripod ~22 s, the
 #: nine external robots ~16 s, quadruped ~14 s). Order only; the rows do not depend on it.
-_COST = {"wheel_leg": 5, "hybrid_leg": 4, "legs": 3, "tripod": 2}
-
-
-#: Mechanisms whose checks compile another group's kernels: run in that group's process (the quadruped's checks
-#: compare against :mod:`legkin.legs`' leg IK, whose kernels the external robots use: compiled once, ~5 s).
-_SHARES = {"quadruped": "legs"}
+_COST = {"wheel_leg": 5, "hybrid_leg": 4, "tripod": 3, "quadruped": 2, "legs": 1}
 
 
 def _groups(names: list[str]) -> list[list[str]]:
     """The models in groups run by one worker process each, dearest first: one group per mechanism package
-    (the external robots of :mod:`legkin.legs` share their kernels: one group, with the quadruped, see
-    :data:`_SHARES`)."""
+    (the external robots of :mod:`legkin.legs` share their kernels: one group)."""
     groups: dict[str, list[str]] = {}
-    for name in sorted(names, key=lambda name: name not in _SHARES):  # a sharing mechanism first in its group
-        groups.setdefault("legs" if get_spec(name).external else _SHARES.get(name, name), []).append(name)
+    for name in names:
+        groups.setdefault("legs" if get_spec(name).external else name, []).append(name)
     order = sorted(groups, key=lambda key: -_COST.get(key, 1))
     return [groups[key] for key in order]
 

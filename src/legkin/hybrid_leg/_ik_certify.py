@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from .._kernels import kernel
@@ -48,7 +47,7 @@ NOT_NEARER = 0
 SELF = 1
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")  # small and hot: inlined
+@kernel(inline=True)  # small and hot: inlined
 def bernstein_k(c, lo, hi, b, d):
     """Bernstein coefficients b (9,) on [lo, hi] of the degree-8 polynomial c (9,) (ascending); d (9,) work."""
     for k in range(_N + 1):
@@ -68,7 +67,7 @@ def bernstein_k(c, lo, hi, b, d):
         b[i] = s
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")  # small and hot: inlined
+@kernel(inline=True)  # small and hot: inlined
 def _split_k(b, left, right, w):
     """de Casteljau at the midpoint: the Bernstein coefficients of both halves; w (9,) work."""
     for i in range(_N + 1):
@@ -80,7 +79,7 @@ def _split_k(b, left, right, w):
         left[r], right[_N - r] = w[0], w[_N - r]
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")  # small and hot: inlined
+@kernel(inline=True)  # small and hot: inlined
 def _signs_k(b, eps):
     """+1 / -1 where every entry of b exceeds eps / is below -eps, else 0."""
     pos = True
@@ -91,7 +90,7 @@ def _signs_k(b, eps):
     return 1 if pos else (-1 if neg else 0)
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")  # small and hot: inlined
+@kernel(inline=True)  # small and hot: inlined
 def _slope_k(b, eps):
     """The sign of the polynomial's slope where its Bernstein coefficients b are strictly monotone, else 0."""
     up = True
@@ -103,7 +102,7 @@ def _slope_k(b, eps):
     return 1 if up else (-1 if down else 0)
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")  # small and hot: inlined
+@kernel(inline=True)  # small and hot: inlined
 def _horner_k(c, t):
     """(c(t), c'(t)) of the polynomial c (9,) (ascending)."""
     p = c[_N]

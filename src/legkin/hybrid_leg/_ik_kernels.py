@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import math
 
-import numba
 import numpy as np
 
 from .._kernels import OK, batch_kernel, kernel
@@ -78,7 +77,7 @@ def platform_pose_b(u, llb, rb, pose, info):
         platform_pose_k(u[j, 0], u[j, 1], u[j, 2], llb, rb, pose[j], info[j])
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")  # hot, per candidate: inlined
+@kernel(inline=True)  # hot, per candidate: inlined
 def candidate_pose_k(ux, uy, uz, llb, rb, pose, arc, rot, trig):
     """The platform pose (3,) of one (ll_branch, roll_branch) (:func:`platform_pose_k`, arc (3,) its info), roll
     and pitch clipped to the platform limits within rounding, its rotation rot (3, 3) and trig (6,) = (cos, sin)
@@ -98,7 +97,7 @@ def candidate_pose_k(ux, uy, uz, llb, rb, pose, arc, rot, trig):
     return near1 and near2
 
 
-@numba.njit(cache=True, error_model="numpy", inline="always")  # hot, per candidate: inlined
+@kernel(inline=True)  # hot, per candidate: inlined
 def candidate_motors_k(ux, uy, uz, sv, pose, arc, trig, inlim, b1, b2, th, kx, ok, motors, info, tip, dtip, g, nm,
                        dd):
     """The rest of one candidate (:func:`ik_candidate_k`) from its pose (3,), arc (3,) and trig (6,)

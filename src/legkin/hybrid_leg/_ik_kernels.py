@@ -280,7 +280,7 @@ def ik_all_k(ux, uy, uz, sv, fk_in_band, motors, pose, info, fk):
             fk[j] = live and reproduced_k(pose[j], motors[j], b1, b2, info[j, 2], work)
 
 
-@kernel(inline=True)
+@kernel(entry=True, inline=True)  # entry: ik_all's single call (the 1-row batch loop costs ~0.6 us)
 def ik_all_out_k(ux, uy, uz, sv, motors, pose, mask, asm, within, valid):
     """:func:`ik_all` of one target: motors, pose (16, 3) (NaN where the branch does not exist), mask (exists),
     asm (assembly mode, int), within (inside the limits, and exists), valid (fk reproduces it, off the band).

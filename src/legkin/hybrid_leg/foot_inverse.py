@@ -3,7 +3,6 @@ angles in the mode asked for (:func:`ik`), and every closed-form branch with its
 
 from __future__ import annotations
 
-import math
 from typing import Literal, NamedTuple, Sequence, overload
 
 import numpy as np
@@ -15,6 +14,7 @@ from ._ik_errors import arc_error, axis_error, ik_error, platform_pose
 from ._ik_kernels import (
     foot_ik_b,
     ik_all_b,
+    ik_all_out_k,
     platform_pose_b,
 )
 from ._options import (
@@ -31,6 +31,7 @@ from ._options import (
     fmt,
     resolve,
 )
+from .chains import CX, CY, CZ
 from .geometry import CENTER, FOOT_IK_ORDER, Geometry
 
 __all__ = ["foot_platform_ik", "ik", "ik_all", "FootIKSolutions", "foot_ik", "foot_ik_solutions"]
@@ -233,10 +234,9 @@ def ik_all(p: ArrayLike, *, geometry: Geometry | None = None) -> FootIKSolutions
     g = fast_geometry(geometry)
     if (type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64 and g is not None
             and g.center == "universal"):
-        if math.isfinite(p[0] + p[1] + p[2]):  # (the kernel gives a non-finite target no branch; as_input raises)
-            out = _all_outputs((1,))
-            ik_all_b.kernel((p - CENTER).reshape(1, 3), g.starting_value, *out)
-            return FootIKSolutions(*(a[0] for a in out))
+        out = _all_outputs(())
+        if ik_all_out_k(p[0] - CX, p[1] - CY, p[2] - CZ, g.starting_value, *out):
+            return FootIKSolutions(*out)
     g = resolve(geometry, universal="ik_all")
     _, u, shape = _targets(p)
     n = len(u)

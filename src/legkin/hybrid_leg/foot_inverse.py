@@ -59,6 +59,17 @@ def _search(u: np.ndarray, sv: float, combos: list, b: np.ndarray, s: float, lim
     return motors, pose, ok
 
 
+def _one(p: np.ndarray, sv: float, b1: float, b2: float, s: float, limits_only: bool, axis_ok: bool
+         ) -> np.ndarray | None:
+    """The fast single call: the batch loop :func:`foot_ik_b` on one row (its kernel then has one caller and is
+    inlined, see CONTRIBUTING.md), in the default order of the branches; (motors, pose) as a (2, 3) array, or None
+    (the checked path then decides, and raises)."""
+    out, ok = np.empty((2, 1, 3)), np.empty(1, dtype=np.bool_)
+    foot_ik_b.kernel((p - CENTER).reshape(1, 3), sv, _COMBOS, b1, b2, s, limits_only, axis_ok, _NO_NEAR, out[0],
+                     out[1], ok)
+    return out[:, 0] if ok[0] else None
+
+
 def _targets(p: ArrayLike) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
     pp = as_input(p, "p", (3,))
     return pp, (pp - CENTER).reshape(-1, 3), pp.shape[:-1]
@@ -106,10 +117,9 @@ def foot_platform_ik(p: ArrayLike, *, ll_branch: int | None = None, roll_branch:
     """
     if (ll_branch is None and roll_branch is None and branch is None and assembly is None and return_mask is False
             and geometry is None and type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64):
-        u, out, ok = (p - CENTER).reshape(1, 3), np.empty((2, 1, 3)), np.empty(1, dtype=np.bool_)
-        foot_ik_b.kernel(u, 0.0, _COMBOS, 1.0, 1.0, 1.0, True, False, _NO_NEAR, out[0], out[1], ok)
-        if ok[0]:
-            return out[1, 0]
+        out = _one(p, 0.0, 1.0, 1.0, 1.0, True, False)
+        if out is not None:
+            return out[1]
     resolve(geometry)
     pp, u, shape = _targets(p)
     llb = check_sign(ll_branch, "ll_branch", allow_none=True)
@@ -178,11 +188,9 @@ def ik(p: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, ll_branch: i
             and type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64):
         fb, fs, g = fast_branch(branch), fast_sign(assembly), fast_geometry(geometry)
         if fb is not None and fs is not None and g is not None and g.center == "universal":
-            u, out, ok = (p - CENTER).reshape(1, 3), np.empty((2, 1, 3)), np.empty(1, dtype=np.bool_)
-            foot_ik_b.kernel(u, g.starting_value, _COMBOS, fb[0], fb[1], fs, False, True, _NO_NEAR, out[0], out[1],
-                             ok)
-            if ok[0]:
-                return out[0, 0]
+            out = _one(p, g.starting_value, fb[0], fb[1], fs, False, True)
+            if out is not None:
+                return out[0]
     g = resolve(geometry, universal="ik")
     pp, u, shape = _targets(p)
     llb = check_sign(ll_branch, "ll_branch", allow_none=True)

@@ -6,7 +6,7 @@ import numba
 import numpy as np
 import pytest
 
-from legkin._kernels import BatchLoop, KernelDispatcher, _njit, batch_kernel, kernel  # noqa: F401
+from legkin._kernels import BatchLoop, KernelDispatcher, _njit, batch_kernel, kernel, prange  # noqa: F401
 
 
 def _axis_value_py(axis, x):
@@ -104,6 +104,33 @@ def test_chunks_run_on_several_threads(two_threads):
     assert seen == {threading.get_ident()}
 
 
+def _ploop_py(x, shared, ref, out):
+    count = 0
+    for i in prange(x.shape[0]):
+        count += _item(x[i], shared, out[i])
+        out[i, 2] = ref[0, 0]
+    return count
+
+
+def test_parfor_loop_on_one_thread_runs_the_serial_loop(two_threads):
+    """numba set to one thread (a ``legkin check`` worker): a ``parfor`` loop runs its serial compilation and never
+    compiles its parallel twin (a second, slow compilation); on two threads the twin gives the same rows."""
+    loop = BatchLoop(_ploop_py, "x ref out", 8, parfor=True)
+    loop.parfor = _njit(loop.parfor.py_func, cache=False, parallel=True)  # this test compiles it afresh
+    x = np.random.default_rng(1).uniform(0, 1, (64, 2))
+    args = (np.array([0.3, 1.7]), np.zeros((1, 1)))
+    numba.set_num_threads(1)
+    serial = np.empty((64, 3))
+    count = loop(x, *args, serial)
+    assert loop.parfor.signatures == [] and count == int(np.sum(x[:, 0] > 0.5))
+    if two_threads < 2:
+        pytest.skip("numba has one thread here")
+    numba.set_num_threads(2)
+    out = np.empty((64, 3))
+    assert loop(x, *args, out) == count and len(loop.parfor.signatures) == 1
+    np.testing.assert_array_equal(out, serial)
+
+
 def test_row_names_are_checked():
     with pytest.raises(TypeError, match="no argument 'y'"):
         batch_kernel(rows="x y", min_parallel=8)(_loop.__wrapped__)
@@ -169,3 +196,22 @@ def test_checks_call_no_internal_kernel_from_python():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=1800)
     assert out.returncode == 0, out.stderr[-2000:]
     assert out.stdout.strip().splitlines()[-1] == "[]"
+
+
+def test_analytic_calls_do_not_import_pinocchio():
+    """Importing legkin and calling each mechanism's analytic kinematics never imports Pinocchio (about 0.1 s of
+    the first call): only ``legkin.load`` and ``legkin.Robot`` need it, and they import it on first use."""
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, numpy as np, legkin; from legkin import hybrid_leg, quadruped, tripod, wheel_leg; "
+        "quadruped.ik(quadruped.fk(np.array([0.1, 0.8, 1.2]), 'LF'), 'LF'); "
+        "tripod.fk(tripod.ik(np.array([0.2, -0.1]))); "
+        "wheel_leg.ik(wheel_leg.fk(np.array([1.2, 0.3, 0.1]), 'FL'), 'FL'); "
+        "hybrid_leg.ik(hybrid_leg.fk(np.array([0.0, 0.0, 3.0]))); "
+        "assert 'pinocchio' not in sys.modules, 'pinocchio imported by an analytic call'; "
+        "assert legkin.load('tripod').model.nq == 12 and 'pinocchio' in sys.modules"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=1800)
+    assert out.returncode == 0, out.stderr[-2000:]

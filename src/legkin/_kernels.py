@@ -158,11 +158,12 @@ class BatchLoop:
     """A compiled batch loop (:func:`batch_kernel`), called like its Python function. The arguments named in
     ``rows`` hold one row per item (inputs and outputs alike); the first of them gives the item count n.
 
-    Below ``min_parallel`` items the loop runs on the calling thread. From there on, either (default) the rows
-    are split into contiguous chunks, one per thread, each run by the same compiled loop without the GIL (a row
-    argument with a single row, shared by all items, is passed whole; an int return value, a count, is summed
-    over the chunks); or, with ``parfor=True``, the loop's ``prange`` runs on numba's parallel backend, from a
-    second compilation of the same source made on the first large batch. ``parfor`` suits the cheapest loops
+    Below ``min_parallel`` items, or with numba set to one thread, the loop runs on the calling thread. From there
+    on, either (default) the rows are split into contiguous chunks, one per thread, each run by the same compiled
+    loop without the GIL (a row argument with a single row, shared by all items, is passed whole; an int return
+    value, a count, is summed over the chunks); or, with ``parfor=True``, the loop's ``prange`` runs on numba's
+    parallel backend, from a second compilation of the same source made on the first large batch on more than one
+    thread (a process on one thread, such as a ``legkin check`` worker, never compiles it). ``parfor`` suits the cheapest loops
     (~0.1 us an item: numba's parallel loop saves ~30 ns an item of array-view bookkeeping); the chunks need no
     second compilation (numba's parallel compiler is slow) and suit everything else."""
 
@@ -181,13 +182,11 @@ class BatchLoop:
 
     def __call__(self, *args: Any) -> Any:
         n = args[self.rows[0]].shape[0]
-        if n < self.min_parallel:
+        k = min(threads(), n) if n >= self.min_parallel else 1
+        if k <= 1:  # small, or numba set to one thread: no parallel loop (nor its compilation)
             return self.kernel(*args)
         if self.parfor is not None:
             return self.parfor(*args)
-        k = min(threads(), n)
-        if k <= 1:
-            return self.kernel(*args)
         edges = [n * j // k for j in range(k + 1)]
         chunks = []
         for lo, hi in zip(edges[:-1], edges[1:]):

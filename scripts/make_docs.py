@@ -1,10 +1,12 @@
 #!/usr/bin/env python3
-"""Regenerate the README's pictures and tables: ``python scripts/make_docs.py [--skip-bench] [--samples N]``.
+"""Regenerate the README's pictures and tables: ``python scripts/make_docs.py [--skip-bench] [--only NAME ...]
+[--samples N]``.
 
 Writes ``docs/img/<model>.png`` (a meshcat page of each model rendered by headless Chromium),
 ``docs/img/plots/*.png`` (``legkin check --plots``), ``docs/check.json`` and ``docs/bench.json``, then
 rewrites the README sections between ``<!-- legkin:NAME -->`` and ``<!-- /legkin:NAME -->`` markers
-(NAME = models, pictures, check, bench). Needs the ``plots`` and ``bench`` extras and Chromium.
+(NAME = models, pictures, check, bench; ``--only`` picks some) and, with the bench, the single-call tables of
+``docs/bench.md`` (its ``single-calls`` markers). Needs the ``plots`` and ``bench`` extras and Chromium.
 """
 
 from __future__ import annotations
@@ -88,12 +90,45 @@ def _num(x, fmt: str = ".1e", missing: str = "-") -> str:
     return format(x, fmt) if x == x and abs(x) != float("inf") else "fail"
 
 
+def _machine(mach: dict) -> str:
+    return (f"{mach.get('cpu', '?')} ({mach.get('cpu_count', '?')} cores, {mach.get('numba_threads', '?')} numba "
+            f"threads, 1-min load {mach.get('load_average_1min', float('nan')):.2f})")
+
+
+def single_call_tables(doc: dict) -> str:
+    """docs/bench.md's single-call tables, from the bench run's JSON (``models.<name>.single_calls``)."""
+    out = [
+        f"`python scripts/make_docs.py --only bench` (it runs `legkin bench --json docs/bench.json`), one run on "
+        f"{_machine(doc['machine'])}, legkin {doc['machine'].get('legkin', '?')}, numba "
+        f"{doc['machine'].get('numba', '?')}. Ratio = function / yardstick, both timed the same way in the same run "
+        "(< 1 is faster than Pinocchio). The peer tables are in the README.\n"
+    ]
+    for name, entry in doc["models"].items():
+        single = entry.get("single_calls")
+        if not single:
+            continue
+        out += [f"**{name}**\n", "| function | time per call | yardstick | yardstick per call | ratio |",
+                "| --- | ---: | --- | ---: | ---: |"]
+        for r in single["rows"]:
+            out.append(f"| `{r['name']}` | {r['time_per_call_s'] * 1e6:.2f} us | {r['yardstick']} | "
+                       f"{r['yardstick_time_per_call_s'] * 1e6:.2f} us | {_num(r['ratio'], '.2f')} |")
+        out.append("")
+        out += [f"* {key}: {y['label']}" for key, y in single.get("yardsticks", {}).items()]
+        skipped = single.get("skipped") or {}
+        out += [f"* not timed: {item}" + (f" ({skipped[item]})" if isinstance(skipped, dict) else "")
+                for item in skipped]
+        out.append("")
+    return "\n".join(out)
+
+
 def bench_tables() -> str:
     from legkin.__main__ import main
 
     path = DOCS / "bench.json"
     main(["bench", "--json", str(path)])
     doc = json.loads(path.read_text())
+    bench_md = DOCS / "bench.md"
+    bench_md.write_text(_replace_section(bench_md.read_text(), "single-calls", single_call_tables(doc)))
     mach = doc["machine"]
     out = [
         f"Measured in one run on {mach.get('cpu', '?')} ({mach.get('cpu_count', '?')} cores, 1-min load "
@@ -115,20 +150,24 @@ def bench_tables() -> str:
     return "\n".join(out)
 
 
+SECTIONS = ("models", "pictures", "check", "bench")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--samples", type=int, default=10_000)
     parser.add_argument("--skip-bench", action="store_true")
+    parser.add_argument("--only", nargs="+", choices=SECTIONS, help="regenerate only these sections")
     args = parser.parse_args()
+    names = args.only or [name for name in SECTIONS if not (name == "bench" and args.skip_bench)]
     readme = ROOT / "README.md"
     text = readme.read_text()
-    text = _replace_section(text, "models", model_table())
-    text = _replace_section(text, "pictures", pictures())
-    text = _replace_section(text, "check", check_tables(args.samples))
-    if not args.skip_bench:
-        text = _replace_section(text, "bench", bench_tables())
+    makers = {"models": model_table, "pictures": pictures, "check": lambda: check_tables(args.samples),
+              "bench": bench_tables}
+    for name in names:
+        text = _replace_section(text, name, makers[name]())
     readme.write_text(text)
-    print("README.md, docs/img/, docs/check.json updated")
+    print(f"README.md sections updated: {', '.join(names)}")
 
 
 if __name__ == "__main__":

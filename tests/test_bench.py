@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import importlib
 import json
 
 import numpy as np
@@ -151,6 +152,21 @@ def test_single_call_entries_run_and_name_known_yardsticks():
             assert isinstance(e, SingleCall), (name, e)
             assert e.yardstick in YARDSTICKS, (name, e.name, e.yardstick)
             e.call()  # every entry's call runs
+
+
+def test_single_call_table_covers_every_public_function():
+    """Every public function of a mechanism (its kinematics module's ``__all__``, less the deprecated names) has a
+    row in its bench's single-call table."""
+    import inspect
+
+    for name, module in _bench_modules().items():
+        if module is None or not hasattr(module, "single_calls"):
+            continue
+        kin = importlib.import_module(f"legkin.{name}.kinematics")
+        public = [n for n in kin.__all__ if inspect.isfunction(getattr(kin, n))
+                  and "deprecated" not in (getattr(kin, n).__doc__ or "").lower()]
+        timed = {e.name.split(" ")[0] for e in module.single_calls()}
+        assert [n for n in public if n not in timed] == [], name
 
 
 def test_yardstick_calls_every_key_every_model():

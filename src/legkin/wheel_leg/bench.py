@@ -42,7 +42,7 @@ def single_calls() -> list[SingleCall]:
 
     Yardsticks: Pinocchio ``forwardKinematics`` + ``updateFramePlacement`` on the quadruped (``quadruped_fk``)
     for the closed forms; ``Robot.solve_loops`` on the wheel-leg (``solve_loops``, ``iterative=True``) for
-    ``ik`` (every method).
+    ``ik`` (every method) and the stance IK (root finding, its target the ground contact of :data:`SINGLE_Q`).
     """
     q = SINGLE_Q.copy()
     theta, beta, gamma = (float(v) for v in q)
@@ -50,6 +50,7 @@ def single_calls() -> list[SingleCall]:
     phi_L, phi_R = (float(v) for v in wl.motor_angles(theta, beta))
     target = wl.fk(q, LEG, alpha=alpha, w=w)
     p_L = wl.rim_point(theta, beta, alpha, w)
+    ground = wl.ground_contact(q, LEG).point
     cf, it = "quadruped_fk", "solve_loops"
     return [
         SingleCall("linkage_constants", lambda: wl.linkage_constants(), cf),
@@ -71,6 +72,12 @@ def single_calls() -> list[SingleCall]:
                    iterative=True),
         SingleCall("ik (method='gauss_newton_fd')",
                    lambda: wl.ik(target, LEG, alpha=alpha, w=w, method="gauss_newton_fd"), it, iterative=True),
+        SingleCall("tyre_point", lambda: wl.tyre_point(theta, beta, alpha / (2 * np.pi) + 0.5, w), cf),
+        SingleCall("tyre_pieces", lambda: wl.tyre_pieces(theta, beta), cf),
+        SingleCall("tyre_length", lambda: wl.tyre_length(theta), cf),
+        SingleCall("ground_contact", lambda: wl.ground_contact(q, LEG), cf),
+        SingleCall("stance_ik", lambda: wl.stance_ik(ground, LEG), it, iterative=True),
+        SingleCall("stance_ik_all", lambda: wl.stance_ik_all(ground, LEG), it, iterative=True),
     ]
 
 

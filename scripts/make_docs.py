@@ -131,21 +131,17 @@ def bench_tables() -> str:
     bench_md.write_text(_replace_section(bench_md.read_text(), "single-calls", single_call_tables(doc)))
     mach = doc["machine"]
     out = [
-        f"Measured in one run on {mach.get('cpu', '?')} ({mach.get('cpu_count', '?')} cores, 1-min load "
-        f"{mach.get('load_average_1min', float('nan')):.2f}), Python {mach.get('python', '?')}, numpy "
+        f"Measured in one run on {_machine(mach)}, Python {mach.get('python', '?')}, numpy "
         f"{mach.get('numpy', '?')}, pin {mach.get('pin', '?')}. Ratios are within a group of methods solving "
         "the same problem; 'fail' in an error column means some targets were not solved.\n"
     ]
     for name, entry in doc["models"].items():
-        out.append(f"**{name}**\n")
-        out.append("| method | targets | solved | median error | max error | time per target | ratio to fastest |")
-        out.append("| --- | ---: | ---: | ---: | ---: | ---: | ---: |")
-        for m in entry["methods"]:
-            out.append(
-                f"| {m['name']} | {m['targets']} | {m['solved']:.1f}% | {_num(m['median_error'])} | "
+        out += [f"**{name}**\n",
+                "| method | targets | solved | median error | max error | time per target | ratio to fastest |",
+                "| --- | ---: | ---: | ---: | ---: | ---: | ---: |"]
+        out += [f"| {m['name']} | {m['targets']} | {m['solved']:.1f}% | {_num(m['median_error'])} | "
                 f"{_num(m['max_error'], missing='fail')} | {_num(m['time_per_target_s'], '.2e')} s | "
-                f"{_num(m.get('ratio_to_fastest'), '.3g')}x |"
-            )
+                f"{_num(m.get('ratio_to_fastest'), '.3g')}x |" for m in entry["methods"]]
         out.append("")
     return "\n".join(out)
 

@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -41,8 +40,8 @@ from .._batch import as_angles, check_number
 from .._kernels import as_rows, batch_kernel, kernel
 from .._rotations import wrap_k
 from ..errors import InvalidInputError
-from ._common import _check_theta
-from .geometry import _DEFAULT_GEOMETRY, TYRE_THICKNESS, Geometry, _geometry
+from ._common import _SCALARS, _check_theta
+from .geometry import _DEFAULT_GEOMETRY, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry
 from .linkage import _IF, _IG, _IH, _IL, _IU, _k_closed, _kconst
 
 __all__ = ["TYRE_THICKNESS", "PIECES", "PIECE_LINKS", "TyrePieces", "tyre_pieces", "tyre_point", "tyre_length"]
@@ -204,15 +203,35 @@ def _k_tyre_point_batch(theta, beta, s, w, r, K, KC, out):
         _k_tyre_point(theta[i], beta[i], s[i], w[i], r, K, KC, out[i])
 
 
-@batch_kernel(rows="theta C RAD A0 SPAN CUM", min_parallel=256)
-def _k_pieces_batch(theta, r, K, KC, C, RAD, A0, SPAN, CUM):
+@kernel(entry=True, inline=True)
+def _k_tyre_pieces(theta, beta, r, K, KC, centre, radius, start, span, s_start, s_end):
+    """:func:`tyre_pieces` for one item: the pieces at (theta, beta) in {L} into centre (16, 2), radius, start,
+    span, s_start, s_end (16,); returns the curve's length."""
+    C = np.empty(_NP, dtype=np.complex128)
+    A0, CUM = np.empty(_NP), np.empty(_NP + 1)
+    _k_pieces(theta, r, K, KC, C, radius, A0, span)
+    _k_cumulative(radius, span, CUM)
+    rot = complex(math.cos(beta + math.pi / 2), math.sin(beta + math.pi / 2))
+    total = CUM[_NP]
+    for p in range(_NP):
+        z = C[p] * rot
+        centre[p, 0], centre[p, 1] = z.real, z.imag
+        start[p] = A0[p] + beta + math.pi / 2
+        s_start[p], s_end[p] = CUM[p] / total, CUM[p + 1] / total
+    return total
+
+
+@batch_kernel(rows="theta beta centre radius start span s_start s_end length", min_parallel=256)
+def _k_tyre_pieces_batch(theta, beta, r, K, KC, centre, radius, start, span, s_start, s_end, length):
     for i in range(theta.shape[0]):
-        _k_pieces(theta[i], r, K, KC, C[i], RAD[i], A0[i], SPAN[i])
-        _k_cumulative(RAD[i], SPAN[i], CUM[i])
+        length[i] = _k_tyre_pieces(theta[i], beta[i], r, K, KC, centre[i], radius[i], start[i], span[i],
+                                   s_start[i], s_end[i])
 
 
 def _thickness(r: object, geo: Geometry) -> float:
     """The tyre thickness checked: a number in (0, R) (the inner offset R - r must stay positive)."""
+    if type(r) is float and 0.0 < r < geo.R:  # the common case, fast
+        return r
     return check_number(r, "r", 0.0, geo.R, low_open=True, high_open=True)
 
 
@@ -245,13 +264,25 @@ class TyrePieces:
         return self.centre[..., k, :] + self.radius[..., k, None] * np.stack([np.cos(ang), np.sin(ang)], -1)
 
 
-def _prepared(theta, beta, r, geometry) -> tuple[np.ndarray, np.ndarray, tuple[int, ...], float, Any, Any]:
-    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
-    rho = _thickness(r, geo)
-    theta, beta = as_angles(theta, beta, names=("theta", "beta"))
-    _check_theta(theta)
-    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
-    return as_rows(theta, 1)[:, 0], as_rows(beta, 1)[:, 0], theta.shape, rho, K, KC
+def _pieces_one(theta, beta, rho, K, KC):
+    """:func:`tyre_pieces` of two numbers in range (the kernel directly), else None (the full checks)."""
+    if not (type(theta) in _SCALARS and type(beta) in _SCALARS and THETA_MIN - 1e-12 <= theta <= THETA_MAX + 1e-12
+            and math.isfinite(beta)):
+        return None
+    centre, (radius, start, span, s_start, s_end) = np.empty((_NP, 2)), np.empty((5, _NP))
+    length = _k_tyre_pieces(float(theta), float(beta), rho, K, KC, centre, radius, start, span, s_start, s_end)
+    return TyrePieces(PIECES, centre, radius, start, span, s_start, s_end, np.array(length))
+
+
+def _point_fast(theta, beta, s, w, geo, rho, K, KC):
+    """:func:`tyre_point` of four numbers in range (the kernel directly), else None (the full checks)."""
+    if (type(theta) in _SCALARS and type(beta) in _SCALARS and type(s) in _SCALARS and type(w) in _SCALARS
+            and THETA_MIN - 1e-12 <= theta <= THETA_MAX + 1e-12 and math.isfinite(beta) and 0.0 <= s <= 1.0
+            and abs(w) <= geo.T / 2 + 1e-15):
+        point = np.empty(3)
+        _k_tyre_point(float(theta), float(beta), float(s), float(w), rho, K, KC, point)
+        return point
+    return None
 
 
 def tyre_pieces(theta: ArrayLike, beta: ArrayLike = 0.0, *, r: float = TYRE_THICKNESS,
@@ -263,20 +294,21 @@ def tyre_pieces(theta: ArrayLike, beta: ArrayLike = 0.0, *, r: float = TYRE_THIC
         r: tyre thickness (m) in (0, R).
         geometry: robot parameters.
     """
-    t, b, shape, rho, K, KC = _prepared(theta, beta, r, geometry)
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    rho = _thickness(r, geo)
+    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
+    one = _pieces_one(theta, beta, rho, K, KC)
+    if one is not None:
+        return one
+    theta, beta = as_angles(theta, beta, names=("theta", "beta"))
+    _check_theta(theta)
+    shape, t, b = theta.shape, as_rows(theta, 1)[:, 0], as_rows(beta, 1)[:, 0]
     n = t.shape[0]
-    C = np.empty((n, _NP), dtype=np.complex128)
-    RAD, A0, SPAN, CUM = np.empty((n, _NP)), np.empty((n, _NP)), np.empty((n, _NP)), np.empty((n, _NP + 1))
-    _k_pieces_batch(t, rho, K, KC, C, RAD, A0, SPAN, CUM)
-    rot = np.exp(1j * (b + np.pi / 2))[:, None]
-    Cr = C * rot
-    total = CUM[:, -1:]
-    return TyrePieces(
-        PIECES, np.stack([Cr.real, Cr.imag], -1).reshape(shape + (_NP, 2)), RAD.reshape(shape + (_NP,)),
-        (A0 + b[:, None] + np.pi / 2).reshape(shape + (_NP,)), SPAN.reshape(shape + (_NP,)),
-        (CUM[:, :-1] / total).reshape(shape + (_NP,)), (CUM[:, 1:] / total).reshape(shape + (_NP,)),
-        total[:, 0].reshape(shape),
-    )
+    centre, length, (radius, start, span, s_start, s_end) = np.empty((n, _NP, 2)), np.empty(n), np.empty((5, n, _NP))
+    _k_tyre_pieces_batch(t, b, rho, K, KC, centre, radius, start, span, s_start, s_end, length)
+    core = shape + (_NP,)
+    return TyrePieces(PIECES, centre.reshape(core + (2,)), radius.reshape(core), start.reshape(core),
+                      span.reshape(core), s_start.reshape(core), s_end.reshape(core), length.reshape(shape))
 
 
 def tyre_length(theta: ArrayLike, *, r: float = TYRE_THICKNESS, geometry: Geometry | None = None) -> np.ndarray:
@@ -302,13 +334,16 @@ def tyre_point(theta: ArrayLike, beta: ArrayLike, s: ArrayLike, w: ArrayLike = 0
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     rho = _thickness(r, geo)
+    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
+    point = _point_fast(theta, beta, s, w, geo, rho, K, KC)
+    if point is not None:
+        return point
     theta, beta, s, w = as_angles(theta, beta, s, w, names=("theta", "beta", "s", "w"))
     _check_theta(theta)
     if np.any((s < 0.0) | (s > 1.0)):
         raise InvalidInputError(f"s={float(s[(s < 0) | (s > 1)].ravel()[0])!r} is out of range: must be in [0, 1]")
     if np.any(np.abs(w) > geo.T / 2 + 1e-15):
         raise InvalidInputError(f"w is out of range: must be in [-T/2, T/2] = [{-geo.T / 2:g}, {geo.T / 2:g}]")
-    K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
     shape = theta.shape
     rows = [as_rows(x, 1)[:, 0] for x in (theta, beta, s, w)]
     out = np.empty((rows[0].shape[0], 3))

@@ -112,20 +112,21 @@ def _ploop_py(x, shared, ref, out):
     return count
 
 
-def test_parfor_loop_on_one_thread_runs_the_serial_loop(two_threads):
-    """numba set to one thread (a ``legkin check`` worker): a ``parfor`` loop runs its serial compilation and never
-    compiles its parallel twin (a second, slow compilation); on two threads the twin gives the same rows."""
+def test_parfor_loop_runs_serially_when_asked(two_threads, monkeypatch):
+    """``serial_parfor_loops`` (the ``legkin check`` workers): a ``parfor`` loop runs its serial compilation and never
+    compiles its parallel twin; otherwise the twin runs, on one thread too, and gives the same rows bit for bit."""
+    import legkin._kernels as kernels
+
     loop = BatchLoop(_ploop_py, "x ref out", 8, parfor=True)
     loop.parfor = _njit(loop.parfor.py_func, cache=False, parallel=True)  # this test compiles it afresh
     x = np.random.default_rng(1).uniform(0, 1, (64, 2))
     args = (np.array([0.3, 1.7]), np.zeros((1, 1)))
-    numba.set_num_threads(1)
+    monkeypatch.setattr(kernels, "serial_parfor_loops", True)
     serial = np.empty((64, 3))
     count = loop(x, *args, serial)
     assert loop.parfor.signatures == [] and count == int(np.sum(x[:, 0] > 0.5))
-    if two_threads < 2:
-        pytest.skip("numba has one thread here")
-    numba.set_num_threads(2)
+    monkeypatch.setattr(kernels, "serial_parfor_loops", False)
+    numba.set_num_threads(1)
     out = np.empty((64, 3))
     assert loop(x, *args, out) == count and len(loop.parfor.signatures) == 1
     np.testing.assert_array_equal(out, serial)

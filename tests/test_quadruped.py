@@ -521,17 +521,26 @@ def test_list_input_and_float64_fast_path_agree():
     assert aq.ik(np.zeros((0, 3)), "LF").shape == (0, 3)
 
 
-def test_thread_count_does_not_change_results(rng):
+def test_thread_count_does_not_change_results(rng, monkeypatch):
+    """numba's parallel loops on one thread, on all, and their serial compilation (legkin check's workers,
+    ``_kernels.serial_parfor_loops``) give the same batch results bit for bit."""
     import numba
 
+    import legkin._kernels as kernels
+
     lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
-    p = aq.fk(rng.uniform(lo, hi, (2000, 3)), "LF")
+    q = rng.uniform(lo, hi, (2000, 3))
+    p = aq.fk(q, "LF")
     before = numba.get_num_threads()
     try:
         numba.set_num_threads(1)
-        one = aq.ik(p, "LF")
+        one = aq.ik(p, "LF"), aq.fk(q, "LF"), aq.jacobian(q, "LF")
         numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
-        np.testing.assert_array_equal(aq.ik(p, "LF"), one)
+        for a, b in zip((aq.ik(p, "LF"), aq.fk(q, "LF"), aq.jacobian(q, "LF")), one):
+            np.testing.assert_array_equal(a, b)
+        monkeypatch.setattr(kernels, "serial_parfor_loops", True)
+        for a, b in zip((aq.ik(p, "LF"), aq.fk(q, "LF"), aq.jacobian(q, "LF")), one):
+            np.testing.assert_array_equal(a, b)
     finally:
         numba.set_num_threads(before)
 

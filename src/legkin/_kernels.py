@@ -154,16 +154,22 @@ def _executor(workers: int) -> ThreadPoolExecutor:
         return _pool
 
 
+#: True: a ``parfor`` batch loop runs its serial compilation and never compiles its parallel twin (numba's parallel
+#: compiler, 0.4-0.9 s a loop on the first run). Set in ``legkin check``'s worker processes, which run on one
+#: thread and need the rows, not the speed (the rows are the same bit for bit).
+serial_parfor_loops = False
+
+
 class BatchLoop:
     """A compiled batch loop (:func:`batch_kernel`), called like its Python function. The arguments named in
     ``rows`` hold one row per item (inputs and outputs alike); the first of them gives the item count n.
 
-    Below ``min_parallel`` items, or with numba set to one thread, the loop runs on the calling thread. From there
-    on, either (default) the rows are split into contiguous chunks, one per thread, each run by the same compiled
-    loop without the GIL (a row argument with a single row, shared by all items, is passed whole; an int return
-    value, a count, is summed over the chunks); or, with ``parfor=True``, the loop's ``prange`` runs on numba's
-    parallel backend, from a second compilation of the same source made on the first large batch on more than one
-    thread (a process on one thread, such as a ``legkin check`` worker, never compiles it). ``parfor`` suits the cheapest loops
+    Below ``min_parallel`` items the loop runs on the calling thread. From there on, either (default) the rows
+    are split into contiguous chunks, one per thread, each run by the same compiled loop without the GIL (a row
+    argument with a single row, shared by all items, is passed whole; an int return value, a count, is summed
+    over the chunks); or, with ``parfor=True``, the loop's ``prange`` runs on numba's parallel backend, from a
+    second compilation of the same source made on the first large batch (also on one thread: numba's parallel
+    loop is faster there too), unless :data:`serial_parfor_loops` is set. ``parfor`` suits the cheapest loops
     (~0.1 us an item: numba's parallel loop saves ~30 ns an item of array-view bookkeeping); the chunks need no
     second compilation (numba's parallel compiler is slow) and suit everything else."""
 
@@ -182,11 +188,13 @@ class BatchLoop:
 
     def __call__(self, *args: Any) -> Any:
         n = args[self.rows[0]].shape[0]
-        k = min(threads(), n) if n >= self.min_parallel else 1
-        if k <= 1:  # small, or numba set to one thread: no parallel loop (nor its compilation)
+        if n < self.min_parallel:
             return self.kernel(*args)
-        if self.parfor is not None:
+        if self.parfor is not None and not serial_parfor_loops:
             return self.parfor(*args)
+        k = min(threads(), n)
+        if k <= 1:
+            return self.kernel(*args)
         edges = [n * j // k for j in range(k + 1)]
         chunks = []
         for lo, hi in zip(edges[:-1], edges[1:]):

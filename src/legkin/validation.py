@@ -168,10 +168,14 @@ def run_checks(
 
 def _one_thread() -> None:
     """A worker process runs its batches on one thread: the worker processes are the parallelism (numba's threads
-    in each would oversubscribe the CPUs; the rows do not depend on the thread count)."""
+    in each would oversubscribe the CPUs; the rows do not depend on the thread count), and its ``parfor`` loops on
+    their serial compilation (no parallel twin to compile: ~4 s of CPU on a first run)."""
     import numba
 
+    from . import _kernels
+
     numba.set_num_threads(1)
+    _kernels.serial_parfor_loops = True
 
 
 #: The order in which the worker processes take the groups: dearest first by the first-run time of their checks

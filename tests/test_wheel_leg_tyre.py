@@ -226,3 +226,15 @@ def test_stance_ik_single_equals_batch_and_rules():
     with pytest.raises(JointLimitError):
         gd.stance_ik(t_out, "FL")
     assert gd.stance_ik(t_out, "FL", limits=False)[2] == pytest.approx(2.6, abs=1e-9)
+
+
+def test_tyre_point_batch_reuses_the_pieces_of_equal_theta_bit_for_bit():
+    """A batch computes the pieces once per run of equal theta (one configuration's curve sampled in s); the points
+    are the single calls' bit for bit, also where theta changes within the batch and in the threads' chunks."""
+    rng = np.random.default_rng(5)
+    theta = np.repeat(rng.uniform(THETA_MIN, THETA_MAX, 4), 100)  # runs of 100 equal theta
+    theta[50] = THETA_MIN  # a run broken inside
+    beta, s, w = rng.uniform(-3, 3, 400), rng.uniform(0, 1, 400), rng.uniform(-0.01, 0.01, 400)
+    batch = ty.tyre_point(theta, beta, s, w)
+    single = np.array([ty.tyre_point(float(t), float(b), float(x), float(y)) for t, b, x, y in zip(theta, beta, s, w)])
+    np.testing.assert_array_equal(batch, single)

@@ -183,13 +183,10 @@ def _k_locate(s, CUM):
     return _NP - 1, 1.0
 
 
-@kernel(entry=True, inline=True)
-def _k_tyre_point(theta, beta, s, w, r, K, KC, out):
-    """:func:`tyre_point` for one item into out (3,)."""
-    C = np.empty(_NP, dtype=np.complex128)
-    RAD, A0, SPAN, CUM = np.empty(_NP), np.empty(_NP), np.empty(_NP), np.empty(_NP + 1)
-    _k_pieces(theta, r, K, KC, C, RAD, A0, SPAN)
-    _k_cumulative(RAD, SPAN, CUM)
+@kernel(inline=True)
+def _k_tyre_point_at(C, RAD, A0, SPAN, CUM, beta, s, w, out):
+    """The point of contact parameter s on the pieces (C, RAD, A0, SPAN, CUM) of one theta, turned by beta, into
+    out (3,)."""
     p, u = _k_locate(s, CUM)
     ang = A0[p] + u * SPAN[p]
     z = C[p] + RAD[p] * complex(math.cos(ang), math.sin(ang))
@@ -197,10 +194,29 @@ def _k_tyre_point(theta, beta, s, w, r, K, KC, out):
     out[0], out[1], out[2] = z.real, z.imag, w
 
 
+@kernel(entry=True, inline=True)
+def _k_tyre_point(theta, beta, s, w, r, K, KC, out):
+    """:func:`tyre_point` for one item into out (3,)."""
+    C = np.empty(_NP, dtype=np.complex128)
+    RAD, A0, SPAN, CUM = np.empty(_NP), np.empty(_NP), np.empty(_NP), np.empty(_NP + 1)
+    _k_pieces(theta, r, K, KC, C, RAD, A0, SPAN)
+    _k_cumulative(RAD, SPAN, CUM)
+    _k_tyre_point_at(C, RAD, A0, SPAN, CUM, beta, s, w, out)
+
+
 @batch_kernel(rows="theta beta s w out", min_parallel=256)
 def _k_tyre_point_batch(theta, beta, s, w, r, K, KC, out):
+    """:func:`_k_tyre_point` per item, the pieces computed once per run of equal theta (the points of one
+    configuration's curve: the same arithmetic, so the same bits, as item by item)."""
+    C = np.empty(_NP, dtype=np.complex128)
+    RAD, A0, SPAN, CUM = np.empty(_NP), np.empty(_NP), np.empty(_NP), np.empty(_NP + 1)
+    last = math.nan
     for i in range(theta.shape[0]):
-        _k_tyre_point(theta[i], beta[i], s[i], w[i], r, K, KC, out[i])
+        if not theta[i] == last:
+            _k_pieces(theta[i], r, K, KC, C, RAD, A0, SPAN)
+            _k_cumulative(RAD, SPAN, CUM)
+            last = theta[i]
+        _k_tyre_point_at(C, RAD, A0, SPAN, CUM, beta[i], s[i], w[i], out[i])
 
 
 @kernel(entry=True, inline=True)

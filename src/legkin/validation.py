@@ -284,14 +284,15 @@ def pinocchio_frames(robot, qs, frames: list[str], jacobians: bool = False):
     for i, q in enumerate(qs):
         if jacobians:
             pin.computeJointJacobians(model, data, q)
-        else:
-            pin.forwardKinematics(model, data, q)
-        pin.updateFramePlacements(model, data)
-        for k, fid in enumerate(ids):
-            pos[i, k] = data.oMf[fid].translation
-            rot[i, k] = data.oMf[fid].rotation
-            if jacobians:
+            pin.updateFramePlacements(model, data)
+            placements = np.array([data.oMf[fid].homogeneous for fid in ids])
+            for k, fid in enumerate(ids):
                 jac[i, k] = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+        else:  # only the frames asked (one Python call each: ~4x faster than copying them out of data.oMf)
+            pin.forwardKinematics(model, data, q)
+            placements = np.array([pin.updateFramePlacement(model, data, fid).homogeneous for fid in ids])
+        pos[i] = placements[:, :3, 3]
+        rot[i] = placements[:, :3, :3]
     return (pos, rot, jac) if jacobians else (pos, rot)
 
 

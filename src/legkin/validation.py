@@ -179,8 +179,9 @@ def _one_thread() -> None:
 
 
 #: The order in which the worker processes take the groups: dearest first by the first-run time of their checks
-#: (compiling the kernels dominates; measured in 2-worker runs on 2 cores: wheel_leg 50-60 s, hybrid_leg 26-34 s,
-#: tripod 19-21 s, the nine external robots 12-15 s, quadruped 10-11 s). Order only; the rows do not depend on it.
+#: (compiling the kernels dominates; measured in 2-worker runs on 2 cores, calm and slow spells of a shared machine:
+#: wheel_leg 48-69 s, hybrid_leg 27-45 s, tripod 17-32 s, the nine external robots 11-19 s, quadruped 7-13 s).
+#: Order only; the rows do not depend on it.
 _COST = {"wheel_leg": 5, "hybrid_leg": 4, "tripod": 3, "legs": 2, "quadruped": 1}
 
 

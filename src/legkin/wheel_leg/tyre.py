@@ -290,7 +290,7 @@ def _pieces_one(theta, beta, rho, K, KC):
     return TyrePieces(PIECES, centre, radius, start, span, s_start, s_end, np.array(length))
 
 
-def _point_fast(theta, beta, s, w, geo, rho, K, KC):
+def _point_one(theta, beta, s, w, geo, rho, K, KC):
     """:func:`tyre_point` of four numbers in range (the kernel directly), else None (the full checks)."""
     if (type(theta) in _SCALARS and type(beta) in _SCALARS and type(s) in _SCALARS and type(w) in _SCALARS
             and THETA_MIN - 1e-12 <= theta <= THETA_MAX + 1e-12 and math.isfinite(beta) and 0.0 <= s <= 1.0
@@ -351,7 +351,7 @@ def tyre_point(theta: ArrayLike, beta: ArrayLike, s: ArrayLike, w: ArrayLike = 0
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     rho = _thickness(r, geo)
     K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
-    point = _point_fast(theta, beta, s, w, geo, rho, K, KC)
+    point = _point_one(theta, beta, s, w, geo, rho, K, KC)
     if point is not None:
         return point
     theta, beta, s, w = as_angles(theta, beta, s, w, names=("theta", "beta", "s", "w"))

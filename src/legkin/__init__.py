@@ -36,6 +36,10 @@ def __getattr__(name: str) -> Any:
         return getattr(robot, name)
     raise AttributeError(f"module 'legkin' has no attribute {name!r}")
 
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | {"Robot", "load"})
+
 __all__ = [
     "quadruped",
     "tripod",

@@ -114,9 +114,6 @@ def single_call_tables(doc: dict) -> str:
                        f"{r['yardstick_time_per_call_s'] * 1e6:.2f} us | {_num(r['ratio'], '.2f')} |")
         out.append("")
         out += [f"* {key}: {y['label']}" for key, y in single.get("yardsticks", {}).items()]
-        skipped = single.get("skipped") or {}
-        out += [f"* not timed: {item}" + (f" ({skipped[item]})" if isinstance(skipped, dict) else "")
-                for item in skipped]
         out.append("")
     return "\n".join(out)
 

@@ -180,17 +180,27 @@ def _one_thread() -> None:
 
 #: The order in which the worker processes take the groups: dearest first by the first-run time of their checks
 #: (compiling the kernels dominates; measured in 2-worker runs on 2 cores, calm and slow spells of a shared machine:
-#: wheel_leg 48-69 s, hybrid_leg 27-45 s, tripod 17-32 s, the nine external robots 11-19 s, quadruped 7-13 s).
+#: wheel_leg 48-69 s, hybrid_leg 27-45 s, tripod 17-32 s, the nine external robots with the quadruped 18-35 s).
 #: Order only; the rows do not depend on it.
-_COST = {"wheel_leg": 5, "hybrid_leg": 4, "tripod": 3, "legs": 2, "quadruped": 1}
+_COST = {"wheel_leg": 4, "hybrid_leg": 3, "tripod": 2, "legs": 1}
+
+
+def _group_key(name: str) -> str:
+    """The worker group of a model: ``"legs"`` for the external robots of :mod:`legkin.legs` (they share their
+    kernels), a checks module's ``KERNEL_GROUP`` when it runs another group's kernels (the quadruped's checks run
+    :mod:`legkin.legs` on POPI: in one process the legs kernels compile once), else the model's own name."""
+    spec = get_spec(name)
+    if spec.external:
+        return "legs"
+    return str(getattr(importlib.import_module(f"{spec.package}.checks"), "KERNEL_GROUP", name))
 
 
 def _groups(names: list[str]) -> list[list[str]]:
-    """The models in groups run by one worker process each, dearest first: one group per mechanism package
-    (the external robots of :mod:`legkin.legs` share their kernels: one group)."""
+    """The models in groups run by one worker process each, dearest first: one group per mechanism package,
+    models whose checks share kernels together (:func:`_group_key`)."""
     groups: dict[str, list[str]] = {}
     for name in names:
-        groups.setdefault("legs" if get_spec(name).external else name, []).append(name)
+        groups.setdefault(_group_key(name), []).append(name)
     order = sorted(groups, key=lambda key: -_COST.get(key, 1))
     return [groups[key] for key in order]
 

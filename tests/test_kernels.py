@@ -144,6 +144,8 @@ def test_parfor_twin_has_its_own_cache_files():
     from legkin.quadruped.inverse import _ik_batch
 
     assert _ik_batch.parfor is not None
+    for loop in (_ik_batch.kernel, _ik_batch.parfor):
+        loop.ensure_cache()  # set up on the first compile otherwise
     assert _ik_batch.kernel._cache._cache_file._index_path != _ik_batch.parfor._cache._cache_file._index_path
     assert _ik_batch.parfor.py_func.__code__ is _ik_batch.kernel.py_func.__code__
 
@@ -214,6 +216,27 @@ def test_analytic_calls_do_not_import_pinocchio():
         "assert 'pinocchio' not in sys.modules, 'pinocchio imported by an analytic call'; "
         "assert {'load', 'Robot'} <= set(dir(legkin)) and 'pinocchio' not in sys.modules; "
         "assert legkin.load('tripod').model.nq == 12 and 'pinocchio' in sys.modules"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=1800)
+    assert out.returncode == 0, out.stderr[-2000:]
+
+
+def test_numba_cache_is_set_up_on_first_compile_only():
+    """A kernel's numba cache is set up by its first compile or cache load (``KernelDispatcher.ensure_cache``), not
+    at import: importing a mechanism sets up none, a call sets up the kernels it runs, and they are numba's
+    on-disk caches (a second call in a new process loads them: the read-only test of .ci/run)."""
+    import subprocess
+    import sys
+
+    code = (
+        "import gc, numpy as np; from numba.core.caching import FunctionCache; "
+        "from legkin import _kernels, quadruped; import legkin.quadruped.kinematics; "
+        "ks = lambda: [o for o in gc.get_objects() if isinstance(o, _kernels.KernelDispatcher)]; "
+        "assert ks() and not [k for k in ks() if k._cache_ready], 'a cache set up at import'; "
+        "quadruped.fk(np.array([0.1, 0.8, 1.2]), 'LF'); "
+        "ready = [k for k in ks() if k._cache_ready]; "
+        "assert ready and len(ready) < len(ks()) // 2, (len(ready), len(ks())); "
+        "assert all(isinstance(k._cache, FunctionCache) for k in ready)"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=1800)
     assert out.returncode == 0, out.stderr[-2000:]

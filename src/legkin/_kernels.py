@@ -61,11 +61,26 @@ class KernelDispatcher(CPUDispatcher):
     from Python. A kernel's code never depends on a literal argument, so one version serves them all."""
 
     _cache_enabled = True  # numba's on-disk cache (cache=True), also for an InternalKernel's twin
+    _cache_ready = False  # the cache is set up by the first compile (or cache load), not at import
 
     def get_call_template(self, args, kws):  # noqa: D102 - numba API
         args = tuple(types.unliteral(a) for a in args)
         kws = {k: types.unliteral(v) for k, v in kws.items()}
         return super().get_call_template(args, kws)
+
+    def compile(self, sig):  # noqa: D102 - numba API
+        # Every compile and cache load of a dispatcher goes through this method.
+        self.ensure_cache()
+        return super().compile(sig)
+
+    def ensure_cache(self) -> None:
+        """Set up numba's on-disk cache of this kernel (once; a no-op with ``cache=False``). numba's
+        ``enable_caching`` finds the cache directory on the file system (a test file written and deleted per
+        kernel): done for the ~250 kernels at import it took 30-50 ms of a warm start; done on the first
+        compile, only for the kernels a process uses."""
+        if self._cache_enabled and not self._cache_ready:
+            self._cache_ready = True
+            self.enable_caching()
 
 
 class InternalKernel(KernelDispatcher):
@@ -104,9 +119,7 @@ def _njit(fn: Callable[..., Any], *, cache: bool = True, entry: bool = True, **o
         targetoptions["no_cpython_wrapper"] = True
     cls = KernelDispatcher if entry else InternalKernel
     disp = cls(py_func=fn, locals={}, targetoptions={**targetoptions, **options})
-    disp._cache_enabled = cache
-    if cache:
-        disp.enable_caching()
+    disp._cache_enabled = cache  # numba's cache, set up on the first compile (KernelDispatcher.compile)
     return disp
 
 

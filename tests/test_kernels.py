@@ -191,22 +191,14 @@ def test_checks_call_no_internal_kernel_from_python():
     """Every kernel the checks (and the public functions they call) call from Python is an entry kernel or a batch
     loop: a run of every model's checks, in a fresh process, compiles no Python twin (a twin is a second compile of
     a kernel with its whole call tree)."""
-    import subprocess
-    import sys
-
     code = ("from legkin import _kernels, validation; "
             "validation.run_checks(samples=60, ik_targets=60, classify=60); print(_kernels.python_twins)")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=1800)
-    assert out.returncode == 0, out.stderr[-2000:]
-    assert out.stdout.strip().splitlines()[-1] == "[]"
+    assert _fresh_python(code).strip().splitlines()[-1] == "[]"
 
 
 def test_analytic_calls_do_not_import_pinocchio():
     """Importing legkin and calling each mechanism's analytic kinematics never imports Pinocchio (about 0.1 s of
     the first call): only ``legkin.load`` and ``legkin.Robot`` need it, and they import it on first use."""
-    import subprocess
-    import sys
-
     code = (
         "import sys, numpy as np, legkin; from legkin import hybrid_leg, quadruped, tripod, wheel_leg; "
         "quadruped.ik(quadruped.fk(np.array([0.1, 0.8, 1.2]), 'LF'), 'LF'); "
@@ -217,17 +209,13 @@ def test_analytic_calls_do_not_import_pinocchio():
         "assert {'load', 'Robot'} <= set(dir(legkin)) and 'pinocchio' not in sys.modules; "
         "assert legkin.load('tripod').model.nq == 12 and 'pinocchio' in sys.modules"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=1800)
-    assert out.returncode == 0, out.stderr[-2000:]
+    _fresh_python(code)
 
 
 def test_numba_cache_is_set_up_on_first_compile_only():
     """A kernel's numba cache is set up by its first compile or cache load (``KernelDispatcher.ensure_cache``), not
     at import: importing a mechanism sets up none, a call sets up the kernels it runs, and they are numba's
     on-disk caches (a second call in a new process loads them: the read-only test of .ci/run)."""
-    import subprocess
-    import sys
-
     code = (
         "import gc, numpy as np; from numba.core.caching import FunctionCache; "
         "from legkin import _kernels, quadruped; import legkin.quadruped.kinematics; "
@@ -238,5 +226,14 @@ def test_numba_cache_is_set_up_on_first_compile_only():
         "assert ready and len(ready) < len(ks()) // 2, (len(ready), len(ks())); "
         "assert all(isinstance(k._cache, FunctionCache) for k in ready)"
     )
+    _fresh_python(code)
+
+
+def _fresh_python(code: str) -> str:
+    """Run ``code`` in a new Python process; its stdout (the test fails with the end of stderr if it fails)."""
+    import subprocess
+    import sys
+
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=1800)
     assert out.returncode == 0, out.stderr[-2000:]
+    return out.stdout

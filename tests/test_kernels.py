@@ -237,3 +237,25 @@ def _fresh_python(code: str) -> str:
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=1800)
     assert out.returncode == 0, out.stderr[-2000:]
     return out.stdout
+
+
+def test_compile_profile_script_lists_the_kernels_of_a_first_run():
+    """``scripts/compile_profile.py`` (CONTRIBUTING.md, first-run compile): a fresh cache, so the external robot's
+    check compiles the legs kernels, listed dearest first with their exclusive time (<= inclusive)."""
+    import os
+    import pathlib
+    import re
+    import subprocess
+    import sys
+
+    script = pathlib.Path(__file__).parents[1] / "scripts" / "compile_profile.py"
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_CACHE_DIR"}
+    out = subprocess.run([sys.executable, str(script), "a1", "--top", "4"], capture_output=True, text=True,
+                         timeout=1800, env=env)
+    assert out.returncode == 0, out.stderr[-2000:]
+    total = re.search(r"compile ([0-9.]+) s in (\d+) compiles", out.stdout)
+    rows = re.findall(r"^ +([0-9.]+)s +([0-9.]+)s +\d+  (\S+)$", out.stdout, re.M)
+    assert total and float(total.group(1)) > 0 and len(rows) == 4, out.stdout[-2000:]
+    exclusive = [float(r[0]) for r in rows]
+    assert exclusive == sorted(exclusive, reverse=True)
+    assert all(float(e) <= float(i) for e, i, _ in rows) and rows[0][2].startswith("legs.")

@@ -278,3 +278,35 @@ def test_run_checks_rejects_bad_jobs(jobs):
 
     with pytest.raises(InvalidArgumentError, match="jobs"):
         validation.run_checks(["quadruped"], samples=5, jobs=jobs)
+
+
+# ---------------------------------------------------------------------------------------------- first run
+def test_check_says_when_the_kernels_are_not_cached_yet(tmp_path):
+    """A first run after an install (an empty numba cache) says on stderr that the kernels compile once; a run on
+    a warm cache, or with --quiet, does not (``_first_run_note``, from ``_kernels.cache_status``)."""
+    code = (
+        "import sys; from legkin import _kernels; from legkin.__main__ import _first_run_note; "
+        "note = _first_run_note(['tripod']); cached, total = _kernels.cache_status(); "
+        "print(cached, total, note is not None, 'of' in (note or '') and str(total - cached) in note)"
+    )
+    env = {**os.environ, "NUMBA_CACHE_DIR": str(tmp_path)}
+    run = lambda: subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=env, timeout=600)  # noqa: E731
+    cold = run().stdout.split()
+    assert cold[0] == "0" and int(cold[1]) > 10 and cold[2:] == ["True", "True"], cold
+    warm_up = "import numpy as np; from legkin import tripod; tripod.fk(tripod.ik(np.array([0.2, -0.1])))"
+    assert subprocess.run([sys.executable, "-c", warm_up], env=env, timeout=600).returncode == 0
+    after = run().stdout.split()
+    assert 0 < int(after[0]) < int(after[1]) == int(cold[1]), after  # the kernels of those calls, cached
+
+
+def test_check_prints_the_first_run_note_unless_quiet(monkeypatch, capsys):
+    import legkin.__main__ as cli
+
+    seen = _capture_run_checks(monkeypatch)
+    monkeypatch.setattr(cli, "_first_run_note", lambda models: f"first run of {models}")
+    assert main(["check", "tripod", "--samples", "5"]) == 0 and seen["models"] == ["tripod"]
+    assert "first run of ['tripod']" in capsys.readouterr().err
+    assert main(["check", "tripod", "--samples", "5", "--quiet"]) == 0
+    assert "first run" not in capsys.readouterr().err
+    monkeypatch.setattr(cli, "_first_run_note", lambda models: None)
+    assert main(["check", "tripod", "--samples", "5"]) == 0 and "first run" not in capsys.readouterr().err

@@ -146,6 +146,10 @@ def _cmd_check(args) -> int:
         args.jobs = min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
     if args.plots and importlib.util.find_spec("matplotlib") is None:
         raise errors.LegkinError('--plots needs matplotlib: pip install -e ".[plots]"')
+    if not getattr(args, "quiet", False):
+        note = _first_run_note(models)
+        if note:
+            print(note, file=sys.stderr, flush=True)
     results = run_checks(
         models,
         samples=args.samples,
@@ -170,6 +174,23 @@ def _cmd_check(args) -> int:
     ok = all_passed(results)
     print("all checks passed" if ok else "SOME CHECKS FAILED")
     return 0 if ok else 1
+
+
+def _first_run_note(models: list[str] | None) -> str | None:
+    """The note of a first run after an install (most of the models' kernels, default all, not in numba's cache
+    yet), or None."""
+    from . import _kernels
+    from ._registry import get_spec, list_models
+    from .validation import _checks_module
+
+    for name in models or list_models():
+        _checks_module(get_spec(name))  # imports the model's kernels
+    cached, total = _kernels.cache_status()
+    if total == 0 or cached >= total / 2:
+        return None
+    return (f"legkin check: {total - cached} of {total} kernels are not in numba's cache yet (a first run after an "
+            "install): numba compiles them once (1-2 minutes of CPU for all of legkin's, by machine); later runs load "
+            "them from the cache")
 
 
 def _cmd_view(args) -> int:

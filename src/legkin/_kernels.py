@@ -36,8 +36,10 @@ install writes every file anew, so users never see a stale kernel).
 from __future__ import annotations
 
 import inspect
+import os
 import threading
 import types as pytypes
+import weakref
 from concurrent.futures import ThreadPoolExecutor
 from typing import Any, Callable, TypeVar, overload
 
@@ -120,7 +122,29 @@ def _njit(fn: Callable[..., Any], *, cache: bool = True, entry: bool = True, **o
     cls = KernelDispatcher if entry else InternalKernel
     disp = cls(py_func=fn, locals={}, targetoptions={**targetoptions, **options})
     disp._cache_enabled = cache  # numba's cache, set up on the first compile (KernelDispatcher.compile)
+    if cache and not options.get("parallel"):  # a parfor twin compiles only on a large batch: not counted
+        _cached_kernels.append(weakref.ref(disp))
     return disp
+
+
+#: The cached kernels created in this process (weak references), for :func:`cache_status`.
+_cached_kernels: list[weakref.ref] = []
+
+
+def cache_status() -> tuple[int, int]:
+    """``(in numba's on-disk cache, all)``: the count of this process's legkin kernels (those of the modules
+    imported so far, less the ``parfor`` twins) that a first call would load from numba's cache rather than
+    compile. ``legkin check`` tells a first run after an install by it."""
+    cached = total = 0
+    for ref in _cached_kernels:
+        disp = ref()
+        if disp is None:
+            continue
+        disp.ensure_cache()
+        index = getattr(getattr(disp._cache, "_cache_file", None), "_index_path", None)
+        total += 1
+        cached += index is not None and os.path.exists(index)
+    return cached, total
 
 
 @overload

@@ -43,7 +43,7 @@ from .geometry import _DEFAULT_GEOMETRY, THETA_MAX, THETA_MIN, TYRE_THICKNESS, G
 from .linkage import _IF, _IG, _IL, _IU, _k_closed, _kconst
 from .tyre import _LINK_A, _LINK_B, _NP, PIECES, _k_cumulative, _k_pieces, _thickness
 
-__all__ = ["GroundContact", "ground_contact", "normal_in_leg_frame"]
+__all__ = ["GroundContact", "ground_contact"]
 
 _NONFINITE = 1
 #: Below this a normal component counts as zero (lateral: the lowest set is a segment; in-plane: a face).
@@ -270,18 +270,6 @@ def ground_contact(q: ArrayLike, leg: Leg, normal: ArrayLike = _Z, *, r: float =
     if shape == () and not bool(ok[0]):
         raise InvalidInputError(f"the ground contact is not finite at q={q.tolist()}")
     return (gc, ok.reshape(shape)) if return_mask else gc
-
-
-def normal_in_leg_frame(gamma: ArrayLike, leg: Leg, normal: ArrayLike = (0.0, 0.0, 1.0)) -> np.ndarray:
-    """The unit ground normal (robot frame) written in the leg frame {L} at ABAD angle gamma: (..., 3)."""
-    sl, _o, RLM, R0 = _leg_consts(leg, _DEFAULT_GEOMETRY)
-    n = _normals(normal)
-    g = as_input(gamma, "gamma")
-    c, s = np.cos(g)[..., None], np.sin(g)[..., None]
-    v = n @ R0  # R0^T n
-    u = np.stack([c[..., 0] * v[..., 0] + s[..., 0] * v[..., 1], -s[..., 0] * v[..., 0] + c[..., 0] * v[..., 1],
-                  np.broadcast_to(v[..., 2], np.broadcast_shapes(v[..., 2].shape, g.shape))], -1)
-    return u @ RLM  # RLM^T u
 
 
 def __getattr__(name: str) -> Any:

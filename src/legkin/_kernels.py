@@ -46,6 +46,7 @@ from typing import Any, Callable, TypeVar, overload
 import numba
 import numpy as np
 from numba.core import config, types
+from numba.core.compiler_lock import global_compiler_lock
 from numba.core.registry import CPUDispatcher
 
 __all__ = ["kernel", "batch_kernel", "BatchLoop", "OK", "as_items", "as_rows", "prange", "threads"]
@@ -71,9 +72,11 @@ class KernelDispatcher(CPUDispatcher):
         return super().get_call_template(args, kws)
 
     def compile(self, sig):  # noqa: D102 - numba API
-        # Every compile and cache load of a dispatcher goes through this method.
-        self.ensure_cache()
-        return super().compile(sig)
+        # Every compile and cache load of a dispatcher goes through this method; numba's (re-entrant) compiler
+        # lock makes the cache's set-up happen once before any thread's compile.
+        with global_compiler_lock:
+            self.ensure_cache()
+            return super().compile(sig)
 
     def ensure_cache(self) -> None:
         """Set up numba's on-disk cache of this kernel (once; a no-op with ``cache=False``). numba's

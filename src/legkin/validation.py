@@ -180,7 +180,8 @@ def _one_thread() -> None:
 
 #: The order in which the worker processes take the groups: dearest first by the first-run time of their checks
 #: (compiling the kernels dominates; measured in 2-worker runs on 2 cores, calm and slow spells of a shared machine:
-#: wheel_leg 48-69 s, hybrid_leg 27-45 s, tripod 17-32 s, the nine external robots with the quadruped 18-35 s).
+#: wheel_leg 48-69 s, hybrid_leg 27-45 s, tripod 17-32 s; the nine external robots and the quadruped, one group
+#: as they share the legs kernels, 29-32 s on a slower machine where wheel_leg took 60-68 s).
 #: Order only; the rows do not depend on it.
 _COST = {"wheel_leg": 4, "hybrid_leg": 3, "tripod": 2, "legs": 1}
 

@@ -282,8 +282,8 @@ def test_run_checks_rejects_bad_jobs(jobs):
 
 # ---------------------------------------------------------------------------------------------- first run
 def test_check_says_when_the_kernels_are_not_cached_yet(tmp_path):
-    """A first run after an install (an empty numba cache) says on stderr that the kernels compile once; a run on
-    a warm cache, or with --quiet, does not (``_first_run_note``, from ``_kernels.cache_status``)."""
+    """A first run after an install (an empty numba cache): ``_first_run_note`` names the count of kernels not yet
+    cached (``_kernels.cache_status``: none of them at first, some after one call has compiled its kernels)."""
     code = (
         "import sys; from legkin import _kernels; from legkin.__main__ import _first_run_note; "
         "note = _first_run_note(['tripod']); cached, total = _kernels.cache_status(); "

@@ -193,7 +193,7 @@ def _group_key(name: str) -> str:
     spec = get_spec(name)
     if spec.external:
         return "legs"
-    return str(getattr(importlib.import_module(f"{spec.package}.checks"), "KERNEL_GROUP", name))
+    return str(getattr(_checks_module(spec), "KERNEL_GROUP", name))
 
 
 def _groups(names: list[str]) -> list[list[str]]:

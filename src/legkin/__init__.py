@@ -11,6 +11,7 @@ from .errors import (
     InvalidParameterError,
     JointLimitError,
     LegkinError,
+    LegStructureError,
     LoopClosureError,
     SingularityError,
     UnknownModelError,
@@ -24,7 +25,7 @@ if TYPE_CHECKING:
 # The mechanisms, one package each, after the registry (which finds them); their kinematics load on first use.
 from . import hybrid_leg, quadruped, tripod, wheel_leg
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"
 
 
 def __getattr__(name: str) -> Any:
@@ -55,6 +56,7 @@ __all__ = [
     "InvalidArgumentError",
     "UnreachableError",
     "JointLimitError",
+    "LegStructureError",
     "AssemblyModeError",
     "SingularityError",
     "LoopClosureError",

@@ -170,7 +170,7 @@ def get_spec(name: str) -> ModelSpec:
         return MODELS[name]
     except (KeyError, TypeError):
         raise UnknownModelError(
-            f"unknown model {name!r}; known models: {', '.join(sorted(MODELS))}"
+            f"unknown model {name!r}; known models: {', '.join(sorted(MODELS))}", name=name, known=sorted(MODELS)
         ) from None
 
 

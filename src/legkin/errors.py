@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from typing import Any, Sequence
+
 __all__ = [
     "LegkinError",
     "UnknownModelError",
@@ -10,6 +12,7 @@ __all__ = [
     "InvalidArgumentError",
     "UnreachableError",
     "JointLimitError",
+    "LegStructureError",
     "AssemblyModeError",
     "SingularityError",
     "LoopClosureError",
@@ -22,7 +25,17 @@ class LegkinError(Exception):
 
 
 class UnknownModelError(LegkinError, KeyError):
-    """A model name that is not in the registry."""
+    """A model name that is not in the registry.
+
+    Attributes:
+        name: the name that was asked for.
+        known: the valid names, sorted.
+    """
+
+    def __init__(self, message: str, name: object = None, known: Sequence[str] = ()) -> None:
+        super().__init__(message)
+        self.name = name
+        self.known = list(known)
 
     def __str__(self) -> str:  # KeyError would quote the message
         return str(self.args[0]) if self.args else ""
@@ -49,17 +62,45 @@ class UnreachableError(LegkinError):
 
     Attributes:
         target: the target that was asked for.
-        closest: the closest point reached, when the solver knows one.
+        closest: the closest point reached, when the solver knows one (else None).
+        distance: how far the target lies from ``closest`` or from the reachable set (m, or rad for an
+            orientation), when known (else NaN).
     """
 
-    def __init__(self, message: str, target=None, closest=None):
+    def __init__(self, message: str, target: Any = None, closest: Any = None, distance: float = float("nan")) -> None:
         super().__init__(message)
         self.target = target
         self.closest = closest
+        self.distance = distance
 
 
 class JointLimitError(UnreachableError):
-    """A target that is geometrically reachable, but only outside the joint limits."""
+    """A target that is geometrically reachable, but only outside the joint limits.
+
+    Attributes:
+        joint: the name of the (first) joint whose limit the solutions violate, when known.
+        value: that joint's value in the closest solution (rad or m).
+        lower: the joint's lower limit (rad or m).
+        upper: the joint's upper limit (rad or m).
+    """
+
+    def __init__(
+        self,
+        message: str,
+        target: Any = None,
+        closest: Any = None,
+        distance: float = float("nan"),
+        *,
+        joint: str | None = None,
+        value: float = float("nan"),
+        lower: float = float("nan"),
+        upper: float = float("nan"),
+    ) -> None:
+        super().__init__(message, target=target, closest=closest, distance=distance)
+        self.joint = joint
+        self.value = value
+        self.lower = lower
+        self.upper = upper
 
 
 class AssemblyModeError(UnreachableError):
@@ -69,9 +110,25 @@ class AssemblyModeError(UnreachableError):
         modes: the mode arguments under which the target is reachable, e.g. ``[{"ll_branch": 1}]``.
     """
 
-    def __init__(self, message: str, target=None, closest=None, modes=None):
+    def __init__(
+        self, message: str, target: Any = None, closest: Any = None, modes: Sequence[Any] | None = None
+    ) -> None:
         super().__init__(message, target=target, closest=closest)
-        self.modes = modes or []
+        self.modes = list(modes or [])
+
+
+class LegStructureError(LegkinError, ValueError):
+    """A robot description whose chains match no leg structure that legkin supports.
+
+    Attributes:
+        found: what was found, e.g. ``{"LF": "HAA-HFE (2 joints)"}`` or a list of chain descriptions.
+        expected: the structures legkin supports, e.g. ``["HAA-HFE-KFE", "6-DOF"]``.
+    """
+
+    def __init__(self, message: str, found: Any = None, expected: Sequence[str] = ()) -> None:
+        super().__init__(message)
+        self.found = found
+        self.expected = list(expected)
 
 
 class SingularityError(LegkinError):

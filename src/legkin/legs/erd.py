@@ -92,7 +92,9 @@ def _robot(name: str) -> ErdRobot:
         return ERD_ROBOTS[name]
     except (KeyError, TypeError):
         raise UnknownModelError(
-            f"unknown example-robot-data quadruped {name!r}; known: {', '.join(ERD_ROBOTS)}"
+            f"unknown example-robot-data quadruped {name!r}; known: {', '.join(ERD_ROBOTS)}",
+            name=name,
+            known=sorted(ERD_ROBOTS),
         ) from None
 
 

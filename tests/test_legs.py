@@ -13,6 +13,7 @@ from hypothesis import assume, example, given
 from hypothesis import strategies as st
 
 from legkin import legs
+from legkin._registry import get_spec
 from legkin.errors import (
     InvalidInputError,
     InvalidParameterError,
@@ -63,21 +64,20 @@ def test_erd_files_come_from_the_installed_distribution():
     base = Path(dist.locate_file("")).resolve()
     assert len(ROBOTS) == 9
     assert set(ROBOTS) == {"solo12", "anymal", "anymal_c", "hyq", "go1", "go2", "a1", "b1", "laikago"}
-    specs = legs.external_models()
-    assert set(specs) == set(ROBOTS)
     for name in ROBOTS:
-        spec = legs.erd_spec(name)
-        assert spec == specs[name]
-        urdf = Path(spec["urdf"])
+        spec = get_spec(name)  # a first-class registry entry of the shared package legkin.legs
+        assert spec.package == "legkin.legs" and spec.shared_package and not spec.generated
+        urdf, srdf, package_dirs = spec.locate(name)
+        assert (urdf, srdf, package_dirs) == legs.erd_files(name)
         assert urdf.is_file() and base in urdf.parents
-        assert (spec["srdf"] is None) == (name == "laikago")
-        if spec["srdf"]:
-            assert Path(spec["srdf"]).is_file()
-            assert spec["reference_pose"] == "standing"
+        assert (srdf is None) == (name == "laikago")
+        if srdf is not None:
+            assert srdf.is_file()
+            assert spec.reference_pose == "standing"
         # package://example-robot-data/... resolves in the first package dir
-        assert (Path(spec["package_dirs"][0]) / "example-robot-data" / "robots").is_dir()
+        assert (Path(package_dirs[0]) / "example-robot-data" / "robots").is_dir()
         model, path, dirs = legs.load_erd(name)
-        assert isinstance(model, pin.Model) and Path(path) == urdf and dirs == spec["package_dirs"]
+        assert isinstance(model, pin.Model) and Path(path) == urdf and dirs == package_dirs
         q = legs.reference_configuration(model, name)
         assert q.shape == (model.nq,)
     with pytest.raises(UnknownModelError, match="known: solo12"):

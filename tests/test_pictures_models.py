@@ -63,8 +63,8 @@ def test_figures_are_nonblank_pngs(model, tmp_path):
 
 def test_check_plots_pick_up_model_figures(tmp_path):
     pytest.importorskip("matplotlib")
+    from legkin._checkkit import compare
     from legkin.figures import write_check_plots
-    from legkin.validation import compare
 
     row = compare("a check row", [1e-16, 1e-15], 1e-12)
     paths = write_check_plots({m: ([row], None) for m in ("tripod", "wheel_leg")}, tmp_path)

@@ -115,7 +115,7 @@ def _cmd_list(args) -> int:
 
     for name in sorted(MODELS):
         spec = MODELS[name]
-        origin = f"from {spec.source}" if spec.external else f"seed {spec.seed}"
+        origin = f"seed {spec.seed}" if spec.generated else f"from {spec.source}"
         print(f"{name:<12} {origin:<24} {spec.title}")
     return 0
 
@@ -196,7 +196,7 @@ def _first_run_note(models: list[str] | None) -> str | None:
 def _cmd_view(args) -> int:
     import numpy as np
 
-    from . import load
+    from .robot import load
     from .viewer import show, write_html
 
     if args.animate and (args.q is not None or args.pose is not None):

@@ -1,4 +1,4 @@
-"""Bench modules, one per model: ``build(n, rng, quick) -> legkin.bench.ModelBench``; shared helpers here."""
+"""Bench modules, one per model: ``build(n, rng, quick) -> ModelBench``; the bench's types and shared helpers here."""
 
 from __future__ import annotations
 
@@ -6,10 +6,17 @@ import contextlib
 import importlib.util
 import os
 import sys
+from dataclasses import dataclass, field
+from typing import Any, Callable
 
 import numpy as np
 
-__all__ = ["missing", "quiet_stdout", "pinocchio_positions", "levenberg_marquardt", "rotation_error", "SOLVE_TOL"]
+__all__ = [
+    "Score",
+    "Method",
+    "ModelBench",
+    "MethodResult",
+    "missing", "quiet_stdout", "pinocchio_positions", "levenberg_marquardt", "rotation_error", "SOLVE_TOL"]
 
 #: A target counts as solved when the method's result is within this distance (m or rad) of it.
 SOLVE_TOL = 1e-9
@@ -90,3 +97,119 @@ def rotation_error(r1: np.ndarray, r2: np.ndarray) -> np.ndarray:
         [rel[..., 2, 1] - rel[..., 1, 2], rel[..., 0, 2] - rel[..., 2, 0], rel[..., 1, 0] - rel[..., 0, 1]], -1
     )
     return np.arctan2(0.5 * np.linalg.norm(skew, axis=-1), 0.5 * (tr - 1.0))
+
+
+@dataclass
+class Score:
+    """Per-target outcome of one method (arrays of length = number of targets; NaN marks a failure).
+
+    Attributes:
+        error: primary error per target (position in m, or orientation in rad; see ``ModelBench.units``).
+        solved: boolean mask: the target was reached within the model's tolerance (and joint limits).
+        orientation: secondary error per target (rad), when the task has one.
+        iterations: iterations per target, for iterative methods.
+        fk_evals: forward-kinematics evaluations per target, for iterative methods.
+        reached: error within tolerance, whatever the joint limits (when ``solved`` also asks for limits).
+    """
+
+    error: np.ndarray
+    solved: np.ndarray
+    orientation: np.ndarray | None = None
+    iterations: np.ndarray | None = None
+    fk_evals: np.ndarray | None = None
+    reached: np.ndarray | None = None
+
+
+@dataclass
+class Method:
+    """One way of solving a model's task.
+
+    Attributes:
+        name: row label (the batch closed form's contains "batch", Pinocchio's contains "pinocchio").
+        inputs: targets, first axis = targets (shared with the other methods of the group).
+        run: ``run(inputs) -> output``; the timed part (everything a user would call).
+        score: ``score(inputs, output) -> Score``; not timed.
+        group: methods are compared (ratio to fastest) within their group.
+        max_targets: solve only the first ``max_targets`` inputs (slow per-target methods).
+        repeats: timed runs; the time reported is their median.
+        skip: if set, the method is not run and this reason is printed instead.
+        note: printed under the table.
+    """
+
+    name: str
+    inputs: Any = None
+    run: Callable[[Any], Any] | None = None
+    score: Callable[[Any, Any], Score] | None = None
+    group: str = "ik"
+    max_targets: int | None = None
+    repeats: int = 5
+    skip: str | None = None
+    note: str = ""
+
+
+@dataclass
+class ModelBench:
+    """What a bench module returns for one model.
+
+    Attributes:
+        methods: the rows, in display order.
+        units: unit of ``Score.error`` per group (e.g. ``{"ik": "m"}``).
+        tolerance: the ``solved`` threshold, same for every method (stated in the table).
+        notes: lines printed under the table (how the targets were made, what each peer was given).
+        summary: ``summary(results) -> lines``: derived figures (speed-ups, IK/FK), printed and in the JSON.
+        secondary: column label of ``Score.orientation`` (e.g. "rot" in rad, or "loop |r|").
+    """
+
+    methods: list[Method]
+    units: dict[str, str] = field(default_factory=lambda: {"ik": "m"})
+    tolerance: str = ""
+    notes: list[str] = field(default_factory=list)
+    summary: Callable[[list], list[str]] | None = None
+    secondary: str = "rot"
+
+
+@dataclass
+class MethodResult:
+    """A timed and scored method (one table row)."""
+
+    name: str
+    group: str
+    unit: str
+    targets: int
+    solved: float  # percent
+    solved_count: int
+    median_error: float
+    max_error: float
+    time_per_target_s: float
+    repeats: int
+    ratio: float = float("nan")
+    median_orientation_error: float | None = None
+    max_orientation_error: float | None = None
+    iterations_median: float | None = None
+    fk_evals_mean: float | None = None
+    reached: float | None = None  # percent
+    note: str = ""
+
+    def as_dict(self) -> dict:
+        d = {
+            "name": self.name,
+            "targets": self.targets,
+            "solved": self.solved,
+            "median_error": self.median_error,
+            "max_error": self.max_error,
+            "time_per_target_s": self.time_per_target_s,
+            "group": self.group,
+            "error_unit": self.unit,
+            "solved_count": self.solved_count,
+            "repeats": self.repeats,
+            "ratio_to_fastest": self.ratio,
+        }
+        for key in ("reached", "iterations_median", "fk_evals_mean"):
+            if getattr(self, key) is not None:
+                d[key] = getattr(self, key)
+        if self.median_orientation_error is not None:
+            d["median_secondary_error"] = self.median_orientation_error
+            d["max_secondary_error"] = self.max_orientation_error
+        if self.note:
+            d["note"] = self.note
+        return d

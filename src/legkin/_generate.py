@@ -121,7 +121,7 @@ def generate_all(names: list[str] | None = None, out_dir: str | Path | None = No
 def _generated_spec(name: str) -> ModelSpec:
     """The registry entry of a model legkin generates (an external robot's URDF is its distribution's)."""
     spec = get_spec(name)
-    if spec.external:
+    if not spec.generated:
         raise LegkinError(f"model {name!r} comes from {spec.source}: legkin does not generate its URDF")
     return spec
 

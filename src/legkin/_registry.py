@@ -7,7 +7,7 @@ import math
 import pkgutil
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Mapping
+from typing import Any, Callable, Mapping
 
 from .errors import InvalidParameterError, UnknownModelError
 
@@ -75,8 +75,17 @@ class ModelSpec:
         actuated_joints: names of the actuated joints.
         floating: whether ``load(..., floating=True)`` makes sense (a walking robot).
         reference_pose: the SRDF pose used as ``Robot.q0``.
+        actuated_joints: names of the actuated joints; None: every one-coordinate joint (an open tree).
         source: ``"legkin"`` (the model is generated from ``xacro/``) or the distribution whose installed URDF
-            it is (``"example-robot-data"``: the nine quadrupeds whose leg IK :mod:`legkin.legs` derives).
+            it is (``"example-robot-data"``: the robots whose leg kinematics :mod:`legkin.legs` measures).
+        package: the package of its kinematics, checks, bench and clips (default ``legkin.<name>``).
+        locate: for a model legkin does not generate, ``locate(name) -> (urdf, srdf or None, package dirs)``.
+        default_pose: ``default_pose(model, name)``, the reference configuration when the SRDF has none (or None).
+        geometry: ``geometry(robot)``, what :attr:`legkin.Robot.geometry` returns (default:
+            ``<package>.Geometry.from_params(robot.params)``).
+        yardstick_frame: the frame of the bench's Pinocchio yardstick calls, or ``yardstick_frame(robot)``
+            ("": the model's last frame).
+        mjcf: whether ``legkin check`` runs the MuJoCo export's rows on it.
 
     The mechanism itself is the package ``legkin.<name>`` (:attr:`package`), found by one rule: every
     sub-package of :mod:`legkin` with a ``spec`` module defining ``SPEC``. Its modules are found by name:
@@ -89,20 +98,31 @@ class ModelSpec:
     title: str
     seed: str
     params: Mapping[str, Param] = field(default_factory=dict)
-    actuated_joints: tuple[str, ...] = ()
+    actuated_joints: tuple[str, ...] | None = ()
     floating: bool = False
     reference_pose: str = "standing"
     source: str = "legkin"
+    package: str = ""
+    locate: Callable[[str], tuple[Path, Path | None, list[str]]] | None = None
+    default_pose: Callable[[Any, str], Any] | None = None
+    geometry: Callable[[Any], Any] | None = None
+    yardstick_frame: str | Callable[[Any], str] = ""
+    mjcf: bool = True
+
+    def __post_init__(self) -> None:
+        if not self.package:
+            object.__setattr__(self, "package", f"legkin.{self.name}")
 
     @property
-    def external(self) -> bool:
-        """A robot whose URDF comes from another distribution (example-robot-data), not from legkin's xacro."""
-        return self.source != "legkin"
+    def generated(self) -> bool:
+        """Whether legkin generates the model's URDF from its xacro (else :attr:`locate` finds a distribution's)."""
+        return self.locate is None
 
     @property
-    def package(self) -> str:
-        """Dotted name of the mechanism's package (``legkin.legs`` for the external quadrupeds)."""
-        return "legkin.legs" if self.external else f"legkin.{self.name}"
+    def shared_package(self) -> bool:
+        """Whether :attr:`package` serves several models (``legkin.legs``: the robots it measures). Its
+        ``checks.run``, ``bench.build`` and ``bench.single_calls`` then take the model's name first."""
+        return self.package != f"legkin.{self.name}"
 
     @property
     def xacro_file(self) -> str:
@@ -123,41 +143,25 @@ class ModelSpec:
 
 
 def _discover() -> dict[str, ModelSpec]:
-    """Collect ``SPEC`` from every mechanism package: each sub-package ``legkin.<name>`` with a ``spec``
-    module (the one rule by which the framework finds a mechanism)."""
-    import legkin
-
+    """Collect the registry entries of every mechanism package: each sub-package ``legkin.<name>`` with a
+    ``spec`` module (the one rule by which the framework finds a mechanism), defining ``SPEC`` (the package's own
+    model, named ``<name>``) or ``SPECS`` (the models a shared package serves, e.g. :mod:`legkin.legs`)."""
     found: dict[str, ModelSpec] = {}
-    for info in sorted(pkgutil.iter_modules(legkin.__path__), key=lambda m: m.name):
+    for info in sorted(pkgutil.iter_modules([str(Path(__file__).parent)]), key=lambda m: m.name):
         if not info.ispkg or info.name.startswith("_"):
             continue
         if not (Path(info.module_finder.path) / info.name / "spec.py").is_file():  # type: ignore[union-attr]
             continue  # a package that is not a mechanism (read from disk: nothing else is imported)
-        spec = importlib.import_module(f"legkin.{info.name}.spec").SPEC
-        if spec.name != info.name:
-            raise RuntimeError(f"legkin.{info.name}.spec.SPEC is named {spec.name!r}: it must be {info.name!r}")
-        found[spec.name] = spec
+        module = importlib.import_module(f"legkin.{info.name}.spec")
+        specs = [module.SPEC] if hasattr(module, "SPEC") else list(module.SPECS)
+        for spec in specs:
+            if spec.package != f"legkin.{info.name}" or (hasattr(module, "SPEC") and spec.name != info.name):
+                raise RuntimeError(f"legkin.{info.name}.spec declares {spec.name!r} of package {spec.package!r}")
+            found[spec.name] = spec
     return found
 
 
-def _external() -> dict[str, ModelSpec]:
-    """The quadrupeds of example-robot-data (:data:`legkin.legs.ERD_ROBOTS`; their files are found when loaded)."""
-    from .legs.erd import ERD_ROBOTS
-
-    return {
-        r.name: ModelSpec(
-            name=r.name,
-            title=f"{r.title}: closed-form leg IK measured from its URDF (legkin.legs)",
-            seed="",
-            floating=True,
-            reference_pose=r.reference_pose or "",
-            source="example-robot-data",
-        )
-        for r in ERD_ROBOTS.values()
-    }
-
-
-MODELS: Mapping[str, ModelSpec] = {**_discover(), **_external()}
+MODELS: Mapping[str, ModelSpec] = _discover()
 
 
 def get_spec(name: str) -> ModelSpec:

@@ -21,7 +21,6 @@ import numpy as np
 __all__ = [
     "SingleCall",
     "YARDSTICKS",
-    "YARDSTICK_FRAMES",
     "SOLVE_LOOPS_PERTURBATION",
     "SingleCallResult",
     "time_call",
@@ -58,8 +57,6 @@ class SingleCall:
 
 
 # ------------------------------------------------------------------------------------------- single calls
-#: The frame each yardstick uses, per model (a foot / platform / rim frame); other models: their last frame.
-YARDSTICK_FRAMES = {"quadruped": "LF_FOOT", "tripod": "platform", "wheel_leg": "FL_rim_upper_L", "hybrid_leg": "FCS"}
 #: Perturbation (rad or m, normal) of the passive coordinates the ``solve_loops`` yardstick starts from.
 SOLVE_LOOPS_PERTURBATION = 1e-2
 
@@ -129,12 +126,12 @@ def _closed_configuration(robot) -> np.ndarray:
 
 
 def _frame_name(name: str, robot) -> str:
-    if robot.spec.external:  # the foot of the benched leg (legkin.legs.bench.LEG)
-        from .legs.bench import LEG
-
-        legs = robot.geometry
-        return legs[LEG if LEG in legs else next(iter(legs))].foot_frame
-    return YARDSTICK_FRAMES.get(name) or robot.model.frames[len(robot.model.frames) - 1].name
+    """The frame of the yardstick calls: the registry entry's :attr:`ModelSpec.yardstick_frame`, else the model's
+    last frame."""
+    frame = robot.spec.yardstick_frame
+    if callable(frame):
+        return frame(robot)
+    return frame or robot.model.frames[len(robot.model.frames) - 1].name
 
 
 def yardstick_calls(name: str, keys, seed: int = 0) -> dict[str, tuple[Callable[[], object], str]]:
@@ -147,7 +144,7 @@ def yardstick_calls(name: str, keys, seed: int = 0) -> dict[str, tuple[Callable[
     """
     import pinocchio as pin
 
-    from . import load
+    from .robot import load
 
     out: dict[str, tuple[Callable[[], object], str]] = {}
     robots: dict[str, Any] = {}

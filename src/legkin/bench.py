@@ -23,15 +23,14 @@ import os
 import platform
 import sys
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
+from ._benchkit import Method, MethodResult, ModelBench, Score
 from ._registry import MODELS, get_spec, list_models
 from ._single_call import SOLVE_LOOPS_PERTURBATION as SOLVE_LOOPS_PERTURBATION  # re-exported: the single-call
-from ._single_call import YARDSTICK_FRAMES as YARDSTICK_FRAMES  # table's machinery lives in _single_call
 from ._single_call import SingleCallResult, _fmt_time, format_single_table, time_call, yardstick_calls
 from ._single_call import _closed_configuration as _closed_configuration
 from ._single_call import _frame_name as _frame_name
@@ -56,122 +55,6 @@ __all__ = [
 ]
 
 
-@dataclass
-class Score:
-    """Per-target outcome of one method (arrays of length = number of targets; NaN marks a failure).
-
-    Attributes:
-        error: primary error per target (position in m, or orientation in rad; see ``ModelBench.units``).
-        solved: boolean mask: the target was reached within the model's tolerance (and joint limits).
-        orientation: secondary error per target (rad), when the task has one.
-        iterations: iterations per target, for iterative methods.
-        fk_evals: forward-kinematics evaluations per target, for iterative methods.
-        reached: error within tolerance, whatever the joint limits (when ``solved`` also asks for limits).
-    """
-
-    error: np.ndarray
-    solved: np.ndarray
-    orientation: np.ndarray | None = None
-    iterations: np.ndarray | None = None
-    fk_evals: np.ndarray | None = None
-    reached: np.ndarray | None = None
-
-
-@dataclass
-class Method:
-    """One way of solving a model's task.
-
-    Attributes:
-        name: row label (the batch closed form's contains "batch", Pinocchio's contains "pinocchio").
-        inputs: targets, first axis = targets (shared with the other methods of the group).
-        run: ``run(inputs) -> output``; the timed part (everything a user would call).
-        score: ``score(inputs, output) -> Score``; not timed.
-        group: methods are compared (ratio to fastest) within their group.
-        max_targets: solve only the first ``max_targets`` inputs (slow per-target methods).
-        repeats: timed runs; the time reported is their median.
-        skip: if set, the method is not run and this reason is printed instead.
-        note: printed under the table.
-    """
-
-    name: str
-    inputs: Any = None
-    run: Callable[[Any], Any] | None = None
-    score: Callable[[Any, Any], Score] | None = None
-    group: str = "ik"
-    max_targets: int | None = None
-    repeats: int = 5
-    skip: str | None = None
-    note: str = ""
-
-
-@dataclass
-class ModelBench:
-    """What a bench module returns for one model.
-
-    Attributes:
-        methods: the rows, in display order.
-        units: unit of ``Score.error`` per group (e.g. ``{"ik": "m"}``).
-        tolerance: the ``solved`` threshold, same for every method (stated in the table).
-        notes: lines printed under the table (how the targets were made, what each peer was given).
-        summary: ``summary(results) -> lines``: derived figures (speed-ups, IK/FK), printed and in the JSON.
-        secondary: column label of ``Score.orientation`` (e.g. "rot" in rad, or "loop |r|").
-    """
-
-    methods: list[Method]
-    units: dict[str, str] = field(default_factory=lambda: {"ik": "m"})
-    tolerance: str = ""
-    notes: list[str] = field(default_factory=list)
-    summary: Callable[[list], list[str]] | None = None
-    secondary: str = "rot"
-
-
-@dataclass
-class MethodResult:
-    """A timed and scored method (one table row)."""
-
-    name: str
-    group: str
-    unit: str
-    targets: int
-    solved: float  # percent
-    solved_count: int
-    median_error: float
-    max_error: float
-    time_per_target_s: float
-    repeats: int
-    ratio: float = float("nan")
-    median_orientation_error: float | None = None
-    max_orientation_error: float | None = None
-    iterations_median: float | None = None
-    fk_evals_mean: float | None = None
-    reached: float | None = None  # percent
-    note: str = ""
-
-    def as_dict(self) -> dict:
-        d = {
-            "name": self.name,
-            "targets": self.targets,
-            "solved": self.solved,
-            "median_error": self.median_error,
-            "max_error": self.max_error,
-            "time_per_target_s": self.time_per_target_s,
-            "group": self.group,
-            "error_unit": self.unit,
-            "solved_count": self.solved_count,
-            "repeats": self.repeats,
-            "ratio_to_fastest": self.ratio,
-        }
-        for key in ("reached", "iterations_median", "fk_evals_mean"):
-            if getattr(self, key) is not None:
-                d[key] = getattr(self, key)
-        if self.median_orientation_error is not None:
-            d["median_secondary_error"] = self.median_orientation_error
-            d["max_secondary_error"] = self.max_orientation_error
-        if self.note:
-            d["note"] = self.note
-        return d
-
-
 # ------------------------------------------------------------------------------------------- progress
 class _Progress:
     """A progress bar (tqdm) on stderr: methods timed so far, the one running now; off when disabled.
@@ -180,7 +63,7 @@ class _Progress:
     """
 
     def __init__(self, total: int, label: str, enabled: bool | None = None):
-        from .validation import progress_bar
+        from ._progress import progress_bar
 
         self.enabled = sys.stderr.isatty() if enabled is None else bool(enabled)
         self._ctx = progress_bar(max(total, 1), f"legkin bench {label}".rstrip(), enabled=self.enabled)
@@ -307,13 +190,13 @@ def _run_methods(bench: ModelBench, runnable: list[Method], progress: _Progress)
 
 
 def _load_bench_module(name: str):
-    """The bench module of ``name``, or None if there is none (an external quadruped: :mod:`legkin.legs.bench`,
-    its ``build(name, n, rng, quick)`` bound to the name)."""
+    """The bench module of ``name``, or None if there is none (for a model of a shared package, e.g.
+    :mod:`legkin.legs.bench`, its ``build(name, n, rng, quick)`` and ``single_calls(name)`` bound to the name)."""
     spec = MODELS.get(name)
-    if spec is not None and spec.external:
+    if spec is not None and spec.shared_package:
         import types
 
-        module = importlib.import_module("legkin.legs.bench")
+        module = importlib.import_module(f"{spec.package}.bench")
         if not hasattr(module, "build"):
             return None
         return types.SimpleNamespace(

@@ -34,7 +34,7 @@ def _reference(bench):
 
 
 def _robot():
-    from . import load
+    from .robot import load
 
     robot = load("quadruped")
     iq = robot.idx_q(f"{LEG}_HAA")
@@ -208,7 +208,7 @@ PEERS = [
 
 def add_quadruped_peers(bench) -> None:
     """Append the peer rows (or their skip reasons) and their notes to the quadruped ``ModelBench``."""
-    from .bench import Method
+    from ._benchkit import Method
 
     try:
         ref = _reference(bench)

@@ -69,10 +69,8 @@ class Robot:
         self.name = name
         self.params = dict(params)
         self.floating = floating
-        if spec.external:
-            from .legs.erd import erd_files
-
-            self.urdf_path, self.srdf_path, pkg = erd_files(name)
+        if spec.locate is not None:  # a distribution's installed URDF
+            self.urdf_path, self.srdf_path, pkg = spec.locate(name)
         else:
             self.urdf_path, self.srdf_path = model_files(spec, self.params)
             pkg = [str(self.urdf_path.parent)]
@@ -89,20 +87,18 @@ class Robot:
         self._loopset = LoopSet(self.model, self.loops)
         self.constraint_models = self._loopset.models
         self.constraint_datas = self._loopset.datas
-        for j in spec.actuated_joints:
+        for j in spec.actuated_joints or ():
             self.joint_id(j)  # raises if the URDF and the registry disagree
-        self.actuated_joints = spec.actuated_joints
-        if spec.external:  # an open tree: every one-coordinate joint is driven
+        self.actuated_joints: tuple[str, ...] = spec.actuated_joints or ()
+        if spec.actuated_joints is None:  # an open tree: every one-coordinate joint is driven
             self.actuated_joints = tuple(
                 n for n, j in zip(self.model.names[1:], self.model.joints[1:]) if j.nq == 1 and j.nv == 1
             )
         if self.srdf_path is not None:
             pin.loadReferenceConfigurations(self.model, str(self.srdf_path), False)
         self.poses = {e.key(): np.array(e.data()) for e in self.model.referenceConfigurations}
-        if spec.external and spec.reference_pose and spec.reference_pose not in self.poses:
-            from .legs.erd import standing_pose
-
-            pose = standing_pose(self.model, name)  # a robot without SRDF: legkin's own standing pose
+        if spec.default_pose is not None and spec.reference_pose and spec.reference_pose not in self.poses:
+            pose = spec.default_pose(self.model, name)  # a robot without SRDF: legkin's own standing pose
             if pose is not None:
                 self.poses[spec.reference_pose] = pose
         self.q0 = self.poses.get(spec.reference_pose, pin.neutral(self.model)).copy()
@@ -116,11 +112,11 @@ class Robot:
     def geometry(self) -> Any:
         """``legkin.<name>.Geometry.from_params(self.params)``: the geometry this model was generated with.
 
-        For an external quadruped (example-robot-data), the legs measured from its model:
-        ``legkin.legs.from_model(self.model)``, a dict ``{leg name: Leg}``.
+        A registry entry may say otherwise (:attr:`ModelSpec.geometry`): for a robot of :mod:`legkin.legs`, the
+        legs measured from its model, ``legkin.legs.from_model(self.model)``, a dict ``{leg name: Leg}``.
         """
-        if self.spec.external:
-            return self.kinematics.from_model(self.model)
+        if self.spec.geometry is not None:
+            return self.spec.geometry(self)
         return self.kinematics.Geometry.from_params(self.params)
 
     def __repr__(self) -> str:

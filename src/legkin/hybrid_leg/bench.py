@@ -13,12 +13,19 @@ from typing import Callable
 
 import numpy as np
 
-from .. import load
-from .._benchkit import SOLVE_TOL, levenberg_marquardt, pinocchio_positions, sizes
+from .._benchkit import (
+    SOLVE_TOL,
+    Method,
+    MethodResult,
+    ModelBench,
+    Score,
+    levenberg_marquardt,
+    pinocchio_positions,
+    sizes,
+)
 from .._single_call import SingleCall
-from ..bench import Method, MethodResult, ModelBench, Score
 from ..errors import LegkinError
-from ..robot import Robot
+from ..robot import Robot, load
 from . import kinematics as ah
 from .configuration import LL_RANGE, closed_configuration, sample_workspace
 

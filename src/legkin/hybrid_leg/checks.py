@@ -6,9 +6,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import load
+from .._checkkit import CheckResult, compare, per_sample, pinocchio_frames
 from .._rotations import rot_x, rot_y, rot_z
-from ..validation import CheckResult, compare, per_sample, pinocchio_frames
+from ..robot import load
 from . import kinematics as ah
 from .configuration import (
     ACTUATED,
@@ -420,7 +420,7 @@ def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 20
     (default options); up to ``classify`` unsolved targets (None: all; FK-made ones first) are classified by the
     error a single ``ik`` call raises (:func:`legkin.validation.classify_failures`).
     """
-    from ..validation import classify_failures, robustness_row
+    from .._checkkit import classify_failures, robustness_row
 
     targets, made = ik_robustness_targets(n, rng)
     exceptions = 0

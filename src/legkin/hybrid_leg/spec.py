@@ -23,4 +23,5 @@ SPEC = ModelSpec(
     actuated_joints=("MCS1", "MCS2", "LL"),
     floating=False,
     reference_pose="neutral",
+    yardstick_frame="FCS",  # the bench's Pinocchio yardstick calls (legkin.bench)
 )

@@ -8,7 +8,7 @@
 Modules: :mod:`.kinematics` (the :class:`Leg`; its compiled kernels in :mod:`._fk_kernels` (forward map, Jacobian)
 and :mod:`._ik_kernels` (closed-form IK, Newton polish), constants in :mod:`._layout`), :mod:`.extract` (finding
 and measuring legs in a Pinocchio model), :mod:`.erd` (the nine quadrupeds of example-robot-data),
-:mod:`.registry`, :mod:`.checks` (rows of ``legkin check``), :mod:`.bench`.
+:mod:`.spec` (their registry entries), :mod:`.checks` (rows of ``legkin check``), :mod:`.bench`.
 """
 
 from __future__ import annotations
@@ -17,15 +17,14 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # at run time the names load on first use: `import legkin` (its registry) imports no numba
-    from .erd import ERD_ROBOTS, ErdRobot, erd_files, external_models, load_erd, reference_configuration
+    from .erd import ERD_ROBOTS, ErdRobot, erd_files, load_erd, reference_configuration
     from .extract import find_chains, from_model, from_urdf
     from .kinematics import BRANCHES, Leg, LegStructureError
-    from .registry import erd_spec
 
 _WHERE = {
-    "ERD_ROBOTS": "erd", "ErdRobot": "erd", "erd_files": "erd", "external_models": "erd", "load_erd": "erd",
+    "ERD_ROBOTS": "erd", "ErdRobot": "erd", "erd_files": "erd", "load_erd": "erd",
     "reference_configuration": "erd", "find_chains": "extract", "from_model": "extract", "from_urdf": "extract",
-    "BRANCHES": "kinematics", "Leg": "kinematics", "LegStructureError": "kinematics", "erd_spec": "registry",
+    "BRANCHES": "kinematics", "Leg": "kinematics", "LegStructureError": "kinematics",
 }
 
 __all__ = [
@@ -40,8 +39,6 @@ __all__ = [
     "erd_files",
     "load_erd",
     "reference_configuration",
-    "external_models",
-    "erd_spec",
 ]
 
 

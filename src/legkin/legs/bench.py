@@ -22,8 +22,7 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .._benchkit import SOLVE_TOL, missing, sizes
-from ..bench import Method, MethodResult, ModelBench, Score
+from .._benchkit import SOLVE_TOL, Method, MethodResult, ModelBench, Score, missing, sizes
 
 __all__ = ["build", "LEG", "CLIK_MAX_ITER", "CLIK_DAMPING", "PEER_TOL", "stripped_urdf", "urdf_chain"]
 
@@ -203,7 +202,7 @@ def build(name: str, n: int | None, rng: np.random.Generator, quick: bool) -> Mo
     ``dq = J^T (J J^T + lambda I)^-1 e`` on the leg's three joints from mid-limit, clipped into the limits,
     <= :data:`CLIK_MAX_ITER` iterations), ikpy and roboticstoolbox ``ik_LM`` (position only) when installed.
     """
-    from .. import load
+    from ..robot import load
 
     n_batch, n_single, n_iter = _sizes(n, quick)
     n_clik = min(n_batch, 10 * n_iter)
@@ -321,8 +320,8 @@ def single_calls(name: str) -> list:
     """One single call per public function of :class:`~legkin.legs.Leg` for robot ``name``'s leg :data:`LEG`,
     inputs bound (the standing pose and its foot), against Pinocchio's FK + frame (and frame Jacobian) of
     that leg's foot on the same model (``legkin bench <name>``'s single-call table)."""
-    from .. import load
     from .._single_call import SingleCall
+    from ..robot import load
 
     robot = load(name)
     legs = robot.geometry

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..validation import CheckResult, compare
+from .._checkkit import CheckResult, compare
 
 __all__ = ["run", "TOL", "load_model", "sample_legs", "pinocchio_feet"]
 
@@ -30,7 +30,7 @@ def load_model(robot_name: str):
 
     if robot_name in ERD_ROBOTS:
         return load_erd(robot_name)[0]
-    from .. import load
+    from ..robot import load
 
     return load(robot_name).model
 

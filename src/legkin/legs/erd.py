@@ -16,7 +16,7 @@ import numpy as np
 
 from ..errors import InvalidParameterError, UnknownModelError
 
-__all__ = ["ErdRobot", "ERD_ROBOTS", "erd_files", "load_erd", "external_models", "reference_configuration"]
+__all__ = ["ErdRobot", "ERD_ROBOTS", "erd_files", "load_erd", "reference_configuration"]
 
 _DIST = "example-robot-data"
 _ROBOTS = "example-robot-data/robots/"
@@ -176,10 +176,3 @@ def load_erd(name: str, *, free_flyer: bool | None = None):
     except Exception as exc:  # noqa: BLE001 - Pinocchio's parse errors become a legkin error
         raise InvalidParameterError(f"cannot load {name} from {urdf}: {exc}") from exc
     return model, urdf, dirs
-
-
-def external_models() -> dict[str, dict]:
-    """``{name: erd_spec(name)}`` for the nine robots (for legkin's registry)."""
-    from .registry import erd_spec
-
-    return {name: erd_spec(name) for name in ERD_ROBOTS}

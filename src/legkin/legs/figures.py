@@ -73,7 +73,7 @@ def render(out: str | Path = "docs/img/legs_go2_anymal_c.png", robots=ROBOTS, fr
     """Render the picture into ``out`` (PNG, palette-quantized) and return its path."""
     from PIL import Image, ImageDraw
 
-    from .. import load
+    from ..robot import load
     from ..viewer import screenshot
     from .clips import feet_circles
 

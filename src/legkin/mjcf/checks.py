@@ -14,8 +14,8 @@ from ._base import _mujoco
 from .mechanism import MujocoMechanism, load_mujoco
 
 if TYPE_CHECKING:  # pragma: no cover
+    from .._checkkit import CheckResult
     from ..robot import Robot
-    from ..validation import CheckResult
 
 #: Tolerances of the rows of :func:`check_rows`.
 TOL_PLACEMENT = 1e-12
@@ -245,7 +245,7 @@ def check_rows(
         LegkinError: MuJoCo is not installed (:func:`unavailable_reason` says so without raising).
         UnknownModelError: ``name`` is not registered.
     """
-    from ..validation import compare
+    from .._checkkit import compare
 
     _mujoco()
     samples = check_count("samples", samples)

@@ -20,11 +20,20 @@ from typing import Any, Callable
 
 import numpy as np
 
-from .. import load
-from .._benchkit import SOLVE_TOL, missing, pinocchio_positions, quiet_stdout, sizes
+from .._benchkit import (
+    SOLVE_TOL,
+    Method,
+    MethodResult,
+    ModelBench,
+    Score,
+    missing,
+    pinocchio_positions,
+    quiet_stdout,
+    sizes,
+)
 from .._single_call import SingleCall
-from ..bench import Method, MethodResult, ModelBench, Score
 from ..errors import UnreachableError
+from ..robot import load
 from . import kinematics as aq
 from .configuration import leg_slice, pinocchio_configuration, sample_joints
 

@@ -6,9 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from .. import load
-from .._rotations import wrap
-from ..validation import (
+from .._checkkit import (
     CheckResult,
     classify_failures,
     compare,
@@ -17,6 +15,8 @@ from ..validation import (
     robustness_row,
     sample_within_limits,
 )
+from .._rotations import wrap
+from ..robot import load
 from . import kinematics as aq
 from .configuration import leg_slice, made_joints, near_singular_joints, pinocchio_configuration, random_targets, rho
 

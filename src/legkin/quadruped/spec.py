@@ -13,4 +13,5 @@ SPEC = ModelSpec(
     },
     actuated_joints=tuple(f"{leg}_{j}" for leg in LEGS for j in ("HAA", "HFE", "KFE")),
     floating=True,
+    yardstick_frame="LF_FOOT",  # the bench's Pinocchio yardstick calls (legkin.bench)
 )

@@ -10,10 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import load
-from .._benchkit import SOLVE_TOL, levenberg_marquardt, rotation_error, sizes
-from ..bench import Method, MethodResult, ModelBench, Score
+from .._benchkit import SOLVE_TOL, Method, MethodResult, ModelBench, Score, levenberg_marquardt, rotation_error, sizes
 from ..errors import LegkinError, LoopClosureError
+from ..robot import load
 from . import kinematics as at
 from .configuration import MOTOR_COLUMNS, sample_workspace
 

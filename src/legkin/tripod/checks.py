@@ -6,11 +6,11 @@ import math
 
 import numpy as np
 
-from .. import load
+from .._checkkit import CheckResult, classify_failures, compare, per_sample, pinocchio_frames, robustness_row
 from .._rotations import rotation_angle as _rot_err
 from .._rotations import wrap
 from ..errors import LoopClosureError
-from ..validation import CheckResult, classify_failures, compare, per_sample, pinocchio_frames, robustness_row
+from ..robot import load
 from . import kinematics as at
 from ._common import BOUNDARY_TOL, HOME_MODE, SINGULAR_TOL
 from .configuration import MOTOR_COLUMNS, sample_workspace

@@ -23,4 +23,5 @@ SPEC = ModelSpec(
     actuated_joints=tuple(f"{leg}_q1" for leg in LEGS),
     floating=False,
     reference_pose="home",
+    yardstick_frame="platform",  # the bench's Pinocchio yardstick calls (legkin.bench)
 )

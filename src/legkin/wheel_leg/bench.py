@@ -11,11 +11,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import load
-from .._benchkit import SOLVE_TOL, levenberg_marquardt, sizes
+from .._benchkit import SOLVE_TOL, Method, MethodResult, ModelBench, Score, levenberg_marquardt, sizes
 from .._single_call import SingleCall
-from ..bench import Method, MethodResult, ModelBench, Score
 from ..errors import UnreachableError
+from ..robot import load
 from . import kinematics as wl
 from .configuration import SEGMENT_LINKS, configuration, ik_start, leg_joint_names, local_contact_point, sample_leg_q
 

@@ -6,9 +6,9 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .. import load
+from .._checkkit import CheckResult, compare, per_sample, pinocchio_frames
 from .._rotations import wrap
-from ..validation import CheckResult, compare, per_sample, pinocchio_frames
+from ..robot import load
 from . import kinematics as wl
 from . import tyre_checks
 from .configuration import SEGMENT_LINKS, configuration, leg_joint_names, local_contact_point, sample_leg_q
@@ -287,7 +287,7 @@ def ik_robustness(n: int, rng: np.random.Generator, *, classify: int | None = 20
     uniform in a 0.8 m box around the module origin. Legs in turn. Each solved answer is scored by the
     default :func:`wl.fk`; up to ``classify`` unsolved targets are classified by single calls.
     """
-    from ..validation import classify_failures, robustness_row
+    from .._checkkit import classify_failures, robustness_row
 
     legs = np.arange(n) % 4
     m_made, m_push = n // 2, n // 4

@@ -46,6 +46,7 @@ SPEC = ModelSpec(
     actuated_joints=tuple(f"{leg}_{j}" for leg in LEGS for j in ("abad", "phi_L", "phi_R")),
     floating=True,
     reference_pose="wheel",
+    yardstick_frame="FL_rim_upper_L",  # the bench's Pinocchio yardstick calls (legkin.bench)
 )
 
 

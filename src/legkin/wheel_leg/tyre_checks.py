@@ -11,7 +11,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from ..validation import CheckResult, compare, per_sample
+from .._checkkit import CheckResult, compare, per_sample
 from .configuration import configuration
 from .frames import leg_frame_to_robot
 from .geometry import ABAD_LIMIT, LEGS, THETA0, THETA_MAX, THETA_MIN, Geometry
@@ -262,7 +262,7 @@ def _pinocchio_rows(rng: np.random.Generator, r: float) -> list[CheckResult]:
     """The material-point Jacobian against Pinocchio's closed-loop Jacobian of that point on its rim link."""
     import pinocchio as pin
 
-    from .. import load
+    from ..robot import load
 
     robot = load("wheel_leg")
     geo = Geometry.from_params(robot.params)
@@ -369,7 +369,7 @@ def standing_base_heights(r: float = TYRE_THICKNESS) -> dict[str, float]:
     ``root_joint`` entries, 0 where absent), which are also returned."""
     import pinocchio as pin
 
-    from .. import load
+    from ..robot import load
 
     out = {}
     wl_robot = load("wheel_leg", floating=True)

@@ -8,6 +8,7 @@ export's (:mod:`legkin.mjcf.checks`) make them from this module.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any, Callable, Iterable
 
 import numpy as np
 
@@ -46,7 +47,7 @@ class CheckResult:
     #: the counts of an IK robustness row (:class:`IKRobustness`), else None.
     counts: object = field(default=None, repr=False, compare=False)
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, Any]:
         """The JSON row (per-sample errors left out)."""
         row = {k: getattr(self, k) for k in ("name", "samples", "max_error", "p99_error", "tolerance", "passed")}
         if self.counts is not None:
@@ -54,8 +55,17 @@ class CheckResult:
         return row
 
 
-def compare(name: str, errors, tolerance: float) -> CheckResult:
-    """Summarise per-sample errors (any shape; NaN counts as a failure) into a row."""
+def compare(name: str, errors: Any, tolerance: float) -> CheckResult:
+    """Summarise per-sample errors (any shape; NaN counts as a failure) into a row.
+
+    Args:
+        name: the row's name.
+        errors: the per-sample errors (array-like of any shape; m, rad or the quantity's unit).
+        tolerance: the bound every sample must meet (same unit).
+
+    Returns:
+        The row: passed when every error is finite and at most ``tolerance``.
+    """
     e = np.abs(np.asarray(errors, dtype=float)).ravel()
     if e.size == 0:
         return CheckResult(name, 0, float("nan"), float("nan"), tolerance, False, e)
@@ -65,13 +75,28 @@ def compare(name: str, errors, tolerance: float) -> CheckResult:
     return CheckResult(name, int(e.size), emax, p99, tolerance, finite and emax <= tolerance, e)
 
 
-def per_sample(diff, axis=-1):
-    """Euclidean norm of a difference along ``axis`` (per-sample error)."""
-    return np.linalg.norm(np.asarray(diff, dtype=float), axis=axis)
+def per_sample(diff: Any, axis: int = -1) -> np.ndarray:
+    """Euclidean norm of a difference along ``axis`` (per-sample error).
+
+    Args:
+        diff: the differences (array-like; m or rad).
+        axis: the axis of the vector components.
+
+    Returns:
+        The norms, ``diff``'s shape without ``axis`` (same unit).
+    """
+    norms: np.ndarray = np.linalg.norm(np.asarray(diff, dtype=float), axis=axis)
+    return norms
 
 
-def pinocchio_frames(robot, qs, frames: list[str], jacobians: bool = False):
+def pinocchio_frames(robot: Any, qs: np.ndarray, frames: list[str], jacobians: bool = False) -> tuple[np.ndarray, ...]:
     """Pinocchio's world placements (and LOCAL_WORLD_ALIGNED Jacobians) of ``frames`` for each row of ``qs``.
+
+    Args:
+        robot: a loaded :class:`legkin.Robot`.
+        qs: ``(N, nq)`` configurations (rad, m).
+        frames: the frames' names.
+        jacobians: also return the frame Jacobians.
 
     Returns:
         ``(positions (N, F, 3), rotations (N, F, 3, 3))``, plus ``jacobians (N, F, 6, nv)`` if asked.
@@ -99,8 +124,18 @@ def pinocchio_frames(robot, qs, frames: list[str], jacobians: bool = False):
     return (pos, rot, jac) if jacobians else (pos, rot)
 
 
-def sample_within_limits(robot, n: int, rng: np.random.Generator, joints: list[str] | None = None) -> np.ndarray:
-    """``n`` configurations: ``q0`` with the given 1-DOF joints (default: all) drawn uniformly in their limits."""
+def sample_within_limits(robot: Any, n: int, rng: np.random.Generator, joints: list[str] | None = None) -> np.ndarray:
+    """``n`` configurations: ``q0`` with the given 1-DOF joints (default: all) drawn uniformly in their limits.
+
+    Args:
+        robot: a loaded :class:`legkin.Robot`.
+        n: how many configurations.
+        rng: the random generator.
+        joints: the joints to draw (default: every joint; those that are not 1-DOF keep their ``q0`` value).
+
+    Returns:
+        ``(n, nq)`` configurations (rad, m).
+    """
     model = robot.model
     qs = np.tile(robot.q0, (n, 1))
     for name in joints or robot.joint_names:
@@ -126,7 +161,7 @@ class IKRobustness:
     solved: int
     wrong: int
     missed: int
-    reasons: dict
+    reasons: dict[str, int]
     exceptions: int
     max_error: float
 
@@ -139,7 +174,7 @@ class IKRobustness:
         )
 
 
-def classify_failures(call, indices) -> tuple[dict, int]:
+def classify_failures(call: Callable[[int], object], indices: Iterable[int]) -> tuple[dict[str, int], int]:
     """Classify unsolved targets by the legkin error that a single call on each raises.
 
     ``call(i)`` runs the default IK on target ``i`` as a single call. Returns ``(reasons, exceptions)``:
@@ -176,7 +211,7 @@ def robustness_row(
     made: np.ndarray,
     solved: np.ndarray,
     error: np.ndarray,
-    reasons: dict,
+    reasons: dict[str, int],
     classified: int,
     exceptions: int,
     tolerance: float = 1e-9,

@@ -34,7 +34,7 @@ def progress_bar(total: int, desc: str, enabled: bool = True) -> Iterator[Any]:
     )
     stop = threading.Event()
 
-    def tick():
+    def tick() -> None:
         while not stop.wait(1.0):
             bar.refresh()
 

@@ -43,14 +43,26 @@ class Param:
         right = ")" if self.high_open or self.high is None else "]"
         return f"{left}{lo}, {hi}{right}"
 
-    def check(self, name: str, value) -> float | str:
-        """Return the value converted to the argument's type, or raise."""
+    def check(self, name: str, value: object) -> float | str:
+        """Return the value converted to the argument's type, or raise.
+
+        Args:
+            name: the argument's name (for the message).
+            value: the value given.
+
+        Returns:
+            The value: one of :attr:`choices` for a string argument, else a float in the range (in the
+            argument's unit).
+
+        Raises:
+            InvalidParameterError: not one of the choices, not a number, or out of range.
+        """
         if self.choices:
             if value not in self.choices:
                 raise InvalidParameterError(f"{name}={value!r} is not valid: must be {self.range_text()}")
-            return value
+            return str(value)
         try:
-            x = float(value)
+            x = float(value)  # type: ignore[arg-type]  # anything float() takes; the rest is refused below
         except (TypeError, ValueError):
             raise InvalidParameterError(f"{name}={value!r} is not a number; valid range {self.range_text()}") from None
         bad = not math.isfinite(x)

@@ -143,7 +143,7 @@ class LoopClosureError(LegkinError):
         iterations: iterations performed.
     """
 
-    def __init__(self, message: str, residual: float = float("nan"), iterations: int = 0, q=None):
+    def __init__(self, message: str, residual: float = float("nan"), iterations: int = 0, q: Any = None) -> None:
         super().__init__(message)
         self.residual = residual
         self.iterations = iterations

@@ -3,20 +3,8 @@
 from typing import TYPE_CHECKING, Any
 
 from ._registry import list_models
-from .errors import (
-    AssemblyModeError,
-    ConvergenceError,
-    InvalidArgumentError,
-    InvalidInputError,
-    InvalidParameterError,
-    JointLimitError,
-    LegkinError,
-    LegStructureError,
-    LoopClosureError,
-    SingularityError,
-    UnknownModelError,
-    UnreachableError,
-)
+from .errors import *  # noqa: F403 - every error class (errors.__all__) at the top level
+from .errors import __all__ as _errors
 
 if TYPE_CHECKING:
     from .robot import Robot, load
@@ -49,16 +37,5 @@ __all__ = [
     "list_models",
     "load",
     "Robot",
-    "LegkinError",
-    "UnknownModelError",
-    "InvalidParameterError",
-    "InvalidInputError",
-    "InvalidArgumentError",
-    "UnreachableError",
-    "JointLimitError",
-    "LegStructureError",
-    "AssemblyModeError",
-    "SingularityError",
-    "LoopClosureError",
-    "ConvergenceError",
+    *_errors,
 ]

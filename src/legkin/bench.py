@@ -24,7 +24,7 @@ import platform
 import sys
 import time
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 import numpy as np
 
@@ -262,25 +262,37 @@ def _summary(bench: ModelBench, results: list[MethodResult]) -> list[str]:
     return list(bench.summary(results)) if bench.summary is not None else []
 
 
+def _optional(x: float | None, fmt: str) -> str:
+    return "-" if x is None else format(x, fmt)
+
+
+def _columns(bench: ModelBench, results: list[MethodResult]) -> list[tuple[str, int, Callable[[MethodResult], str]]]:
+    """The columns after solved that some result fills: ``(header, width, cell)``."""
+    sec = bench.secondary[:4]
+    candidates = [
+        (any(r.reached is not None for r in results), [
+            ("reached", 7, lambda r: "-" if r.reached is None else f"{r.reached:.1f}%")]),
+        (True, [("err med", 8, lambda r: _fmt_err(r.median_error)), ("err max", 8, lambda r: _fmt_err(r.max_error))]),
+        (any(r.median_orientation_error is not None for r in results), [
+            (sec + " med", 8, lambda r: _fmt_err(r.median_orientation_error)),
+            (sec + " max", 8, lambda r: _fmt_err(r.max_orientation_error))]),
+        (any(r.iterations_median is not None for r in results), [
+            ("iters", 5, lambda r: _optional(r.iterations_median, "g"))]),
+        (any(r.fk_evals_mean is not None for r in results), [
+            ("FK/solve", 8, lambda r: _optional(r.fk_evals_mean, ".3g"))]),
+        (True, [("time/target", 11, lambda r: _fmt_time(r.time_per_target_s))]),
+    ]
+    return [col for present, cols in candidates if present for col in cols]
+
+
 def format_table(name: str, bench: ModelBench, results: list[MethodResult]) -> str:
     """One model's table: method, targets, solved, errors, time per target, ratio to the fastest."""
     lines = [f"{name}" + (f"  (solved: {bench.tolerance})" if bench.tolerance else "")]
     has_ori = any(r.median_orientation_error is not None for r in results)
-    has_it = any(r.iterations_median is not None for r in results)
-    has_fk = any(r.fk_evals_mean is not None for r in results)
     width = max([len(r.name) for r in results] + [len(m.name) for m in bench.methods] + [6])
-    has_reach = any(r.reached is not None for r in results)
+    columns = _columns(bench, results)
     head = f"  {'method':<{width}}  {'targets':>7}  {'solved':>7}"
-    if has_reach:
-        head += f"  {'reached':>7}"
-    head += f"  {'err med':>8}  {'err max':>8}"
-    if has_ori:
-        head += f"  {bench.secondary[:4] + ' med':>8}  {bench.secondary[:4] + ' max':>8}"
-    if has_it:
-        head += f"  {'iters':>5}"
-    if has_fk:
-        head += f"  {'FK/solve':>8}"
-    head += f"  {'time/target':>11}  {'ratio':>8}"
+    head += "".join(f"  {title:>{w}}" for title, w, _ in columns) + f"  {'ratio':>8}"
     groups = list(dict.fromkeys(m.group for m in bench.methods))
     for g in groups:
         rows = [r for r in results if r.group == g]
@@ -289,16 +301,7 @@ def format_table(name: str, bench: ModelBench, results: list[MethodResult]) -> s
         lines.append(head)
         for r in rows:
             line = f"  {r.name:<{width}}  {r.targets:>7d}  {r.solved:>6.1f}%"
-            if has_reach:
-                line += f"  {'-' if r.reached is None else f'{r.reached:.1f}%':>7}"
-            line += f"  {_fmt_err(r.median_error):>8}  {_fmt_err(r.max_error):>8}"
-            if has_ori:
-                line += f"  {_fmt_err(r.median_orientation_error):>8}  {_fmt_err(r.max_orientation_error):>8}"
-            if has_it:
-                line += f"  {'-' if r.iterations_median is None else f'{r.iterations_median:g}':>5}"
-            if has_fk:
-                line += f"  {'-' if r.fk_evals_mean is None else f'{r.fk_evals_mean:.3g}':>8}"
-            line += f"  {_fmt_time(r.time_per_target_s):>11}  {r.ratio:>7.1f}x"
+            line += "".join(f"  {cell(r):>{w}}" for _, w, cell in columns) + f"  {r.ratio:>7.1f}x"
             lines.append(line)
         for m in bench.methods:
             if m.group == g and m.skip is not None:

@@ -134,6 +134,12 @@ class Robot:
     def joint_id(self, name: str) -> int:
         """Pinocchio id of joint ``name``.
 
+        Args:
+            name: a joint of the model.
+
+        Returns:
+            Its index in ``model.joints`` (the universe is 0).
+
         Raises:
             InvalidInputError: ``name`` is not a string or not a joint of the model (the message lists them).
         """
@@ -145,15 +151,35 @@ class Robot:
         return self.model.getJointId(name)
 
     def idx_q(self, name: str) -> int:
-        """Index of joint ``name``'s first coordinate in ``q``."""
+        """Index of joint ``name``'s first coordinate in ``q``.
+
+        Args:
+            name: a joint of the model.
+
+        Returns:
+            The index in a configuration vector (whose entries are rad or m, by joint type).
+        """
         return self.model.joints[self.joint_id(name)].idx_q
 
     def idx_v(self, name: str) -> int:
-        """Index of joint ``name``'s first coordinate in a velocity vector."""
+        """Index of joint ``name``'s first coordinate in a velocity vector.
+
+        Args:
+            name: a joint of the model.
+
+        Returns:
+            The index in a velocity vector (whose entries are rad/s or m/s, by joint type).
+        """
         return self.model.joints[self.joint_id(name)].idx_v
 
     def frame_id(self, name: str) -> int:
         """Pinocchio id of frame ``name``.
+
+        Args:
+            name: a frame of the model.
+
+        Returns:
+            Its index in ``model.frames``.
 
         Raises:
             InvalidInputError: ``name`` is not a string or not a frame of the model (with close matches).
@@ -181,6 +207,13 @@ class Robot:
     def configuration(self, values: Mapping[str, float] | None = None, base: np.ndarray | None = None) -> np.ndarray:
         """A configuration vector: ``base`` (default ``q0``) with the named joints set.
 
+        Args:
+            values: joint name -> value (rad or m; a vector of its ``nq`` coordinates for a multi-coordinate joint).
+            base: the configuration to start from (default :attr:`q0`).
+
+        Returns:
+            The configuration, shape ``(nq,)`` (rad, m).
+
         Raises:
             InvalidInputError: an unknown joint, a value that is not a finite number (or, for a joint of several
                 coordinates, not a vector of its ``nq`` coordinates), or ``base`` not a valid configuration.
@@ -195,8 +228,15 @@ class Robot:
             q[sl] = x
         return q
 
-    def check_q(self, q, name: str = "q") -> np.ndarray:
+    def check_q(self, q: Any, name: str = "q") -> np.ndarray:
         """``q`` as a float vector of shape ``(nq,)``, finite and real.
+
+        Args:
+            q: a configuration (array-like; rad, m).
+            name: its name in the error message.
+
+        Returns:
+            ``q`` as a float64 array of shape ``(nq,)``.
 
         Raises:
             InvalidInputError: (a ``ValueError``) a wrong shape, NaN/inf entries (named by joint), complex,
@@ -216,18 +256,31 @@ class Robot:
             )
         return arr
 
-    def frame_placement(self, q, frame: str) -> pin.SE3:
-        """World placement of ``frame`` at ``q`` (loops are not enforced)."""
+    def frame_placement(self, q: Any, frame: str) -> pin.SE3:
+        """World placement of ``frame`` at ``q`` (loops are not enforced).
+
+        Args:
+            q: a configuration, shape ``(nq,)`` (rad, m).
+            frame: a frame of the model.
+
+        Returns:
+            The frame's placement in the world frame (translation in m).
+        """
         q = self.check_q(q)
         fid = self.frame_id(frame)
         pin.framesForwardKinematics(self.model, self.data, q)
         return self.data.oMf[fid].copy()
 
-    def frame_jacobian(self, q, frame: str, reference=pin.LOCAL_WORLD_ALIGNED) -> np.ndarray:
+    def frame_jacobian(self, q: Any, frame: str, reference: Any = pin.LOCAL_WORLD_ALIGNED) -> np.ndarray:
         """6 x nv Jacobian of ``frame`` of the tree (loops are not enforced).
 
         Args:
+            q: a configuration, shape ``(nq,)`` (rad, m).
+            frame: a frame of the model.
             reference: a ``pinocchio.ReferenceFrame`` or its name (``"LOCAL"``, ``"WORLD"``, ``"LOCAL_WORLD_ALIGNED"``).
+
+        Returns:
+            ``(6, nv)``: linear rows (m per unit of velocity coordinate) then angular rows (rad per unit).
         """
         q = self.check_q(q)
         fid = self.frame_id(frame)
@@ -248,21 +301,38 @@ class Robot:
             free[j.idx_v : j.idx_v + j.nv] = False
         return free
 
-    def constraint_residual(self, q) -> np.ndarray:
-        """Stacked loop-closure residual at ``q`` (empty for open chains); units m and rad."""
+    def constraint_residual(self, q: Any) -> np.ndarray:
+        """Stacked loop-closure residual at ``q`` (empty for open chains).
+
+        Args:
+            q: a configuration, shape ``(nq,)`` (rad, m).
+
+        Returns:
+            The residuals of every loop, stacked: 3 per point loop (m), 6 per frame loop (m, then rad).
+        """
         return self._loopset.residual(self.check_q(q))
 
-    def constraint_jacobian(self, q) -> np.ndarray:
-        """Stacked loop-closure Jacobian (rows, nv) at ``q``."""
+    def constraint_jacobian(self, q: Any) -> np.ndarray:
+        """Stacked loop-closure Jacobian at ``q``.
+
+        Args:
+            q: a configuration, shape ``(nq,)`` (rad, m).
+
+        Returns:
+            ``(rows, nv)``: the derivative of :meth:`constraint_residual` per velocity coordinate.
+        """
         return self._loopset.residual_and_jacobian(self.check_q(q))[1]
 
-    def mobility(self, q, locked: Iterable[str] = (), tol: float = 1e-9) -> int:
+    def mobility(self, q: Any, locked: Iterable[str] = (), tol: float = 1e-9) -> int:
         """Degrees of freedom left at ``q``: free velocity coordinates minus the constraint rank.
 
         Args:
             q: configuration (the loops should be closed).
             locked: joints held fixed (their velocity columns are removed), a collection of names.
             tol: singular values below ``tol`` times the largest count as zero; in [0, 1).
+
+        Returns:
+            The number of independent velocities the loops leave (unitless).
 
         Raises:
             InvalidInputError: a bad ``q``, an unknown joint in ``locked``, ``tol`` outside [0, 1).

@@ -41,16 +41,15 @@ def site(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return out
 
 
-def rendered_ids(page: Path) -> set[str]:
-    """The element ids of ``page`` as headless Chromium renders it (the DOM after its scripts ran)."""
+def rendered_dom(page: Path) -> str:
+    """The DOM of ``page`` after headless Chromium ran its scripts."""
     with tempfile.TemporaryDirectory(prefix="legkin-chromium-") as profile:
         cmd = [
             str(chromium_path()), "--headless=new", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
             "--disable-component-update", "--disable-sync", "--no-first-run", f"--user-data-dir={profile}",
             "--dump-dom", page.as_uri(),
         ]
-        dom = subprocess.run(cmd, check=True, timeout=180, capture_output=True, text=True).stdout
-    return set(re.findall(r'id="([^"]+)"', dom))
+        return subprocess.run(cmd, check=True, timeout=180, capture_output=True, text=True).stdout
 
 
 def documented_modules(page: Path) -> list[str]:
@@ -68,7 +67,10 @@ def test_every_mechanism_has_an_api_page() -> None:
 
 @pytest.mark.parametrize("page", PAGES, ids=lambda p: p.stem)
 def test_api_page_lists_its_functions(site: Path, page: Path) -> None:
-    ids = rendered_ids(site / "reference" / page.stem / "index.html")
+    dom = rendered_dom(site / "reference" / page.stem / "index.html")
+    ids = set(re.findall(r'id="([^"]+)"', dom))
+    role = re.search(r":(func|meth|mod|class|data|attr|exc):", dom)
+    assert role is None, f"{page.name}: a Sphinx role is shown as text: {dom[role.start() - 60:role.end() + 60]!r}"
     modules = documented_modules(page)
     assert modules, f"{page} documents no module"
     for name in modules:

@@ -6,8 +6,6 @@ InvalidInputError, hence a ValueError) naming the option and the value given.
 
 from __future__ import annotations
 
-import warnings
-from dataclasses import replace
 from typing import Final
 
 import numpy as np
@@ -25,16 +23,6 @@ ST_SINGULAR: Final = 5  # N singular / reach boundary
 
 #: Scalar types a single-call fast path passes straight to a kernel (anything else takes the checked path).
 SCALARS = (float, np.float64)
-
-
-class Unset:
-    """The type of :data:`UNSET`, the default of a deprecated keyword (tells "not given" from any value)."""
-
-    def __repr__(self) -> str:
-        return "UNSET"
-
-
-UNSET: Final = Unset()
 
 
 def flat(a: np.ndarray) -> np.ndarray:
@@ -133,8 +121,8 @@ def fast_geometry(geometry: object) -> Geometry | None:
     return None
 
 
-def resolve(geometry: object, starting_value: object = UNSET, *, universal: str = "") -> Geometry:
-    """The checked geometry of a call, with the deprecated ``starting_value=`` keyword mapped onto it.
+def resolve(geometry: object, *, universal: str = "") -> Geometry:
+    """The checked geometry of a call (None: the default).
 
     ``universal``: the function's name when it needs the universal centre (refuses ``center="spherical"``).
     """
@@ -144,10 +132,6 @@ def resolve(geometry: object, starting_value: object = UNSET, *, universal: str 
         g = geometry
     else:
         raise InvalidArgumentError(f"geometry must be a legkin.hybrid_leg.Geometry or None, got {geometry!r}")
-    if starting_value is not UNSET:
-        warnings.warn("the starting_value= keyword is deprecated; pass geometry=Geometry(starting_value=...)",
-                      DeprecationWarning, stacklevel=3)
-        g = replace(g, starting_value=starting_value)  # type: ignore[arg-type]
     if universal and g.center != "universal":
         raise InvalidArgumentError(
             f"{universal} needs the universal centre (geometry.center='universal'), got center={g.center!r}: with the "
@@ -155,11 +139,6 @@ def resolve(geometry: object, starting_value: object = UNSET, *, universal: str 
             "motors do not fix the platform"
         )
     return g
-
-
-def deprecated(old: str, new: str) -> None:
-    """Warn that ``old`` is deprecated in favour of ``new`` (at the caller's caller)."""
-    warnings.warn(f"{old} is deprecated; use {new}", DeprecationWarning, stacklevel=3)
 
 
 def unreachable(what: str, k: np.ndarray) -> UnreachableError:

@@ -18,11 +18,8 @@ from ._options import (
     ST_BAND,
     ST_INPUT,
     ST_SINGULAR,
-    UNSET,
-    Unset,
     check_assembly,
     check_branch,
-    deprecated,
     fast_branch,
     fast_geometry,
     fast_sign,
@@ -35,7 +32,7 @@ from .extension import ll_k
 from .forward import fk_failure, fk_select_k
 from .geometry import FK_GAIN_MAX, FOOT_X, RATIO, Geometry
 
-__all__ = ["foot_position_from_platform", "fk", "jacobian", "foot_position", "foot_jacobian"]
+__all__ = ["foot_position_from_platform", "fk", "jacobian"]
 
 Branch = Sequence[int]
 
@@ -328,27 +325,3 @@ def _checked_motors(q: ArrayLike, branch: Branch, assembly: int, geometry: Geome
     s = check_assembly(assembly)
     flag(return_mask, "return_mask")
     return g, qq, b, s, qq.shape[:-1], np.ascontiguousarray(qq.reshape(-1, 3))
-
-
-def _stack(theta1: ArrayLike, theta2: ArrayLike, theta0: ArrayLike) -> np.ndarray:
-    return np.stack(as_angles(theta1, theta2, theta0, names=("theta1", "theta2", "theta0")), -1)
-
-
-def foot_position(theta1: ArrayLike, theta2: ArrayLike, theta0: ArrayLike, *, starting_value: float | Unset = UNSET,
-                  branch: Branch = (1, 1), assembly: int = 1, geometry: Geometry | None = None,
-                  return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
-    """Deprecated: ``fk(np.stack([theta1, theta2, theta0], -1), ...)`` (``starting_value`` -> ``geometry``)."""
-    deprecated("foot_position(theta1, theta2, theta0)", "fk(q) with q = (theta1, theta2, theta0)")
-    g = resolve(geometry, starting_value)
-    return fk(_stack(theta1, theta2, theta0), branch=branch, assembly=assembly, geometry=g,  # type: ignore[call-overload]
-              return_mask=return_mask)
-
-
-def foot_jacobian(theta1: ArrayLike, theta2: ArrayLike, theta0: ArrayLike, *, starting_value: float | Unset = UNSET,
-                  branch: Branch = (1, 1), assembly: int = 1, geometry: Geometry | None = None,
-                  return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
-    """Deprecated: ``jacobian(np.stack([theta1, theta2, theta0], -1), ...)`` (``starting_value`` -> ``geometry``)."""
-    deprecated("foot_jacobian(theta1, theta2, theta0)", "jacobian(q) with q = (theta1, theta2, theta0)")
-    g = resolve(geometry, starting_value)
-    return jacobian(_stack(theta1, theta2, theta0), branch=branch, assembly=assembly,  # type: ignore[call-overload]
-                    geometry=g, return_mask=return_mask)

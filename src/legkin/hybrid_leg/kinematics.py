@@ -24,10 +24,9 @@ boolean mask of successes.
 
 from __future__ import annotations
 
-from ..errors import InvalidArgumentError
 from .extension import extension_motor_angle, ll_angle
-from .foot import fk, foot_jacobian, foot_position, foot_position_from_platform, jacobian
-from .foot_inverse import FootIKSolutions, foot_ik, foot_ik_solutions, foot_platform_ik, ik, ik_all
+from .foot import fk, foot_position_from_platform, jacobian
+from .foot_inverse import FootIKSolutions, foot_platform_ik, ik, ik_all, ik_branches
 from .forward import PlatformPoses, platform_orientation, platform_poses
 from .geometry import (
     ARC_RADIUS,
@@ -64,7 +63,7 @@ from .rotation import motor_angles_from_rotation, sphere_joint_angles, spherical
 
 __all__ = [
     # the API of docs/api.md
-    "Geometry", "fk", "ik", "ik_all", "jacobian", "FootIKSolutions",
+    "Geometry", "fk", "ik", "ik_all", "jacobian", "ik_branches", "FootIKSolutions",
     # the closed sub-chain, the extension joint, the foot
     "ll_angle", "extension_motor_angle", "platform_rotation", "rod_spans", "motor_angles",
     "motor_angles_from_rotation", "motor_jacobian", "sphere_joint_angles", "spherical_free_axis", "assembly_mode",
@@ -74,6 +73,4 @@ __all__ = [
     "ARC_RADIUS", "RATIO", "MOTOR_BRANCHES", "FOOT_IK_BRANCHES", "LL_DELTA", "K_TOL", "IK_K_TOL", "CLIP_FOOT_TOL",
     "BOUNDARY_TOL", "LL_TOL", "RHO_TOL", "PLATFORM_LIMIT", "LL_LIMIT", "MOTOR_LIMIT", "FK_GAIN_MAX", "PITCH_SPLIT",
     "FOOT_IK_ORDER",
-    # deprecated aliases (legkin 0.1 names, kept for one release; they warn)
-    "foot_position", "foot_jacobian", "foot_ik", "foot_ik_solutions", "InvalidArgumentError",
 ]

@@ -10,7 +10,7 @@ from typing import Any, Literal, Sequence, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_angles, as_input, check_integer, check_number
+from .._batch import as_input, check_integer, check_number
 from .._kernels import OK
 from ..errors import AssemblyModeError, ConvergenceError, SingularityError, UnreachableError
 from ._common import (
@@ -21,24 +21,19 @@ from ._common import (
     MODES,
     ST_GAIN,
     ST_LEFT,
-    ST_NONFINITE,
     ST_NOT_CONVERGED,
     ST_OUTSIDE,
     ST_SINGULAR_PLANES,
     checked_mode,
-    deprecated,
     flag,
     geometry_of,
     modes_sel,
-    split_legacy,
 )
 from .forward_kernels import FK_LOOP, _k_fk, _k_initial_guess
 from .geometry import Geometry
 from .inverse import ik_one, ik_single_error
 
 __all__ = ["fk", "FKInfo"]
-
-_GEOMETRY_KW = ("d", "alpha", "eta")
 
 
 @dataclass(frozen=True)
@@ -126,8 +121,8 @@ def _fk_error(qs: Sequence[float], out: np.ndarray, status: int, mode: str, othe
     )
 
 
-def _single(qs: tuple[float, float, float], g: Geometry, mode: str, tol: float, max_iter: int, max_inc: float,
-            bad: Any) -> tuple[np.ndarray, np.ndarray]:
+def _single(qs: tuple[float, float, float], g: Geometry, mode: str, tol: float, max_iter: int,
+            max_inc: float) -> tuple[np.ndarray, np.ndarray]:
     """A single fk call: (out (3,) or (16, 3) for mode "all", ok); a legkin error on failure."""
     G = g._vector
     if mode == "all":
@@ -135,8 +130,6 @@ def _single(qs: tuple[float, float, float], g: Geometry, mode: str, tol: float, 
         first: tuple[np.ndarray, int] | None = None
         for j, m in enumerate(MODES):
             out, st = _fk_one(*qs, G, m, tol, max_iter, max_inc)
-            if st == ST_NONFINITE:
-                bad()
             first = first or (out, st)
             if st == OK:
                 outs[j], ok[j] = out, True
@@ -146,8 +139,6 @@ def _single(qs: tuple[float, float, float], g: Geometry, mode: str, tol: float, 
         return outs, ok
     out, st = _fk_one(*qs, G, mode, tol, max_iter, max_inc)
     if st != OK:
-        if st == ST_NONFINITE:
-            bad()
         others = []
         if st != ST_SINGULAR_PLANES:  # consistent motors fit the mode their planes' intersection E points to
             likely = _motor_mode(np.array(qs), g)
@@ -216,13 +207,9 @@ def fk(q: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ..., tol: f
 def fk(q: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ..., tol: float = ..., max_iter: int = ...,
        max_inconsistency: float = ..., return_mask: Literal[True],
        return_info: Literal[True]) -> tuple[np.ndarray, np.ndarray, FKInfo]: ...
-@overload
-def fk(q_A1: ArrayLike, q_B1: ArrayLike, q_C1: ArrayLike, d: float = ..., alpha: float = ...,
-       eta: Sequence[float] | None = ..., /, *, mode: str = ..., tol: float = ..., max_iter: int = ...,
-       max_inconsistency: float = ..., return_mask: bool = ...) -> Any: ...
-def fk(q: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | None = None, tol: float = 1e-13,
-       max_iter: int = 30, max_inconsistency: float = 1e-9, return_mask: bool = False, return_info: bool = False,
-       **legacy: Any) -> Any:
+def fk(q: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | None = None, tol: float = 1e-13,
+       max_iter: int = 30, max_inconsistency: float = 1e-9, return_mask: bool = False,
+       return_info: bool = False) -> Any:
     """Platform orientation (alpha_y, alpha_z) from the motor angles ``q = (q_A1, q_B1, q_C1)``: Gauss-Newton on
     :func:`ik` with :func:`jacobian`.
 
@@ -271,56 +258,20 @@ def fk(q: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | Non
         ConvergenceError: (single) no convergence within ``max_iter``.
         InvalidInputError: non-finite, complex or wrongly shaped motors; InvalidParameterError: bad geometry,
             mode, tol, max_iter, max_inconsistency, return_mask or return_info.
-
-    Deprecated form (legkin 0.1, one release): ``fk(q_A1, q_B1, q_C1, d, alpha, eta, *, mode, tol, max_iter,
-    max_inconsistency, return_mask)`` returns ``(alpha_y, alpha_z, inconsistency[, mask])``.
     """
     mode, tol, max_iter, max_inc = _options(mode, tol, max_iter, max_inconsistency)
     return_mask = flag(return_mask, "return_mask")
     return_info = flag(return_info, "return_info")
-    if geometry is None and not args and not legacy and type(q) is np.ndarray and q.shape == (3,) and \
-            q.dtype == np.float64 and mode != "all" and not return_mask and not return_info:  # single-call fast path
+    if geometry is None and type(q) is np.ndarray and q.shape == (3,) and q.dtype == np.float64 and \
+            mode != "all" and not return_mask and not return_info:  # single-call fast path
         out, st = _fk_one(float(q[0]), float(q[1]), float(q[2]), geometry_of(None)._vector, mode, tol, max_iter,
                           max_inc)
         if st == OK:
             return out[:2].copy()
-    if len(args) >= 2:
-        return _legacy_fk(q, args, legacy, geometry, mode, tol, max_iter, max_inc, return_mask)
-    if args:
-        raise TypeError("fk() takes the motors as one array q (..., 3), or (deprecated) q_A1, q_B1, q_C1")
-    geo = split_legacy(legacy, "fk", _GEOMETRY_KW) if legacy else legacy
-    g = geometry_of(geometry, geo, "fk") if geo else geometry_of(geometry)
+    g = geometry_of(geometry)
     qm = as_input(q, "q", (3,))
     if qm.ndim == 1:
-        out, ok = _single((float(qm[0]), float(qm[1]), float(qm[2])), g, mode, tol, max_iter, max_inc, None)
+        out, ok = _single((float(qm[0]), float(qm[1]), float(qm[2])), g, mode, tol, max_iter, max_inc)
     else:
         out, ok = _batch(qm, g, mode, tol, max_iter, max_inc)
     return _finish(out, ok, return_mask, return_info)
-
-
-def _legacy_fk(q_A1: Any, args: tuple[Any, ...], legacy: dict[str, Any], geometry: Geometry | None, mode: str,
-               tol: float, max_iter: int, max_inc: float, return_mask: bool) -> Any:
-    """The deprecated ``fk(q_A1, q_B1, q_C1, d, alpha, eta, ...)``: ``(alpha_y, alpha_z, inconsistency[, mask])``."""
-    deprecated("fk(q_A1, q_B1, q_C1, d, alpha, eta)", "fk(q, geometry=...) with q (..., 3)")
-    if len(args) > 5:
-        raise TypeError("fk() takes at most 6 positional arguments in its deprecated form")
-    geo = {**dict(zip(_GEOMETRY_KW, args[2:])), **split_legacy(legacy, "fk", _GEOMETRY_KW)}
-    g = geometry_of(geometry, geo, "fk") if geo else geometry_of(geometry)
-    raw = (q_A1, args[0], args[1])
-
-    def bad() -> None:
-        as_angles(*raw, names=("q_A1", "q_B1", "q_C1"))
-
-    if all(type(v) is float for v in raw):
-        out, ok = _single(raw, g, mode, tol, max_iter, max_inc, bad)
-    else:
-        a, b, c = as_angles(*raw, names=("q_A1", "q_B1", "q_C1"))
-        if a.ndim:
-            out, ok = _batch(np.stack([a, b, c], axis=-1), g, mode, tol, max_iter, max_inc)
-        else:
-            out, ok = _single((float(a), float(b), float(c)), g, mode, tol, max_iter, max_inc, bad)
-    if out.ndim == 1:
-        res = tuple(np.float64(v) for v in out)
-    else:
-        res = tuple(np.ascontiguousarray(out[..., k]) for k in range(3))
-    return (*res, ok) if return_mask else res

@@ -3,12 +3,12 @@ public wrappers over the kernels of :mod:`legkin.tripod.closure`, and the diagno
 
 from __future__ import annotations
 
-from typing import Any, Literal, Sequence, overload
+from typing import Any, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_angles, as_input
+from .._batch import as_input
 from .._kernels import OK
 from ..errors import SingularityError, UnreachableError
 from ._common import (
@@ -22,18 +22,15 @@ from ._common import (
     SINGULAR_TOL,
     ST_NONFINITE,
     checked_mode,
-    deprecated,
     flag,
     geometry_of,
     modes_sel,
-    split_legacy,
 )
 from .closure import IK_ALL_LOOP, IK_LOOP, JACOBIAN_LOOP, _k_actuation_jacobian, _k_ik, _k_ik_all
 from .geometry import DEFAULT, Geometry
 
-__all__ = ["ik", "ik_all", "ik_joints", "jacobian", "actuation_jacobian"]
+__all__ = ["ik", "ik_all", "ik_joints", "jacobian"]
 
-_GEOMETRY_KW = ("d", "alpha", "eta")
 _G_DEFAULT = DEFAULT._vector
 _F64 = np.dtype(np.float64)  # the fast paths test ``dtype is _F64`` (3x cheaper than ``== np.float64``)
 
@@ -189,28 +186,9 @@ def _nonfinite_target(target: ArrayLike) -> Any:
     return lambda: as_input(target, "target", (2,))
 
 
-def _legacy_call(fn: str, target: ArrayLike, args: tuple[Any, ...], legacy: dict[str, Any],
-                 geometry: Geometry | None) -> tuple[Any, Any, bool, Geometry, Any]:
-    """The deprecated ``fn(alpha_y, alpha_z, d, alpha, eta, ...)``: (alpha_y, alpha_z, scalar, geometry, bad_input)."""
-    deprecated(f"{fn}(alpha_y, alpha_z, d, alpha, eta)", f"{fn}(target, geometry=...) with target (..., 2)")
-    if len(args) > 4:
-        raise TypeError(f"{fn}() takes at most 5 positional arguments in its deprecated form")
-    alpha_z = args[0] if args else legacy.pop("alpha_z")
-    geo = {**dict(zip(_GEOMETRY_KW, args[1:])), **split_legacy(legacy, fn, _GEOMETRY_KW)}
-    g = geometry_of(geometry, geo, fn) if geo else geometry_of(geometry)
-    raw = (target, alpha_z)
-    if type(target) is float and type(alpha_z) is float:
-        return target, alpha_z, True, g, lambda: as_angles(*raw, names=("alpha_y", "alpha_z"))
-    ay, az = as_angles(target, alpha_z, names=("alpha_y", "alpha_z"))
-    if ay.ndim:
-        return ay, az, False, g, None
-    return float(ay), float(az), True, g, None
-
-
-def _new_call(fn: str, target: ArrayLike, legacy: dict[str, Any],
-              geometry: Geometry | None) -> tuple[Any, Any, bool, Geometry, Any]:
-    geo = split_legacy(legacy, fn, _GEOMETRY_KW) if legacy else legacy
-    g = geometry_of(geometry, geo, fn) if geo else geometry_of(geometry)
+def _call(target: ArrayLike, geometry: Geometry | None) -> tuple[Any, Any, bool, Geometry, Any]:
+    """(alpha_y, alpha_z, scalar, geometry, bad_input) of a checked call."""
+    g = geometry_of(geometry)
     ay, az, scalar = _target(target)
     return ay, az, scalar, g, _nonfinite_target(target)
 
@@ -222,11 +200,8 @@ def ik(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
 @overload
 def ik(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
        return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
-@overload
-def ik(alpha_y: ArrayLike, alpha_z: ArrayLike, d: float = ..., alpha: float = ..., eta: Sequence[float] | None = ...,
-       /, *, mode: str = ..., return_mask: bool = ...) -> Any: ...
-def ik(target: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | None = None,
-       return_mask: bool = False, **legacy: Any) -> Any:
+def ik(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | None = None,
+       return_mask: bool = False) -> Any:
     """The three motor angles (q_A1, q_B1, q_C1) for the platform orientation ``target = (alpha_y, alpha_z)``.
 
     Seed eqs (98), (102) per leg K (``c_K = cos eta_K``, ``s_K = sin eta_K``), with E = (x, y, z) from
@@ -261,12 +236,9 @@ def ik(target: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry 
             ``|A_u|_F > GAIN_GUARD``.
         InvalidInputError: non-finite, complex or wrongly shaped target; InvalidParameterError: bad geometry,
             mode or return_mask.
-
-    Deprecated form (legkin 0.1, one release): ``ik(alpha_y, alpha_z, d, alpha, eta, *, mode, return_mask)``
-    returns every joint (..., 12), as :func:`ik_joints` does.
     """
-    if type(target) is np.ndarray and target.dtype is _F64 and target.shape == (2,) and not args and \
-            not legacy and type(mode) is str and (return_mask is False or return_mask is True):
+    if type(target) is np.ndarray and target.dtype is _F64 and target.shape == (2,) and \
+            type(mode) is str and (return_mask is False or return_mask is True):
         G = _fast_g(geometry)  # the single-call fast path: straight to the kernel, the motors only
         args_m = MODE_ARGS.get(mode)
         if G is not None and args_m is not None:
@@ -275,10 +247,7 @@ def ik(target: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry 
                 return (out, np.asarray(True)) if return_mask else out
     mode = checked_mode(mode, allow_all=True)
     return_mask = flag(return_mask, "return_mask")
-    if args or "alpha_z" in legacy:
-        ay, az, scalar, g, bad = _legacy_call("ik", target, args, legacy, geometry)
-        return _solve(ay, az, scalar, g, mode, return_mask, True, bad)
-    ay, az, scalar, g, bad = _new_call("ik", target, legacy, geometry)
+    ay, az, scalar, g, bad = _call(target, geometry)
     return _solve(ay, az, scalar, g, mode, return_mask, False, bad)
 
 
@@ -302,7 +271,7 @@ def ik_all(target: ArrayLike, *, geometry: Geometry | None = None, return_mask: 
             if _k_ik_all(target[0], target[1], G, q, ok) == OK:
                 return (q, ok) if return_mask else q
     return_mask = flag(return_mask, "return_mask")
-    ay, az, scalar, g, bad = _new_call("ik_all", target, {}, geometry)
+    ay, az, scalar, g, bad = _call(target, geometry)
     return _all_modes(ay, az, scalar, g._vector, return_mask, False, bad)
 
 
@@ -327,7 +296,7 @@ def ik_joints(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | 
                 return (q, np.asarray(True)) if return_mask else q
     mode = checked_mode(mode, allow_all=True)
     return_mask = flag(return_mask, "return_mask")
-    ay, az, scalar, g, bad = _new_call("ik_joints", target, {}, geometry)
+    ay, az, scalar, g, bad = _call(target, geometry)
     return _solve(ay, az, scalar, g, mode, return_mask, True, bad)
 
 
@@ -388,21 +357,5 @@ def jacobian(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | N
                 return (a, np.asarray(True)) if return_mask else a
     mode = checked_mode(mode)
     return_mask = flag(return_mask, "return_mask")
-    ay, az, scalar, g, bad = _new_call("jacobian", target, {}, geometry)
+    ay, az, scalar, g, bad = _call(target, geometry)
     return _jacobian(ay, az, scalar, g, mode, return_mask, bad)
-
-
-def actuation_jacobian(target: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | None = None,
-                       return_mask: bool = False, **legacy: Any) -> Any:
-    """Deprecated alias of :func:`jacobian` (legkin 0.1, kept for one release); also in its old form
-    ``actuation_jacobian(alpha_y, alpha_z, d, alpha, eta, *, mode, return_mask)``."""
-    deprecated("actuation_jacobian", "jacobian", stacklevel=3)
-    mode = checked_mode(mode)
-    return_mask = flag(return_mask, "return_mask")
-    if args or "alpha_z" in legacy:
-        ay, az, scalar, g, bad = _legacy_call("actuation_jacobian", target, args, legacy, geometry)
-    else:
-        ay, az, scalar, g, bad = _new_call("actuation_jacobian", target, legacy, geometry)
-    return _jacobian(ay, az, scalar, g, mode, return_mask, bad)
-
-

@@ -211,8 +211,7 @@ def orientation_from_axis(axis: ArrayLike, *, geometry: Geometry | None = None) 
     return out[:, 0].reshape(shape), out[:, 1].reshape(shape)
 
 
-def platform_position(alpha_y: ArrayLike, alpha_z: ArrayLike, *args: float, geometry: Geometry | None = None,
-                      **legacy: float) -> np.ndarray:
+def platform_position(alpha_y: ArrayLike, alpha_z: ArrayLike, *, geometry: Geometry | None = None) -> np.ndarray:
     """Platform centre E for the orientation (alpha_y, alpha_z), from Appendix B (eqs 64a-64d), shape (..., 3).
 
     Derivation. With ``r = R e_x = (c_z c_y, s_z c_y, -s_y)`` and ``b = e_x + r = (1 + c_y c_z, s_z c_y, -s_y)``,
@@ -229,19 +228,14 @@ def platform_position(alpha_y: ArrayLike, alpha_z: ArrayLike, *args: float, geom
         ``L = d sqrt(2 (1 - c_alpha))`` (eq 18).
 
     Checked against Pinocchio's platform frame at configurations from :func:`ik` (``legkin check tripod``).
-    Undefined on ``1 + c_y c_z = 0`` (NaN there). ``d``, ``alpha`` (positional or keyword) are deprecated:
-    pass ``geometry=``.
+    Undefined on ``1 + c_y c_z = 0`` (NaN there).
+
+    Args:
+        alpha_y, alpha_z: platform orientation angles (rad), broadcast together.
+        geometry: the tripod's :class:`Geometry` (None: the default).
+
+    Returns:
+        (..., 3) platform centres E (m).
     """
-    if args or legacy:
-        if len(args) > 2:
-            raise TypeError(f"platform_position() takes at most 4 positional arguments ({2 + len(args)} given)")
-        legacy = {**dict(zip(("d", "alpha"), args)), **_split_kw(legacy)}
-    g = geometry_of(geometry, legacy, "platform_position", stacklevel=3)
+    g = geometry_of(geometry)
     return _uv_closed(2, alpha_y, alpha_z, (3,), g._vector)
-
-
-def _split_kw(kw: dict[str, float]) -> dict[str, float]:
-    bad = set(kw) - {"d", "alpha"}
-    if bad:
-        raise TypeError(f"platform_position() got unexpected keyword argument(s) {', '.join(map(repr, sorted(bad)))}")
-    return kw

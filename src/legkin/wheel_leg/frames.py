@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import inspect
 import math
-import warnings
 from functools import lru_cache
 from typing import Literal, NamedTuple, overload
 
@@ -14,7 +12,7 @@ from numpy.typing import ArrayLike
 from .._batch import as_input, check_choice, check_flag, check_number, finish
 from .._kernels import OK, as_items, as_rows, batch_kernel, kernel
 from ..errors import InvalidInputError
-from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, legacy_geometry, rim_name
+from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, rim_name
 from .geometry import _DEFAULT_GEOMETRY, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry, _leg
 from .linkage import _Const, _constants, _kconst
 from .rim import _k_plane, _k_select, _Sel, _select
@@ -30,29 +28,22 @@ _R_0 = {  # columns: x_M, y_M, z_M in {R} at gamma = 0
 }
 
 
-def module_origin(leg: Leg, *args: Geometry | None, geometry: Geometry | None = None) -> np.ndarray:
+def module_origin(leg: Leg, *, geometry: Geometry | None = None) -> np.ndarray:
     """Origin of the module frame {M_i} in {R}: (+-L_body/2, +-W_body/2, d_abad) (a new array).
 
-    legkin 0.1's positional geometry, ``module_origin(leg, geo)``, still works for one release
-    (DeprecationWarning).
+    Args:
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (3,) the origin (m).
     """
-    if args:
-        geometry = legacy_geometry(  # type: ignore[assignment]
-            "module_origin", ("geometry",), args, {}, geometry, positional_geometry=True)
     geo = _geometry(geometry)
     try:
         return _origin(leg, geo).copy()
     except TypeError:  # unhashable: let _leg name it
         _leg(leg)
         raise
-
-
-def _module_origin_signature(leg: Leg, *, geometry: Geometry | None = None) -> np.ndarray:
-    raise NotImplementedError  # a signature only
-
-
-# help() and inspect show today's call form (the function also takes legkin 0.1's positional geometry)
-module_origin.__signature__ = inspect.signature(_module_origin_signature)  # type: ignore[attr-defined]
 
 
 @lru_cache(maxsize=64)
@@ -313,22 +304,6 @@ def jacobian(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0
     ``R0 Rz(gamma) (e_z x p_M)``. Arguments as :func:`fk`.
     """
     return _contact_call(q, alpha, w, leg, rim_name(rim), radius, geometry, True, return_mask)
-
-
-def contact_point(q: ArrayLike, alpha: ArrayLike, w: ArrayLike, leg: Leg, *, rim: str = "continuous",
-                  radius: float | None = None, geometry: Geometry | None = None) -> np.ndarray:
-    """Deprecated (legkin 0.1): ``fk(q, leg, alpha=alpha, w=w, ...)``."""
-    warnings.warn("contact_point(q, alpha, w, leg) is deprecated; use fk(q, leg, alpha=alpha, w=w)",
-                  DeprecationWarning, stacklevel=2)
-    return _contact_call(q, alpha, w, leg, rim_name(rim, 3), radius, geometry, False)
-
-
-def contact_jacobian(q: ArrayLike, alpha: ArrayLike, w: ArrayLike, leg: Leg, *, rim: str = "continuous",
-                     radius: float | None = None, geometry: Geometry | None = None) -> np.ndarray:
-    """Deprecated (legkin 0.1): ``jacobian(q, leg, alpha=alpha, w=w, ...)``."""
-    warnings.warn("contact_jacobian(q, alpha, w, leg) is deprecated; use jacobian(q, leg, alpha=alpha, w=w)",
-                  DeprecationWarning, stacklevel=2)
-    return _contact_call(q, alpha, w, leg, rim_name(rim, 3), radius, geometry, True)
 
 
 #: Kernel status codes (besides :data:`OK`): NaN/inf input or result, theta / alpha / w out of range.

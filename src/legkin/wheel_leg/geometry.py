@@ -21,11 +21,6 @@ PSI_FG = math.radians(40.0)
 #: (radius R) offset by it; it is the foot radius minus the pitch radius of the seed's rim formula
 #: (0.02225 + 0.01225 m: R + 0.0345 = 0.1345 m) and the outer radius of the rim meshes (R + TYRE_THICKNESS).
 TYRE_THICKNESS = 0.0345
-#: Deprecated alias of :data:`TYRE_THICKNESS` (the seed's foot radius minus the pitch radius); kept for one release.
-FOOT_OFFSET = TYRE_THICKNESS
-#: Deprecated alias of :data:`TYRE_THICKNESS` (was 0.035, the visual rim's outer radius minus R, before the rim
-#: meshes took the tyre thickness); kept for one release.
-TYRE_OFFSET = TYRE_THICKNESS
 
 _ARC_HF = math.radians(130.0)
 _ARC_BC = math.radians(101.0)

@@ -13,7 +13,7 @@ import pytest
 
 import legkin
 from legkin._contract import Case, Contract
-from legkin.errors import InvalidInputError, LegkinError
+from legkin.errors import AssemblyModeError, InvalidInputError, JointLimitError, LegkinError, UnreachableError
 
 N = 200  # joint samples per case (the check rows and the 10^6-target robustness rows do the volume)
 
@@ -105,8 +105,26 @@ def test_unreachable_targets_give_nan_and_mask(model, case):
     assert ok[: len(x)].all() and not ok[len(x) :].any()
     assert np.isnan(q[len(x) :]).all() and np.isfinite(q[: len(x)]).all()
     for target in bad:
-        with pytest.raises(LegkinError):
+        with pytest.raises(LegkinError) as info:
             case.ik(target)
+        _check_error_data(info.value, target)
+
+
+def _check_error_data(exc: LegkinError, target: np.ndarray) -> None:
+    """The data an IK error carries (legkin.errors): the target asked for, a distance >= 0 (or NaN: unknown), a
+    closest point of the target's shape; a joint limit names the joint, its limits, and a value outside them."""
+    if isinstance(exc, UnreachableError):
+        assert exc.target is not None, f"{type(exc).__name__} without .target: {exc}"
+        np.testing.assert_array_equal(np.asarray(exc.target, dtype=float), target)
+        assert np.isnan(exc.distance) or exc.distance >= 0.0, exc.distance
+        if exc.closest is not None:
+            assert np.shape(exc.closest) == target.shape
+    if isinstance(exc, JointLimitError):
+        assert isinstance(exc.joint, str) and exc.joint, exc
+        assert exc.lower <= exc.upper, exc
+        assert np.isnan(exc.value) or not exc.lower <= exc.value <= exc.upper, exc
+    if isinstance(exc, AssemblyModeError):
+        assert isinstance(exc.modes, list)
 
 
 def _bad_arrays(n: int) -> dict:

@@ -8,8 +8,9 @@ leading dimensions) returns arrays with NaN where an item fails, and with
 
 from __future__ import annotations
 
+import math
 import numbers
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
@@ -17,6 +18,7 @@ from .errors import InvalidArgumentError, InvalidInputError
 
 __all__ = [
     "as_input",
+    "dispatch",
     "as_angles",
     "finish",
     "real_number",
@@ -24,6 +26,8 @@ __all__ = [
     "check_integer",
     "check_flag",
     "check_choice",
+    "interval_text",
+    "outside",
 ]
 
 
@@ -63,6 +67,72 @@ def as_angles(*xs, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
         raise InvalidInputError(f"inputs do not broadcast together: {shapes}") from exc
     # writeable arrays (a copy where one is broadcast): numba types read-only arrays apart (a second compilation)
     return tuple(a if a.shape == shape else np.broadcast_to(a, shape).copy() for a in arrs)
+
+
+#: The float64 dtype: the fast path tests ``x.dtype is F64`` (3x cheaper than ``== np.float64``).
+F64 = np.dtype(np.float64)
+_TRUE = np.asarray(True)
+_TRUE.setflags(write=False)
+
+
+def dispatch(
+    x: object,
+    name: str,
+    core: tuple[int, ...],
+    fast: Callable[..., Any],
+    batch: Callable[..., tuple[np.ndarray, np.ndarray]],
+    error: Callable[..., Exception],
+    args: tuple[Any, ...],
+    return_mask: bool,
+) -> Any:
+    """The single/batch rule of a kinematic function of one array argument, written once.
+
+    Three paths, in this order:
+
+    1. **fast**: ``x`` is a float64 ndarray of exactly the ``core`` shape: ``fast(x, *args)`` (the kernel on that
+       item) returns the result, or None when the item is not solved (then path 2 decides, and raises);
+    2. **single call**: any other single input (a list, ints, NaN...) is checked by :func:`as_input` (which raises
+       :class:`~legkin.errors.InvalidInputError`) and run through ``batch`` as one row, so that a single call equals
+       its row of a batch bit for bit; if the row is not solved, ``error(item, out, ok, *args)`` is raised;
+    3. **batch**: leading dimensions: ``batch(rows, *args)`` on the C-contiguous float64 rows ``(n, *core)``.
+
+    ``batch`` returns ``(out, ok)``, ``out`` (n, ...) NaN where not solved, ``ok`` (n,) (or (n, K) for ``ik_all``:
+    then a single item counts as solved when any of its K is). The wrapper only checks its options and binds them
+    in ``args`` (module-level callables: no closure is built on the fast path).
+
+    Args:
+        x: the input, array-like with trailing shape ``core``.
+        name: its name in error messages (``"q"``, ``"target"``).
+        core: the shape of one item, e.g. ``(3,)``.
+        fast: ``fast(item, *args) -> out | (out, ok) | None``: one float64 item straight to the kernel.
+        batch: ``batch(rows, *args) -> (out, ok)``: the compiled loop.
+        error: ``error(item, out, ok, *args) -> Exception``: why the single item ``item`` failed.
+        args: the checked options.
+        return_mask: also return the mask (True / False, already checked).
+
+    Returns:
+        ``out`` (shape ``batch shape + item shape``), or ``(out, mask)`` with ``return_mask``.
+
+    Raises:
+        InvalidInputError: ``x`` is not a finite real array of trailing shape ``core``.
+        LegkinError: ``error``'s, for a single input that is not solved.
+    """
+    if type(x) is np.ndarray and x.dtype is F64 and x.shape == core:
+        res = fast(x, *args)
+        if res is not None:
+            if type(res) is tuple:
+                return res if return_mask else res[0]
+            return (res, _TRUE) if return_mask else res
+    arr = as_input(x, name, core)
+    shape = arr.shape[: arr.ndim - len(core)]
+    rows = np.ascontiguousarray(arr.reshape((-1,) + core))
+    out, ok = batch(rows, *args)
+    if not shape:
+        if not ok[0].any():
+            raise error(arr, out[0], ok[0], *args)
+        return (out[0], np.asarray(ok[0])) if return_mask else out[0]
+    out, ok = out.reshape(shape + out.shape[1:]), ok.reshape(shape + ok.shape[1:])
+    return (out, ok) if return_mask else out
 
 
 def finish(
@@ -112,10 +182,21 @@ def real_number(value, name: str, valid) -> float:
         raise InvalidArgumentError(f"{name}={value!r} is out of range: valid range {text}") from None
 
 
-def _range_text(low, high, low_open: bool, high_open: bool) -> str:
+def interval_text(low: float | None, high: float | None, low_open: bool = False, high_open: bool = False) -> str:
+    """The interval as text, e.g. ``(0, inf)`` or ``[1, 10000]`` (None: unbounded, an open end)."""
     lo = "-inf" if low is None else f"{low:g}"
     hi = "inf" if high is None else f"{high:g}"
     return f"{'(' if low_open or low is None else '['}{lo}, {hi}{')' if high_open or high is None else ']'}"
+
+
+def outside(x: float, low: float | None, high: float | None, low_open: bool = False, high_open: bool = False) -> bool:
+    """True if ``x`` is NaN, infinite or outside the interval (the one range test of every option checker)."""
+    bad = not math.isfinite(x)
+    if low is not None:
+        bad |= x <= low if low_open else x < low
+    if high is not None:
+        bad |= x >= high if high_open else x > high
+    return bad
 
 
 def check_number(
@@ -128,7 +209,7 @@ def check_number(
         InvalidArgumentError: (a ``ValueError``) not a real number, NaN/inf, or outside the range; the
             message names the value and the range.
     """
-    rng = _range_text(low, high, low_open, high_open)
+    rng = interval_text(low, high, low_open, high_open)
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
         if not (isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf"):
             raise InvalidArgumentError(f"{name} must be a real number in {rng}, got {value!r}")
@@ -136,12 +217,7 @@ def check_number(
         v = float(value)
     except OverflowError:  # an int beyond the float range
         raise InvalidArgumentError(f"{name}={value!r} is out of range: must be a finite number in {rng}") from None
-    bad = not np.isfinite(v)
-    if low is not None:
-        bad |= v <= low if low_open else v < low
-    if high is not None:
-        bad |= v >= high if high_open else v > high
-    if bad:
+    if outside(v, low, high, low_open, high_open):
         raise InvalidArgumentError(f"{name}={v!r} is out of range: must be a finite number in {rng}")
     return v
 
@@ -149,11 +225,11 @@ def check_number(
 def check_integer(value, name: str, low: int | None = None, high: int | None = None) -> int:
     """A keyword parameter that must be an integer in ``[low, high]``."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        span = _range_text(low, high, False, False)
+        span = interval_text(low, high)
         raise InvalidArgumentError(f"{name} must be an integer in {span}, got {value!r}")
     v = int(value)
     if (low is not None and v < low) or (high is not None and v > high):
-        span = _range_text(low, high, False, False)
+        span = interval_text(low, high)
         raise InvalidArgumentError(f"{name}={v} is out of range: must be an integer in {span}")
     return v
 

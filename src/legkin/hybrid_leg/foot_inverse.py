@@ -8,7 +8,7 @@ from typing import Literal, NamedTuple, Sequence, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input, finish
+from .._batch import as_input, check_flag, dispatch, finish
 from ..errors import InvalidInputError, UnreachableError
 from ._ik_errors import arc_error, axis_error, ik_error, platform_pose
 from ._ik_kernels import (
@@ -21,11 +21,9 @@ from ._options import (
     check_assembly,
     check_branch,
     check_sign,
-    fast_branch,
     fast_geometry,
-    fast_sign,
-    flag,
     fmt,
+    mode_args,
     resolve,
 )
 from .chains import CX, CY, CZ
@@ -125,7 +123,7 @@ def foot_platform_ik(target: ArrayLike, *, ll_branch: int | None = None, roll_br
     moded = branch is not None or assembly is not None
     b = check_branch((1, 1) if branch is None else branch)
     s = check_assembly(1 if assembly is None else assembly)
-    flag(return_mask, "return_mask")
+    check_flag(return_mask, "return_mask")
     if (llb is not None or rb is not None) and not moded:
         n = len(u)
         out, info = np.empty((n, 3)), np.empty((n, 3))
@@ -182,31 +180,50 @@ def ik(target: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, ll_bran
         SingularityError: single target in the forward-singularity band, or exactly on the roll axis (where roll
             is undetermined and ik tries roll = 0 and pi) with neither roll reaching it in the mode.
     """
-    if (ll_branch is None and roll_branch is None and q_near is None and return_mask is False
-            and type(target) is np.ndarray and target.shape == (3,) and target.dtype == np.float64):
-        fb, fs, g = fast_branch(branch), fast_sign(assembly), fast_geometry(geometry)
-        if fb is not None and fs is not None and g is not None and g.center == "universal":
-            out = _one(target, g.starting_value, fb[0], fb[1], fs, False, True)
-            if out is not None:
-                return out[0]
-    g = resolve(geometry, universal="ik")
-    pp, u, shape = _targets(target)
-    llb = check_sign(ll_branch, "ll_branch", allow_none=True)
-    rb = check_sign(roll_branch, "roll_branch", allow_none=True)
-    b = check_branch(branch)
-    s = check_assembly(assembly)
-    flag(return_mask, "return_mask")
-    near = None
+    sv, b1, b2, s, return_mask = mode_args(branch, assembly, geometry, return_mask, "ik")
+    combos: Sequence[tuple[int, int]] = FOOT_IK_ORDER
+    order = _COMBOS
+    if ll_branch is not None or roll_branch is not None:
+        combos = _combos(check_sign(ll_branch, "ll_branch", allow_none=True),
+                         check_sign(roll_branch, "roll_branch", allow_none=True))
+        order = np.array(combos, dtype=np.float64).reshape(-1, 2)
+    near = _NO_NEAR
     if q_near is not None:
-        qn = as_input(q_near, "q_near", (3,))
-        try:
-            near = np.ascontiguousarray(np.broadcast_to(qn, shape + (3,)).reshape(-1, 3))
-        except ValueError:
-            raise InvalidInputError(f"q_near must broadcast to shape {shape + (3,)}, got shape {qn.shape}") from None
-    combos = _combos(llb, rb)
-    motors, _, ok = _search(u, g.starting_value, combos, b, s, near=near)
-    return finish(motors.reshape(shape + (3,)), ok.reshape(shape), pp.ndim == 1, return_mask,
-                  lambda: ik_error(pp, g.starting_value, combos, b, s))
+        target = as_input(target, "target", (3,))
+        near = _near_rows(q_near, target.shape[:-1])
+    return dispatch(target, "target", (3,), _ik_fast, _ik_batch, _ik_fail, (sv, b1, b2, s, combos, order, near),
+                    return_mask)
+
+
+def _near_rows(q_near: ArrayLike, shape: tuple[int, ...]) -> np.ndarray:
+    """``q_near`` (3,) or (..., 3) broadcast to the targets' batch shape, as rows (n, 3)."""
+    qn = as_input(q_near, "q_near", (3,))
+    try:
+        return np.ascontiguousarray(np.broadcast_to(qn, shape + (3,)).reshape(-1, 3))
+    except ValueError:
+        raise InvalidInputError(f"q_near must broadcast to shape {shape + (3,)}, got shape {qn.shape}") from None
+
+
+def _ik_fast(p: np.ndarray, sv: float, b1: float, b2: float, s: float, combos: Sequence[tuple[int, int]],
+             order: np.ndarray, near: np.ndarray) -> np.ndarray | None:
+    """One target: the batch loop :func:`foot_ik_b` on one row (its kernel then has one caller and is inlined)."""
+    out, ok = np.empty((2, 1, 3)), np.empty(1, dtype=np.bool_)
+    foot_ik_b.kernel((p - CENTER).reshape(1, 3), sv, order, b1, b2, s, False, True, near, out[0], out[1], ok)
+    return out[0, 0] if ok[0] else None
+
+
+def _ik_batch(rows: np.ndarray, sv: float, b1: float, b2: float, s: float, combos: Sequence[tuple[int, int]],
+              order: np.ndarray, near: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    n = len(rows)
+    motors, pose, ok = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.bool_)
+    nr = np.full((n, 3), np.nan) if near is _NO_NEAR else near
+    foot_ik_b(rows - CENTER, sv, order, b1, b2, s, False, True, nr, motors, pose, ok)
+    return motors, ok
+
+
+def _ik_fail(p: np.ndarray, out: np.ndarray, ok: np.ndarray, sv: float, b1: float, b2: float, s: float,
+             combos: Sequence[tuple[int, int]], order: np.ndarray, near: np.ndarray) -> Exception:
+    return ik_error(p, sv, list(combos), np.array([b1, b2]), s)
 
 
 class FootIKSolutions(NamedTuple):
@@ -285,12 +302,28 @@ def ik_all(target: ArrayLike, *, geometry: Geometry | None = None,
         SingularityError: (single) the target is on the roll axis, and no branch exists.
     """
     if return_mask is not False and return_mask is not True:
-        return_mask = flag(return_mask, "return_mask")
-    sol = ik_branches(target, geometry=geometry)
-    motors, mask = sol.motors, sol.mask
-    if motors.ndim == 2 and not bool(mask.any()):
-        raise _no_branch(np.asarray(target, dtype=float))
-    return (motors, mask) if return_mask else motors
+        return_mask = check_flag(return_mask, "return_mask")
+    g = fast_geometry(geometry)
+    if g is None or g.center != "universal":
+        g = resolve(geometry, universal="ik_all")
+    return dispatch(target, "target", (3,), _all_fast, _all_batch, _all_fail, (g.starting_value,), return_mask)
+
+
+def _all_fast(p: np.ndarray, sv: float) -> tuple[np.ndarray, np.ndarray] | None:
+    out = _all_outputs(())
+    if ik_all_out_k(p[0] - CX, p[1] - CY, p[2] - CZ, sv, *out) and out[2].any():
+        return out[0], out[2]
+    return None
+
+
+def _all_batch(rows: np.ndarray, sv: float) -> tuple[np.ndarray, np.ndarray]:
+    out = _all_outputs((len(rows),))
+    ik_all_b(rows - CENTER, sv, *out)
+    return out[0], out[2]
+
+
+def _all_fail(p: np.ndarray, out: np.ndarray, ok: np.ndarray, sv: float) -> Exception:
+    return _no_branch(p)
 
 
 def _no_branch(target: np.ndarray) -> Exception:

@@ -9,7 +9,7 @@ from typing import Literal, NamedTuple, Sequence, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_angles, as_input, finish
+from .._batch import as_angles, as_input, check_flag, check_integer, check_number, finish
 from .._kernels import OK, batch_kernel, kernel
 from .._rotations import wrap_k
 from ..errors import ConvergenceError, InvalidInputError
@@ -19,13 +19,10 @@ from ._options import (
     ST_INPUT,
     check_assembly,
     check_branch,
-    count,
     fast_branch,
     fast_sign,
-    flag,
     flat,
     mode_text,
-    real,
     resolve,
 )
 from .chains import chains_k, ref_of, rot_k, tips_k
@@ -171,8 +168,8 @@ def platform_poses(theta1: ArrayLike, theta2: ArrayLike, *, tol: float = 1e-12, 
         return PlatformPoses(x, bran, asm, np.isfinite(x[:, 0]))
     resolve(geometry, universal="platform_poses")
     t1, t2 = as_angles(theta1, theta2, names=("theta1", "theta2"))
-    tol = real(tol, "tol", 0.0, 1e-6, "rod-length residual, m")
-    max_iter = count(max_iter, "max_iter", 1, 10_000, "Newton iterations")
+    tol = check_number(tol, "tol", 0.0, 1e-6, low_open=True)
+    max_iter = check_integer(max_iter, "max_iter", 1, 10_000)
     shape = t1.shape
     n = t1.size
     x = np.empty((n, 8, 2))
@@ -261,9 +258,9 @@ def platform_orientation(
     t1, t2 = as_angles(theta1, theta2, names=("theta1", "theta2"))
     b = check_branch(branch)
     s = check_assembly(assembly)
-    tol = real(tol, "tol", 0.0, 1e-6, "rod-length residual, m")
-    max_iter = count(max_iter, "max_iter", 1, 10_000, "Newton iterations")
-    flag(return_mask, "return_mask")
+    tol = check_number(tol, "tol", 0.0, 1e-6, low_open=True)
+    max_iter = check_integer(max_iter, "max_iter", 1, 10_000)
+    check_flag(return_mask, "return_mask")
     shape = t1.shape
     n = t1.size
     x = np.empty((n, 2))

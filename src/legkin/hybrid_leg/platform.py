@@ -15,7 +15,7 @@ from typing import Literal, Sequence, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_angles, finish
+from .._batch import as_angles, check_flag, finish
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import SingularityError
 from ._options import (
@@ -24,7 +24,6 @@ from ._options import (
     ST_SINGULAR,
     check_branch,
     fast_branch,
-    flag,
     flat,
     resolve,
     unreachable,
@@ -193,7 +192,7 @@ def motor_angles(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *, 
     resolve(geometry)
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
     b = check_branch(branch)
-    flag(return_mask, "return_mask")
+    check_flag(return_mask, "return_mask")
     n = r.size
     theta, k, ok = np.empty((n, 2)), np.empty((n, 2)), np.empty(n, dtype=np.bool_)
     _motor_angles_b(flat(r), flat(p), float(b[0]), float(b[1]), theta, k, ok)
@@ -239,7 +238,7 @@ def motor_jacobian(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *
     resolve(geometry)
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
     b = check_branch(branch)
-    flag(return_mask, "return_mask")
+    check_flag(return_mask, "return_mask")
     jac, k, st, _ = _jacobian_and_mode(r, p, b)
 
     def error() -> Exception:
@@ -278,7 +277,7 @@ def assembly_mode(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *,
     resolve(geometry)
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
     b = check_branch(branch)
-    flag(return_mask, "return_mask")
+    check_flag(return_mask, "return_mask")
     _, k, st, mode = _jacobian_and_mode(r, p, b)
     return finish(mode.astype(int), st != ST_REACH, r.ndim == 0, return_mask,
                   lambda: unreachable(_pose_text(r, p), k))

@@ -14,10 +14,10 @@ from typing import Callable, Literal, Sequence, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input, finish
+from .._batch import as_input, check_flag, finish
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import InvalidInputError
-from ._options import ST_INPUT, check_branch, fast_branch, flag, resolve, unreachable
+from ._options import ST_INPUT, check_branch, fast_branch, resolve, unreachable
 from .chains import AX0, AX1, AY0, AY1, AZ0, AZ1, CX, CY, CZ, L, chains_k, is_rotation_k, rotation_error_k, tips_k
 from .geometry import BETA, K_TOL, Geometry
 
@@ -116,7 +116,7 @@ def _rotation_call(kernels: Callable[..., object], core: tuple[int, ...],
     resolve(geometry)
     rot = as_input(rotation, "rotation", (3, 3))
     b = check_branch(branch)
-    flag(return_mask, "return_mask")
+    check_flag(return_mask, "return_mask")
     shape = rot.shape[:-2]
     m = np.ascontiguousarray(rot.reshape(-1, 3, 3))
     n = len(m)

@@ -8,7 +8,7 @@ from typing import Any, Literal, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input
+from .._batch import dispatch
 from .._kernels import OK
 from ..errors import SingularityError, UnreachableError
 from ._common import (
@@ -20,7 +20,6 @@ from ._common import (
     MODE_ARGS,
     MODES,
     SINGULAR_TOL,
-    ST_NONFINITE,
     checked_mode,
     flag,
     geometry_of,
@@ -63,7 +62,7 @@ def _ik_error(ay: float, az: float, c2: np.ndarray, sing: Any, unreachable: np.n
             return UnreachableError(
                 f"{where} is outside the workspace: leg {leg} would need cos q_{leg}2 = {float(c2[k]):.17g}, "
                 "outside [-1, 1] (eq 98)",
-                target=(float(ay), float(az)),
+                target=np.array([float(ay), float(az)]),
             )
     for k, leg in enumerate(LEGS):
         if leg_sing[k]:
@@ -118,79 +117,79 @@ def _run(ay: np.ndarray, az: np.ndarray, G: np.ndarray, mode: str,
     return q.reshape(shape + (m, width)), aux.reshape(shape + (m, 6)), status.reshape(shape + (m,))
 
 
-def _fast_g(geometry: object) -> np.ndarray | None:
-    """The kernels' geometry vector for the single-call fast paths (None: not a plain geometry argument)."""
-    if geometry is None:
-        return _G_DEFAULT
-    return geometry._vector if type(geometry) is Geometry else None
+def _checked(mode: object, geometry: object, return_mask: object,
+             allow_all: bool = True) -> tuple[str, np.ndarray, bool]:
+    """(mode, the kernels' geometry vector, return_mask) of a call, checked (fast for the common values)."""
+    if not (type(mode) is str and mode in MODE_ARGS):
+        mode = checked_mode(mode, allow_all=allow_all)
+    G = _G_DEFAULT if geometry is None else geometry_of(geometry)._vector
+    if return_mask is not False and return_mask is not True:
+        return_mask = flag(return_mask, "return_mask")
+    return mode, G, return_mask  # type: ignore[return-value]
 
 
-def _all_modes(ay: Any, az: Any, scalar: bool, G: np.ndarray, return_mask: bool, joints: bool,
-               bad_input: Any) -> Any:
-    """ik in every mode (:func:`legkin.tripod.closure._k_ik_all`): (..., 16, 12) joints or (..., 16, 3) motors,
-    per the single/batch rule (a single call raises only when no mode solves the target)."""
-    w = 12 if joints else 3
-    if scalar:
-        q, ok = np.empty((16, w)), np.empty(16, dtype=np.bool_)
-        st = _k_ik_all(ay, az, G, q, ok)
-        if st != OK:
-            if st == ST_NONFINITE:
-                bad_input()
-            aux = ik_one(ay, az, G, HOME_MODE)[1]
-            raise ik_single_error(np.float64(ay), np.float64(az), G, HOME_MODE, aux)
-        return (q, ok) if return_mask else q
-    shape = ay.shape
-    y = np.ascontiguousarray(ay, dtype=np.float64).reshape(-1)
-    z = np.ascontiguousarray(az, dtype=np.float64).reshape(-1)
-    n = y.shape[0]
-    q, ok, status = np.empty((n, 16, w)), np.empty((n, 16), dtype=np.bool_), np.empty(n, dtype=np.int64)
-    IK_ALL_LOOP(y, z, G, q, ok, status)
-    q, ok = q.reshape(shape + (16, w)), ok.reshape(shape + (16,))
-    return (q, ok) if return_mask else q
+def _yz(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return np.ascontiguousarray(rows[:, 0]), np.ascontiguousarray(rows[:, 1])
 
 
-def _solve(ay: Any, az: Any, scalar: bool, g: Geometry, mode: str, return_mask: bool, joints: bool,
-           bad_input: Any) -> Any:
-    """ik on checked orientations (floats when ``scalar``, broadcast arrays otherwise): the 12 joints or the
-    motors (``joints=False``), per the single/batch rule. ``bad_input()`` raises the InvalidInputError of a
-    non-finite scalar input."""
-    G = g._vector
-    if mode == "all":
-        return _all_modes(ay, az, scalar, G, return_mask, joints, bad_input)
-    if scalar:
-        home, e, s = MODE_ARGS[mode]
-        q, aux = np.empty(12 if joints else 3), np.empty(6)
-        st = _k_ik(ay, az, G, home, e, s, q, aux)
-        if st != OK:
-            if st == ST_NONFINITE:
-                bad_input()
-            raise ik_single_error(np.float64(ay), np.float64(az), G, mode, aux)
-        return (q, np.asarray(True)) if return_mask else q
-    q, aux, status = _run(np.asarray(ay, dtype=np.float64), np.asarray(az, dtype=np.float64), G, mode,
-                          12 if joints else 3)
-    q, ok = q[..., 0, :], status[..., 0] == OK
-    return (q, ok) if return_mask else q
+# ---- ik / ik_joints: one mode (width 3: the motors, 12: every joint)
+def _ik_fast(t: np.ndarray, G: np.ndarray, mode: str, width: int) -> np.ndarray | None:
+    home, e, s = MODE_ARGS[mode]
+    out, aux = np.empty(width), np.empty(6)
+    ay, az = t.tolist()  # Python floats: numba dispatches them faster than numpy scalars
+    return out if _k_ik(ay, az, G, home, e, s, out, aux) == OK else None
 
 
-def _target(target: ArrayLike) -> tuple[Any, Any, bool]:
-    """(alpha_y, alpha_z, scalar) of a checked target (..., 2)."""
-    if type(target) is np.ndarray and target.dtype is _F64 and target.shape == (2,):
-        return float(target[0]), float(target[1]), True
-    t = as_input(target, "target", (2,))
-    if t.ndim == 1:
-        return float(t[0]), float(t[1]), True
-    return t[..., 0], t[..., 1], False
+def _ik_batch(rows: np.ndarray, G: np.ndarray, mode: str, width: int) -> tuple[np.ndarray, np.ndarray]:
+    q, _, status = _run(*_yz(rows), G, mode, width)
+    return q[:, 0], status[:, 0] == OK
 
 
-def _nonfinite_target(target: ArrayLike) -> Any:
-    return lambda: as_input(target, "target", (2,))
+def _ik_fail(t: np.ndarray, out: np.ndarray, ok: np.ndarray, G: np.ndarray, mode: str, width: int) -> Exception:
+    ay, az = float(t[0]), float(t[1])
+    return ik_single_error(np.float64(ay), np.float64(az), G, mode, ik_one(ay, az, G, mode)[1])
 
 
-def _call(target: ArrayLike, geometry: Geometry | None) -> tuple[Any, Any, bool, Geometry, Any]:
-    """(alpha_y, alpha_z, scalar, geometry, bad_input) of a checked call."""
-    g = geometry_of(geometry)
-    ay, az, scalar = _target(target)
-    return ay, az, scalar, g, _nonfinite_target(target)
+# ---- ik_all: every mode
+def _all_fast(t: np.ndarray, G: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray] | None:
+    q, ok = np.empty((16, width)), np.empty(16, dtype=np.bool_)
+    ay, az = t.tolist()
+    return (q, ok) if _k_ik_all(ay, az, G, q, ok) == OK else None
+
+
+def _all_batch(rows: np.ndarray, G: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray]:
+    n = rows.shape[0]
+    q, ok, status = np.empty((n, 16, width)), np.empty((n, 16), dtype=np.bool_), np.empty(n, dtype=np.int64)
+    IK_ALL_LOOP(*_yz(rows), G, q, ok, status)
+    return q, ok
+
+
+def _all_fail(t: np.ndarray, out: np.ndarray, ok: np.ndarray, G: np.ndarray, width: int) -> Exception:
+    return _ik_fail(t, out, ok, G, HOME_MODE, width)
+
+
+# ---- jacobian
+def _jac_fast(t: np.ndarray, G: np.ndarray, mode: str) -> np.ndarray | None:
+    home, e, s = MODE_ARGS[mode]
+    a, aux = np.empty((3, 2)), np.empty(4)
+    ay, az = t.tolist()
+    return a if _k_actuation_jacobian(ay, az, G, home, e, s, a, aux) == OK else None
+
+
+def _jac_batch(rows: np.ndarray, G: np.ndarray, mode: str) -> tuple[np.ndarray, np.ndarray]:
+    home, e, s = MODE_ARGS[mode]
+    n = rows.shape[0]
+    a, aux, status = np.empty((n, 3, 2)), np.empty((n, 4)), np.empty(n, dtype=np.int64)
+    JACOBIAN_LOOP(*_yz(rows), G, home, e, s, a, aux, status)
+    return a, status == OK
+
+
+def _jac_fail(t: np.ndarray, out: np.ndarray, ok: np.ndarray, G: np.ndarray, mode: str) -> Exception:
+    home, e, s = MODE_ARGS[mode]
+    a, aux = np.empty((3, 2)), np.empty(4)
+    _k_actuation_jacobian(float(t[0]), float(t[1]), G, home, e, s, a, aux)
+    c2 = aux[:3].copy()
+    return _ik_error(np.float64(t[0]), np.float64(t[1]), c2, *_ik_status(c2, np.asarray(aux[3])))
 
 
 # ------------------------------------------------------------------------------------------ public
@@ -237,18 +236,10 @@ def ik(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | None = 
         InvalidInputError: non-finite, complex or wrongly shaped target; InvalidParameterError: bad geometry,
             mode or return_mask.
     """
-    if type(target) is np.ndarray and target.dtype is _F64 and target.shape == (2,) and \
-            type(mode) is str and (return_mask is False or return_mask is True):
-        G = _fast_g(geometry)  # the single-call fast path: straight to the kernel, the motors only
-        args_m = MODE_ARGS.get(mode)
-        if G is not None and args_m is not None:
-            out, aux = np.empty(3), np.empty(6)
-            if _k_ik(target[0], target[1], G, args_m[0], args_m[1], args_m[2], out, aux) == OK:
-                return (out, np.asarray(True)) if return_mask else out
-    mode = checked_mode(mode, allow_all=True)
-    return_mask = flag(return_mask, "return_mask")
-    ay, az, scalar, g, bad = _call(target, geometry)
-    return _solve(ay, az, scalar, g, mode, return_mask, False, bad)
+    mode, G, return_mask = _checked(mode, geometry, return_mask)
+    if mode == "all":
+        return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3), return_mask)
+    return dispatch(target, "target", (2,), _ik_fast, _ik_batch, _ik_fail, (G, mode, 3), return_mask)
 
 
 @overload
@@ -263,16 +254,8 @@ def ik_all(target: ArrayLike, *, geometry: Geometry | None = None, return_mask: 
     mode solves the target. Equals :func:`ik` with ``mode="all"``, and row j equals ``ik(target, mode=MODES[j])``
     bit for bit: one kernel (:func:`legkin.tripod.closure._k_ik_all`) solves each leg once per side of E and sign
     of sin q_K2 and combines the 12 leg solutions into the 16 modes; the batch is a compiled loop over it."""
-    if type(target) is np.ndarray and target.dtype is _F64 and target.shape == (2,) and \
-            (return_mask is False or return_mask is True):
-        G = _fast_g(geometry)  # the single-call fast path
-        if G is not None:
-            q, ok = np.empty((16, 3)), np.empty(16, dtype=np.bool_)
-            if _k_ik_all(target[0], target[1], G, q, ok) == OK:
-                return (q, ok) if return_mask else q
-    return_mask = flag(return_mask, "return_mask")
-    ay, az, scalar, g, bad = _call(target, geometry)
-    return _all_modes(ay, az, scalar, g._vector, return_mask, False, bad)
+    _, G, return_mask = _checked(HOME_MODE, geometry, return_mask)
+    return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3), return_mask)
 
 
 @overload
@@ -286,39 +269,10 @@ def ik_joints(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | 
     """Every joint for ``target`` (..., 2): (..., 12) ordered A_q1..A_q4, B_q1..B_q4, C_q1..C_q4 (the Pinocchio
     order: a closed configuration of ``legkin.load("tripod")``), ``q_K3 = q_K2``, ``q_K4 = q_K1``; otherwise as
     :func:`ik` (whose motors are columns 0, 4, 8). ``mode="all"``: (..., 16, 12)."""
-    if type(target) is np.ndarray and target.dtype is _F64 and target.shape == (2,) and \
-            type(mode) is str and (return_mask is False or return_mask is True):
-        G = _fast_g(geometry)  # the single-call fast path
-        args_m = MODE_ARGS.get(mode)
-        if G is not None and args_m is not None:
-            q, aux = np.empty(12), np.empty(6)
-            if _k_ik(target[0], target[1], G, args_m[0], args_m[1], args_m[2], q, aux) == OK:
-                return (q, np.asarray(True)) if return_mask else q
-    mode = checked_mode(mode, allow_all=True)
-    return_mask = flag(return_mask, "return_mask")
-    ay, az, scalar, g, bad = _call(target, geometry)
-    return _solve(ay, az, scalar, g, mode, return_mask, True, bad)
-
-
-def _jacobian(ay: Any, az: Any, scalar: bool, g: Geometry, mode: str, return_mask: bool, bad: Any) -> Any:
-    home, e, s = MODE_ARGS[mode]
-    G = g._vector
-    if not scalar:
-        shape = ay.shape
-        y, z = np.ascontiguousarray(ay).reshape(-1), np.ascontiguousarray(az).reshape(-1)
-        n = y.shape[0]
-        ab, auxb, status = np.empty((n, 3, 2)), np.empty((n, 4)), np.empty(n, dtype=np.int64)
-        JACOBIAN_LOOP(y, z, G, home, e, s, ab, auxb, status)
-        ab, ok = ab.reshape(shape + (3, 2)), (status == OK).reshape(shape)
-        return (ab, ok) if return_mask else ab
-    a, aux = np.empty((3, 2)), np.empty(4)
-    st = _k_actuation_jacobian(ay, az, G, home, e, s, a, aux)
-    if st != OK:
-        if st == ST_NONFINITE and bad is not None:
-            bad()
-        c2 = aux[:3].copy()
-        raise _ik_error(np.float64(ay), np.float64(az), c2, *_ik_status(c2, np.asarray(aux[3])))
-    return (a, np.asarray(True)) if return_mask else a
+    mode, G, return_mask = _checked(mode, geometry, return_mask)
+    if mode == "all":
+        return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 12), return_mask)
+    return dispatch(target, "target", (2,), _ik_fast, _ik_batch, _ik_fail, (G, mode, 12), return_mask)
 
 
 @overload
@@ -347,15 +301,5 @@ def jacobian(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | N
     pose is outside the workspace or singular (NaN / the exceptions of :func:`ik`); the actuation-singularity
     guard of :func:`ik` (:data:`DET_GUARD`) does not apply: A_u is defined there.
     """
-    if type(target) is np.ndarray and target.dtype is _F64 and target.shape == (2,) and \
-            type(mode) is str and (return_mask is False or return_mask is True):
-        G = _fast_g(geometry)  # the single-call fast path
-        args_m = MODE_ARGS.get(mode)
-        if G is not None and args_m is not None:
-            a, aux = np.empty((3, 2)), np.empty(4)
-            if _k_actuation_jacobian(target[0], target[1], G, args_m[0], args_m[1], args_m[2], a, aux) == OK:
-                return (a, np.asarray(True)) if return_mask else a
-    mode = checked_mode(mode)
-    return_mask = flag(return_mask, "return_mask")
-    ay, az, scalar, g, bad = _call(target, geometry)
-    return _jacobian(ay, az, scalar, g, mode, return_mask, bad)
+    mode, G, return_mask = _checked(mode, geometry, return_mask, allow_all=False)
+    return dispatch(target, "target", (2,), _jac_fast, _jac_batch, _jac_fail, (G, mode), return_mask)

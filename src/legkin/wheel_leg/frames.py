@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import math
 from functools import lru_cache
-from typing import Literal, NamedTuple, overload
+from typing import Any, Literal, NamedTuple, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input, check_choice, check_flag, check_number, finish
+from .._batch import as_input, check_choice, check_flag, check_number, dispatch
 from .._kernels import OK, as_items, as_rows, batch_kernel, kernel
 from ..errors import InvalidInputError
 from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, rim_name
@@ -211,38 +211,61 @@ def _kctx(leg, rim, radius, geo: Geometry):
         raise
 
 
-def _contact_call(q, alpha, w, leg, rim, radius, geometry, want_jac, return_mask=False):
-    """The wrapper of :func:`fk` / :func:`jacobian`: kernel for a single item (fast path: a float64 (3,) q and
-    number alpha, w), batch kernel otherwise; any failure status -> the checks' error."""
+def _contact_call(q: ArrayLike, alpha: ArrayLike, w: ArrayLike, leg: Leg, rim: str, radius: float | None,
+                  geometry: Geometry | None, want_jac: bool, return_mask: bool = False) -> Any:
+    """The wrapper of :func:`fk` / :func:`jacobian` (:func:`legkin._batch.dispatch`): number alpha, w go to the
+    kernels as they are; arrays are broadcast with q first (then q is a batch of that shape)."""
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
-    if (type(q) is np.ndarray and q.shape == (3,) and q.dtype == np.float64 and type(alpha) in _SCALARS
-            and type(w) in _SCALARS and return_mask is False):
-        try:
-            kc = _kctx(leg, rim, radius, geo)
-        except Exception:  # noqa: BLE001 - the full checks below raise the documented error in order
-            kc = None
-        if kc is not None:
-            p = np.empty(3)
-            J = np.empty(9) if want_jac else _NO_JAC
-            if _k_contact(q, float(alpha), float(w), *kc, want_jac, p, J) == OK:
-                return J.reshape(3, 3) if want_jac else p
-    return_mask = check_flag(return_mask, "return_mask")
-    q, alpha, w = _q_inputs(q, alpha, w, geo)  # raises the documented error for a bad input
+    a: Any
+    b: Any
+    if type(alpha) in _SCALARS and type(w) in _SCALARS:
+        a, b = float(alpha), float(w)  # type: ignore[arg-type]
+        checked = None
+    else:  # broadcast together (and range-checked) before the single/batch rule
+        qb, a_arr, w_arr = _q_inputs(q, alpha, w, geo)
+        q = np.array(qb)  # writeable copies: numba types read-only arrays apart (a second compilation)
+        a, b = (float(a_arr), float(w_arr)) if a_arr.ndim == 0 else (np.array(a_arr).reshape(-1),
+                                                                     np.array(w_arr).reshape(-1))
+        checked = True
+    if return_mask is not False and return_mask is not True:
+        return_mask = check_flag(return_mask, "return_mask")
     kc = _kctx(leg, rim, radius, geo)
-    shape = q.shape[:-1]
-    n = int(np.prod(shape, dtype=int))
+    return dispatch(q, "q", (3,), _contact_fast, _contact_batch, _contact_fail, (a, b, geo, kc, want_jac, checked),
+                    return_mask)
+
+
+def _contact_fast(q: np.ndarray, a: Any, b: Any, geo: Geometry, kc: tuple, want_jac: bool,
+                  checked: Any) -> np.ndarray | None:
+    """One joint vector straight to :func:`_k_contact` (None unless solved: NaN, theta / alpha / w out of range)."""
+    p = np.empty(3)
+    J = np.empty(9) if want_jac else _NO_JAC
+    if _k_contact(q, a, b, *kc, want_jac, p, J) == OK:  # type: ignore[call-arg]
+        return J.reshape(3, 3) if want_jac else p
+    return None
+
+
+def _contact_batch(rows: np.ndarray, a: Any, b: Any, geo: Geometry, kc: tuple, want_jac: bool,
+                   checked: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The compiled loop on joint rows (n, 3), after the range checks (an out-of-range theta, alpha or w raises,
+    in a batch too)."""
+    n = rows.shape[0]
+    if checked is None:
+        _q_inputs(rows, a, b, geo)
+    alpha = np.full(n, a) if type(a) is float else a
+    w = np.full(n, b) if type(b) is float else b
     P = np.empty((n, 3))
     J = np.empty((n, 9) if want_jac else (n, 0))
     status = np.empty(n, dtype=np.int64)
-    _k_contact_batch(as_rows(q, 3), as_rows(alpha, 1)[:, 0], as_rows(w, 1)[:, 0], *kc, want_jac, P, J, status)
-    ok = (status == OK).reshape(shape)
-    value = J.reshape(shape + (3, 3)) if want_jac else P.reshape(shape + (3,))
+    _k_contact_batch(rows, alpha, w, *kc, want_jac, P, J, status)
+    ok = status == OK
+    value = J.reshape(n, 3, 3) if want_jac else P
     value[~ok] = np.nan
+    return value, ok
 
-    def error() -> Exception:
-        return InvalidInputError(f"the contact {'Jacobian' if want_jac else 'point'} is not finite at q={q.tolist()}")
 
-    return finish(value, ok, shape == (), return_mask, error)
+def _contact_fail(q: np.ndarray, out: np.ndarray, ok: np.ndarray, a: Any, b: Any, geo: Geometry, kc: tuple,
+                  want_jac: bool, checked: Any) -> Exception:
+    return InvalidInputError(f"the contact {'Jacobian' if want_jac else 'point'} is not finite at q={q.tolist()}")
 
 
 _NO_JAC = np.empty(0)

@@ -20,11 +20,21 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_input, check_choice, check_flag, check_integer, check_number, finish
-from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
+from ..errors import InvalidInputError, InvalidParameterError, UnreachableError
 from . import ik_iterative
 from ._common import _LIMITS, _SCALARS, _SOLVED, Leg, Rim, _check_alpha, _check_theta, _check_w, rim_name
 from .frames import _context, _fk, _kctx_cached
-from .geometry import _DEFAULT_GEOMETRY, _LIMIT_ROUNDING, ABAD_LIMIT, THETA_MAX, THETA_MIN, Geometry, _geometry, _leg
+from .geometry import (
+    _DEFAULT_GEOMETRY,
+    _LIMIT_ROUNDING,
+    ABAD_LIMIT,
+    THETA_MAX,
+    THETA_MIN,
+    Geometry,
+    _geometry,
+    _leg,
+    abad_limit_error,
+)
 from .ik_radial import _NO_Q0, _RADIAL_SOLS, _ik_radial, _k_ik_radial, _radial_table
 from .rim import _k_select
 
@@ -217,17 +227,18 @@ def _error(run: _Run, q_raw, leg, alpha, w, method, tol) -> Exception:
     target = np.asarray(run.target).reshape(3)
     where = f"target {target.tolist()} for leg {leg!r} (alpha={float(alpha)!r}, w={float(w)!r})"
     if int(run.reason) == _LIMITS:
-        return JointLimitError(
+        return abad_limit_error(
             f"{where} is reachable only with the ABAD angle outside its limits [-pi/2, pi/2] "
             f"(gamma={float(q_raw[2]):.6g} rad); pass limits=False to accept it",
-            target=target, closest=run.closest,
+            leg, target, float(q_raw[2]), run.closest,
         )
     closest = run.closest
+    distance = math.nan if closest is None else float(np.linalg.norm(closest - target))
     return UnreachableError(
         f"{where} not reached with method {method!r}: final error {float(run.info.error):.3e} m after "
         f"{int(run.info.iterations)} iterations (tolerance {tol:.1e} m, theta in [17, 160] deg); closest point "
-        f"reached {None if closest is None else closest.tolist()}",
-        target=target, closest=closest,
+        f"reached {None if closest is None else closest.tolist()} ({distance:.3g} m away)",
+        target=target, closest=closest, distance=distance,
     )
 
 
@@ -300,7 +311,7 @@ def ik(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     opts = _options(options)
-    rim = rim_name(rim)
+    rim_ = rim_name(rim)
     if (type(target) is np.ndarray and target.shape == (3,) and target.dtype == np.float64 and type(alpha) in _SCALARS
             and type(w) in _SCALARS and type(method) is str and method in METHODS and type(limits) is bool
             and type(return_mask) is bool and type(return_info) is bool):
@@ -308,13 +319,13 @@ def ik(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.
         both = q_near is not None and q_start is not None
         if not both and (start is None or (type(start) is np.ndarray and start.shape == (3,)
                                            and start.dtype == np.float64 and (q_start is None or method != "radial"))):
-            out = _single(target, float(alpha), float(w), leg, rim, radius, geo, method, opts, return_mask,
+            out = _single(target, float(alpha), float(w), leg, rim_, radius, geo, method, opts, return_mask,
                           return_info, limits, start)
             if out is not None:
                 return out
     return_mask = check_flag(return_mask, "return_mask")
     return_info = check_flag(return_info, "return_info")
-    run, q_raw = _run(target, alpha, w, leg, q_near, q_start, method, rim, radius, limits, opts, geo)
+    run, q_raw = _run(target, alpha, w, leg, q_near, q_start, method, rim_, radius, limits, opts, geo)
     out = finish(run.q, run.ok, run.ok.shape == (), return_mask,
                  lambda: _error(run, q_raw, leg, alpha, w, method, opts.tol))
     if return_info:

@@ -35,9 +35,19 @@ from numpy.typing import ArrayLike
 from .._batch import as_input, check_flag
 from .._kernels import as_rows, batch_kernel, kernel
 from .._rotations import wrap_k
-from ..errors import InvalidInputError, JointLimitError, UnreachableError
+from ..errors import InvalidInputError, UnreachableError
 from ._common import Leg
-from .geometry import _DEFAULT_GEOMETRY, ABAD_LIMIT, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry, _leg
+from .geometry import (
+    _DEFAULT_GEOMETRY,
+    ABAD_LIMIT,
+    THETA_MAX,
+    THETA_MIN,
+    TYRE_THICKNESS,
+    Geometry,
+    _geometry,
+    _leg,
+    abad_limit_error,
+)
 from .ground import _ZERO, _k_ground, _k_normal_leg, _leg_consts, _normals
 from .linkage import _IF, _IG, _IH, _IL, _IU, _k_closed, _kconst, linkage_points
 from .tyre import _thickness
@@ -485,7 +495,8 @@ def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = _Z, q_near: Ar
         if status == 0:
             return (q[0], np.asarray(True)) if return_mask else q[0]
     if status == 2:
-        raise JointLimitError(f"target {t[0].tolist()} is reached only with |gamma| > ABAD_LIMIT", target=t[0])
+        raise abad_limit_error(f"target {t[0].tolist()} is reached only with |gamma| > ABAD_LIMIT = pi/2 "
+                               "(joint <leg>_abad)", leg, t[0], math.nan)
     if status == _OVERFLOW:
         raise _overflow()
     raise UnreachableError(f"no configuration puts the ground contact of {leg} at {t[0].tolist()}", target=t[0])

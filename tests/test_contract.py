@@ -1,7 +1,8 @@
 """The kinematic contract, written once and run on every registered mechanism (see legkin._contract).
 
 A mechanism takes part by having a module ``legkin.<name>.contract`` with ``contract()``; a registered
-mechanism without one fails ``test_every_mechanism_signs_the_contract``.
+mechanism without one fails ``test_every_mechanism_signs_the_contract``. The registry's external robots (the
+example-robot-data quadrupeds) sign it through :mod:`legkin._leg_contract` (one case per ``legkin.legs.Leg``).
 """
 
 from __future__ import annotations
@@ -34,6 +35,16 @@ def _cases() -> list:
         try:
             cases = importlib.import_module(f"legkin.{model}.contract").contract().cases
         except ModuleNotFoundError:
+            continue
+        out += [pytest.param(model, k, id=f"{model}-{k.name}") for k in cases]
+    from legkin._leg_contract import contract as leg_contract
+
+    for model in legkin.list_models("example-robot-data"):  # the registry's external robots: legkin.legs.Leg
+        try:
+            cases = leg_contract(model).cases
+        except (ImportError, OSError, legkin.LegkinError) as exc:  # example-robot-data not installed
+            out.append(pytest.param(model, None, id=f"{model}-missing",
+                                    marks=pytest.mark.skip(reason=f"{model}: {exc}")))
             continue
         out += [pytest.param(model, k, id=f"{model}-{k.name}") for k in cases]
     return out

@@ -132,12 +132,17 @@ def _yz(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return np.ascontiguousarray(rows[:, 0]), np.ascontiguousarray(rows[:, 1])
 
 
+#: The kernels' diagnostic output on the fast paths, never read there (a failure is diagnosed again by the
+#: error function), so one buffer serves every call.
+_SCRATCH_AUX, _SCRATCH_AUX4 = np.empty(6), np.empty(4)
+
+
 # ---- ik / ik_joints: one mode (width 3: the motors, 12: every joint)
 def _ik_fast(t: np.ndarray, G: np.ndarray, mode: str, width: int) -> np.ndarray | None:
     home, e, s = MODE_ARGS[mode]
-    out, aux = np.empty(width), np.empty(6)
+    out = np.empty(width)
     ay, az = t.tolist()  # Python floats: numba dispatches them faster than numpy scalars
-    return out if _k_ik(ay, az, G, home, e, s, out, aux) == OK else None
+    return out if _k_ik(ay, az, G, home, e, s, out, _SCRATCH_AUX) == OK else None
 
 
 def _ik_batch(rows: np.ndarray, G: np.ndarray, mode: str, width: int) -> tuple[np.ndarray, np.ndarray]:
@@ -171,9 +176,9 @@ def _all_fail(t: np.ndarray, out: np.ndarray, ok: np.ndarray, G: np.ndarray, wid
 # ---- jacobian
 def _jac_fast(t: np.ndarray, G: np.ndarray, mode: str) -> np.ndarray | None:
     home, e, s = MODE_ARGS[mode]
-    a, aux = np.empty((3, 2)), np.empty(4)
+    a = np.empty((3, 2))
     ay, az = t.tolist()
-    return a if _k_actuation_jacobian(ay, az, G, home, e, s, a, aux) == OK else None
+    return a if _k_actuation_jacobian(ay, az, G, home, e, s, a, _SCRATCH_AUX4) == OK else None
 
 
 def _jac_batch(rows: np.ndarray, G: np.ndarray, mode: str) -> tuple[np.ndarray, np.ndarray]:

@@ -590,10 +590,15 @@ def test_ik_all_fk_certificate_agrees_with_forward_kinematics():
 def test_joint_limit_error():
     """Reachable only with |roll| > pi/2 (LCS_x limit): JointLimitError, mask False; no answer outside the limits."""
     p = ah.foot_position_from_platform(-0.06284610557749781, -1.0207832560887642, 0.23457715140921453)
-    with pytest.raises(legkin.JointLimitError, match="outside the joint limits"):
+    with pytest.raises(legkin.JointLimitError, match="outside the joint limits") as info:
         ah.ik(p)
+    err = info.value  # the data: the first platform joint (LCS_x: roll, LCS_y: pitch) outside its URDF limits
+    assert err.joint in ("LCS_x", "LCS_y") and (err.lower, err.upper) == (-ah.PLATFORM_LIMIT, ah.PLATFORM_LIMIT)
+    assert abs(err.value) > ah.PLATFORM_LIMIT and np.array_equal(err.target, p)
     every = ah.ik_branches(p)
     assert every.mask.any() and not every.within_limits[every.mask].any()
+    k = 1 if err.joint == "LCS_x" else 2  # that joint's value is the branch's roll or pitch
+    assert np.isclose(every.pose[every.mask][:, k], err.value).any()
     assert not ah.ik(p[None], return_mask=True)[1][0]
 
 

@@ -523,8 +523,12 @@ def test_ik_reachable_only_outside_the_abad_limits():
     sols = wl.ik(target, "FL", limits=False, return_info=True)[1].solutions
     sols = sols[~np.isnan(sols[:, 0])]
     assert sols.shape[0] >= 1 and np.all(np.abs(sols[:, 2]) > wl.ABAD_LIMIT)  # every solution outside the limits
-    with pytest.raises(legkin.JointLimitError, match=r"ABAD angle outside its limits \[-pi/2, pi/2\]"):
+    with pytest.raises(legkin.JointLimitError, match=r"ABAD angle outside its limits \[-pi/2, pi/2\]") as info:
         wl.ik(target, "FL")
+    err = info.value  # the data: the URDF joint FL_abad, its limits, and gamma of the first solution
+    assert (err.joint, err.lower, err.upper) == ("FL_abad", -wl.ABAD_LIMIT, wl.ABAD_LIMIT)
+    assert err.value == sols[0, 2] and np.array_equal(err.target, target)
+    assert err.distance == pytest.approx(np.linalg.norm(err.closest - target), abs=0.0)
     qs, ok = wl.ik(np.stack([target, target]), "FL", return_mask=True)
     assert not ok.any() and np.isnan(qs).all()
     assert np.linalg.norm(wl.fk(wl.ik(target, "FL", limits=False), "FL")

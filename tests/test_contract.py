@@ -189,3 +189,24 @@ def test_the_package_exports_its_kinematics_and_no_submodule_hides_a_function(mo
         assert not isinstance(value, types.ModuleType), f"legkin.{model}.{name} is a module"
         assert value is getattr(kinematics, name), name
     assert pkg.Geometry.from_params(legkin.load(model).params) == pkg.Geometry()
+
+
+@pytest.mark.parametrize("model", ["tripod", "wheel_leg", "hybrid_leg"])  # quadruped: with its move onto legs.Leg
+def test_public_functions_are_typed_and_document_args_and_returns(model):
+    """Every public function of the mechanism (its kinematics ``__all__``) has a full signature annotation and a
+    Google-style docstring with Args and Returns (docs/api.md)."""
+    import inspect
+
+    kinematics = importlib.import_module(f"legkin.{model}.kinematics")
+    missing = []
+    for name in kinematics.__all__:
+        fn = getattr(kinematics, name)
+        if not inspect.isfunction(fn):
+            continue
+        sig = inspect.signature(fn)
+        typed = sig.return_annotation is not inspect.Signature.empty and all(
+            p.annotation is not inspect.Parameter.empty for p in sig.parameters.values())
+        doc = fn.__doc__ or ""
+        if not typed or "Args:" not in doc or "Returns:" not in doc:
+            missing.append(name)
+    assert not missing, f"legkin.{model}: not typed or without Args/Returns: {missing}"

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from typing import Any, Callable
+from typing import Any, Callable, Iterable
 
 import numpy as np
 
@@ -31,8 +31,17 @@ __all__ = [
 ]
 
 
-def as_input(x, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = False) -> np.ndarray:
+def as_input(x: object, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = False) -> np.ndarray:
     """Return ``x`` as a float array whose trailing shape is ``core``.
+
+    Args:
+        x: the input, array-like.
+        name: its name in the messages.
+        core: the trailing shape of one item (``()``: scalars).
+        allow_nan: accept NaN and inf entries.
+
+    Returns:
+        a float64 array (``x`` itself when it already is one).
 
     Raises:
         InvalidInputError: (a ``ValueError``) wrong trailing shape, NaN/inf entries, complex or non-numeric
@@ -57,8 +66,19 @@ def as_input(x, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = Fals
     return arr
 
 
-def as_angles(*xs, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
-    """Check scalar-per-item inputs (angles) and broadcast them together."""
+def as_angles(*xs: object, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
+    """Check scalar-per-item inputs (angles) and broadcast them together.
+
+    Args:
+        *xs: the inputs (rad, or any unit), array-like.
+        names: their names in the messages.
+
+    Returns:
+        the float64 arrays, each of the broadcast shape (writeable).
+
+    Raises:
+        InvalidInputError: an input :func:`as_input` refuses, or shapes that do not broadcast.
+    """
     arrs = [as_input(x, n) for x, n in zip(xs, names)]
     try:
         shape = np.broadcast_shapes(*(a.shape for a in arrs))
@@ -136,12 +156,12 @@ def dispatch(
 
 
 def finish(
-    value,
-    ok: np.ndarray,
+    value: Any,
+    ok: Any,
     scalar: bool,
     return_mask: bool,
     error: Callable[[], Exception],
-):
+) -> Any:
     """Apply the scalar/batch rule to a computed result.
 
     Args:
@@ -150,6 +170,9 @@ def finish(
         scalar: True for a single input: raise ``error()`` on failure.
         return_mask: also return the mask.
         error: builds the exception for a failed scalar call (called only then).
+
+    Returns:
+        ``value``, or ``(value, ok)`` (``(*value, ok)`` for a tuple) with ``return_mask``.
     """
     ok = np.asarray(ok, dtype=bool)
     if scalar and not bool(ok):
@@ -161,11 +184,20 @@ def finish(
     return value
 
 
-def real_number(value, name: str, valid) -> float:
+def real_number(value: object, name: str, valid: str | Callable[[], str]) -> float:
     """A real scalar parameter (int, float, numpy real, 0-d real array; not bool, str, complex) as float.
 
-    ``valid``: the range text for the message (or a callable making it, called only on failure). The range
-    itself is the caller's to check.
+    Args:
+        value: the value.
+        name: its name in the message.
+        valid: the range text for the message (or a callable making it, called only on failure). The range
+            itself is the caller's to check.
+
+    Returns:
+        the value as a float.
+
+    Raises:
+        InvalidArgumentError: not a real number.
     """
     if type(value) is float:  # the common case, fast
         return value
@@ -176,21 +208,38 @@ def real_number(value, name: str, valid) -> float:
         text = valid() if callable(valid) else valid
         raise InvalidArgumentError(f"{name} must be a real number, got {value!r}; valid range {text}")
     try:
-        return float(value)
+        return float(value)  # type: ignore[arg-type]  # a real number (checked above)
     except OverflowError:  # an int beyond the float range
         text = valid() if callable(valid) else valid
         raise InvalidArgumentError(f"{name}={value!r} is out of range: valid range {text}") from None
 
 
 def interval_text(low: float | None, high: float | None, low_open: bool = False, high_open: bool = False) -> str:
-    """The interval as text, e.g. ``(0, inf)`` or ``[1, 10000]`` (None: unbounded, an open end)."""
+    """The interval as text, e.g. ``(0, inf)`` or ``[1, 10000]``.
+
+    Args:
+        low, high: the bounds (None: unbounded, an open end).
+        low_open, high_open: exclude the bound itself.
+
+    Returns:
+        the text.
+    """
     lo = "-inf" if low is None else f"{low:g}"
     hi = "inf" if high is None else f"{high:g}"
     return f"{'(' if low_open or low is None else '['}{lo}, {hi}{')' if high_open or high is None else ']'}"
 
 
 def outside(x: float, low: float | None, high: float | None, low_open: bool = False, high_open: bool = False) -> bool:
-    """True if ``x`` is NaN, infinite or outside the interval (the one range test of every option checker)."""
+    """Whether ``x`` is NaN, infinite or outside the interval (the one range test of every option checker).
+
+    Args:
+        x: the value.
+        low, high: the bounds (None: unbounded).
+        low_open, high_open: exclude the bound itself.
+
+    Returns:
+        True if ``x`` is not a finite number inside the interval.
+    """
     bad = not math.isfinite(x)
     if low is not None:
         bad |= x <= low if low_open else x < low
@@ -200,10 +249,19 @@ def outside(x: float, low: float | None, high: float | None, low_open: bool = Fa
 
 
 def check_number(
-    value, name: str, low: float | None = None, high: float | None = None, *,
+    value: object, name: str, low: float | None = None, high: float | None = None, *,
     low_open: bool = False, high_open: bool = False,
 ) -> float:
     """A keyword parameter that must be one finite real number in a range; returns it as a float.
+
+    Args:
+        value: the value (int, float, numpy real or 0-d real array; not a bool).
+        name: its name in the message.
+        low, high: the bounds (None: unbounded), in the option's unit.
+        low_open, high_open: exclude the bound itself.
+
+    Returns:
+        the value as a float.
 
     Raises:
         InvalidArgumentError: (a ``ValueError``) not a real number, NaN/inf, or outside the range; the
@@ -222,8 +280,20 @@ def check_number(
     return v
 
 
-def check_integer(value, name: str, low: int | None = None, high: int | None = None) -> int:
-    """A keyword parameter that must be an integer in ``[low, high]``."""
+def check_integer(value: object, name: str, low: int | None = None, high: int | None = None) -> int:
+    """A keyword parameter that must be an integer in ``[low, high]``.
+
+    Args:
+        value: the value (int or numpy integer; not a bool, not a float).
+        name: its name in the message.
+        low, high: the bounds (None: unbounded).
+
+    Returns:
+        the value as an int.
+
+    Raises:
+        InvalidArgumentError: not an integer, or outside the range.
+    """
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
         span = interval_text(low, high)
         raise InvalidArgumentError(f"{name} must be an integer in {span}, got {value!r}")
@@ -234,15 +304,38 @@ def check_integer(value, name: str, low: int | None = None, high: int | None = N
     return v
 
 
-def check_flag(value, name: str) -> bool:
-    """A keyword parameter that must be a bool."""
+def check_flag(value: object, name: str) -> bool:
+    """A keyword parameter that must be a bool.
+
+    Args:
+        value: the value (bool or numpy bool).
+        name: its name in the message.
+
+    Returns:
+        the value as a bool.
+
+    Raises:
+        InvalidArgumentError: anything else.
+    """
     if not isinstance(value, (bool, np.bool_)):
         raise InvalidArgumentError(f"{name} must be True or False, got {value!r}")
     return bool(value)
 
 
-def check_choice(value, name: str, choices) -> object:
-    """A keyword parameter that must be one of ``choices`` (compared with ==, hashable values only)."""
+def check_choice(value: object, name: str, choices: Iterable[Any]) -> object:
+    """A keyword parameter that must be one of ``choices`` (compared with ==, hashable values only).
+
+    Args:
+        value: the value.
+        name: its name in the message.
+        choices: the valid values.
+
+    Returns:
+        the value.
+
+    Raises:
+        InvalidArgumentError: any other value (the message lists the choices).
+    """
     try:
         ok = value in tuple(choices)
     except Exception:  # noqa: BLE001 - an unhashable or array value is simply not a valid choice

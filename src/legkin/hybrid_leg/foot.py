@@ -188,6 +188,13 @@ def foot_position_from_platform(roll: ArrayLike, pitch: ArrayLike, theta_ll: Arr
 
     Seed eqs 1, 17, 18, 20 (eq 18 printed without its last row (0, 0, 0, 1)). At theta_LL = 0 the foot is at
     (0.140, 0, -0.037) in P.
+
+    Args:
+        roll, pitch: platform angles (rad); theta_ll: LL joint angle (rad); broadcast together.
+        geometry: accepted for uniformity (None: the default).
+
+    Returns:
+        (..., 3) foot positions in CCS (m).
     """
     if type(roll) in SCALARS and type(pitch) in SCALARS and type(theta_ll) in SCALARS and geometry is None:
         out = np.empty(3)
@@ -236,6 +243,9 @@ def fk(q: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, geometry: Ge
         geometry: the geometry (universal centre); None = the default.
         return_mask: also return the mask of successes.
 
+    Returns:
+        (..., 3) foot positions in CCS (m), NaN where a batch item fails; then the mask, if asked.
+
     Raises:
         ConvergenceError: single input whose closed sub-chain does not assemble in that mode.
         SingularityError: single input in the forward-singularity band.
@@ -260,6 +270,15 @@ def jacobian(q: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, geomet
     gives ``dp/droll = e_x x R f``, ``dp/dpitch = (Rx(roll) e_y) x R f``, ``dp/dtheta_LL = R_P df/dtheta_LL`` and
     ``dtheta_LL/dtheta0 = -RATIO`` (eq 19). Finite on the reach boundary (D = 0: a column vanishes);
     undefined where N is singular (the platform moves with the motors locked).
+
+    Args:
+        q: motor angles (theta1, theta2, theta0) (rad), shape (..., 3).
+        branch, assembly: the assembly mode, as in :func:`fk`.
+        geometry: the geometry (universal centre); None = the default.
+        return_mask: also return the mask of successes.
+
+    Returns:
+        (..., 3, 3) d(foot, m) / d(theta1, theta2, theta0) (m/rad); then the mask, if asked.
 
     Raises:
         ConvergenceError: single input whose closed sub-chain did not assemble in that mode.

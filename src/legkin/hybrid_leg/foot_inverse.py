@@ -106,6 +106,16 @@ def foot_platform_ik(target: ArrayLike, *, ll_branch: int | None = None, roll_br
     ``assembly`` given, as :func:`ik`, roll 0 or pi is tried there); within :data:`RHO_TOL` of it roll is
     taken as 0 (roll_branch +1) or pi (-1).
 
+    Args:
+        target: foot targets (..., 3) in CCS (m).
+        ll_branch, roll_branch: None (search, default) or +1 / -1.
+        branch, assembly: None (no mode check, default) or the mode of :func:`ik`.
+        geometry: the geometry (universal centre); None = the default.
+        return_mask: also return the mask of successes.
+
+    Returns:
+        (..., 3) (theta_LL, roll, pitch) (rad), NaN where a batch item fails; then the mask, if asked.
+
     Raises:
         UnreachableError: single target out of reach (JointLimitError: only outside the limits;
             AssemblyModeError: only in another mode).
@@ -173,6 +183,10 @@ def ik(target: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, ll_bran
             nearest them in the joints (MCS1, MCS2 wrapped, LL = RATIO theta0) instead of the first.
         geometry: the geometry (universal centre; ``starting_value`` of eq 19); None = the default.
         return_mask: also return the mask of successes.
+
+    Returns:
+        (..., 3) motor angles (theta1, theta2, theta0) (rad), NaN where a batch item fails; then the
+        mask, if asked.
 
     Raises:
         UnreachableError: single target out of reach (of the LL arc or of the motors);

@@ -160,6 +160,15 @@ def platform_poses(theta1: ArrayLike, theta2: ArrayLike, *, tol: float = 1e-12, 
     roots of a degree-8 polynomial in tan(roll / 2), the pitch of each from the two (linear in cos, sin) rod
     equations, polished by Newton's method. All modes, nearest R_P = I first. Never raises for valid input (a
     single input gives arrays of shape (8, ...)).
+
+    Args:
+        theta1, theta2: motor angles (rad), broadcast together.
+        tol: rod-length residual (m), in (0, 1e-6].
+        max_iter: Newton iterations, in [1, 10000].
+        geometry: the geometry (universal centre); None = the default.
+
+    Returns:
+        a :class:`PlatformPoses` (angles in rad).
     """
     if (type(theta1) in SCALARS and type(theta2) in SCALARS and geometry is None and type(tol) is float
             and 0.0 < tol <= 1e-6 and type(max_iter) is int and 1 <= max_iter <= 10_000):
@@ -240,6 +249,9 @@ def platform_orientation(
         tol: required rod-length residual | |A_i - S_i| - L | (m), in (0, 1e-6].
         max_iter: Newton iterations, in [1, 10000].
         geometry: must have the universal centre (None: the default geometry).
+
+    Returns:
+        (..., 2) (roll, pitch) (rad), NaN where a batch item fails; then the mask, if asked.
 
     Raises:
         ConvergenceError: single input whose closed sub-chain does not assemble in that mode within the joint

@@ -258,7 +258,17 @@ def ik_all(target: ArrayLike, *, geometry: Geometry | None = None, return_mask: 
     its own actuation singularities, :data:`DET_GUARD`, :data:`GAIN_GUARD`). A single call raises only when no
     mode solves the target. Equals :func:`ik` with ``mode="all"``, and row j equals ``ik(target, mode=MODES[j])``
     bit for bit: one kernel (:func:`legkin.tripod.closure._k_ik_all`) solves each leg once per side of E and sign
-    of sin q_K2 and combines the 12 leg solutions into the 16 modes; the batch is a compiled loop over it."""
+    of sin q_K2 and combines the 12 leg solutions into the 16 modes; the batch is a compiled loop over it.
+
+    Args:
+        target: platform orientation(s) (..., 2) = (alpha_y, alpha_z) (rad).
+        geometry: the tripod's :class:`Geometry` (None: the default).
+        return_mask: also return the mask (..., 16) of the modes that solve the target.
+
+    Returns:
+        (..., 16, 3) motor angles (rad) in :data:`MODES` order, NaN rows where a mode does not solve the target;
+        then the mask, if asked.
+    """
     _, G, return_mask = _checked(HOME_MODE, geometry, return_mask)
     return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3), return_mask)
 
@@ -273,7 +283,17 @@ def ik_joints(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | 
               return_mask: bool = False) -> Any:
     """Every joint for ``target`` (..., 2): (..., 12) ordered A_q1..A_q4, B_q1..B_q4, C_q1..C_q4 (the Pinocchio
     order: a closed configuration of ``legkin.load("tripod")``), ``q_K3 = q_K2``, ``q_K4 = q_K1``; otherwise as
-    :func:`ik` (whose motors are columns 0, 4, 8). ``mode="all"``: (..., 16, 12)."""
+    :func:`ik` (whose motors are columns 0, 4, 8). ``mode="all"``: (..., 16, 12).
+
+    Args:
+        target: platform orientation(s) (..., 2) = (alpha_y, alpha_z) (rad).
+        mode: assembly mode, one of :data:`MODES` or ``"all"``.
+        geometry: the tripod's :class:`Geometry` (None: the default).
+        return_mask: (batch) also return the success mask.
+
+    Returns:
+        (..., 12) joint angles (rad) (``mode="all"``: (..., 16, 12)); then the mask, if asked.
+    """
     mode, G, return_mask = _checked(mode, geometry, return_mask)
     if mode == "all":
         return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 12), return_mask)
@@ -305,6 +325,15 @@ def jacobian(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | N
     In another assembly ``mode`` (:data:`MODES`) the chain rule through that mode's IK. Undefined where the
     pose is outside the workspace or singular (NaN / the exceptions of :func:`ik`); the actuation-singularity
     guard of :func:`ik` (:data:`DET_GUARD`) does not apply: A_u is defined there.
+
+    Args:
+        target: platform orientation(s) (..., 2) = (alpha_y, alpha_z) (rad).
+        mode: assembly mode, one of :data:`MODES`.
+        geometry: the tripod's :class:`Geometry` (None: the default).
+        return_mask: (batch) also return the success mask.
+
+    Returns:
+        (..., 3, 2) A_u (rad/rad), NaN where undefined; then the mask, if asked.
     """
     mode, G, return_mask = _checked(mode, geometry, return_mask, allow_all=False)
     return dispatch(target, "target", (2,), _jac_fast, _jac_batch, _jac_fail, (G, mode), return_mask)

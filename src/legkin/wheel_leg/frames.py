@@ -80,6 +80,15 @@ def leg_frame_to_robot(p_L: ArrayLike, gamma: ArrayLike, leg: Leg, *, geometry: 
 
     ``p_M = T_L^M p_L`` (the seed's matrices, offset d_wheel), ``p_R = o_i + R0_i Rz(gamma) p_M``; the
     seed does not print ``T_M^R``: this is the module placement of "Coord definitions".
+
+    Args:
+        p_L: (..., 3) points in the leg frame {L} (m).
+        gamma: (...) ABAD angle(s) (rad), broadcast with p_L's leading shape.
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (..., 3) the points in the robot frame {R} (m).
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     try:
@@ -325,6 +334,18 @@ def jacobian(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0
     theta-derivatives are carried through every step (forward mode by hand,
     :func:`~legkin.wheel_leg.linkage._k_closed`), d/dbeta is ``i z`` in the leg plane and d/dgamma is
     ``R0 Rz(gamma) (e_z x p_M)``. Arguments as :func:`fk`.
+
+    Args:
+        q: (..., 3) (theta, beta, gamma) in rad, theta in [17 deg, 160 deg].
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        alpha: rim parameter (rad) in [-pi, pi]; w: lateral coordinate (m) in [-T/2, T/2]; broadcast with q's
+        leading shape.
+        rim, radius: the rim model and arc radius (m), as in :func:`fk`.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+        return_mask: also return the mask of successes (batch).
+
+    Returns:
+        (..., 3, 3) d(contact point, m) / d(theta, beta, gamma) (m/rad); then the mask, if asked.
     """
     return _contact_call(q, alpha, w, leg, rim_name(rim), radius, geometry, True, return_mask)
 

@@ -369,6 +369,11 @@ def passive_angles(theta: ArrayLike, beta: ArrayLike = 0.0, *,
 
     Returns:
         dict joint name (without the ``<leg>_`` prefix, see :data:`PASSIVE_JOINTS`) -> array.
+
+    Args:
+        theta: (...) the leg's theta (rad), in [17 deg, 160 deg].
+        beta: (...) the leg's beta (rad), broadcast with theta.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     t, b, shape = _angle_pair(theta, beta)
@@ -422,6 +427,13 @@ def motor_angles(theta: ArrayLike, beta: ArrayLike, *,
 
     Broadcast together; two numbers give two 0-d arrays. It does not depend on the geometry (``geometry`` is
     checked, for a uniform signature).
+
+    Args:
+        theta, beta: (...) leg angles (rad), broadcast together; theta in [17 deg, 160 deg].
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (phi_L, phi_R) (rad), each of the broadcast shape.
     """
     if geometry is not None:
         _geometry(geometry)
@@ -434,6 +446,13 @@ def theta_beta(phi_L: ArrayLike, phi_R: ArrayLike, *,
 
     theta is not range-checked here (the motors can be commanded anywhere; the linkage cannot). Independent of
     the geometry (``geometry`` is checked, for a uniform signature).
+
+    Args:
+        phi_L, phi_R: (...) motor angles (rad), broadcast together.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (theta, beta) (rad), each of the broadcast shape.
     """
     if geometry is not None:
         _geometry(geometry)

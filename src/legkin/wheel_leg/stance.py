@@ -420,6 +420,17 @@ def stance_ik_all(target: ArrayLike, leg: Leg, *, normal: ArrayLike = _Z, r: flo
     The search is the module docstring's (:mod:`legkin.wheel_leg.stance`). Sorted by |gamma|, then theta.
     ``limits=True``: only |gamma| <= ABAD_LIMIT (theta is always in [17, 160] deg).
 
+    Args:
+        target: (..., 3) ground-contact points in {R} (m).
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        normal: the ground normal (3,) in {R}.
+        r: tyre thickness (m).
+        limits: keep only solutions inside the ABAD limits.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (..., S, 3) every (theta, beta, gamma) (rad), NaN rows padding a batch to the largest count S.
+
     Raises:
         InvalidInputError: NaN/inf/complex/wrong shapes, a zero normal.
         InvalidParameterError: unknown leg, r out of range, geometry not a Geometry.
@@ -462,6 +473,19 @@ def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = _Z, q_near: Ar
 
     Raises (single target): UnreachableError (no solution), JointLimitError (solutions only outside the limits),
     InvalidInputError (bad input). A batch gives NaN and mask False instead.
+
+    Args:
+        target: (..., 3) ground-contact points in {R} (m).
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        normal: the ground normal (3,) in {R} (any nonzero length).
+        q_near: (..., 3) the configuration to stay near (rad).
+        r: tyre thickness (m).
+        limits: keep only answers inside the ABAD limits.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+        return_mask: also return the mask of solved targets (batch).
+
+    Returns:
+        (..., 3) (theta, beta, gamma) (rad), NaN where a batch item is not solved; then the mask, if asked.
     """
     TH, TAB, RUNS, NRUN, K, KC, gargs = _consts(leg, r, geometry)
     if (normal is _Z and type(limits) is bool and return_mask is False and _plain(target)

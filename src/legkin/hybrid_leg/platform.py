@@ -249,10 +249,8 @@ def motor_jacobian(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *
     Infinite (NaN here) on the reach boundary, where ``d_i . dS_i/dtheta_i = 0``.
 
     Args:
-        roll, pitch: platform angles (rad), broadcast together.
-        branch: the motor branch pair (b1, b2), each +1 or -1.
-        geometry: the geometry (universal centre); None = the default.
-        return_mask: also return the mask of successes.
+        roll, pitch: platform angles (rad), broadcast together; branch, geometry, return_mask: as
+            :func:`motor_angles`.
 
     Returns:
         (..., 2, 2) dtheta/d(roll, pitch) (rad/rad); then the mask, if asked.
@@ -298,10 +296,8 @@ def assembly_mode(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *,
     0-d integer array.
 
     Args:
-        roll, pitch: platform angles (rad), broadcast together.
-        branch: the motor branch pair (b1, b2), each +1 or -1.
-        geometry: the geometry (universal centre); None = the default.
-        return_mask: also return the mask of successes.
+        roll, pitch: platform angles (rad), broadcast together; branch, geometry, return_mask: as
+            :func:`motor_angles`.
 
     Returns:
         (...) +1 or -1 (an integer array); then the mask, if asked.

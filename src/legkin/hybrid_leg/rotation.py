@@ -196,10 +196,8 @@ def sphere_joint_angles(rotation: ArrayLike, branch: Branch = (1, 1), *, geometr
     closure itself and has no joint angles.
 
     Args:
-        rotation: (..., 3, 3) platform rotation matrices.
-        branch: the motor branch pair (b1, b2), each +1 or -1.
-        geometry: the geometry (universal centre); None = the default.
-        return_mask: also return the mask of successes.
+        rotation: (..., 3, 3) platform rotation matrices; branch, geometry, return_mask: as
+            :func:`motor_angles_from_rotation`.
 
     Returns:
         (..., 2, 3) the z-y-x angles (rad) of the two lever-tip spheres; then the mask, if asked.

@@ -10,7 +10,8 @@ The public API, re-exported from the modules that implement it (each kernel besi
 * :mod:`.forward`: the closed sub-chain's forward kinematics (:func:`platform_orientation`, :func:`platform_poses`;
   the degree-8 polynomial of :mod:`.polynomial`);
 * :mod:`.foot`: the foot (eqs 17, 18, 20), the leg's forward kinematics :func:`fk` and :func:`jacobian`;
-* :mod:`.foot_inverse`: the foot IK :func:`ik`, :func:`ik_all`, :func:`foot_platform_ik`.
+* :mod:`.foot_inverse`: the foot IK :func:`ik`, :func:`ik_all` (every branch; :func:`ik_branches` with their modes),
+  :func:`foot_platform_ik`.
 
 Assembly modes: :func:`fk`, :func:`jacobian`, :func:`platform_orientation` and :func:`ik` take ``branch`` and
 ``assembly`` (:func:`assembly_mode`), by default ``(1, 1)`` and ``+1``, the mode of the SRDF reference pose

@@ -59,7 +59,7 @@ CASES = [
      legkin.InvalidInputError),
     ("tripod", "ik((0, pi))  (the flip)", lambda: at.ik(np.array([0.0, math.pi])), legkin.SingularityError),
     ("tripod", "ik((0.2 + 1j, 0))", lambda: at.ik(np.array([0.2 + 1j, 0.0])), legkin.InvalidInputError),
-    ("tripod", "ik(0.2, -0.1, d=nan)  (deprecated form)", lambda: at.ik(0.2, -0.1, d=NAN),
+    ("tripod", "ik(u, return_mask='yes')", lambda: at.ik(np.array([0.2, -0.1]), return_mask="yes"),
      legkin.InvalidParameterError),
     # ---- wheel_leg
     ("wheel_leg", "IKOptions(tol=nan)", lambda: wl.IKOptions(tol=NAN), legkin.InvalidParameterError),

@@ -24,9 +24,9 @@ def _misuse(tmp_path):
     a_file = tmp_path / "a_file"
     a_file.write_text("x")
     return [
-        (["check", "--seed", "-1"], "--random-seed"),
         (["check", "--random-seed", "-1"], "--random-seed"),
-        (["check", "--seed", "x"], "--random-seed"),
+        (["check", "--seed", "1"], "unrecognized arguments: --seed"),
+        (["check", "--random-seed", "x"], "--random-seed"),
         (["check", "--samples", "0"], "--samples"),
         (["check", "--samples", "-5"], "--samples"),
         (["check", "--samples", "1.5"], "--samples"),
@@ -49,7 +49,7 @@ def _misuse(tmp_path):
         (["view", "quadruped", "--animate", "foot_circles", "--pose", "standing"], "--animate"),
         (["view", "quadruped", "--pose", "standing", "--q", "0"], "not allowed"),
         (["bench", "--n", "0"], "--n"),
-        (["bench", "--seed", "-1"], "--random-seed"),
+        (["bench", "--random-seed", "-1"], "--random-seed"),
         (["bench", "--json", f"{NO_DIR}/b.json"], "does not exist"),
         (["bench", "no_such_robot"], "known models"),
         (["generate", "no_such_robot"], "known models"),
@@ -77,7 +77,7 @@ def test_misuse_is_one_line_and_status_2(case, tmp_path, capsys):
     "argv",
     [
         ["view", "tripod", "--html", f"{NO_DIR}/v.html"],
-        ["check", "--seed", "-1"],
+        ["check", "--random-seed", "-1"],
         ["check", "--samples", "0"],
         ["check", "--json", f"{NO_DIR}/c.json"],
         ["view", "tripod", "--q", "x"],
@@ -141,7 +141,7 @@ def test_check_passes_ik_options(monkeypatch, capsys):
     assert main(["check", "wheel_leg", "--samples", "30"]) == 0
     assert seen["ik_targets"] is None and seen["classify"] == 2000 and seen["samples"] == 30
     assert seen["models"] == ["wheel_leg"]
-    assert main(["check", "--ik-targets", "7", "--classify-all", "--seed", "3"]) == 0
+    assert main(["check", "--ik-targets", "7", "--classify-all", "--random-seed", "3"]) == 0
     assert seen["ik_targets"] == 7 and seen["classify"] is None and seen["seed"] == 3
     assert seen["models"] is None
     assert seen["progress"] is False  # stderr is captured, not a terminal
@@ -219,7 +219,7 @@ def test_bench_progress_bar(capsys, monkeypatch):
         return {"models": {}, "single": {}, "skipped": {}}
 
     monkeypatch.setattr(bench, "run_bench", fake)
-    assert main(["bench", "--quiet", "--n", "5", "--seed", "2"]) == 0
+    assert main(["bench", "--quiet", "--n", "5", "--random-seed", "2"]) == 0
     assert seen == {"quiet": True, "seed": 2, "n": 5}
 
 

@@ -217,7 +217,7 @@ def test_solve_loops_nan_held_value_names_the_joint(tripod):
         ({"tol": INF}, ["tol", "(0, inf)", "inf"]),
         ({"tol": "1e-9"}, ["tol", "real number"]),
         ({"tol": 1e-9 + 0j}, ["tol", "real number"]),
-        ({"max_iter": -1}, ["max_iter", ">= 0", "-1"]),
+        ({"max_iter": -1}, ["max_iter", "[0, inf)", "-1"]),
         ({"max_iter": 2.5}, ["max_iter", "integer", "2.5"]),
         ({"max_iter": True}, ["max_iter", "integer"]),
         ({"max_iter": NAN}, ["max_iter", "integer"]),

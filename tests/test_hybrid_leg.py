@@ -1,4 +1,4 @@
-"""Tests of the hybrid leg: model, loops, mobility, analytic kinematics (legkin.analytic.hybrid_leg), checks."""
+"""Tests of the hybrid leg: model, loops, mobility, analytic kinematics (legkin.hybrid_leg), checks."""
 
 from __future__ import annotations
 
@@ -278,7 +278,7 @@ def test_foot_ik_near_ll_branch_merge(roll, log_alpha, side):
 
 def test_foot_ik_all_branches():
     p = ah.foot_position_from_platform(0.1, 0.2, -0.1)
-    every = ah.ik_all(p)
+    every = ah.ik_branches(p)
     allb, ok = every.motors, every.mask
     assert allb.shape == (16, 3) and ok.shape == (16,)
     assert ok.sum() >= 2 and ok[0]
@@ -308,7 +308,7 @@ def test_batch_shapes_and_scalar_wrapper():
     assert np.array_equal(ah.jacobian(_q(th[1, 2, 0], th[1, 2, 1], 0.0)), jac[1, 2])
     sol = ah.ik(foot)
     assert sol.shape == (3, 4, 3)
-    assert ah.ik_all(foot).motors.shape == (3, 4, 16, 3)
+    assert ah.ik_all(foot).shape == (3, 4, 16, 3)
     assert ah.sphere_joint_angles(ah.platform_rotation(r, p)).shape == (3, 4, 2, 3)
 
 
@@ -391,7 +391,7 @@ def test_unreachable_foot():
             ah.ik(p)
         with pytest.raises(UnreachableError):
             ah.foot_platform_ik(p)
-        assert not ah.ik_all(p).mask.any()
+        assert not ah.ik_branches(p).mask.any()
     # on the LL arc but beyond the motors on the extension side (ll_branch -1): needs the platform pitched
     # ~ -90 deg. (The default search also tries ll_branch +1, which reaches it in the neutral mode at pitch 0.66.)
     beyond = ah.foot_position_from_platform(0.0, -1.5, -0.2)
@@ -550,7 +550,7 @@ def test_other_assembly_mode_raises_and_modes_reach_it():
         fk, fk_ok = ah.fk(_q(m[:1], m[1:2], m[2:]), return_mask=True)
         assert not fk_ok[0] or np.linalg.norm(fk[0] - p) > 1e-6
     # all modes on request
-    every = ah.ik_all(p)
+    every = ah.ik_branches(p)
     assert every.valid.sum() == len(err.modes) and not (every.valid & (every.assembly == 1))[[0, 4, 8, 12]].any()
 
 
@@ -590,10 +590,15 @@ def test_ik_all_fk_certificate_agrees_with_forward_kinematics():
 def test_joint_limit_error():
     """Reachable only with |roll| > pi/2 (LCS_x limit): JointLimitError, mask False; no answer outside the limits."""
     p = ah.foot_position_from_platform(-0.06284610557749781, -1.0207832560887642, 0.23457715140921453)
-    with pytest.raises(legkin.JointLimitError, match="outside the joint limits"):
+    with pytest.raises(legkin.JointLimitError, match="outside the joint limits") as info:
         ah.ik(p)
-    every = ah.ik_all(p)
+    err = info.value  # the data: the first platform joint (LCS_x: roll, LCS_y: pitch) outside its URDF limits
+    assert err.joint in ("LCS_x", "LCS_y") and (err.lower, err.upper) == (-ah.PLATFORM_LIMIT, ah.PLATFORM_LIMIT)
+    assert abs(err.value) > ah.PLATFORM_LIMIT and np.array_equal(err.target, p)
+    every = ah.ik_branches(p)
     assert every.mask.any() and not every.within_limits[every.mask].any()
+    k = 1 if err.joint == "LCS_x" else 2  # that joint's value is the branch's roll or pitch
+    assert np.isclose(every.pose[every.mask][:, k], err.value).any()
     assert not ah.ik(p[None], return_mask=True)[1][0]
 
 
@@ -659,16 +664,10 @@ _BAD_KEYWORDS = [
     ("ik", {"branch": (1, 1j)}, "branch"),
     ("ik", {"assembly": 0}, "assembly"),
     ("ik", {"assembly": "all"}, "assembly"),
-    ("foot_ik", {"starting_value": float("inf")}, "starting_value"),
-    ("foot_ik", {"starting_value": 4.0}, "starting_value"),
-    ("foot_ik", {"starting_value": np.array([0.1, 0.2])}, "starting_value"),
-    ("foot_ik", {"starting_value": 1j}, "starting_value"),
-    ("foot_ik", {"starting_value": 10**400}, "starting_value"),
-    ("foot_ik", {"all_branches": 1}, "all_branches"),
+    ("ik_all", {"return_mask": 1}, "return_mask"),
     ("ik", {"return_mask": "yes"}, "return_mask"),
     ("foot_platform_ik", {"ll_branch": np.array([1])}, "ll_branch"),
     ("foot_platform_ik", {"assembly": 2}, "assembly"),
-    ("foot_ik_solutions", {"starting_value": None}, "starting_value"),
 ]
 
 
@@ -676,8 +675,7 @@ _BAD_KEYWORDS = [
                          ids=[f"{f}-{n}-{i}" for i, (f, _, n) in enumerate(_BAD_KEYWORDS)])
 def test_bad_keyword_arguments(func, kwargs, name):
     """Defect 3: every keyword validated, a legkin error naming it and its valid values (never a numpy error)."""
-    with pytest.raises(InvalidParameterError) as info, warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)  # foot_ik, foot_ik_solutions: the deprecated aliases
+    with pytest.raises(InvalidParameterError) as info:
         getattr(ah, func)([0.4, 0.0, -0.2], **kwargs)
     assert isinstance(info.value, InvalidInputError)
     assert name in str(info.value) and repr(kwargs[name])[:20] in str(info.value)
@@ -693,7 +691,6 @@ def test_bad_keyword_arguments(func, kwargs, name):
         lambda: ah.platform_orientation(0.3, -0.3, max_iter=0),
         lambda: ah.platform_orientation(0.3, -0.3, max_iter=2.5),
         lambda: ah.platform_orientation(0.3, -0.3, max_iter=True),
-        lambda: ah.platform_orientation(0.3, -0.3, steps=-1),
         lambda: ah.platform_orientation(0.3, -0.3, assembly=-2),
         lambda: ah.platform_orientation(0.3, -0.3, branch=[1, 1, 1]),
         lambda: ah.platform_poses(0.3, -0.3, tol=-1.0),
@@ -715,7 +712,7 @@ def test_bad_parameters_of_other_functions(call):
     [
         lambda: ah.ik([[0.4, 0.0, -0.2], [0.4, 0.0]]),
         lambda: ah.ik(["0.4", "0", "-0.2"]),
-        lambda: ah.ik_all([0.4, 0.0, float("nan")]),
+        lambda: ah.ik_branches([0.4, 0.0, float("nan")]),
         lambda: ah.foot_platform_ik(np.zeros(2)),
         lambda: ah.platform_poses([0.3, 0.2], [0.1, 0.2, 0.3]),
         lambda: ah.platform_orientation(0.3, -0.3, q_start=[0.0, float("nan")]),
@@ -738,10 +735,10 @@ def test_extreme_inputs_give_nan_and_mask_or_legkin_errors():
         for p in big[:4]:
             with pytest.raises(legkin.LegkinError):
                 f(p)
-    every = ah.ik_all(big)
+    every = ah.ik_branches(big)
     assert not every.mask[[0, 1, 3]].any()
     assert ah.ik(np.zeros((0, 3))).shape == (0, 3)
-    assert ah.ik_all(np.zeros((0, 3))).motors.shape == (0, 16, 3)
+    assert ah.ik_all(np.zeros((0, 3))).shape == (0, 16, 3)
     assert ah.fk(_q(np.zeros(0), np.zeros(0), np.zeros(0))).shape == (0, 3)
     assert ah.platform_orientation(np.zeros((2, 0)), np.zeros((2, 0))).shape == (2, 0, 2)
     assert ah.platform_poses(np.zeros(0), np.zeros(0)).x.shape == (0, 8, 2)
@@ -860,7 +857,7 @@ def test_ik_contract_property(case):
         assert ah.assembly_mode(x[0], x[1]) == 1  # (d) the default mode
         return
     assert np.all(np.isnan(sol[0]))
-    every = ah.ik_all(p)
+    every = ah.ik_branches(p)
     if isinstance(err, legkin.AssemblyModeError):
         assert not (every.valid & (every.assembly == 1))[[0, 4, 8, 12]].any()  # no default-mode answer ...
         for mode in err.modes[:3]:  # ... but each named mode reaches it
@@ -908,39 +905,24 @@ def test_starting_value_shifts_ll_only():
     assert not np.allclose(ah.fk(sol), p)
 
 
-def test_deprecated_names_warn_and_agree():
+def test_ik_all_is_the_motors_and_mask_of_ik_branches():
+    """ik_all: (..., 16, 3) motors, NaN rows exactly where ik_branches says a branch does not exist; the mask is
+    that; a single target without any branch raises, a batch gives all-NaN rows."""
     q = np.array([*ah.motor_angles(0.1, 0.2), 1.0])
     p = ah.fk(q)
-    geo = ah.Geometry(starting_value=0.1)
-    with pytest.warns(DeprecationWarning, match="foot_position"):
-        assert np.array_equal(ah.foot_position(q[0], q[1], q[2]), p)
-    with pytest.warns(DeprecationWarning, match="starting_value"), pytest.warns(DeprecationWarning, match="foot_pos"):
-        assert np.array_equal(ah.foot_position(q[0], q[1], q[2], starting_value=0.1), ah.fk(q, geometry=geo))
-    with pytest.warns(DeprecationWarning, match="foot_jacobian"):
-        assert np.array_equal(ah.foot_jacobian(*q), ah.jacobian(q))
-    with pytest.warns(DeprecationWarning, match="foot_ik"):
-        assert np.array_equal(ah.foot_ik(p), ah.ik(p))
-    with pytest.warns(DeprecationWarning, match="foot_ik"):
-        allb, ok = ah.foot_ik(p, all_branches=True, return_mask=True)
-    every = ah.ik_all(p)
-    assert np.array_equal(allb, every.motors, equal_nan=True) and np.array_equal(ok, every.mask)
-    with pytest.warns(DeprecationWarning, match="foot_ik_solutions"):
-        old = ah.foot_ik_solutions(p)
-    assert all(np.array_equal(a, b, equal_nan=True) for a, b in zip(old, every))
-    with pytest.warns(DeprecationWarning, match="starting_value"):
-        assert ah.ll_angle(1.0, 0.1) == ah.ll_angle(1.0, geometry=geo)
-    with pytest.warns(DeprecationWarning, match="starting_value"):
-        assert ah.extension_motor_angle(0.0, 0.1) == ah.extension_motor_angle(0.0, geometry=geo)
-    with pytest.warns(DeprecationWarning, match="guess"):
-        assert np.array_equal(ah.platform_orientation(q[0], q[1], guess=[0.0, 0.0]),
-                              ah.platform_orientation(q[0], q[1], q_start=[0.0, 0.0]))
-    with pytest.warns(DeprecationWarning, match="legkin.analytic.hybrid_leg"):
-        import importlib
-        import sys
-
-        sys.modules.pop("legkin.analytic.hybrid_leg", None)
-        shim = importlib.import_module("legkin.analytic.hybrid_leg")
-    assert shim.fk is ah.fk and shim.foot_ik is ah.foot_ik
+    far = np.array([0.0, 0.0, -5.0])
+    every = ah.ik_branches(np.stack([p, far]))
+    sols, mask = ah.ik_all(np.stack([p, far]), return_mask=True)
+    assert sols.shape == (2, 16, 3) and mask.shape == (2, 16)
+    assert np.array_equal(mask, every.mask) and mask[0].any() and not mask[1].any()
+    assert np.array_equal(np.isnan(sols).any(-1), ~mask)
+    assert np.array_equal(sols[mask], every.motors[mask])
+    single, single_mask = ah.ik_all(p, return_mask=True)
+    assert np.array_equal(single, sols[0], equal_nan=True) and np.array_equal(single_mask, mask[0])
+    assert np.array_equal(ah.ik_all(p), single, equal_nan=True)
+    with pytest.raises(legkin.UnreachableError) as info:
+        ah.ik_all(far)
+    assert np.array_equal(info.value.target, far)
 
 
 def test_new_api_does_not_warn():
@@ -950,7 +932,7 @@ def test_new_api_does_not_warn():
         p = ah.fk(q)
         ah.jacobian(q[None])
         ah.ik(p, q_near=q)
-        ah.ik_all(p)
+        ah.ik_branches(p)
         ah.platform_orientation(q[0], q[1], q_start=[0.0, 0.0])
         ah.ll_angle(np.zeros(2), geometry=ah.Geometry())
 
@@ -958,7 +940,7 @@ def test_new_api_does_not_warn():
 def test_q_near_picks_the_nearest_valid_branch():
     """Of the candidates the default IK keeps (in the mode, in the limits), q_near selects the nearest in the joints."""
     p = ah.fk(np.array([*ah.motor_angles(0.1, 0.2), 1.0]))  # both LL sides reach it in the mode, in the limits
-    every = ah.ik_all(p)
+    every = ah.ik_branches(p)
     keep = every.valid & (every.assembly == 1) & np.array([b[2:] == (1, 1) for b in ah.FOOT_IK_BRANCHES])
     assert keep.sum() >= 2
     first = ah.ik(p)
@@ -971,7 +953,7 @@ def test_q_near_picks_the_nearest_valid_branch():
 
 
 def test_docs_examples_run():
-    """The code blocks of docs/hybrid_leg.md run (and their asserts hold) without a deprecation warning."""
+    """The code blocks of docs/hybrid_leg.md run (and their asserts hold) without a warning."""
     import pathlib
     import re
 

@@ -88,7 +88,7 @@ FREE = np.array([False, True, True])
         (np.zeros(3), np.ones(2, bool), {}, ["free", "(3,)"]),
         (np.zeros(3), FREE, {"tol": np.nan}, ["tol", "(0, inf)"]),
         (np.zeros(3), FREE, {"tol": -1.0}, ["tol", "(0, inf)"]),
-        (np.zeros(3), FREE, {"max_iter": -1}, ["max_iter", ">= 0"]),
+        (np.zeros(3), FREE, {"max_iter": -1}, ["max_iter", "[0, inf)"]),
         (np.zeros(3), FREE, {"max_iter": 1.5}, ["max_iter", "integer"]),
         (np.zeros(3), FREE, {"damping": 0.0}, ["damping", "(0, inf)"]),
     ],
@@ -128,15 +128,16 @@ def test_breakdown_becomes_loop_closure_error(fourbar, monkeypatch):
         loops.solve(q, FREE, 1e-12, 50)
 
 
-def test_check_real_and_check_count():
-    from legkin.loops import check_count, check_real
+def test_the_option_checkers_take_numpy_scalars_and_refuse_the_rest():
+    """legkin._batch.check_number / check_integer: the one option checker of every module (loops, robot, mjcf)."""
+    from legkin._batch import check_integer, check_number
 
-    assert check_real("x", np.float32(0.5), 0.0, 1.0) == 0.5
-    assert check_real("x", np.array(0.25), 0.0, 1.0) == 0.25
-    assert check_count("n", np.int64(3)) == 3
+    assert check_number(np.float32(0.5), "x", 0.0, 1.0) == 0.5
+    assert check_number(np.array(0.25), "x", 0.0, 1.0) == 0.25
+    assert check_integer(np.int64(3), "n", 0) == 3
     for bad in (np.nan, np.inf, 2.0, -0.1, True, "0.5", 0.5j, [0.5], np.array([0.5])):
-        with pytest.raises(InvalidInputError, match=r"x must be .*\[0, 1\]"):
-            check_real("x", bad, 0.0, 1.0)
+        with pytest.raises(InvalidInputError, match=r"x.* must be .*\[0, 1\]"):
+            check_number(bad, "x", 0.0, 1.0)
     for bad in (-1, 2.5, np.nan, True, "3", None):
-        with pytest.raises(InvalidInputError, match="n must be an integer >= 0"):
-            check_count("n", bad)
+        with pytest.raises(InvalidInputError, match=r"n.* must be an integer in \[0, inf\)"):
+            check_integer(bad, "n", 0)

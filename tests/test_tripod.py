@@ -112,26 +112,6 @@ def test_solve_loops_from_home_reaches_tilted_pose(robot):
     assert np.abs(q - qt).max() < 1e-10
 
 
-# ------------------------------------------------------------------------------------------ the deprecated forms
-def test_deprecated_forms_still_work_and_warn():
-    """The 0.1 call forms (one release): same answers as the 0.2 API, each with a DeprecationWarning."""
-    u = np.array([0.3, -0.4])
-    q = at.ik_joints(u)
-    with pytest.warns(DeprecationWarning, match="deprecated"):
-        assert np.array_equal(at.ik(0.3, -0.4, alpha=at.ALPHA), q)
-    with pytest.warns(DeprecationWarning, match="deprecated"):
-        y, z, inc = at.fk(q[0], q[4], q[8])
-    assert np.array_equal([y, z], at.fk(q[MOTORS])) and inc < 1e-12
-    with pytest.warns(DeprecationWarning, match="deprecated"):
-        assert np.array_equal(at.actuation_jacobian(u), at.jacobian(u))
-    with pytest.warns(DeprecationWarning, match="deprecated"):
-        assert np.array_equal(at.leg_transform(q[:4], at.ETA[0]), at.leg_transform(q[:4], "A"))
-    with pytest.warns(DeprecationWarning, match="legkin.analytic"):
-        from legkin.analytic import tripod as old
-
-        assert old.ik is at.ik
-
-
 # ------------------------------------------------------------------------------------------ properties
 @settings(max_examples=60, deadline=None)
 @given(st.floats(-math.pi, math.pi), st.floats(-10, -3), st.sampled_from(ALPHAS), st.integers(0, 2))

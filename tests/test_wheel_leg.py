@@ -163,7 +163,7 @@ def test_wheel_mode_rim_is_the_wheel(alpha, beta):
     assert np.abs(p - [z.real, z.imag, 0.0]).max() < 1e-15
     # the seed formula is the same circle, at the foot radius, in wheel mode
     ps = wl.rim_point_seed(17 * DEG, beta, alpha, 0.0)
-    zs = (0.1 + wl.FOOT_OFFSET) * np.exp(1j * (beta + math.pi / 2 + math.pi + alpha))
+    zs = (0.1 + wl.TYRE_THICKNESS) * np.exp(1j * (beta + math.pi / 2 + math.pi + alpha))
     assert np.abs(ps - [zs.real, zs.imag, 0.0]).max() < 1e-15
 
 
@@ -523,8 +523,12 @@ def test_ik_reachable_only_outside_the_abad_limits():
     sols = wl.ik(target, "FL", limits=False, return_info=True)[1].solutions
     sols = sols[~np.isnan(sols[:, 0])]
     assert sols.shape[0] >= 1 and np.all(np.abs(sols[:, 2]) > wl.ABAD_LIMIT)  # every solution outside the limits
-    with pytest.raises(legkin.JointLimitError, match=r"ABAD angle outside its limits \[-pi/2, pi/2\]"):
+    with pytest.raises(legkin.JointLimitError, match=r"ABAD angle outside its limits \[-pi/2, pi/2\]") as info:
         wl.ik(target, "FL")
+    err = info.value  # the data: the URDF joint FL_abad, its limits, and gamma of the first solution
+    assert (err.joint, err.lower, err.upper) == ("FL_abad", -wl.ABAD_LIMIT, wl.ABAD_LIMIT)
+    assert err.value == sols[0, 2] and np.array_equal(err.target, target)
+    assert err.distance == pytest.approx(np.linalg.norm(err.closest - target), abs=0.0)
     qs, ok = wl.ik(np.stack([target, target]), "FL", return_mask=True)
     assert not ok.any() and np.isnan(qs).all()
     assert np.linalg.norm(wl.fk(wl.ik(target, "FL", limits=False), "FL")
@@ -606,7 +610,7 @@ def test_ik_info_counts_evaluations():
             np.testing.assert_array_equal(info.evaluations, info.iterations + 1)
 
 
-# ---------------------------------------------------------------- API of 0.2: new names, old names kept
+# ---------------------------------------------------------------- API of 0.2
 def test_ik_all_lists_every_solution_and_ik_picks_the_first_in_limits():
     q_true = np.array([1.4, 0.4, -0.3])
     target = wl.fk(q_true, "FR", alpha=0.3, w=0.01)
@@ -618,7 +622,9 @@ def test_ik_all_lists_every_solution_and_ik_picks_the_first_in_limits():
     np.testing.assert_array_equal(wl.ik(target, "FR", alpha=0.3, w=0.01), inside[0])
     far = np.array([0.3, 0.2, -0.6])
     batch, ok = wl.ik_all(np.stack([target, far]), "FR", alpha=0.3, w=0.01, return_mask=True)
-    assert ok.tolist() == [True, False] and np.isnan(batch[1]).all()
+    assert ok.shape == batch.shape[:-1] and ok[0, : len(sols)].all() and not ok[0, len(sols):].any()
+    assert not ok[1].any() and np.isnan(batch[1]).all()
+    assert np.array_equal(np.isnan(batch).any(-1), ~ok)
     np.testing.assert_array_equal(batch[0, : len(sols)], sols)
     with pytest.raises(legkin.UnreachableError):
         wl.ik_all(far, "FR", alpha=0.3, w=0.01)
@@ -662,39 +668,22 @@ def test_geometry_from_params_and_keyword():
             fn()
 
 
-def test_legkin_01_calls_warn_and_agree():
+def test_leg_is_required_and_0_1_call_forms_are_gone():
+    """legkin 0.2: ``leg`` is required (no "FL" default), and the 0.1 forms (positional alpha, w; q0=, tol=;
+    method="seed", rim="seed"; contact_point) are refused with a plain error."""
     q = np.array([1.2, 0.3, 0.2])
     target = wl.fk(q, "FL", alpha=0.5, w=0.01)
-    with pytest.warns(DeprecationWarning, match="fk"):
-        np.testing.assert_array_equal(wl.contact_point(q, 0.5, 0.01, "FL"), target)
-    with pytest.warns(DeprecationWarning, match="jacobian"):
-        np.testing.assert_array_equal(wl.contact_jacobian(q, 0.5, 0.01, "FL"), wl.jacobian(q, "FL", alpha=0.5, w=0.01))
-    new = wl.ik(target, "FL", alpha=0.5, w=0.01)
-    for call in (lambda: wl.ik(target, 0.5, 0.01, "FL"), lambda: wl.ik(target, 0.5, 0.01, leg="FL"),
-                 lambda: wl.ik(target, alpha=0.5, w=0.01), lambda: wl.ik(target, "FL", alpha=0.5, w=0.01, tol=1e-12)):
-        with pytest.warns(DeprecationWarning, match="legkin 0.1"):
-            np.testing.assert_array_equal(call(), new)
-    with pytest.warns(DeprecationWarning, match="q_near"):
-        np.testing.assert_array_equal(wl.ik(target, 0.5, 0.01, "FL", q0=q + 0.01),
-                                      wl.ik(target, "FL", alpha=0.5, w=0.01, q_near=q + 0.01))
-    with pytest.warns(DeprecationWarning, match="q_start"):
-        np.testing.assert_array_equal(wl.ik(target, 0.5, 0.01, "FL", q0=q + 0.01, method="damped"),
-                                      wl.ik(target, "FL", alpha=0.5, w=0.01, q_start=q + 0.01, method="damped"))
-    with pytest.warns(DeprecationWarning, match="geometry"):
-        assert wl.linkage_constants(0.12) == wl.linkage_constants(geometry=wl.Geometry(R=0.12))
-    with pytest.warns(DeprecationWarning, match="geometry"):
-        np.testing.assert_array_equal(wl.module_origin("RR", wl.Geometry(W_body=0.3)),
-                                      wl.module_origin("RR", geometry=wl.Geometry(W_body=0.3)))
-    with pytest.warns(DeprecationWarning, match="gauss_newton_fd"):
-        old = wl.ik(target, "FL", alpha=0.5, w=0.01, method="seed")
-    np.testing.assert_array_equal(old, wl.ik(target, "FL", alpha=0.5, w=0.01, method="gauss_newton_fd"))
-    with pytest.warns(DeprecationWarning, match="three_arc"):
-        old = wl.fk(q, "FL", alpha=0.5, rim="seed")
-    np.testing.assert_array_equal(old, wl.fk(q, "FL", alpha=0.5, rim="three_arc"))
+    with pytest.raises(TypeError):
+        wl.ik(target, alpha=0.5, w=0.01)  # type: ignore[call-overload]
+    with pytest.raises(TypeError):
+        wl.ik(target, "FL", 0.5)  # type: ignore[call-overload]
     with pytest.raises(TypeError, match="unexpected keyword"):
-        wl.ik(target, "FL", q00=q)
-    with pytest.raises(TypeError, match="2 positional arguments"):
-        wl.ik(target, "FL", 0.5)
+        wl.ik(target, "FL", q0=q)  # type: ignore[call-overload]
+    with pytest.raises(legkin.InvalidParameterError, match="method"):
+        wl.ik(target, "FL", method="seed")  # type: ignore[arg-type]
+    with pytest.raises(legkin.InvalidParameterError, match="rim"):
+        wl.fk(q, "FL", rim="seed")  # type: ignore[arg-type]
+    assert not hasattr(wl, "contact_point") and not hasattr(wl, "FOOT_OFFSET")
 
 
 def test_no_warning_from_the_new_api():
@@ -715,7 +704,7 @@ def test_kinematics_module_reexports_the_public_api():
 
     for name in kinematics.__all__:
         assert getattr(wheel_leg, name) is getattr(kinematics, name)
-    assert {"fk", "ik", "ik_all", "jacobian", "Geometry", "IKOptions", "contact_point"} <= set(kinematics.__all__)
+    assert {"fk", "ik", "ik_all", "jacobian", "Geometry", "IKOptions"} <= set(kinematics.__all__)
 
 
 def test_docs_examples_run():

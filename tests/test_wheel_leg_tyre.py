@@ -223,8 +223,9 @@ def test_stance_ik_single_equals_batch_and_rules():
     t_out = gd.ground_contact(np.array([1.2, 0.3, 2.6]), "FL").point
     sols = gd.stance_ik_all(t_out, "FL")
     assert sols.shape[0] >= 1 and np.all(np.abs(sols[:, 2]) > ABAD_LIMIT)
-    with pytest.raises(JointLimitError):
+    with pytest.raises(JointLimitError) as info:
         gd.stance_ik(t_out, "FL")
+    assert (info.value.joint, info.value.upper) == ("FL_abad", ABAD_LIMIT) and np.array_equal(info.value.target, t_out)
     assert gd.stance_ik(t_out, "FL", limits=False)[2] == pytest.approx(2.6, abs=1e-9)
 
 

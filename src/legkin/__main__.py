@@ -270,8 +270,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--samples", type=positive_int, default=10_000, help="random samples per check (default 10000)")
     p.add_argument("--jobs", "-j", type=positive_int, default=None, metavar="N",
                    help="worker processes, one mechanism each (default: the CPUs available, at most 4)")
-    p.add_argument("--random-seed", "--seed", dest="seed", type=nonnegative_int, default=0, metavar="S",
-                   help="seed of the random samples, an integer >= 0 (default 0; --seed: the 0.1 spelling)")
+    p.add_argument("--random-seed", dest="seed", type=nonnegative_int, default=0, metavar="S",
+                   help="seed of the random samples, an integer >= 0 (default 0)")
     p.add_argument(
         "--ik-targets", type=positive_int, default=None, metavar="N",
         help="random targets of each model's IK robustness row (default: --samples)",
@@ -302,8 +302,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--n", type=positive_int, default=None, help="targets per method (default: per model)")
     p.add_argument("--json", metavar="PATH", type=output_file, help="also write the results as JSON")
     p.add_argument("--quick", action="store_true", help="small run for smoke tests (under a minute)")
-    p.add_argument("--random-seed", "--seed", dest="seed", type=nonnegative_int, default=0, metavar="S",
-                   help="seed of the random samples, an integer >= 0 (default 0; --seed: the 0.1 spelling)")
+    p.add_argument("--random-seed", dest="seed", type=nonnegative_int, default=0, metavar="S",
+                   help="seed of the random samples, an integer >= 0 (default 0)")
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bar on stderr")
     p.set_defaults(func=_cmd_bench)
 

@@ -8,8 +8,9 @@ leading dimensions) returns arrays with NaN where an item fails, and with
 
 from __future__ import annotations
 
+import math
 import numbers
-from typing import Callable
+from typing import Any, Callable, Iterable
 
 import numpy as np
 
@@ -17,6 +18,7 @@ from .errors import InvalidArgumentError, InvalidInputError
 
 __all__ = [
     "as_input",
+    "dispatch",
     "as_angles",
     "finish",
     "real_number",
@@ -24,11 +26,22 @@ __all__ = [
     "check_integer",
     "check_flag",
     "check_choice",
+    "interval_text",
+    "outside",
 ]
 
 
-def as_input(x, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = False) -> np.ndarray:
+def as_input(x: object, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = False) -> np.ndarray:
     """Return ``x`` as a float array whose trailing shape is ``core``.
+
+    Args:
+        x: the input, array-like.
+        name: its name in the messages.
+        core: the trailing shape of one item (``()``: scalars).
+        allow_nan: accept NaN and inf entries.
+
+    Returns:
+        a float64 array (``x`` itself when it already is one).
 
     Raises:
         InvalidInputError: (a ``ValueError``) wrong trailing shape, NaN/inf entries, complex or non-numeric
@@ -53,8 +66,19 @@ def as_input(x, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = Fals
     return arr
 
 
-def as_angles(*xs, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
-    """Check scalar-per-item inputs (angles) and broadcast them together."""
+def as_angles(*xs: object, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
+    """Check scalar-per-item inputs (angles) and broadcast them together.
+
+    Args:
+        *xs: the inputs (rad, or any unit), array-like.
+        names: their names in the messages.
+
+    Returns:
+        the float64 arrays, each of the broadcast shape (writeable).
+
+    Raises:
+        InvalidInputError: an input :func:`as_input` refuses, or shapes that do not broadcast.
+    """
     arrs = [as_input(x, n) for x, n in zip(xs, names)]
     try:
         shape = np.broadcast_shapes(*(a.shape for a in arrs))
@@ -65,13 +89,79 @@ def as_angles(*xs, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
     return tuple(a if a.shape == shape else np.broadcast_to(a, shape).copy() for a in arrs)
 
 
+#: The float64 dtype: the fast path tests ``x.dtype is F64`` (3x cheaper than ``== np.float64``).
+F64 = np.dtype(np.float64)
+_TRUE = np.asarray(True)
+_TRUE.setflags(write=False)
+
+
+def dispatch(
+    x: object,
+    name: str,
+    core: tuple[int, ...],
+    fast: Callable[..., Any],
+    batch: Callable[..., tuple[np.ndarray, np.ndarray]],
+    error: Callable[..., Exception],
+    args: tuple[Any, ...],
+    return_mask: bool,
+) -> Any:
+    """The single/batch rule of a kinematic function of one array argument, written once.
+
+    Three paths, in this order:
+
+    1. **fast**: ``x`` is a float64 ndarray of exactly the ``core`` shape: ``fast(x, *args)`` (the kernel on that
+       item) returns the result, or None when the item is not solved (then path 2 decides, and raises);
+    2. **single call**: any other single input (a list, ints, NaN...) is checked by :func:`as_input` (which raises
+       :class:`~legkin.errors.InvalidInputError`) and run through ``batch`` as one row, so that a single call equals
+       its row of a batch bit for bit; if the row is not solved, ``error(item, out, ok, *args)`` is raised;
+    3. **batch**: leading dimensions: ``batch(rows, *args)`` on the C-contiguous float64 rows ``(n, *core)``.
+
+    ``batch`` returns ``(out, ok)``, ``out`` (n, ...) NaN where not solved, ``ok`` (n,) (or (n, K) for ``ik_all``:
+    then a single item counts as solved when any of its K is). The wrapper only checks its options and binds them
+    in ``args`` (module-level callables: no closure is built on the fast path).
+
+    Args:
+        x: the input, array-like with trailing shape ``core``.
+        name: its name in error messages (``"q"``, ``"target"``).
+        core: the shape of one item, e.g. ``(3,)``.
+        fast: ``fast(item, *args) -> out | (out, ok) | None``: one float64 item straight to the kernel.
+        batch: ``batch(rows, *args) -> (out, ok)``: the compiled loop.
+        error: ``error(item, out, ok, *args) -> Exception``: why the single item ``item`` failed.
+        args: the checked options.
+        return_mask: also return the mask (True / False, already checked).
+
+    Returns:
+        ``out`` (shape ``batch shape + item shape``), or ``(out, mask)`` with ``return_mask``.
+
+    Raises:
+        InvalidInputError: ``x`` is not a finite real array of trailing shape ``core``.
+        LegkinError: ``error``'s, for a single input that is not solved.
+    """
+    if type(x) is np.ndarray and x.dtype is F64 and x.shape == core:
+        res = fast(x, *args)
+        if res is not None:
+            if type(res) is tuple:
+                return res if return_mask else res[0]
+            return (res, _TRUE) if return_mask else res
+    arr = as_input(x, name, core)
+    shape = arr.shape[: arr.ndim - len(core)]
+    rows = np.ascontiguousarray(arr.reshape((-1,) + core))
+    out, ok = batch(rows, *args)
+    if not shape:
+        if not ok[0].any():
+            raise error(arr, out[0], ok[0], *args)
+        return (out[0], np.asarray(ok[0])) if return_mask else out[0]
+    out, ok = out.reshape(shape + out.shape[1:]), ok.reshape(shape + ok.shape[1:])
+    return (out, ok) if return_mask else out
+
+
 def finish(
-    value,
-    ok: np.ndarray,
+    value: Any,
+    ok: Any,
     scalar: bool,
     return_mask: bool,
     error: Callable[[], Exception],
-):
+) -> Any:
     """Apply the scalar/batch rule to a computed result.
 
     Args:
@@ -80,6 +170,9 @@ def finish(
         scalar: True for a single input: raise ``error()`` on failure.
         return_mask: also return the mask.
         error: builds the exception for a failed scalar call (called only then).
+
+    Returns:
+        ``value``, or ``(value, ok)`` (``(*value, ok)`` for a tuple) with ``return_mask``.
     """
     ok = np.asarray(ok, dtype=bool)
     if scalar and not bool(ok):
@@ -91,11 +184,20 @@ def finish(
     return value
 
 
-def real_number(value, name: str, valid) -> float:
+def real_number(value: object, name: str, valid: str | Callable[[], str]) -> float:
     """A real scalar parameter (int, float, numpy real, 0-d real array; not bool, str, complex) as float.
 
-    ``valid``: the range text for the message (or a callable making it, called only on failure). The range
-    itself is the caller's to check.
+    Args:
+        value: the value.
+        name: its name in the message.
+        valid: the range text for the message (or a callable making it, called only on failure). The range
+            itself is the caller's to check.
+
+    Returns:
+        the value as a float.
+
+    Raises:
+        InvalidArgumentError: not a real number.
     """
     if type(value) is float:  # the common case, fast
         return value
@@ -106,29 +208,66 @@ def real_number(value, name: str, valid) -> float:
         text = valid() if callable(valid) else valid
         raise InvalidArgumentError(f"{name} must be a real number, got {value!r}; valid range {text}")
     try:
-        return float(value)
+        return float(value)  # type: ignore[arg-type]  # a real number (checked above)
     except OverflowError:  # an int beyond the float range
         text = valid() if callable(valid) else valid
         raise InvalidArgumentError(f"{name}={value!r} is out of range: valid range {text}") from None
 
 
-def _range_text(low, high, low_open: bool, high_open: bool) -> str:
+def interval_text(low: float | None, high: float | None, low_open: bool = False, high_open: bool = False) -> str:
+    """The interval as text, e.g. ``(0, inf)`` or ``[1, 10000]``.
+
+    Args:
+        low, high: the bounds (None: unbounded, an open end).
+        low_open, high_open: exclude the bound itself.
+
+    Returns:
+        the text.
+    """
     lo = "-inf" if low is None else f"{low:g}"
     hi = "inf" if high is None else f"{high:g}"
     return f"{'(' if low_open or low is None else '['}{lo}, {hi}{')' if high_open or high is None else ']'}"
 
 
+def outside(x: float, low: float | None, high: float | None, low_open: bool = False, high_open: bool = False) -> bool:
+    """Whether ``x`` is NaN, infinite or outside the interval (the one range test of every option checker).
+
+    Args:
+        x: the value.
+        low, high: the bounds (None: unbounded).
+        low_open, high_open: exclude the bound itself.
+
+    Returns:
+        True if ``x`` is not a finite number inside the interval.
+    """
+    bad = not math.isfinite(x)
+    if low is not None:
+        bad |= x <= low if low_open else x < low
+    if high is not None:
+        bad |= x >= high if high_open else x > high
+    return bad
+
+
 def check_number(
-    value, name: str, low: float | None = None, high: float | None = None, *,
+    value: object, name: str, low: float | None = None, high: float | None = None, *,
     low_open: bool = False, high_open: bool = False,
 ) -> float:
     """A keyword parameter that must be one finite real number in a range; returns it as a float.
+
+    Args:
+        value: the value (int, float, numpy real or 0-d real array; not a bool).
+        name: its name in the message.
+        low, high: the bounds (None: unbounded), in the option's unit.
+        low_open, high_open: exclude the bound itself.
+
+    Returns:
+        the value as a float.
 
     Raises:
         InvalidArgumentError: (a ``ValueError``) not a real number, NaN/inf, or outside the range; the
             message names the value and the range.
     """
-    rng = _range_text(low, high, low_open, high_open)
+    rng = interval_text(low, high, low_open, high_open)
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.integer, np.floating)):
         if not (isinstance(value, np.ndarray) and value.ndim == 0 and value.dtype.kind in "iuf"):
             raise InvalidArgumentError(f"{name} must be a real number in {rng}, got {value!r}")
@@ -136,37 +275,67 @@ def check_number(
         v = float(value)
     except OverflowError:  # an int beyond the float range
         raise InvalidArgumentError(f"{name}={value!r} is out of range: must be a finite number in {rng}") from None
-    bad = not np.isfinite(v)
-    if low is not None:
-        bad |= v <= low if low_open else v < low
-    if high is not None:
-        bad |= v >= high if high_open else v > high
-    if bad:
+    if outside(v, low, high, low_open, high_open):
         raise InvalidArgumentError(f"{name}={v!r} is out of range: must be a finite number in {rng}")
     return v
 
 
-def check_integer(value, name: str, low: int | None = None, high: int | None = None) -> int:
-    """A keyword parameter that must be an integer in ``[low, high]``."""
+def check_integer(value: object, name: str, low: int | None = None, high: int | None = None) -> int:
+    """A keyword parameter that must be an integer in ``[low, high]``.
+
+    Args:
+        value: the value (int or numpy integer; not a bool, not a float).
+        name: its name in the message.
+        low, high: the bounds (None: unbounded).
+
+    Returns:
+        the value as an int.
+
+    Raises:
+        InvalidArgumentError: not an integer, or outside the range.
+    """
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
-        span = _range_text(low, high, False, False)
+        span = interval_text(low, high)
         raise InvalidArgumentError(f"{name} must be an integer in {span}, got {value!r}")
     v = int(value)
     if (low is not None and v < low) or (high is not None and v > high):
-        span = _range_text(low, high, False, False)
+        span = interval_text(low, high)
         raise InvalidArgumentError(f"{name}={v} is out of range: must be an integer in {span}")
     return v
 
 
-def check_flag(value, name: str) -> bool:
-    """A keyword parameter that must be a bool."""
+def check_flag(value: object, name: str) -> bool:
+    """A keyword parameter that must be a bool.
+
+    Args:
+        value: the value (bool or numpy bool).
+        name: its name in the message.
+
+    Returns:
+        the value as a bool.
+
+    Raises:
+        InvalidArgumentError: anything else.
+    """
     if not isinstance(value, (bool, np.bool_)):
         raise InvalidArgumentError(f"{name} must be True or False, got {value!r}")
     return bool(value)
 
 
-def check_choice(value, name: str, choices) -> object:
-    """A keyword parameter that must be one of ``choices`` (compared with ==, hashable values only)."""
+def check_choice(value: object, name: str, choices: Iterable[Any]) -> object:
+    """A keyword parameter that must be one of ``choices`` (compared with ==, hashable values only).
+
+    Args:
+        value: the value.
+        name: its name in the message.
+        choices: the valid values.
+
+    Returns:
+        the value.
+
+    Raises:
+        InvalidArgumentError: any other value (the message lists the choices).
+    """
     try:
         ok = value in tuple(choices)
     except Exception:  # noqa: BLE001 - an unhashable or array value is simply not a valid choice

@@ -9,6 +9,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
+import numpy as np
+
+from ._batch import interval_text, outside
 from .errors import InvalidParameterError, UnknownModelError
 
 __all__ = ["Param", "ModelSpec", "MODELS", "get_spec", "list_models"]
@@ -35,42 +38,37 @@ class Param:
     choices: tuple[str, ...] = ()
 
     def range_text(self) -> str:
+        """The valid values as text: ``one of 'a', 'b'`` or an interval such as ``(0, inf)``."""
         if self.choices:
             return "one of " + ", ".join(repr(c) for c in self.choices)
-        lo = "-inf" if self.low is None else f"{self.low:g}"
-        hi = "inf" if self.high is None else f"{self.high:g}"
-        left = "(" if self.low_open or self.low is None else "["
-        right = ")" if self.high_open or self.high is None else "]"
-        return f"{left}{lo}, {hi}{right}"
+        return interval_text(self.low, self.high, self.low_open, self.high_open)
 
     def check(self, name: str, value: object) -> float | str:
         """Return the value converted to the argument's type, or raise.
 
         Args:
             name: the argument's name (for the message).
-            value: the value given.
+            value: a string of :attr:`choices`, or a real number (not a bool, complex or array) in the range.
 
         Returns:
-            The value: one of :attr:`choices` for a string argument, else a float in the range (in the
-            argument's unit).
+            the value (a float for a numeric argument).
 
         Raises:
-            InvalidParameterError: not one of the choices, not a number, or out of range.
+            InvalidParameterError: a value of the wrong kind or out of range; the message names it and the range.
         """
         if self.choices:
-            if value not in self.choices:
+            if not isinstance(value, str) or value not in self.choices:
                 raise InvalidParameterError(f"{name}={value!r} is not valid: must be {self.range_text()}")
-            return str(value)
+            return value
+        wrong_kind = isinstance(value, (bool, np.bool_, complex, np.complexfloating)) or (
+            isinstance(value, np.ndarray) and value.ndim > 0)
         try:
-            x = float(value)  # type: ignore[arg-type]  # anything float() takes; the rest is refused below
-        except (TypeError, ValueError):
-            raise InvalidParameterError(f"{name}={value!r} is not a number; valid range {self.range_text()}") from None
-        bad = not math.isfinite(x)
-        if self.low is not None:
-            bad |= x < self.low or (self.low_open and x == self.low)
-        if self.high is not None:
-            bad |= x > self.high or (self.high_open and x == self.high)
-        if bad:
+            x = math.nan if wrong_kind else float(value)  # type: ignore[arg-type]
+        except (TypeError, ValueError, OverflowError):
+            wrong_kind = True
+        if wrong_kind:
+            raise InvalidParameterError(f"{name}={value!r} is not a number; valid range {self.range_text()}")
+        if outside(x, self.low, self.high, self.low_open, self.high_open):
             raise InvalidParameterError(f"{name}={value!r} is out of range: must be in {self.range_text()}")
         return x
 

@@ -30,10 +30,7 @@ import numpy as np
 
 from ._benchkit import Method, MethodResult, ModelBench, Score
 from ._registry import MODELS, get_spec, list_models
-from ._single_call import SOLVE_LOOPS_PERTURBATION as SOLVE_LOOPS_PERTURBATION  # re-exported: the single-call
 from ._single_call import SingleCallResult, _fmt_time, format_single_table, time_call, yardstick_calls
-from ._single_call import _closed_configuration as _closed_configuration
-from ._single_call import _frame_name as _frame_name
 from ._single_call import single_call_table as _single_call_table
 
 __all__ = [

@@ -13,9 +13,6 @@ coincide when the loop is closed. ``type="point"`` makes their origins coincide
 
 from __future__ import annotations
 
-import math
-import numbers
-import operator
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -23,7 +20,7 @@ from pathlib import Path
 import numpy as np
 import pinocchio as pin
 
-from ._batch import as_input
+from ._batch import as_input, check_integer, check_number
 from .errors import InvalidInputError, LegkinError, LoopClosureError
 
 __all__ = [
@@ -33,58 +30,12 @@ __all__ = [
     "build_constraint",
     "LoopSet",
     "levenberg_marquardt",
-    "check_real",
-    "check_count",
 ]
 
 _TYPES = ("point", "frame")
 
 #: Initial Levenberg-Marquardt damping of :func:`levenberg_marquardt`.
 DEFAULT_DAMPING = 1e-6
-
-
-# ---------------------------------------------------------------- keyword checks
-def _interval(low, high, low_open, high_open) -> str:
-    lo = "-inf" if low is None else f"{low:g}"
-    hi = "inf" if high is None else f"{high:g}"
-    return f"{'(' if low_open or low is None else '['}{lo}, {hi}{')' if high_open or high is None else ']'}"
-
-
-def check_real(
-    name: str, value, low: float | None = None, high: float | None = None, *, low_open: bool = False,
-    high_open: bool = False,
-) -> float:
-    """``value`` as a finite real number in the interval given, or :class:`InvalidInputError` naming both.
-
-    Booleans, strings, complex numbers and arrays of more than one element are refused.
-    """
-    interval = _interval(low, high, low_open, high_open)
-    if isinstance(value, np.ndarray) and value.ndim == 0:
-        value = value[()]
-    if isinstance(value, (bool, np.bool_)) or not isinstance(value, numbers.Real):
-        raise InvalidInputError(f"{name} must be a real number in {interval}, got {value!r}")
-    x = float(value)
-    bad = not math.isfinite(x)
-    if low is not None:
-        bad = bad or x < low or (low_open and x == low)
-    if high is not None:
-        bad = bad or x > high or (high_open and x == high)
-    if bad:
-        raise InvalidInputError(f"{name} must be a finite number in {interval}, got {value!r}")
-    return x
-
-
-def check_count(name: str, value, low: int = 0) -> int:
-    """``value`` as an integer ``>= low`` (a float such as ``2.0`` or a bool is refused)."""
-    if isinstance(value, (bool, np.bool_)):
-        raise InvalidInputError(f"{name} must be an integer >= {low}, got {value!r}")
-    try:
-        n = operator.index(value)
-    except TypeError:
-        raise InvalidInputError(f"{name} must be an integer >= {low}, got {value!r}") from None
-    if n < low:
-        raise InvalidInputError(f"{name} must be an integer >= {low}, got {n}")
-    return n
 
 
 @dataclass(frozen=True)
@@ -182,7 +133,7 @@ class LoopSet:
         The rank counts singular values above ``tol`` times the largest one (relative tolerance, in [0, 1)).
         """
         q, free = self._check(q, free)
-        tol = check_real("tol", tol, 0.0, 1.0, high_open=True)
+        tol = check_number(tol, "tol", 0.0, 1.0, high_open=True)
         _, jac = self.residual_and_jacobian(q)
         jac = jac[:, free]
         if jac.size == 0:
@@ -204,9 +155,9 @@ class LoopSet:
             LoopClosureError: the residual did not reach ``tol``.
         """
         q, free = self._check(q, free)
-        tol = check_real("tol", tol, 0.0, low_open=True)
-        max_iter = check_count("max_iter", max_iter)
-        damping = check_real("damping", damping, 0.0, low_open=True)
+        tol = check_number(tol, "tol", 0.0, low_open=True)
+        max_iter = check_integer(max_iter, "max_iter", 0)
+        damping = check_number(damping, "damping", 0.0, low_open=True)
         try:
             q, it, _, converged, err = levenberg_marquardt(
                 self.model, self.residual_and_jacobian, q, free, tol, max_iter, damping=damping

@@ -47,7 +47,7 @@ def _rtb():
 
     robot, iq = _robot()
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # Robot.URDF is deprecated in favour of URDF_read + Robot
+        warnings.simplefilter("ignore")  # roboticstoolbox warns that Robot.URDF is superseded by URDF_read + Robot
         rob = rtb.Robot.URDF(str(robot.urdf_path))
     ets = rob.ets(start="base", end=f"{LEG}_FOOT")
     q0 = robot.q0[iq : iq + 3].copy()

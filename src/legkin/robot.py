@@ -10,21 +10,15 @@ from typing import Any, Iterable, Literal, Mapping, overload
 import numpy as np
 import pinocchio as pin
 
-from ._batch import as_input
+from ._batch import as_input, check_flag, check_integer, check_number
 from ._generate import model_files
-from ._registry import MODELS, get_spec
+from ._registry import MODELS, ModelSpec, get_spec
 from .errors import InvalidInputError, InvalidParameterError
-from .loops import DEFAULT_DAMPING, LoopSet, LoopSolveInfo, check_count, check_real, parse_loops
+from .loops import DEFAULT_DAMPING, LoopSet, LoopSolveInfo, parse_loops
 
 __all__ = ["Robot", "load"]
 
 _REFERENCE_FRAMES = dict(pin.ReferenceFrame.names)
-
-
-def _check_flag(name: str, value) -> bool:
-    if not isinstance(value, (bool, np.bool_)):
-        raise InvalidInputError(f"{name} must be True or False, got {value!r}")
-    return bool(value)
 
 
 def _names(name: str, value) -> list[str]:
@@ -63,14 +57,14 @@ class Robot:
         kinematics: the mechanism's package (``legkin.<name>``: ``fk``, ``ik``, ``jacobian``, ...).
     """
 
-    def __init__(self, name: str, params: Mapping[str, object], floating: bool = False):
-        spec = get_spec(name)
+    def __init__(self, name: str | ModelSpec, params: Mapping[str, object], floating: bool = False):
+        spec = name if isinstance(name, ModelSpec) else get_spec(name)
         self.spec = spec
-        self.name = name
+        self.name = spec.name
         self.params = dict(params)
         self.floating = floating
         if spec.locate is not None:  # a distribution's installed URDF
-            self.urdf_path, self.srdf_path, pkg = spec.locate(name)
+            self.urdf_path, self.srdf_path, pkg = spec.locate(spec.name)
         else:
             self.urdf_path, self.srdf_path = model_files(spec, self.params)
             pkg = [str(self.urdf_path.parent)]
@@ -98,7 +92,7 @@ class Robot:
             pin.loadReferenceConfigurations(self.model, str(self.srdf_path), False)
         self.poses = {e.key(): np.array(e.data()) for e in self.model.referenceConfigurations}
         if spec.default_pose is not None and spec.reference_pose and spec.reference_pose not in self.poses:
-            pose = spec.default_pose(self.model, name)  # a robot without SRDF: legkin's own standing pose
+            pose = spec.default_pose(self.model, spec.name)  # a robot without SRDF: legkin's own standing pose
             if pose is not None:
                 self.poses[spec.reference_pose] = pose
         self.q0 = self.poses.get(spec.reference_pose, pin.neutral(self.model)).copy()
@@ -339,7 +333,7 @@ class Robot:
         """
         q = self.check_q(q)
         free = self._free_mask(locked, "locked")
-        return self._loopset.mobility(q, free, check_real("tol", tol, 0.0, 1.0, high_open=True))
+        return self._loopset.mobility(q, free, check_number(tol, "tol", 0.0, 1.0, high_open=True))
 
     @overload
     def solve_loops(
@@ -394,10 +388,10 @@ class Robot:
             LoopClosureError: the residual did not reach ``tol`` (carries the residual reached).
         """
         q = self.check_q(self.q0 if q_init is None else q_init, "q_init").copy()
-        tol = check_real("tol", tol, 0.0, low_open=True)
-        max_iter = check_count("max_iter", max_iter)
-        damping = check_real("damping", damping, 0.0, low_open=True)
-        return_info = _check_flag("return_info", return_info)
+        tol = check_number(tol, "tol", 0.0, low_open=True)
+        max_iter = check_integer(max_iter, "max_iter", 0)
+        damping = check_number(damping, "damping", 0.0, low_open=True)
+        return_info = check_flag(return_info, "return_info")
         if fixed is None:
             fixed = ()
         if isinstance(fixed, Mapping):
@@ -426,21 +420,10 @@ def load(name: str, *, floating: bool = False, **params) -> Robot:
     if not isinstance(floating, (bool, np.bool_)):
         raise InvalidParameterError(f"floating must be True or False, got {floating!r}")
     floating = bool(floating)
-    for key, value in params.items():
-        param = spec.params.get(key)
-        if param is None:
-            continue  # resolve_params names every unknown argument
-        if param.choices:
-            if not isinstance(value, str):
-                raise InvalidParameterError(f"{key}={value!r} is not valid: must be {param.range_text()}")
-        elif isinstance(value, (bool, np.bool_, complex, np.complexfloating)) or (
-            isinstance(value, np.ndarray) and value.ndim > 0
-        ):
-            raise InvalidParameterError(f"{key}={value!r} is not a number; valid range {param.range_text()}")
     args = spec.resolve_params(params)
     if floating and not spec.floating:
         floating_models = ", ".join(n for n, s in MODELS.items() if s.floating)
         raise InvalidParameterError(
             f"model {name!r} is fixed-base: floating=True is available only for {floating_models}"
         )
-    return Robot(name, args, floating=floating)
+    return Robot(spec, args, floating=floating)

@@ -12,7 +12,18 @@ from ._ik_kernels import ik_all_k, platform_pose_k
 from ._options import fmt, mode_text, unreachable
 from .chains import chains_k, rot_k
 from .foot import band_message
-from .geometry import CENTER, FK_GAIN_MAX, FOOT_IK_BRANCHES, FOOT_IK_ORDER, K_TOL, LL0, LL_TOL, MOTOR_BRANCHES, H
+from .geometry import (
+    CENTER,
+    FK_GAIN_MAX,
+    FOOT_IK_BRANCHES,
+    FOOT_IK_ORDER,
+    K_TOL,
+    LL0,
+    LL_TOL,
+    MOTOR_BRANCHES,
+    PLATFORM_LIMIT,
+    H,
+)
 
 #: The 16 branches in the order the errors report them (FOOT_IK_ORDER x MOTOR_BRANCHES), as indices of
 #: FOOT_IK_BRANCHES.
@@ -23,12 +34,21 @@ _ORDER = np.array([FOOT_IK_BRANCHES.index((llb, rb, bb[0], bb[1])) for llb, rb, 
 def arc_error(p: np.ndarray) -> UnreachableError:
     r = math.hypot(*(float(v) for v in p - CENTER))  # no overflow for |p| near the float limit
     lo, hi = LL0 - H, LL0 + H
-    side = f"{r - hi:.3g} m beyond its outer end" if r > hi else f"{lo - r:.3g} m inside its inner end"
+    distance = r - hi if r > hi else lo - r
+    side = f"{distance:.3g} m beyond its outer end" if r > hi else f"{distance:.3g} m inside its inner end"
     return UnreachableError(
         f"foot target {fmt(p)} is {r:.17g} m from the LCS centre; the LL arc reaches [{lo:.17g}, {hi:.17g}] m "
         f"(+- {LL_TOL:g} in the arc's cosine for rounding): the target is {side}",
-        target=p,
+        target=p, distance=distance,
     )
+
+
+def _limit_error(message: str, p: np.ndarray, pose: np.ndarray) -> JointLimitError:
+    """A :class:`JointLimitError` for the platform pose (theta_LL, roll, pitch): the first of the joints LCS_x
+    (roll), LCS_y (pitch) outside [-PLATFORM_LIMIT, PLATFORM_LIMIT]."""
+    k = 1 if not abs(float(pose[1])) <= PLATFORM_LIMIT else 2
+    return JointLimitError(message, target=p, joint=("LCS_x", "LCS_y")[k - 1], value=float(pose[k]),
+                           lower=-PLATFORM_LIMIT, upper=PLATFORM_LIMIT)
 
 
 def axis_error(p: np.ndarray, pose: bool = True) -> SingularityError:
@@ -86,10 +106,10 @@ def ik_error(p: np.ndarray, sv: float, combos: list, b: np.ndarray, s: float, li
         c["requested"] = (c["ll"], c["rb"]) in combos and (limits_only or bool(np.all(c["b"] == b)))
     if limits_only and not [c for c in cands if c["requested"] and c["inlim"]]:
         x = platform_pose(p, combos[0][0], combos[0][1])[0]
-        return JointLimitError(
+        return _limit_error(
             f"foot target {fmt(p)} needs (theta_LL, roll, pitch) = ({x[0]:.6g}, {x[1]:.6g}, {x[2]:.6g}) or the "
             f"other branches asked for ({asked}): outside the joint limits |roll|, |pitch| <= pi/2 (LCS_x, LCS_y)",
-            target=p,
+            p, x,
         )
     # reachable in the mode asked for, but in the forward-singularity band
     band = [c for c in cands if c["requested"] and c["exists"] and c["inlim"] and c["mode"] == s and c["fk"]
@@ -120,11 +140,11 @@ def ik_error(p: np.ndarray, sv: float, combos: list, b: np.ndarray, s: float, li
     if out:
         c = out[0]
         raw = platform_pose(p, c["ll"], c["rb"])[0]
-        return JointLimitError(
+        return _limit_error(
             f"foot target {fmt(p)} is reachable only outside the joint limits |roll|, |pitch| <= pi/2 (LCS_x, LCS_y): "
             f"{len(out)} of the 16 closed-form branches reach it, none within the limits (e.g. (roll, pitch) = "
             f"({raw[1]:.6g}, {raw[2]:.6g}) with ll_branch={c['ll']:+d}, roll_branch={c['rb']:+d})",
-            target=p,
+            p, raw,
         )
     x = platform_pose(p, combos[0][0], combos[0][1])[0]
     rot, th, k = np.empty((3, 3)), np.empty(2), np.empty(2)

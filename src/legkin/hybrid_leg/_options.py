@@ -6,14 +6,12 @@ InvalidInputError, hence a ValueError) naming the option and the value given.
 
 from __future__ import annotations
 
-import warnings
-from dataclasses import replace
 from typing import Final
 
 import numpy as np
 
-from .._batch import check_flag, check_integer, check_number
-from ..errors import InvalidArgumentError, InvalidParameterError, UnreachableError
+from .._batch import check_flag
+from ..errors import InvalidArgumentError, UnreachableError
 from .geometry import DEFAULT, K_TOL, MOTOR_BRANCHES, Geometry
 
 # Status codes of the kernels (OK = legkin._kernels.OK = 0).
@@ -25,16 +23,6 @@ ST_SINGULAR: Final = 5  # N singular / reach boundary
 
 #: Scalar types a single-call fast path passes straight to a kernel (anything else takes the checked path).
 SCALARS = (float, np.float64)
-
-
-class Unset:
-    """The type of :data:`UNSET`, the default of a deprecated keyword (tells "not given" from any value)."""
-
-    def __repr__(self) -> str:
-        return "UNSET"
-
-
-UNSET: Final = Unset()
 
 
 def flat(a: np.ndarray) -> np.ndarray:
@@ -83,31 +71,6 @@ def check_assembly(value: object) -> float:
     )
 
 
-def flag(value: object, name: str) -> bool:
-    """:func:`legkin._batch.check_flag`, raising an InvalidArgumentError."""
-    try:
-        return check_flag(value, name)
-    except InvalidParameterError as exc:
-        raise InvalidArgumentError(str(exc)) from None
-
-
-def real(value: object, name: str, lo: float, hi: float, what: str) -> float:
-    """A real number in (lo, hi] (:func:`legkin._batch.check_number`), raising an InvalidArgumentError."""
-    try:
-        return check_number(value, name, lo, hi, low_open=True)
-    except (InvalidParameterError, OverflowError):
-        raise InvalidArgumentError(f"{name} must be a finite real number in ({lo:g}, {hi:g}] ({what}), "
-                                   f"got {value!r}") from None
-
-
-def count(value: object, name: str, lo: int, hi: int, what: str) -> int:
-    """An integer in [lo, hi] (:func:`legkin._batch.check_integer`), raising an InvalidArgumentError."""
-    try:
-        return check_integer(value, name, lo, hi)
-    except InvalidParameterError:
-        raise InvalidArgumentError(f"{name} must be an integer in [{lo}, {hi}] ({what}), got {value!r}") from None
-
-
 def fast_branch(branch: object) -> tuple[float, float] | None:
     """(b1, b2) as floats for a plain tuple of two ints +-1, else None (the checked path then)."""
     if type(branch) is tuple and len(branch) == 2:
@@ -133,8 +96,8 @@ def fast_geometry(geometry: object) -> Geometry | None:
     return None
 
 
-def resolve(geometry: object, starting_value: object = UNSET, *, universal: str = "") -> Geometry:
-    """The checked geometry of a call, with the deprecated ``starting_value=`` keyword mapped onto it.
+def resolve(geometry: object, *, universal: str = "") -> Geometry:
+    """The checked geometry of a call (None: the default).
 
     ``universal``: the function's name when it needs the universal centre (refuses ``center="spherical"``).
     """
@@ -144,10 +107,6 @@ def resolve(geometry: object, starting_value: object = UNSET, *, universal: str 
         g = geometry
     else:
         raise InvalidArgumentError(f"geometry must be a legkin.hybrid_leg.Geometry or None, got {geometry!r}")
-    if starting_value is not UNSET:
-        warnings.warn("the starting_value= keyword is deprecated; pass geometry=Geometry(starting_value=...)",
-                      DeprecationWarning, stacklevel=3)
-        g = replace(g, starting_value=starting_value)  # type: ignore[arg-type]
     if universal and g.center != "universal":
         raise InvalidArgumentError(
             f"{universal} needs the universal centre (geometry.center='universal'), got center={g.center!r}: with the "
@@ -157,9 +116,18 @@ def resolve(geometry: object, starting_value: object = UNSET, *, universal: str 
     return g
 
 
-def deprecated(old: str, new: str) -> None:
-    """Warn that ``old`` is deprecated in favour of ``new`` (at the caller's caller)."""
-    warnings.warn(f"{old} is deprecated; use {new}", DeprecationWarning, stacklevel=3)
+def mode_args(branch: object, assembly: object, geometry: object, return_mask: object,
+             what: str) -> tuple[float, float, float, float, bool]:
+    """(starting_value, b1, b2, assembly, return_mask) of a call of ``fk``, ``jacobian`` or ``ik`` (``what``: its
+    name), checked (straight through for the common values)."""
+    fb, fs, g = fast_branch(branch), fast_sign(assembly), fast_geometry(geometry)
+    if fb is None or fs is None or g is None or g.center != "universal":
+        g = resolve(geometry, universal=what)
+        b = check_branch(branch)
+        fb, fs = (float(b[0]), float(b[1])), check_assembly(assembly)
+    if return_mask is not False and return_mask is not True:
+        return_mask = check_flag(return_mask, "return_mask")
+    return g.starting_value, fb[0], fb[1], fs, return_mask  # type: ignore[return-value]
 
 
 def unreachable(what: str, k: np.ndarray) -> UnreachableError:

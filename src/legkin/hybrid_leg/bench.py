@@ -81,6 +81,7 @@ def single_calls() -> list[SingleCall]:
         SingleCall("fk", lambda: ah.fk(q), it, iterative=True),
         SingleCall("jacobian", lambda: ah.jacobian(q), it, iterative=True),
         SingleCall("ik_all", lambda: ah.ik_all(p), cf),
+        SingleCall("ik_branches", lambda: ah.ik_branches(p), cf),
     ]
 
 

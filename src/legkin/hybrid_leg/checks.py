@@ -222,8 +222,7 @@ def _ik_rows(robot, w: _Workspace, ns: int) -> list[CheckResult]:  # noqa: ANN00
                         jerr[wd], TOL))
     rows.append(compare(f"ik round trip (default branch, kappa > {KAPPA_NEAR:g}): error / kappa",
                         jerr[~wd] / kappa[default][~wd], TOL_KAPPA))
-    every = ah.ik_all(pos[:ns])
-    allb, okb = every.motors, every.mask
+    allb, okb = ah.ik_all(pos[:ns], return_mask=True)
     truth = np.concatenate([th[:ns], theta0[:ns, None]], -1)[:, None, :]
     # theta0 compared as theta_LL (x RATIO): one LL radian is 134.6 motor radians
     diff = (np.abs(allb - truth) * np.array([1.0, 1.0, ah.RATIO])).max(-1)

@@ -9,7 +9,7 @@ from numpy.typing import ArrayLike
 
 from .._batch import as_input
 from .._kernels import batch_kernel, kernel
-from ._options import SCALARS, UNSET, Unset, fast_geometry, flat, resolve
+from ._options import SCALARS, fast_geometry, flat, resolve
 from .geometry import RATIO, Geometry
 
 __all__ = ["ll_angle", "extension_motor_angle"]
@@ -47,8 +47,7 @@ def _apply(x: ArrayLike, name: str, sv: float, batch: Callable[..., object]
     return out.reshape(a.shape) if a.ndim else np.float64(out[0])
 
 
-def ll_angle(theta0: ArrayLike, starting_value: float | Unset = UNSET, *,
-             geometry: Geometry | None = None) -> np.ndarray | float:
+def ll_angle(theta0: ArrayLike, *, geometry: Geometry | None = None) -> np.ndarray | float:
     """LL joint angle driven by the leg-extension motor (seed eq 19, OCR artefact removed).
 
     .. math:: \\theta_{LL} = -\\theta_0 \\frac{0.07}{2 \\pi \\, 1.5} + \\text{startingValue}
@@ -59,27 +58,30 @@ def ll_angle(theta0: ArrayLike, starting_value: float | Unset = UNSET, *,
 
     Args:
         theta0: extension-motor angles (rad), any shape.
-        starting_value: deprecated, use ``geometry=Geometry(starting_value=...)``.
         geometry: the geometry (its ``starting_value`` is the LL zero offset, rad); None = the default.
 
     Returns:
         theta_LL (rad), same shape (a numpy float for a scalar).
     """
     g = fast_geometry(geometry)
-    if type(theta0) in SCALARS and starting_value is UNSET and g is not None:
+    if type(theta0) in SCALARS and g is not None:
         return np.float64(ll_k(theta0, g.starting_value))
-    g = resolve(geometry, starting_value)
+    g = resolve(geometry)
     return _apply(theta0, "theta0", g.starting_value, _ll_b)
 
 
-def extension_motor_angle(theta_ll: ArrayLike, starting_value: float | Unset = UNSET, *,
-                          geometry: Geometry | None = None) -> np.ndarray | float:
+def extension_motor_angle(theta_ll: ArrayLike, *, geometry: Geometry | None = None) -> np.ndarray | float:
     """Inverse of :func:`ll_angle`: ``theta0 = (starting_value - theta_LL) / RATIO`` (eq 19 solved for theta0).
 
-    ``starting_value`` is deprecated (use ``geometry=``).
+    Args:
+        theta_ll: LL joint angles (rad), any shape.
+        geometry: the geometry (its ``starting_value`` is the LL zero offset, rad); None = the default.
+
+    Returns:
+        theta0 (rad), same shape (a numpy float for a scalar).
     """
     g = fast_geometry(geometry)
-    if type(theta_ll) in SCALARS and starting_value is UNSET and g is not None:
+    if type(theta_ll) in SCALARS and g is not None:
         return np.float64(theta0_k(theta_ll, g.starting_value))
-    g = resolve(geometry, starting_value)
+    g = resolve(geometry)
     return _apply(theta_ll, "theta_ll", g.starting_value, _theta0_b)

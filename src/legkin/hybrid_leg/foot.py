@@ -9,7 +9,7 @@ from typing import Literal, Sequence, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_angles, as_input, finish
+from .._batch import as_angles, dispatch
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import ConvergenceError, SingularityError
 from ._options import (
@@ -18,16 +18,8 @@ from ._options import (
     ST_BAND,
     ST_INPUT,
     ST_SINGULAR,
-    UNSET,
-    Unset,
-    check_assembly,
-    check_branch,
-    deprecated,
-    fast_branch,
-    fast_geometry,
-    fast_sign,
-    flag,
     flat,
+    mode_args,
     resolve,
 )
 from .chains import CX, CY, CZ, OX, OZ, rod_rates_k, tips_k
@@ -35,7 +27,7 @@ from .extension import ll_k
 from .forward import fk_failure, fk_select_k
 from .geometry import FK_GAIN_MAX, FOOT_X, RATIO, Geometry
 
-__all__ = ["foot_position_from_platform", "fk", "jacobian", "foot_position", "foot_jacobian"]
+__all__ = ["foot_position_from_platform", "fk", "jacobian"]
 
 Branch = Sequence[int]
 
@@ -196,6 +188,13 @@ def foot_position_from_platform(roll: ArrayLike, pitch: ArrayLike, theta_ll: Arr
 
     Seed eqs 1, 17, 18, 20 (eq 18 printed without its last row (0, 0, 0, 1)). At theta_LL = 0 the foot is at
     (0.140, 0, -0.037) in P.
+
+    Args:
+        roll, pitch: platform angles (rad); theta_ll: LL joint angle (rad); broadcast together.
+        geometry: accepted for uniformity (None: the default).
+
+    Returns:
+        (..., 3) foot positions in CCS (m).
     """
     if type(roll) in SCALARS and type(pitch) in SCALARS and type(theta_ll) in SCALARS and geometry is None:
         out = np.empty(3)
@@ -216,16 +215,6 @@ def band_message(what: str, x: np.ndarray, gain: float) -> str:
         f"{gain:.3g} m per motor radian (limit FK_GAIN_MAX = {FK_GAIN_MAX:g}), so double-precision motor angles do not "
         "fix it to 1e-9 m"
     )
-
-
-def _fast(q: object, branch: object, assembly: object, geometry: object, return_mask: object
-          ) -> tuple[float, float, float, float] | None:
-    """(b1, b2, s, starting_value) for a single call that can go straight to a kernel, else None."""
-    if return_mask is False and type(q) is np.ndarray and q.shape == (3,) and q.dtype == np.float64:
-        fb, fs, g = fast_branch(branch), fast_sign(assembly), fast_geometry(geometry)
-        if fb is not None and fs is not None and g is not None and g.center == "universal":
-            return fb[0], fb[1], fs, g.starting_value
-    return None
 
 
 def _motors_text(q: np.ndarray) -> str:
@@ -254,26 +243,15 @@ def fk(q: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, geometry: Ge
         geometry: the geometry (universal centre); None = the default.
         return_mask: also return the mask of successes.
 
+    Returns:
+        (..., 3) foot positions in CCS (m), NaN where a batch item fails; then the mask, if asked.
+
     Raises:
         ConvergenceError: single input whose closed sub-chain does not assemble in that mode.
         SingularityError: single input in the forward-singularity band.
     """
-    fp = _fast(q, branch, assembly, geometry, return_mask)
-    if fp is not None:
-        out, aux = np.empty(3), np.empty(3)
-        if foot_position_k(q[0], q[1], q[2], fp[3], fp[0], fp[1], fp[2], out, aux) == OK:  # type: ignore[index]
-            return out
-    g, qq, b, s, shape, rows = _checked_motors(q, branch, assembly, geometry, return_mask, "fk")
-    n = len(rows)
-    p, aux, st = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.int64)
-    _fk_b(rows, g.starting_value, float(b[0]), float(b[1]), s, p, aux, st)
-
-    def error() -> Exception:
-        if st[0] == ST_ASSEMBLE:
-            return ConvergenceError(fk_failure(float(qq[0]), float(qq[1]), b, s))
-        return SingularityError(band_message(_motors_text(qq), aux[0, :2], aux[0, 2]))
-
-    return finish(p.reshape(shape + (3,)), (st == OK).reshape(shape), qq.ndim == 1, return_mask, error)
+    args = mode_args(branch, assembly, geometry, return_mask, "fk")
+    return dispatch(q, "q", (3,), _fk_fast, _fk_batch, _fk_fail, args[:4], args[4])
 
 
 @overload
@@ -293,62 +271,70 @@ def jacobian(q: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, geomet
     ``dtheta_LL/dtheta0 = -RATIO`` (eq 19). Finite on the reach boundary (D = 0: a column vanishes);
     undefined where N is singular (the platform moves with the motors locked).
 
+    Args:
+        q: motor angles (theta1, theta2, theta0) (rad), shape (..., 3).
+        branch, assembly: the assembly mode, as in :func:`fk`.
+        geometry: the geometry (universal centre); None = the default.
+        return_mask: also return the mask of successes.
+
+    Returns:
+        (..., 3, 3) d(foot, m) / d(theta1, theta2, theta0) (m/rad); then the mask, if asked.
+
     Raises:
         ConvergenceError: single input whose closed sub-chain did not assemble in that mode.
         SingularityError: single input where N is singular.
     """
-    fp = _fast(q, branch, assembly, geometry, return_mask)
-    if fp is not None:
-        jac = np.empty((3, 3))
-        if foot_jacobian_k(q[0], q[1], q[2], fp[3], fp[0], fp[1], fp[2], jac) == OK:  # type: ignore[index]
-            return jac
-    g, qq, b, s, shape, rows = _checked_motors(q, branch, assembly, geometry, return_mask, "jacobian")
+    args = mode_args(branch, assembly, geometry, return_mask, "jacobian")
+    return dispatch(q, "q", (3,), _jac_fast, _jac_batch, _jac_fail, args[:4], args[4])
+
+
+def _fk_fast(q: np.ndarray, sv: float, b1: float, b2: float, s: float) -> np.ndarray | None:
+    out, aux = np.empty(3), np.empty(3)
+    q0, q1, q2 = q.tolist()
+    return out if foot_position_k(q0, q1, q2, sv, b1, b2, s, out, aux) == OK else None
+
+
+def _fk_rows(rows: np.ndarray, sv: float, b1: float, b2: float, s: float) -> tuple[np.ndarray, ...]:
+    """The fk loop on rows (n, 3): foot (n, 3) NaN where it fails, aux (n, 3), status (n,)."""
+    n = len(rows)
+    p, aux, st = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.int64)
+    _fk_b(rows, sv, b1, b2, s, p, aux, st)
+    return p, aux, st
+
+
+def _fk_batch(rows: np.ndarray, sv: float, b1: float, b2: float, s: float) -> tuple[np.ndarray, np.ndarray]:
+    p, _, st = _fk_rows(rows, sv, b1, b2, s)
+    return p, st == OK
+
+
+def _fk_fail(q: np.ndarray, out: np.ndarray, ok: np.ndarray, sv: float, b1: float, b2: float,
+             s: float) -> Exception:
+    _, aux, st = _fk_rows(np.ascontiguousarray(q.reshape(1, 3)), sv, b1, b2, s)
+    if st[0] == ST_ASSEMBLE:
+        return ConvergenceError(fk_failure(float(q[0]), float(q[1]), np.array([b1, b2]), s))
+    return SingularityError(band_message(_motors_text(q), aux[0, :2], aux[0, 2]))
+
+
+def _jac_fast(q: np.ndarray, sv: float, b1: float, b2: float, s: float) -> np.ndarray | None:
+    jac = np.empty((3, 3))
+    q0, q1, q2 = q.tolist()
+    return jac if foot_jacobian_k(q0, q1, q2, sv, b1, b2, s, jac) == OK else None
+
+
+def _jac_batch(rows: np.ndarray, sv: float, b1: float, b2: float, s: float) -> tuple[np.ndarray, np.ndarray]:
     n = len(rows)
     jac, st = np.empty((n, 3, 3)), np.empty(n, dtype=np.int64)
-    _jacobian_b(rows, g.starting_value, float(b[0]), float(b[1]), s, jac, st)
-
-    def error() -> Exception:
-        if st[0] == ST_ASSEMBLE:
-            return ConvergenceError(fk_failure(float(qq[0]), float(qq[1]), b, s))
-        return SingularityError(
-            f"(theta1, theta2) = ({float(qq[0]):.6g}, {float(qq[1]):.6g}) is a forward singularity: the platform can "
-            "move with both motors locked (N singular), the foot Jacobian is undefined"
-        )
-
-    return finish(jac.reshape(shape + (3, 3)), (st == OK).reshape(shape), qq.ndim == 1, return_mask, error)
+    _jacobian_b(rows, sv, b1, b2, s, jac, st)
+    return jac, st == OK
 
 
-def _checked_motors(q: ArrayLike, branch: Branch, assembly: int, geometry: Geometry | None, return_mask: bool,
-                    what: str) -> tuple[Geometry, np.ndarray, np.ndarray, float, tuple[int, ...], np.ndarray]:
-    """The checked inputs of :func:`fk` and :func:`jacobian` (``what``): geometry, q (..., 3), branch, assembly,
-    the batch shape and q as C-contiguous rows (n, 3); the checks in this order, each raising its legkin error."""
-    g = resolve(geometry, universal=what)
-    qq = as_input(q, "q", (3,))
-    b = check_branch(branch)
-    s = check_assembly(assembly)
-    flag(return_mask, "return_mask")
-    return g, qq, b, s, qq.shape[:-1], np.ascontiguousarray(qq.reshape(-1, 3))
-
-
-def _stack(theta1: ArrayLike, theta2: ArrayLike, theta0: ArrayLike) -> np.ndarray:
-    return np.stack(as_angles(theta1, theta2, theta0, names=("theta1", "theta2", "theta0")), -1)
-
-
-def foot_position(theta1: ArrayLike, theta2: ArrayLike, theta0: ArrayLike, *, starting_value: float | Unset = UNSET,
-                  branch: Branch = (1, 1), assembly: int = 1, geometry: Geometry | None = None,
-                  return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
-    """Deprecated: ``fk(np.stack([theta1, theta2, theta0], -1), ...)`` (``starting_value`` -> ``geometry``)."""
-    deprecated("foot_position(theta1, theta2, theta0)", "fk(q) with q = (theta1, theta2, theta0)")
-    g = resolve(geometry, starting_value)
-    return fk(_stack(theta1, theta2, theta0), branch=branch, assembly=assembly, geometry=g,  # type: ignore[call-overload]
-              return_mask=return_mask)
-
-
-def foot_jacobian(theta1: ArrayLike, theta2: ArrayLike, theta0: ArrayLike, *, starting_value: float | Unset = UNSET,
-                  branch: Branch = (1, 1), assembly: int = 1, geometry: Geometry | None = None,
-                  return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
-    """Deprecated: ``jacobian(np.stack([theta1, theta2, theta0], -1), ...)`` (``starting_value`` -> ``geometry``)."""
-    deprecated("foot_jacobian(theta1, theta2, theta0)", "jacobian(q) with q = (theta1, theta2, theta0)")
-    g = resolve(geometry, starting_value)
-    return jacobian(_stack(theta1, theta2, theta0), branch=branch, assembly=assembly,  # type: ignore[call-overload]
-                    geometry=g, return_mask=return_mask)
+def _jac_fail(q: np.ndarray, out: np.ndarray, ok: np.ndarray, sv: float, b1: float, b2: float,
+              s: float) -> Exception:
+    jac, st = np.empty((1, 3, 3)), np.empty(1, dtype=np.int64)
+    _jacobian_b(np.ascontiguousarray(q.reshape(1, 3)), sv, b1, b2, s, jac, st)
+    if st[0] == ST_ASSEMBLE:
+        return ConvergenceError(fk_failure(float(q[0]), float(q[1]), np.array([b1, b2]), s))
+    return SingularityError(
+        f"(theta1, theta2) = ({float(q[0]):.6g}, {float(q[1]):.6g}) is a forward singularity: the platform can "
+        "move with both motors locked (N singular), the foot Jacobian is undefined"
+    )

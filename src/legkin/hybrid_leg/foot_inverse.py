@@ -8,7 +8,7 @@ from typing import Literal, NamedTuple, Sequence, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input, finish
+from .._batch import as_input, check_flag, dispatch, finish
 from ..errors import InvalidInputError, UnreachableError
 from ._ik_errors import arc_error, axis_error, ik_error, platform_pose
 from ._ik_kernels import (
@@ -18,27 +18,23 @@ from ._ik_kernels import (
     platform_pose_b,
 )
 from ._options import (
-    UNSET,
-    Unset,
     check_assembly,
     check_branch,
     check_sign,
-    deprecated,
-    fast_branch,
     fast_geometry,
-    fast_sign,
-    flag,
     fmt,
+    mode_args,
     resolve,
 )
 from .chains import CX, CY, CZ
 from .geometry import CENTER, FOOT_IK_ORDER, Geometry
 
-__all__ = ["foot_platform_ik", "ik", "ik_all", "FootIKSolutions", "foot_ik", "foot_ik_solutions"]
+__all__ = ["foot_platform_ik", "ik", "ik_all", "ik_branches", "FootIKSolutions"]
 
 Branch = Sequence[int]
 _COMBOS = np.array(FOOT_IK_ORDER, dtype=np.float64)
 _NO_NEAR = np.full((1, 3), np.nan)  # the near row of a single call (none)
+_NO_BRANCH = bytes(16)  # the bytes of a mask (16,) without any branch (10x cheaper to compare than .any())
 
 
 def _combos(llb: float | None, rb: float | None) -> list:
@@ -70,23 +66,23 @@ def _one(p: np.ndarray, sv: float, b1: float, b2: float, s: float, limits_only: 
     return out[:, 0] if ok[0] else None
 
 
-def _targets(p: ArrayLike) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
-    pp = as_input(p, "p", (3,))
+def _targets(target: ArrayLike) -> tuple[np.ndarray, np.ndarray, tuple[int, ...]]:
+    pp = as_input(target, "target", (3,))
     return pp, (pp - CENTER).reshape(-1, 3), pp.shape[:-1]
 
 
 @overload
-def foot_platform_ik(p: ArrayLike, *, ll_branch: int | None = ..., roll_branch: int | None = ...,
+def foot_platform_ik(target: ArrayLike, *, ll_branch: int | None = ..., roll_branch: int | None = ...,
                      branch: Branch | None = ..., assembly: int | None = ..., geometry: Geometry | None = ...,
                      return_mask: Literal[False] = ...) -> np.ndarray: ...
 @overload
-def foot_platform_ik(p: ArrayLike, *, ll_branch: int | None = ..., roll_branch: int | None = ...,
+def foot_platform_ik(target: ArrayLike, *, ll_branch: int | None = ..., roll_branch: int | None = ...,
                      branch: Branch | None = ..., assembly: int | None = ..., geometry: Geometry | None = ...,
                      return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
-def foot_platform_ik(p: ArrayLike, *, ll_branch: int | None = None, roll_branch: int | None = None,
+def foot_platform_ik(target: ArrayLike, *, ll_branch: int | None = None, roll_branch: int | None = None,
                      branch: Branch | None = None, assembly: int | None = None, geometry: Geometry | None = None,
                      return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
-    """(theta_LL, roll, pitch) (..., 3) placing the foot at ``p`` (CCS), in closed form.
+    """(theta_LL, roll, pitch) (..., 3) placing the foot at ``p = target`` (CCS), in closed form.
 
     Inverts :func:`foot_position_from_platform`:
 
@@ -110,24 +106,35 @@ def foot_platform_ik(p: ArrayLike, *, ll_branch: int | None = None, roll_branch:
     ``assembly`` given, as :func:`ik`, roll 0 or pi is tried there); within :data:`RHO_TOL` of it roll is
     taken as 0 (roll_branch +1) or pi (-1).
 
+    Args:
+        target: foot targets (..., 3) in CCS (m).
+        ll_branch, roll_branch: None (search, default) or +1 / -1.
+        branch, assembly: None (no mode check, default) or the mode of :func:`ik`.
+        geometry: the geometry (universal centre); None = the default.
+        return_mask: also return the mask of successes.
+
+    Returns:
+        (..., 3) (theta_LL, roll, pitch) (rad), NaN where a batch item fails; then the mask, if asked.
+
     Raises:
         UnreachableError: single target out of reach (JointLimitError: only outside the limits;
             AssemblyModeError: only in another mode).
         SingularityError: single target exactly on the roll axis.
     """
     if (ll_branch is None and roll_branch is None and branch is None and assembly is None and return_mask is False
-            and geometry is None and type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64):
-        out = _one(p, 0.0, 1.0, 1.0, 1.0, True, False)
+            and geometry is None and type(target) is np.ndarray and target.shape == (3,)
+            and target.dtype == np.float64):
+        out = _one(target, 0.0, 1.0, 1.0, 1.0, True, False)
         if out is not None:
             return out[1]
     resolve(geometry)
-    pp, u, shape = _targets(p)
+    pp, u, shape = _targets(target)
     llb = check_sign(ll_branch, "ll_branch", allow_none=True)
     rb = check_sign(roll_branch, "roll_branch", allow_none=True)
     moded = branch is not None or assembly is not None
     b = check_branch((1, 1) if branch is None else branch)
     s = check_assembly(1 if assembly is None else assembly)
-    flag(return_mask, "return_mask")
+    check_flag(return_mask, "return_mask")
     if (llb is not None or rb is not None) and not moded:
         n = len(u)
         out, info = np.empty((n, 3)), np.empty((n, 3))
@@ -147,17 +154,17 @@ def foot_platform_ik(p: ArrayLike, *, ll_branch: int | None = None, roll_branch:
 
 
 @overload
-def ik(p: ArrayLike, *, branch: Branch = ..., assembly: int = ..., ll_branch: int | None = ...,
+def ik(target: ArrayLike, *, branch: Branch = ..., assembly: int = ..., ll_branch: int | None = ...,
        roll_branch: int | None = ..., q_near: ArrayLike | None = ..., geometry: Geometry | None = ...,
        return_mask: Literal[False] = ...) -> np.ndarray: ...
 @overload
-def ik(p: ArrayLike, *, branch: Branch = ..., assembly: int = ..., ll_branch: int | None = ...,
+def ik(target: ArrayLike, *, branch: Branch = ..., assembly: int = ..., ll_branch: int | None = ...,
        roll_branch: int | None = ..., q_near: ArrayLike | None = ..., geometry: Geometry | None = ...,
        return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
-def ik(p: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, ll_branch: int | None = None,
+def ik(target: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, ll_branch: int | None = None,
        roll_branch: int | None = None, q_near: ArrayLike | None = None, geometry: Geometry | None = None,
        return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
-    """Motor angles ``q = (theta1, theta2, theta0)`` (..., 3) placing the foot at ``p`` (..., 3) (CCS), in closed
+    """Motor angles ``q = (theta1, theta2, theta0)`` (..., 3) placing the foot at ``target`` (..., 3) (CCS), in closed
     form: :func:`foot_platform_ik` (target -> theta_LL -> roll, pitch), :func:`motor_angles` (eqs 3-16 per chain)
     and :func:`extension_motor_angle` (eq 19 inverted).
 
@@ -169,13 +176,17 @@ def ik(p: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, ll_branch: i
     forward-singularity band (:data:`FK_GAIN_MAX`) and the pose the forward kinematics returns for its motor angles.
 
     Args:
-        p: foot targets (..., 3) in CCS.
+        target: foot targets (..., 3) in CCS (m).
         branch, assembly: the assembly mode (default (1, 1), +1), as in :func:`fk`.
         ll_branch, roll_branch: None (search both, default) or +1 / -1.
         q_near: motor angles (theta1, theta2, theta0) (3,) or (..., 3): of the candidates kept, return the one
             nearest them in the joints (MCS1, MCS2 wrapped, LL = RATIO theta0) instead of the first.
         geometry: the geometry (universal centre; ``starting_value`` of eq 19); None = the default.
         return_mask: also return the mask of successes.
+
+    Returns:
+        (..., 3) motor angles (theta1, theta2, theta0) (rad), NaN where a batch item fails; then the
+        mask, if asked.
 
     Raises:
         UnreachableError: single target out of reach (of the LL arc or of the motors);
@@ -184,31 +195,50 @@ def ik(p: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, ll_branch: i
         SingularityError: single target in the forward-singularity band, or exactly on the roll axis (where roll
             is undetermined and ik tries roll = 0 and pi) with neither roll reaching it in the mode.
     """
-    if (ll_branch is None and roll_branch is None and q_near is None and return_mask is False
-            and type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64):
-        fb, fs, g = fast_branch(branch), fast_sign(assembly), fast_geometry(geometry)
-        if fb is not None and fs is not None and g is not None and g.center == "universal":
-            out = _one(p, g.starting_value, fb[0], fb[1], fs, False, True)
-            if out is not None:
-                return out[0]
-    g = resolve(geometry, universal="ik")
-    pp, u, shape = _targets(p)
-    llb = check_sign(ll_branch, "ll_branch", allow_none=True)
-    rb = check_sign(roll_branch, "roll_branch", allow_none=True)
-    b = check_branch(branch)
-    s = check_assembly(assembly)
-    flag(return_mask, "return_mask")
-    near = None
+    sv, b1, b2, s, return_mask = mode_args(branch, assembly, geometry, return_mask, "ik")
+    combos: Sequence[tuple[int, int]] = FOOT_IK_ORDER
+    order = _COMBOS
+    if ll_branch is not None or roll_branch is not None:
+        combos = _combos(check_sign(ll_branch, "ll_branch", allow_none=True),
+                         check_sign(roll_branch, "roll_branch", allow_none=True))
+        order = np.array(combos, dtype=np.float64).reshape(-1, 2)
+    near = _NO_NEAR
     if q_near is not None:
-        qn = as_input(q_near, "q_near", (3,))
-        try:
-            near = np.ascontiguousarray(np.broadcast_to(qn, shape + (3,)).reshape(-1, 3))
-        except ValueError:
-            raise InvalidInputError(f"q_near must broadcast to shape {shape + (3,)}, got shape {qn.shape}") from None
-    combos = _combos(llb, rb)
-    motors, _, ok = _search(u, g.starting_value, combos, b, s, near=near)
-    return finish(motors.reshape(shape + (3,)), ok.reshape(shape), pp.ndim == 1, return_mask,
-                  lambda: ik_error(pp, g.starting_value, combos, b, s))
+        target = as_input(target, "target", (3,))
+        near = _near_rows(q_near, target.shape[:-1])
+    return dispatch(target, "target", (3,), _ik_fast, _ik_batch, _ik_fail, (sv, b1, b2, s, combos, order, near),
+                    return_mask)
+
+
+def _near_rows(q_near: ArrayLike, shape: tuple[int, ...]) -> np.ndarray:
+    """``q_near`` (3,) or (..., 3) broadcast to the targets' batch shape, as rows (n, 3)."""
+    qn = as_input(q_near, "q_near", (3,))
+    try:
+        return np.ascontiguousarray(np.broadcast_to(qn, shape + (3,)).reshape(-1, 3))
+    except ValueError:
+        raise InvalidInputError(f"q_near must broadcast to shape {shape + (3,)}, got shape {qn.shape}") from None
+
+
+def _ik_fast(p: np.ndarray, sv: float, b1: float, b2: float, s: float, combos: Sequence[tuple[int, int]],
+             order: np.ndarray, near: np.ndarray) -> np.ndarray | None:
+    """One target: the batch loop :func:`foot_ik_b` on one row (its kernel then has one caller and is inlined)."""
+    out, ok = np.empty((2, 1, 3)), np.empty(1, dtype=np.bool_)
+    foot_ik_b.kernel((p - CENTER).reshape(1, 3), sv, order, b1, b2, s, False, True, near, out[0], out[1], ok)
+    return out[0, 0] if ok[0] else None
+
+
+def _ik_batch(rows: np.ndarray, sv: float, b1: float, b2: float, s: float, combos: Sequence[tuple[int, int]],
+              order: np.ndarray, near: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    n = len(rows)
+    motors, pose, ok = np.empty((n, 3)), np.empty((n, 3)), np.empty(n, dtype=np.bool_)
+    nr = np.full((n, 3), np.nan) if near is _NO_NEAR else near
+    foot_ik_b(rows - CENTER, sv, order, b1, b2, s, False, True, nr, motors, pose, ok)
+    return motors, ok
+
+
+def _ik_fail(p: np.ndarray, out: np.ndarray, ok: np.ndarray, sv: float, b1: float, b2: float, s: float,
+             combos: Sequence[tuple[int, int]], order: np.ndarray, near: np.ndarray) -> Exception:
+    return ik_error(p, sv, list(combos), np.array([b1, b2]), s)
 
 
 class FootIKSolutions(NamedTuple):
@@ -235,54 +265,87 @@ def _all_outputs(shape: tuple[int, ...]) -> tuple[np.ndarray, ...]:
             np.empty(shape + (16,), dtype=np.bool_))
 
 
-def ik_all(p: ArrayLike, *, geometry: Geometry | None = None) -> FootIKSolutions:
-    """Every foot IK solution with its mode: the 16 closed-form branches ((ll_branch, roll_branch, b1, b2) in
-    :data:`FOOT_IK_BRANCHES` order) with their assembly mode, joint-limit and validity flags (the compiled
-    :func:`._ik_kernels.ik_all_out_k` per target). Never raises for valid input."""
+def ik_branches(target: ArrayLike, *, geometry: Geometry | None = None) -> FootIKSolutions:
+    """Every closed-form foot IK branch of ``target`` with its mode and flags: the 16 branches ((ll_branch,
+    roll_branch, b1, b2) in :data:`FOOT_IK_BRANCHES` order) with their platform pose, assembly mode, joint-limit
+    and validity flags (the compiled :func:`._ik_kernels.ik_all_out_k` per target). :func:`ik_all` returns the
+    ``motors`` and ``mask`` of this.
+
+    Args:
+        target: foot targets (..., 3) in CCS (m).
+        geometry: the geometry (universal centre); None = the default.
+
+    Returns:
+        a :class:`FootIKSolutions` of arrays (..., 16[, 3]) (angles in rad). Never raises for valid input.
+    """
     g = fast_geometry(geometry)
-    if (type(p) is np.ndarray and p.shape == (3,) and p.dtype == np.float64 and g is not None
+    if (type(target) is np.ndarray and target.shape == (3,) and target.dtype == np.float64 and g is not None
             and g.center == "universal"):
         out = _all_outputs(())
-        if ik_all_out_k(p[0] - CX, p[1] - CY, p[2] - CZ, g.starting_value, *out):
+        if ik_all_out_k(target[0] - CX, target[1] - CY, target[2] - CZ, g.starting_value, *out):
             return FootIKSolutions(*out)
-    g = resolve(geometry, universal="ik_all")
-    _, u, shape = _targets(p)
-    n = len(u)
-    out = _all_outputs((n,))
+    g = resolve(geometry, universal="ik_branches")
+    _, u, shape = _targets(target)
+    out = _all_outputs((len(u),))
     ik_all_b(np.ascontiguousarray(u), g.starting_value, *out)
     return FootIKSolutions(*(a.reshape(shape + a.shape[1:]) for a in out))
 
 
-def foot_ik(p: ArrayLike, *, starting_value: float | Unset = UNSET, ll_branch: int | None = None,
-            roll_branch: int | None = None, branch: Branch = (1, 1), assembly: int = 1, all_branches: bool = False,
-            geometry: Geometry | None = None, return_mask: bool = False
-            ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
-    """Deprecated: :func:`ik` (``all_branches=True``: ``ik_all(p).motors`` and ``.mask``; ``starting_value`` ->
-    ``geometry``)."""
-    deprecated("foot_ik", "ik (all_branches=True: ik_all)")
-    g = resolve(geometry, starting_value)
-    if not flag(all_branches, "all_branches"):
-        return ik(p, branch=branch, assembly=assembly, ll_branch=ll_branch, roll_branch=roll_branch,  # type: ignore
-                  geometry=g, return_mask=return_mask)
-    for v, name in ((ll_branch, "ll_branch"), (roll_branch, "roll_branch")):
-        check_sign(v, name, allow_none=True)
-    check_branch(branch)
-    check_assembly(assembly)
-    flag(return_mask, "return_mask")
-    sol = ik_all(p, geometry=g)
-    pp = np.asarray(p, dtype=float)
-    if pp.ndim == 1 and not bool(np.any(sol.mask)):
-        _, arc = platform_pose(pp, -1.0, 1.0)
-        if arc[1] != 1.0:
-            raise arc_error(pp)
-        if not arc[2] > 0.0:
-            raise axis_error(pp, False)
-        raise UnreachableError(f"foot target {fmt(pp)} is out of the motors' reach on every branch", target=pp)
-    return (sol.motors, sol.mask) if return_mask else sol.motors
+@overload
+def ik_all(target: ArrayLike, *, geometry: Geometry | None = ..., return_mask: Literal[False] = ...) -> np.ndarray: ...
+@overload
+def ik_all(target: ArrayLike, *, geometry: Geometry | None = ...,
+           return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+def ik_all(target: ArrayLike, *, geometry: Geometry | None = None,
+           return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """The motor angles of every closed-form foot IK branch: (..., 16, 3) in :data:`FOOT_IK_BRANCHES` order, NaN
+    rows (mask False) where a branch does not exist (LL arc or motors out of reach, target on the roll axis).
+
+    Every branch, whatever its joint limits and assembly mode; :func:`ik_branches` gives each branch's pose,
+    assembly mode and limit / validity flags.
+
+    Args:
+        target: foot targets (..., 3) in CCS (m).
+        geometry: the geometry (universal centre); None = the default.
+        return_mask: also return the mask (..., 16) of the branches that exist.
+
+    Returns:
+        (..., 16, 3) motor angles (theta1, theta2, theta0) (rad); then the mask, if asked.
+
+    Raises:
+        UnreachableError: (single) no branch exists (out of the LL arc's or the motors' reach).
+        SingularityError: (single) the target is on the roll axis, and no branch exists.
+    """
+    if return_mask is not False and return_mask is not True:
+        return_mask = check_flag(return_mask, "return_mask")
+    g = fast_geometry(geometry)
+    if g is None or g.center != "universal":
+        g = resolve(geometry, universal="ik_all")
+    return dispatch(target, "target", (3,), _all_fast, _all_batch, _all_fail, (g.starting_value,), return_mask)
 
 
-def foot_ik_solutions(p: ArrayLike, *, starting_value: float | Unset = UNSET,
-                      geometry: Geometry | None = None) -> FootIKSolutions:
-    """Deprecated: :func:`ik_all` (``starting_value`` -> ``geometry``)."""
-    deprecated("foot_ik_solutions", "ik_all")
-    return ik_all(p, geometry=resolve(geometry, starting_value))
+def _all_fast(p: np.ndarray, sv: float) -> tuple[np.ndarray, np.ndarray] | None:
+    out = _all_outputs(())
+    if ik_all_out_k(p[0] - CX, p[1] - CY, p[2] - CZ, sv, *out) and out[2].tobytes() != _NO_BRANCH:
+        return out[0], out[2]
+    return None
+
+
+def _all_batch(rows: np.ndarray, sv: float) -> tuple[np.ndarray, np.ndarray]:
+    out = _all_outputs((len(rows),))
+    ik_all_b(rows - CENTER, sv, *out)
+    return out[0], out[2]
+
+
+def _all_fail(p: np.ndarray, out: np.ndarray, ok: np.ndarray, sv: float) -> Exception:
+    return _no_branch(p)
+
+
+def _no_branch(target: np.ndarray) -> Exception:
+    """The error of a single :func:`ik_all` call without any branch."""
+    _, arc = platform_pose(target, -1.0, 1.0)
+    if arc[1] != 1.0:
+        return arc_error(target)
+    if not arc[2] > 0.0:
+        return axis_error(target, False)
+    return UnreachableError(f"foot target {fmt(target)} is out of the motors' reach on every branch", target=target)

@@ -9,7 +9,7 @@ from typing import Literal, NamedTuple, Sequence, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_angles, as_input, finish
+from .._batch import as_angles, as_input, check_flag, check_integer, check_number, finish
 from .._kernels import OK, batch_kernel, kernel
 from .._rotations import wrap_k
 from ..errors import ConvergenceError, InvalidInputError
@@ -17,18 +17,12 @@ from ._options import (
     SCALARS,
     ST_ASSEMBLE,
     ST_INPUT,
-    UNSET,
-    Unset,
     check_assembly,
     check_branch,
-    count,
-    deprecated,
     fast_branch,
     fast_sign,
-    flag,
     flat,
     mode_text,
-    real,
     resolve,
 )
 from .chains import chains_k, ref_of, rot_k, tips_k
@@ -166,6 +160,15 @@ def platform_poses(theta1: ArrayLike, theta2: ArrayLike, *, tol: float = 1e-12, 
     roots of a degree-8 polynomial in tan(roll / 2), the pitch of each from the two (linear in cos, sin) rod
     equations, polished by Newton's method. All modes, nearest R_P = I first. Never raises for valid input (a
     single input gives arrays of shape (8, ...)).
+
+    Args:
+        theta1, theta2: motor angles (rad), broadcast together.
+        tol: rod-length residual (m), in (0, 1e-6].
+        max_iter: Newton iterations, in [1, 10000].
+        geometry: the geometry (universal centre); None = the default.
+
+    Returns:
+        a :class:`PlatformPoses` (angles in rad).
     """
     if (type(theta1) in SCALARS and type(theta2) in SCALARS and geometry is None and type(tol) is float
             and 0.0 < tol <= 1e-6 and type(max_iter) is int and 1 <= max_iter <= 10_000):
@@ -174,8 +177,8 @@ def platform_poses(theta1: ArrayLike, theta2: ArrayLike, *, tol: float = 1e-12, 
         return PlatformPoses(x, bran, asm, np.isfinite(x[:, 0]))
     resolve(geometry, universal="platform_poses")
     t1, t2 = as_angles(theta1, theta2, names=("theta1", "theta2"))
-    tol = real(tol, "tol", 0.0, 1e-6, "rod-length residual, m")
-    max_iter = count(max_iter, "max_iter", 1, 10_000, "Newton iterations")
+    tol = check_number(tol, "tol", 0.0, 1e-6, low_open=True)
+    max_iter = check_integer(max_iter, "max_iter", 1, 10_000)
     shape = t1.shape
     n = t1.size
     x = np.empty((n, 8, 2))
@@ -203,14 +206,13 @@ def fk_failure(t1: float, t2: float, b: np.ndarray, s: float, guessed: bool = Fa
 
 @overload
 def platform_orientation(theta1: ArrayLike, theta2: ArrayLike, branch: Branch = ..., *, assembly: int = ...,
-                         q_start: ArrayLike | None = ..., steps: int = ..., tol: float = ..., max_iter: int = ...,
-                         geometry: Geometry | None = ..., return_mask: Literal[False] = ...,
-                         guess: ArrayLike | None | Unset = ...) -> np.ndarray: ...
+                         q_start: ArrayLike | None = ..., tol: float = ..., max_iter: int = ...,
+                         geometry: Geometry | None = ..., return_mask: Literal[False] = ...) -> np.ndarray: ...
 @overload
 def platform_orientation(theta1: ArrayLike, theta2: ArrayLike, branch: Branch = ..., *, assembly: int = ...,
-                         q_start: ArrayLike | None = ..., steps: int = ..., tol: float = ..., max_iter: int = ...,
-                         geometry: Geometry | None = ..., return_mask: Literal[True],
-                         guess: ArrayLike | None | Unset = ...) -> tuple[np.ndarray, np.ndarray]: ...
+                         q_start: ArrayLike | None = ..., tol: float = ..., max_iter: int = ...,
+                         geometry: Geometry | None = ...,
+                         return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
 def platform_orientation(
     theta1: ArrayLike,
     theta2: ArrayLike,
@@ -218,12 +220,10 @@ def platform_orientation(
     *,
     assembly: int = 1,
     q_start: ArrayLike | None = None,
-    steps: int = 4,
     tol: float = 1e-12,
     max_iter: int = 50,
     geometry: Geometry | None = None,
     return_mask: bool = False,
-    guess: ArrayLike | None | Unset = UNSET,
 ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """(roll, pitch) (..., 2) of the universal-centre platform for motor angles (theta1, theta2).
 
@@ -246,38 +246,33 @@ def platform_orientation(
         assembly: +1 (default) or -1, see :func:`assembly_mode`.
         q_start: starting (roll, pitch) (..., 2): plain Newton from it instead (the pose it reaches on
             ``branch``, whatever its assembly mode).
-        steps: unused since the forward kinematics is solved in closed form (kept for compatibility;
-            an integer in [1, 1000]).
         tol: required rod-length residual | |A_i - S_i| - L | (m), in (0, 1e-6].
         max_iter: Newton iterations, in [1, 10000].
         geometry: must have the universal centre (None: the default geometry).
-        guess: deprecated name of ``q_start``.
+
+    Returns:
+        (..., 2) (roll, pitch) (rad), NaN where a batch item fails; then the mask, if asked.
 
     Raises:
         ConvergenceError: single input whose closed sub-chain does not assemble in that mode within the joint
             limits (the message lists the modes in which it does).
     """
-    if (return_mask is False and q_start is None and guess is UNSET and geometry is None
+    if (return_mask is False and q_start is None and geometry is None
             and type(theta1) in SCALARS and type(theta2) in SCALARS
-            and type(steps) is int and 1 <= steps <= 1000 and type(tol) is float and 0.0 < tol <= 1e-6
+            and type(tol) is float and 0.0 < tol <= 1e-6
             and type(max_iter) is int and 1 <= max_iter <= 10_000):
         fb, fs = fast_branch(branch), fast_sign(assembly)
         if fb is not None and fs is not None:
             x = np.empty(2)
             if fk_select_k(theta1, theta2, fb[0], fb[1], fs, tol, max_iter, x) == OK:
                 return x
-    if guess is not UNSET:
-        deprecated("platform_orientation(guess=...)", "q_start=")
-        if q_start is None:
-            q_start = guess  # type: ignore[assignment]
     resolve(geometry, universal="platform_orientation")
     t1, t2 = as_angles(theta1, theta2, names=("theta1", "theta2"))
     b = check_branch(branch)
     s = check_assembly(assembly)
-    count(steps, "steps", 1, 1000, "unused, kept for compatibility")
-    tol = real(tol, "tol", 0.0, 1e-6, "rod-length residual, m")
-    max_iter = count(max_iter, "max_iter", 1, 10_000, "Newton iterations")
-    flag(return_mask, "return_mask")
+    tol = check_number(tol, "tol", 0.0, 1e-6, low_open=True)
+    max_iter = check_integer(max_iter, "max_iter", 1, 10_000)
+    check_flag(return_mask, "return_mask")
     shape = t1.shape
     n = t1.size
     x = np.empty((n, 2))

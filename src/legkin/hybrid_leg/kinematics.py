@@ -10,7 +10,8 @@ The public API, re-exported from the modules that implement it (each kernel besi
 * :mod:`.forward`: the closed sub-chain's forward kinematics (:func:`platform_orientation`, :func:`platform_poses`;
   the degree-8 polynomial of :mod:`.polynomial`);
 * :mod:`.foot`: the foot (eqs 17, 18, 20), the leg's forward kinematics :func:`fk` and :func:`jacobian`;
-* :mod:`.foot_inverse`: the foot IK :func:`ik`, :func:`ik_all`, :func:`foot_platform_ik`.
+* :mod:`.foot_inverse`: the foot IK :func:`ik`, :func:`ik_all` (every branch; :func:`ik_branches` with their modes),
+  :func:`foot_platform_ik`.
 
 Assembly modes: :func:`fk`, :func:`jacobian`, :func:`platform_orientation` and :func:`ik` take ``branch`` and
 ``assembly`` (:func:`assembly_mode`), by default ``(1, 1)`` and ``+1``, the mode of the SRDF reference pose
@@ -24,10 +25,9 @@ boolean mask of successes.
 
 from __future__ import annotations
 
-from ..errors import InvalidArgumentError
 from .extension import extension_motor_angle, ll_angle
-from .foot import fk, foot_jacobian, foot_position, foot_position_from_platform, jacobian
-from .foot_inverse import FootIKSolutions, foot_ik, foot_ik_solutions, foot_platform_ik, ik, ik_all
+from .foot import fk, foot_position_from_platform, jacobian
+from .foot_inverse import FootIKSolutions, foot_platform_ik, ik, ik_all, ik_branches
 from .forward import PlatformPoses, platform_orientation, platform_poses
 from .geometry import (
     ARC_RADIUS,
@@ -64,7 +64,7 @@ from .rotation import motor_angles_from_rotation, sphere_joint_angles, spherical
 
 __all__ = [
     # the API of docs/api.md
-    "Geometry", "fk", "ik", "ik_all", "jacobian", "FootIKSolutions",
+    "Geometry", "fk", "ik", "ik_all", "jacobian", "ik_branches", "FootIKSolutions",
     # the closed sub-chain, the extension joint, the foot
     "ll_angle", "extension_motor_angle", "platform_rotation", "rod_spans", "motor_angles",
     "motor_angles_from_rotation", "motor_jacobian", "sphere_joint_angles", "spherical_free_axis", "assembly_mode",
@@ -74,6 +74,4 @@ __all__ = [
     "ARC_RADIUS", "RATIO", "MOTOR_BRANCHES", "FOOT_IK_BRANCHES", "LL_DELTA", "K_TOL", "IK_K_TOL", "CLIP_FOOT_TOL",
     "BOUNDARY_TOL", "LL_TOL", "RHO_TOL", "PLATFORM_LIMIT", "LL_LIMIT", "MOTOR_LIMIT", "FK_GAIN_MAX", "PITCH_SPLIT",
     "FOOT_IK_ORDER",
-    # deprecated aliases (legkin 0.1 names, kept for one release; they warn)
-    "foot_position", "foot_jacobian", "foot_ik", "foot_ik_solutions", "InvalidArgumentError",
 ]

@@ -15,7 +15,7 @@ from typing import Literal, Sequence, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_angles, finish
+from .._batch import as_angles, check_flag, finish
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import SingularityError
 from ._options import (
@@ -24,7 +24,6 @@ from ._options import (
     ST_SINGULAR,
     check_branch,
     fast_branch,
-    flag,
     flat,
     resolve,
     unreachable,
@@ -136,6 +135,13 @@ def platform_rotation(roll: ArrayLike, pitch: ArrayLike, *, geometry: Geometry |
 
     Seed eq 2 writes R_P as a unit quaternion (a spherical joint); the universal joint is the physical
     2-DOF platform (see the docs: the spherical centre leaves one rotation uncontrolled).
+
+    Args:
+        roll, pitch: platform angles (rad), broadcast together.
+        geometry: accepted for uniformity (None: the default).
+
+    Returns:
+        (..., 3, 3) rotation matrices.
     """
     if type(roll) in SCALARS and type(pitch) in SCALARS and geometry is None:
         out = np.empty((3, 3))
@@ -154,6 +160,13 @@ def rod_spans(theta1: ArrayLike, theta2: ArrayLike, roll: ArrayLike = 0.0, pitch
 
     The chains of seed eqs 3-9 and 10-16 up to the first spherical joint, and the platform points of
     eqs 9, 16. At zero motors and R_P = I the span is 0.0839 m, not 0.11: that pose does not close.
+
+    Args:
+        theta1, theta2: motor angles (rad); roll, pitch: platform angles (rad); broadcast together.
+        geometry: the geometry (universal centre); None = the default.
+
+    Returns:
+        (..., 2) the lever-tip to rod-attachment distances (m).
     """
     if (type(theta1) in SCALARS and type(theta2) in SCALARS and type(roll) in SCALARS and type(pitch) in SCALARS
             and geometry is None and math.isfinite(theta1 + theta2 + roll + pitch)):  # type: ignore[operator, arg-type]
@@ -181,6 +194,15 @@ def motor_angles(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *, 
     replaced by the universal joint). Each chain's rod-length condition is A cos(theta) + B sin(theta) = C,
     solved in closed form; ``branch = (b1, b2)`` picks one of its two solutions per chain.
 
+    Args:
+        roll, pitch: platform angles (rad), broadcast together.
+        branch: the motor branch pair (b1, b2), each +1 or -1.
+        geometry: the geometry (universal centre); None = the default.
+        return_mask: also return the mask of successes.
+
+    Returns:
+        (..., 2) (theta1, theta2) (rad), NaN where out of reach; then the mask, if asked.
+
     Raises:
         UnreachableError: single (roll, pitch) out of reach (message names the chain and its |k|).
     """
@@ -193,7 +215,7 @@ def motor_angles(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *, 
     resolve(geometry)
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
     b = check_branch(branch)
-    flag(return_mask, "return_mask")
+    check_flag(return_mask, "return_mask")
     n = r.size
     theta, k, ok = np.empty((n, 2)), np.empty((n, 2)), np.empty(n, dtype=np.bool_)
     _motor_angles_b(flat(r), flat(p), float(b[0]), float(b[1]), theta, k, ok)
@@ -226,6 +248,13 @@ def motor_jacobian(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *
     ``dA/droll = e_x x R a``, ``dA/dpitch = (Rx(roll) e_y) x R a``, ``dS/dtheta = e_z x Rz(phi) l``.
     Infinite (NaN here) on the reach boundary, where ``d_i . dS_i/dtheta_i = 0``.
 
+    Args:
+        roll, pitch: platform angles (rad), broadcast together; branch, geometry, return_mask: as
+            :func:`motor_angles`.
+
+    Returns:
+        (..., 2, 2) dtheta/d(roll, pitch) (rad/rad); then the mask, if asked.
+
     Raises:
         UnreachableError: single (roll, pitch) out of reach.
         SingularityError: single pose on the reach boundary (a motor cannot move its rod end).
@@ -239,7 +268,7 @@ def motor_jacobian(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *
     resolve(geometry)
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
     b = check_branch(branch)
-    flag(return_mask, "return_mask")
+    check_flag(return_mask, "return_mask")
     jac, k, st, _ = _jacobian_and_mode(r, p, b)
 
     def error() -> Exception:
@@ -266,6 +295,13 @@ def assembly_mode(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *,
     sign. The mechanism is built in mode +1 on branch (1, 1) (the SRDF pose ``neutral``). A single pose gives a
     0-d integer array.
 
+    Args:
+        roll, pitch: platform angles (rad), broadcast together; branch, geometry, return_mask: as
+            :func:`motor_angles`.
+
+    Returns:
+        (...) +1 or -1 (an integer array); then the mask, if asked.
+
     Raises:
         UnreachableError: single pose out of the motors' reach on that branch.
     """
@@ -278,7 +314,7 @@ def assembly_mode(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *,
     resolve(geometry)
     r, p = as_angles(roll, pitch, names=("roll", "pitch"))
     b = check_branch(branch)
-    flag(return_mask, "return_mask")
+    check_flag(return_mask, "return_mask")
     _, k, st, mode = _jacobian_and_mode(r, p, b)
     return finish(mode.astype(int), st != ST_REACH, r.ndim == 0, return_mask,
                   lambda: unreachable(_pose_text(r, p), k))

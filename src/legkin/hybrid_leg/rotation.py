@@ -14,10 +14,10 @@ from typing import Callable, Literal, Sequence, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input, finish
+from .._batch import as_input, check_flag, finish
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import InvalidInputError
-from ._options import ST_INPUT, check_branch, fast_branch, flag, resolve, unreachable
+from ._options import ST_INPUT, check_branch, fast_branch, resolve, unreachable
 from .chains import AX0, AX1, AY0, AY1, AZ0, AZ1, CX, CY, CZ, L, chains_k, is_rotation_k, rotation_error_k, tips_k
 from .geometry import BETA, K_TOL, Geometry
 
@@ -116,7 +116,7 @@ def _rotation_call(kernels: Callable[..., object], core: tuple[int, ...],
     resolve(geometry)
     rot = as_input(rotation, "rotation", (3, 3))
     b = check_branch(branch)
-    flag(return_mask, "return_mask")
+    check_flag(return_mask, "return_mask")
     shape = rot.shape[:-2]
     m = np.ascontiguousarray(rot.reshape(-1, 3, 3))
     n = len(m)
@@ -157,6 +157,15 @@ def motor_angles_from_rotation(rotation: ArrayLike, branch: Branch = (1, 1), *, 
     so ``phi = atan2(B, A) - sigma_i b_i acos(C / sqrt(A^2 + B^2))``. Unreachable where
     ``|C| > sqrt(A^2 + B^2)``. Angles wrapped to (-pi, pi].
 
+    Args:
+        rotation: (..., 3, 3) platform rotation matrices.
+        branch: the motor branch pair (b1, b2), each +1 or -1.
+        geometry: the geometry (universal centre); None = the default.
+        return_mask: also return the mask of successes.
+
+    Returns:
+        (..., 2) (theta1, theta2) (rad), NaN where out of reach; then the mask, if asked.
+
     Raises:
         UnreachableError: single rotation out of reach.
     """
@@ -186,6 +195,13 @@ def sphere_joint_angles(rotation: ArrayLike, branch: Branch = (1, 1), *, geometr
     (|beta| = 90 deg); at the neutral pose |beta| = 3.65 deg. The rod-end sphere (i-2) is the point
     closure itself and has no joint angles.
 
+    Args:
+        rotation: (..., 3, 3) platform rotation matrices; branch, geometry, return_mask: as
+            :func:`motor_angles_from_rotation`.
+
+    Returns:
+        (..., 2, 3) the z-y-x angles (rad) of the two lever-tip spheres; then the mask, if asked.
+
     Raises:
         UnreachableError: single rotation out of reach.
     """
@@ -211,6 +227,15 @@ def spherical_free_axis(rotation: ArrayLike, branch: Branch = (1, 1), *, geometr
     ``2 d_i . (w x R a_i) = 2 w . ((R a_i) x d_i)``; both rods are held when ``w`` is orthogonal to
     ``g_i = (R a_i) x d_i``, so the free axis is ``g_1 x g_2`` (normalised; sign: positive z component).
     At R_P = I on the neutral branch it is ~(-0.39, 0, 0.92) through the LCS centre.
+
+    Args:
+        rotation: (..., 3, 3) platform rotation matrices.
+        branch: the motor branch pair (b1, b2), each +1 or -1.
+        geometry: the geometry; None = the default.
+        return_mask: also return the mask of successes.
+
+    Returns:
+        (..., 3) unit axes of the free rotation (CCS); then the mask, if asked.
 
     Raises:
         UnreachableError: single rotation out of reach.

@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING, Any, Iterable, Mapping
 import numpy as np
 import pinocchio as pin
 
+from .._batch import check_integer, check_number
 from ..errors import InvalidInputError, InvalidParameterError, LegkinError
-from ..loops import check_count, check_real
 
 if TYPE_CHECKING:  # pragma: no cover
 
@@ -116,22 +116,22 @@ def _checked_options(options: Mapping[str, Any]) -> dict[str, Any]:
             f"unknown MJCF option(s) {', '.join(unknown)}; options: {', '.join(DEFAULTS)}"
         )
     o = {**DEFAULTS, **options}
-    o["timestep"] = check_real("timestep", o["timestep"], 0.0, 0.1, low_open=True)
+    o["timestep"] = check_number(o["timestep"], "timestep", 0.0, 0.1, low_open=True)
     if o["integrator"] not in _INTEGRATORS:
         raise InvalidParameterError(f"integrator must be one of {', '.join(_INTEGRATORS)}, got {o['integrator']!r}")
-    o["iterations"] = check_count("iterations", o["iterations"], 1)
-    o["tolerance"] = check_real("tolerance", o["tolerance"], 0.0)
+    o["iterations"] = check_integer(o["iterations"], "iterations", 1)
+    o["tolerance"] = check_number(o["tolerance"], "tolerance", 0.0)
     if o["eq_solref"] is None:
         o["eq_solref"] = (2.0 * o["timestep"], 0.7)
-    o["eq_solref"] = tuple(check_real(f"eq_solref[{i}]", v) for i, v in enumerate(o["eq_solref"]))
-    o["eq_solimp"] = tuple(check_real(f"eq_solimp[{i}]", v) for i, v in enumerate(o["eq_solimp"]))
+    o["eq_solref"] = tuple(check_number(v, f"eq_solref[{i}]") for i, v in enumerate(o["eq_solref"]))
+    o["eq_solimp"] = tuple(check_number(v, f"eq_solimp[{i}]") for i, v in enumerate(o["eq_solimp"]))
     if len(o["eq_solref"]) != 2 or len(o["eq_solimp"]) not in (3, 5):
         raise InvalidParameterError("eq_solref takes 2 numbers and eq_solimp 3 or 5")
-    o["actuator_frequency"] = check_real("actuator_frequency", o["actuator_frequency"], 0.0, low_open=True)
-    o["damping_ratio"] = check_real("damping_ratio", o["damping_ratio"], 0.0)
-    o["min_mass"] = check_real("min_mass", o["min_mass"], 0.0, low_open=True)
-    o["min_radius"] = check_real("min_radius", o["min_radius"], 0.0, low_open=True)
-    o["gravity"] = tuple(check_real(f"gravity[{i}]", v) for i, v in enumerate(o["gravity"]))
+    o["actuator_frequency"] = check_number(o["actuator_frequency"], "actuator_frequency", 0.0, low_open=True)
+    o["damping_ratio"] = check_number(o["damping_ratio"], "damping_ratio", 0.0)
+    o["min_mass"] = check_number(o["min_mass"], "min_mass", 0.0, low_open=True)
+    o["min_radius"] = check_number(o["min_radius"], "min_radius", 0.0, low_open=True)
+    o["gravity"] = tuple(check_number(v, f"gravity[{i}]") for i, v in enumerate(o["gravity"]))
     for flag in ("force_limits", "floor"):
         if not isinstance(o[flag], (bool, np.bool_)):
             raise InvalidParameterError(f"{flag} must be True or False, got {o[flag]!r}")

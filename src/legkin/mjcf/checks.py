@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING, Any, Sequence
 import numpy as np
 import pinocchio as pin
 
+from .._batch import check_integer, check_number
 from ..errors import LoopClosureError
-from ..loops import check_count, check_real
 from ._base import _mujoco
 from .mechanism import MujocoMechanism, load_mujoco
 
@@ -248,9 +248,9 @@ def check_rows(
     from .._checkkit import compare
 
     _mujoco()
-    samples = check_count("samples", samples)
-    seconds = check_real("seconds", seconds, 0.0, low_open=True)
-    frame_time = check_real("frame_time", frame_time, 0.0, low_open=True)
+    samples = check_integer(samples, "samples", 0)
+    seconds = check_number(seconds, "seconds", 0.0, low_open=True)
+    frame_time = check_number(frame_time, "frame_time", 0.0, low_open=True)
     rng = np.random.default_rng(0) if rng is None else rng
     mech = load_mujoco(name) if mech is None else mech
     robot = mech.robot

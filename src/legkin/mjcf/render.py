@@ -7,8 +7,8 @@ from typing import TYPE_CHECKING, Sequence
 
 import numpy as np
 
+from .._batch import check_integer
 from ..errors import LegkinError
-from ..loops import check_count
 from ._base import _mujoco
 from .mechanism import MujocoMechanism
 
@@ -43,7 +43,7 @@ def render_png(
         from PIL import Image
     except ImportError:
         raise LegkinError("render_png needs Pillow: pip install pillow") from None
-    width, height = check_count("width", width, 1), check_count("height", height, 1)
+    width, height = check_integer(width, "width", 1), check_integer(height, "height", 1)
     if q is not None:
         mech.set_configuration(q, forward=False)
     mujoco.mj_forward(mech.model, mech.data)

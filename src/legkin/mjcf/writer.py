@@ -11,8 +11,8 @@ from typing import TYPE_CHECKING, Any, Mapping, Sequence
 import numpy as np
 import pinocchio as pin
 
+from .._batch import check_number
 from ..errors import InvalidParameterError, LegkinError
-from ..loops import check_real
 from ._base import _AXES, _MESH_EXTENSIONS, DEFAULTS, _num, _options, _robot, _set_pose, _vec
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -184,9 +184,9 @@ def _gains(robot: "Robot", joints: Sequence[_Joint], o: Mapping[str, Any]) -> tu
             for name, value in given.items():
                 if name not in gains:
                     raise InvalidParameterError(f"{key}[{name!r}]: not an actuated joint ({', '.join(gains)})")
-                gains[name] = check_real(f"{key}[{name!r}]", value, 0.0)
+                gains[name] = check_number(value, f"{key}[{name!r}]", 0.0)
         else:
-            value = check_real(key, given, 0.0)
+            value = check_number(given, key, 0.0)
             for name in gains:
                 gains[name] = value
     return kp, kv

@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-import warnings
-from typing import Any
-
 import numpy as np
 
 from .._batch import check_choice, check_flag
-from ..errors import InvalidInputError, InvalidParameterError
+from ..errors import InvalidParameterError
 from .geometry import DEFAULT, Geometry
 
 LEGS = ("A", "B", "C")
@@ -59,34 +56,12 @@ def modes_sel(mode: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 # ------------------------------------------------------------------------------------------ arguments
-def geometry_of(
-    geometry: object, legacy: dict[str, Any] | None = None, where: str = "", stacklevel: int = 4
-) -> Geometry:
-    """The call's :class:`Geometry`: ``geometry`` (None: the default), or the deprecated ``d``, ``alpha``, ``eta``
-    (a DeprecationWarning, mapped onto a Geometry)."""
-    if legacy:
-        if geometry is not None:
-            raise InvalidParameterError(
-                f"{where}: pass either geometry= or the deprecated {', '.join(legacy)}, not both"
-            )
-        warnings.warn(
-            f"{where}: the geometry arguments {', '.join(legacy)} are deprecated; pass geometry=tripod.Geometry(...)",
-            DeprecationWarning, stacklevel=stacklevel,
-        )
-        kw = dict(legacy)
-        if kw.get("eta") is None:
-            kw.pop("eta", None)
-        else:
-            try:
-                eta = np.asarray(kw["eta"])
-            except (TypeError, ValueError):
-                eta = None
-            if eta is None or eta.dtype.kind not in "biuf" or eta.shape != (3,):
-                raise InvalidParameterError(
-                    f"eta must be three finite real angles (eta_A, eta_B, eta_C), got {kw['eta']!r}"
-                )
-            kw["eta"] = tuple(float(v) for v in eta)
-        return Geometry(**kw)
+def geometry_of(geometry: object) -> Geometry:
+    """The call's :class:`Geometry`: ``geometry``, or the default for None.
+
+    Raises:
+        InvalidParameterError: ``geometry`` is neither None nor a :class:`Geometry`.
+    """
     if geometry is None:
         return DEFAULT
     if type(geometry) is not Geometry:
@@ -106,22 +81,3 @@ def flag(value: object, name: str) -> bool:
     if value is False or value is True:
         return value  # type: ignore[return-value]
     return check_flag(value, name)
-
-
-def deprecated(old: str, new: str, stacklevel: int = 4) -> None:
-    """Warn that the call form / name ``old`` is deprecated in favour of ``new`` (``stacklevel``: of the user's call
-    as seen from here)."""
-    warnings.warn(f"{old} is deprecated (legkin 0.2); use {new}", DeprecationWarning, stacklevel=stacklevel)
-
-
-def split_legacy(kwargs: dict[str, Any], where: str, allowed: tuple[str, ...]) -> dict[str, Any]:
-    """Pop the deprecated keyword arguments ``allowed`` out of ``kwargs``; refuse any other unknown keyword."""
-    legacy = {k: kwargs.pop(k) for k in allowed if k in kwargs}
-    if kwargs:
-        raise TypeError(f"{where}() got unexpected keyword argument(s) {', '.join(map(repr, kwargs))}")
-    return legacy
-
-
-def raise_nonfinite(name: str) -> None:
-    raise InvalidInputError(f"{name} must be finite, got a NaN or infinite entry")
-

@@ -140,6 +140,25 @@ def _k_jac(cy, sy, cz, sz, c2, s2, nb2, G, home, e, a1, a2):  # type: ignore[no-
 
 
 @kernel(inline=True)
+def _k_plane_cross(K, s, c, G):  # type: ignore[no-untyped-def]
+    """``n_J x n_L`` (J, L = K + 1, K + 2 mod 3) of the motor planes' normals ``n_K = (s_K1, -c_K1 c_K,
+    -c_K1 s_K)``, from the sin / cos tuples of the three motors: a column of the adjugate of M (the same
+    products serve det M and fk's start, :func:`legkin.tripod.forward_kernels._k_initial_guess`)."""
+    J, L = (K + 1) % 3, (K + 2) % 3
+    p, q = c[J] * s[L], s[J] * c[L]
+    x = c[J] * c[L] * G[G_W + K]
+    y = q * G[G_SE + L] - p * G[G_SE + J]
+    z = p * G[G_CE + J] - q * G[G_CE + L]
+    return x, y, z
+
+
+@kernel(inline=True)
+def _k_plane_dot(K, s, c, G, x, y, z):  # type: ignore[no-untyped-def]
+    """``n_K . (x, y, z)``: with (x, y, z) = :func:`_k_plane_cross` (K) the triple product det M."""
+    return s[K] * x - c[K] * (G[G_CE + K] * y + G[G_SE + K] * z)
+
+
+@kernel(inline=True)
 def _k_det_planes(sa_, sb_, sc_, ca_, cb_, cc_, G):  # type: ignore[no-untyped-def]
     """det M of the motor planes' unit normals ``n_K = (s_K1, -c_K1 c_K, -c_K1 s_K)`` from sin / cos of the three
     motors: the triple product ``n_A . (n_B x n_C)`` (the mean of its three cyclic forms)."""
@@ -147,12 +166,8 @@ def _k_det_planes(sa_, sb_, sc_, ca_, cb_, cc_, G):  # type: ignore[no-untyped-d
     c = (ca_, cb_, cc_)
     tot = 0.0
     for K in range(3):
-        J, L = (K + 1) % 3, (K + 2) % 3
-        p, q = c[J] * s[L], s[J] * c[L]
-        x = c[J] * c[L] * G[G_W + K]
-        y = q * G[G_SE + L] - p * G[G_SE + J]
-        z = p * G[G_CE + J] - q * G[G_CE + L]
-        tot += s[K] * x - c[K] * (G[G_CE + K] * y + G[G_SE + K] * z)
+        x, y, z = _k_plane_cross(K, s, c, G)
+        tot += _k_plane_dot(K, s, c, G, x, y, z)
     return tot / 3.0
 
 

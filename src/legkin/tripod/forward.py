@@ -10,7 +10,7 @@ from typing import Any, Literal, Sequence, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_angles, as_input, check_integer, check_number
+from .._batch import check_integer, check_number, dispatch
 from .._kernels import OK
 from ..errors import AssemblyModeError, ConvergenceError, SingularityError, UnreachableError
 from ._common import (
@@ -21,24 +21,19 @@ from ._common import (
     MODES,
     ST_GAIN,
     ST_LEFT,
-    ST_NONFINITE,
     ST_NOT_CONVERGED,
     ST_OUTSIDE,
     ST_SINGULAR_PLANES,
     checked_mode,
-    deprecated,
     flag,
     geometry_of,
     modes_sel,
-    split_legacy,
 )
 from .forward_kernels import FK_LOOP, _k_fk, _k_initial_guess
 from .geometry import Geometry
 from .inverse import ik_one, ik_single_error
 
 __all__ = ["fk", "FKInfo"]
-
-_GEOMETRY_KW = ("d", "alpha", "eta")
 
 
 @dataclass(frozen=True)
@@ -103,7 +98,8 @@ def _fk_error(qs: Sequence[float], out: np.ndarray, status: int, mode: str, othe
         _, aux, st = ik_one(y0, z0, G, mode)
         if st != OK:
             exc = ik_single_error(np.float64(y0), np.float64(z0), G, mode, aux)
-            return type(exc)(f"{motors}: no pose found; their planes meet at {exc}", *exc.args[1:])
+            exc.args = (f"{motors}: no pose found; their planes meet at {exc}",)  # keeps its data attributes
+            return exc
         return UnreachableError(f"{motors}: the solver left the workspace; no pose was found", target=target)
     if status == ST_NOT_CONVERGED:
         return ConvergenceError(f"{motors}: Gauss-Newton did not converge in {max_iter} iterations (singular A_u?)")
@@ -122,57 +118,53 @@ def _fk_error(qs: Sequence[float], out: np.ndarray, status: int, mode: str, othe
         f"(alpha_y, alpha_z) = ({ay:.17g}, {az:.17g}) misses them by {inconsistency:.3e} rad "
         f"(max_inconsistency = {max_inconsistency:.1e})",
         target=target,
-        closest=(ay, az),
+        closest=np.array([ay, az]),
+        distance=inconsistency,
     )
 
 
-def _single(qs: tuple[float, float, float], g: Geometry, mode: str, tol: float, max_iter: int, max_inc: float,
-            bad: Any) -> tuple[np.ndarray, np.ndarray]:
-    """A single fk call: (out (3,) or (16, 3) for mode "all", ok); a legkin error on failure."""
-    G = g._vector
+_SOLVED = np.asarray(True)  # the mask of a solved single call (read-only, shared)
+_SOLVED.setflags(write=False)
+
+
+def _fk_fast(qm: np.ndarray, g: Geometry, mode: str, tol: float, max_iter: int,
+             max_inc: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """One motor triple straight to the kernel: (alpha_y, alpha_z, inconsistency), True; None unless solved (and
+    for ``mode="all"``, which the batch loop solves)."""
     if mode == "all":
-        outs, ok = np.full((len(MODES), 3), np.nan), np.zeros(len(MODES), dtype=bool)
-        first: tuple[np.ndarray, int] | None = None
-        for j, m in enumerate(MODES):
-            out, st = _fk_one(*qs, G, m, tol, max_iter, max_inc)
-            if st == ST_NONFINITE:
-                bad()
-            first = first or (out, st)
-            if st == OK:
-                outs[j], ok[j] = out, True
-        if not ok.any():
-            assert first is not None
-            raise _fk_error(qs, first[0], first[1], HOME_MODE, [], max_iter, max_inc, g)
-        return outs, ok
-    out, st = _fk_one(*qs, G, mode, tol, max_iter, max_inc)
-    if st != OK:
-        if st == ST_NONFINITE:
-            bad()
-        others = []
-        if st != ST_SINGULAR_PLANES:  # consistent motors fit the mode their planes' intersection E points to
-            likely = _motor_mode(np.array(qs), g)
-            for m in [likely] if likely else MODES:
-                if m != mode and _fk_one(*qs, G, m, tol, max_iter, max_inc)[1] == OK:
-                    others.append(m)
-                    break
-        raise _fk_error(qs, out, st, mode, others, max_iter, max_inc, g)
-    return out, np.asarray(True)
+        return None
+    qa, qb, qc = qm.tolist()  # Python floats: numba dispatches them faster than numpy scalars
+    out, st = _fk_one(qa, qb, qc, g._vector, mode, tol, max_iter, max_inc)
+    return (out, _SOLVED) if st == OK else None
 
 
-def _batch(
-    qm: np.ndarray, g: Geometry, mode: str, tol: float, max_iter: int, max_inc: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """A batch fk call on motors (..., 3): out (..., [16,] 3) NaN where an item fails, ok (..., [16])."""
-    shape = qm.shape[:-1]
-    rows = np.ascontiguousarray(qm.reshape(-1, 3), dtype=np.float64)
+def _fk_batch(rows: np.ndarray, g: Geometry, mode: str, tol: float, max_iter: int,
+              max_inc: float) -> tuple[np.ndarray, np.ndarray]:
+    """The fk loop on motor rows (n, 3): out (n, [16,] 3) NaN where an item fails, ok (n, [16])."""
     homes, es, ss = modes_sel(mode)
     n, m = rows.shape[0], homes.shape[0]
     out, status = np.empty((n, m, 3)), np.empty((n, m), dtype=np.int64)
     FK_LOOP(rows, g._vector, homes, es, ss, tol, max_iter, max_inc, out, status)
-    ok = status == OK
     if mode == "all":
-        return out.reshape(shape + (m, 3)), ok.reshape(shape + (m,))
-    return out[:, 0].reshape(shape + (3,)), ok[:, 0].reshape(shape)
+        return out, status == OK
+    return out[:, 0], status[:, 0] == OK
+
+
+def _fk_fail(qm: np.ndarray, out: np.ndarray, ok: np.ndarray, g: Geometry, mode: str, tol: float, max_iter: int,
+             max_inc: float) -> Exception:
+    """The exception of a failed single :func:`fk` call (``mode="all"``: diagnosed in the home mode)."""
+    qs = (float(qm[0]), float(qm[1]), float(qm[2]))
+    m = HOME_MODE if mode == "all" else mode
+    G = g._vector
+    raw, st = _fk_one(*qs, G, m, tol, max_iter, max_inc)
+    others = []
+    if mode != "all" and st != ST_SINGULAR_PLANES:  # consistent motors fit the mode of their planes' E
+        likely = _motor_mode(np.array(qs), g)
+        for other in [likely] if likely else MODES:
+            if other != mode and _fk_one(*qs, G, other, tol, max_iter, max_inc)[1] == OK:
+                others.append(other)
+                break
+    return _fk_error(qs, raw, st, m, others, max_iter, max_inc, g)
 
 
 def _options(mode: Any, tol: Any, max_iter: Any, max_inc: Any) -> tuple[str, float, int, float]:
@@ -216,13 +208,9 @@ def fk(q: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ..., tol: f
 def fk(q: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ..., tol: float = ..., max_iter: int = ...,
        max_inconsistency: float = ..., return_mask: Literal[True],
        return_info: Literal[True]) -> tuple[np.ndarray, np.ndarray, FKInfo]: ...
-@overload
-def fk(q_A1: ArrayLike, q_B1: ArrayLike, q_C1: ArrayLike, d: float = ..., alpha: float = ...,
-       eta: Sequence[float] | None = ..., /, *, mode: str = ..., tol: float = ..., max_iter: int = ...,
-       max_inconsistency: float = ..., return_mask: bool = ...) -> Any: ...
-def fk(q: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | None = None, tol: float = 1e-13,
-       max_iter: int = 30, max_inconsistency: float = 1e-9, return_mask: bool = False, return_info: bool = False,
-       **legacy: Any) -> Any:
+def fk(q: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | None = None, tol: float = 1e-13,
+       max_iter: int = 30, max_inconsistency: float = 1e-9, return_mask: bool = False,
+       return_info: bool = False) -> Any:
     """Platform orientation (alpha_y, alpha_z) from the motor angles ``q = (q_A1, q_B1, q_C1)``: Gauss-Newton on
     :func:`ik` with :func:`jacobian`.
 
@@ -271,56 +259,12 @@ def fk(q: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | Non
         ConvergenceError: (single) no convergence within ``max_iter``.
         InvalidInputError: non-finite, complex or wrongly shaped motors; InvalidParameterError: bad geometry,
             mode, tol, max_iter, max_inconsistency, return_mask or return_info.
-
-    Deprecated form (legkin 0.1, one release): ``fk(q_A1, q_B1, q_C1, d, alpha, eta, *, mode, tol, max_iter,
-    max_inconsistency, return_mask)`` returns ``(alpha_y, alpha_z, inconsistency[, mask])``.
     """
     mode, tol, max_iter, max_inc = _options(mode, tol, max_iter, max_inconsistency)
     return_mask = flag(return_mask, "return_mask")
     return_info = flag(return_info, "return_info")
-    if geometry is None and not args and not legacy and type(q) is np.ndarray and q.shape == (3,) and \
-            q.dtype == np.float64 and mode != "all" and not return_mask and not return_info:  # single-call fast path
-        out, st = _fk_one(float(q[0]), float(q[1]), float(q[2]), geometry_of(None)._vector, mode, tol, max_iter,
-                          max_inc)
-        if st == OK:
-            return out[:2].copy()
-    if len(args) >= 2:
-        return _legacy_fk(q, args, legacy, geometry, mode, tol, max_iter, max_inc, return_mask)
-    if args:
-        raise TypeError("fk() takes the motors as one array q (..., 3), or (deprecated) q_A1, q_B1, q_C1")
-    geo = split_legacy(legacy, "fk", _GEOMETRY_KW) if legacy else legacy
-    g = geometry_of(geometry, geo, "fk") if geo else geometry_of(geometry)
-    qm = as_input(q, "q", (3,))
-    if qm.ndim == 1:
-        out, ok = _single((float(qm[0]), float(qm[1]), float(qm[2])), g, mode, tol, max_iter, max_inc, None)
-    else:
-        out, ok = _batch(qm, g, mode, tol, max_iter, max_inc)
+    g = geometry_of(geometry)
+    out, ok = dispatch(q, "q", (3,), _fk_fast, _fk_batch, _fk_fail, (g, mode, tol, max_iter, max_inc), True)
+    if not return_mask and not return_info:  # the common call: the orientation only
+        return out[..., :2].copy()
     return _finish(out, ok, return_mask, return_info)
-
-
-def _legacy_fk(q_A1: Any, args: tuple[Any, ...], legacy: dict[str, Any], geometry: Geometry | None, mode: str,
-               tol: float, max_iter: int, max_inc: float, return_mask: bool) -> Any:
-    """The deprecated ``fk(q_A1, q_B1, q_C1, d, alpha, eta, ...)``: ``(alpha_y, alpha_z, inconsistency[, mask])``."""
-    deprecated("fk(q_A1, q_B1, q_C1, d, alpha, eta)", "fk(q, geometry=...) with q (..., 3)")
-    if len(args) > 5:
-        raise TypeError("fk() takes at most 6 positional arguments in its deprecated form")
-    geo = {**dict(zip(_GEOMETRY_KW, args[2:])), **split_legacy(legacy, "fk", _GEOMETRY_KW)}
-    g = geometry_of(geometry, geo, "fk") if geo else geometry_of(geometry)
-    raw = (q_A1, args[0], args[1])
-
-    def bad() -> None:
-        as_angles(*raw, names=("q_A1", "q_B1", "q_C1"))
-
-    if all(type(v) is float for v in raw):
-        out, ok = _single(raw, g, mode, tol, max_iter, max_inc, bad)
-    else:
-        a, b, c = as_angles(*raw, names=("q_A1", "q_B1", "q_C1"))
-        if a.ndim:
-            out, ok = _batch(np.stack([a, b, c], axis=-1), g, mode, tol, max_iter, max_inc)
-        else:
-            out, ok = _single((float(a), float(b), float(c)), g, mode, tol, max_iter, max_inc, bad)
-    if out.ndim == 1:
-        res = tuple(np.float64(v) for v in out)
-    else:
-        res = tuple(np.ascontiguousarray(out[..., k]) for k in range(3))
-    return (*res, ok) if return_mask else res

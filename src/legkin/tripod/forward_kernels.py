@@ -43,8 +43,8 @@ from ._common import (
     ST_OUTSIDE,
     ST_SINGULAR_PLANES,
 )
-from .closure import _k_inside, _k_jac, _k_pose
-from .geometry import G_CE, G_K, G_SE, G_W
+from .closure import _k_inside, _k_jac, _k_plane_cross, _k_plane_dot, _k_pose
+from .geometry import G_K
 
 #: Relative singular-value cut-off of the Gauss-Newton step (that of ``np.linalg.pinv(A_u, rcond=1e-12)``).
 STEP_RCOND = 1e-12
@@ -66,12 +66,8 @@ def _k_initial_guess(qa, qb, qc, G):  # type: ignore[no-untyped-def]
     ey = 0.0
     ez = 0.0
     for K in range(3):
-        J, L = (K + 1) % 3, (K + 2) % 3
-        p, q = c[J] * s[L], s[J] * c[L]
-        x = c[J] * c[L] * G[G_W + K]
-        y = q * G[G_SE + L] - p * G[G_SE + J]
-        z = p * G[G_CE + J] - q * G[G_CE + L]
-        det3 += s[K] * x - c[K] * (G[G_CE + K] * y + G[G_SE + K] * z)
+        x, y, z = _k_plane_cross(K, s, c, G)
+        det3 += _k_plane_dot(K, s, c, G, x, y, z)
         ex += x
         ey += y
         ez += z

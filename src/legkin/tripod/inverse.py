@@ -3,12 +3,12 @@ public wrappers over the kernels of :mod:`legkin.tripod.closure`, and the diagno
 
 from __future__ import annotations
 
-from typing import Any, Literal, Sequence, overload
+from typing import Any, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_angles, as_input
+from .._batch import dispatch
 from .._kernels import OK
 from ..errors import SingularityError, UnreachableError
 from ._common import (
@@ -20,20 +20,16 @@ from ._common import (
     MODE_ARGS,
     MODES,
     SINGULAR_TOL,
-    ST_NONFINITE,
     checked_mode,
-    deprecated,
     flag,
     geometry_of,
     modes_sel,
-    split_legacy,
 )
 from .closure import IK_ALL_LOOP, IK_LOOP, JACOBIAN_LOOP, _k_actuation_jacobian, _k_ik, _k_ik_all
 from .geometry import DEFAULT, Geometry
 
-__all__ = ["ik", "ik_all", "ik_joints", "jacobian", "actuation_jacobian"]
+__all__ = ["ik", "ik_all", "ik_joints", "jacobian"]
 
-_GEOMETRY_KW = ("d", "alpha", "eta")
 _G_DEFAULT = DEFAULT._vector
 _F64 = np.dtype(np.float64)  # the fast paths test ``dtype is _F64`` (3x cheaper than ``== np.float64``)
 
@@ -66,7 +62,7 @@ def _ik_error(ay: float, az: float, c2: np.ndarray, sing: Any, unreachable: np.n
             return UnreachableError(
                 f"{where} is outside the workspace: leg {leg} would need cos q_{leg}2 = {float(c2[k]):.17g}, "
                 "outside [-1, 1] (eq 98)",
-                target=(float(ay), float(az)),
+                target=np.array([float(ay), float(az)]),
             )
     for k, leg in enumerate(LEGS):
         if leg_sing[k]:
@@ -121,98 +117,84 @@ def _run(ay: np.ndarray, az: np.ndarray, G: np.ndarray, mode: str,
     return q.reshape(shape + (m, width)), aux.reshape(shape + (m, 6)), status.reshape(shape + (m,))
 
 
-def _fast_g(geometry: object) -> np.ndarray | None:
-    """The kernels' geometry vector for the single-call fast paths (None: not a plain geometry argument)."""
-    if geometry is None:
-        return _G_DEFAULT
-    return geometry._vector if type(geometry) is Geometry else None
+def _checked(mode: object, geometry: object, return_mask: object,
+             allow_all: bool = True) -> tuple[str, np.ndarray, bool]:
+    """(mode, the kernels' geometry vector, return_mask) of a call, checked (fast for the common values)."""
+    if not (type(mode) is str and mode in MODE_ARGS):
+        mode = checked_mode(mode, allow_all=allow_all)
+    G = _G_DEFAULT if geometry is None else geometry_of(geometry)._vector
+    if return_mask is not False and return_mask is not True:
+        return_mask = flag(return_mask, "return_mask")
+    return mode, G, return_mask  # type: ignore[return-value]
 
 
-def _all_modes(ay: Any, az: Any, scalar: bool, G: np.ndarray, return_mask: bool, joints: bool,
-               bad_input: Any) -> Any:
-    """ik in every mode (:func:`legkin.tripod.closure._k_ik_all`): (..., 16, 12) joints or (..., 16, 3) motors,
-    per the single/batch rule (a single call raises only when no mode solves the target)."""
-    w = 12 if joints else 3
-    if scalar:
-        q, ok = np.empty((16, w)), np.empty(16, dtype=np.bool_)
-        st = _k_ik_all(ay, az, G, q, ok)
-        if st != OK:
-            if st == ST_NONFINITE:
-                bad_input()
-            aux = ik_one(ay, az, G, HOME_MODE)[1]
-            raise ik_single_error(np.float64(ay), np.float64(az), G, HOME_MODE, aux)
-        return (q, ok) if return_mask else q
-    shape = ay.shape
-    y = np.ascontiguousarray(ay, dtype=np.float64).reshape(-1)
-    z = np.ascontiguousarray(az, dtype=np.float64).reshape(-1)
-    n = y.shape[0]
-    q, ok, status = np.empty((n, 16, w)), np.empty((n, 16), dtype=np.bool_), np.empty(n, dtype=np.int64)
-    IK_ALL_LOOP(y, z, G, q, ok, status)
-    q, ok = q.reshape(shape + (16, w)), ok.reshape(shape + (16,))
-    return (q, ok) if return_mask else q
+def _yz(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return np.ascontiguousarray(rows[:, 0]), np.ascontiguousarray(rows[:, 1])
 
 
-def _solve(ay: Any, az: Any, scalar: bool, g: Geometry, mode: str, return_mask: bool, joints: bool,
-           bad_input: Any) -> Any:
-    """ik on checked orientations (floats when ``scalar``, broadcast arrays otherwise): the 12 joints or the
-    motors (``joints=False``), per the single/batch rule. ``bad_input()`` raises the InvalidInputError of a
-    non-finite scalar input."""
-    G = g._vector
-    if mode == "all":
-        return _all_modes(ay, az, scalar, G, return_mask, joints, bad_input)
-    if scalar:
-        home, e, s = MODE_ARGS[mode]
-        q, aux = np.empty(12 if joints else 3), np.empty(6)
-        st = _k_ik(ay, az, G, home, e, s, q, aux)
-        if st != OK:
-            if st == ST_NONFINITE:
-                bad_input()
-            raise ik_single_error(np.float64(ay), np.float64(az), G, mode, aux)
-        return (q, np.asarray(True)) if return_mask else q
-    q, aux, status = _run(np.asarray(ay, dtype=np.float64), np.asarray(az, dtype=np.float64), G, mode,
-                          12 if joints else 3)
-    q, ok = q[..., 0, :], status[..., 0] == OK
-    return (q, ok) if return_mask else q
+#: The kernels' diagnostic output on the fast paths, never read there (a failure is diagnosed again by the
+#: error function), so one buffer serves every call.
+_SCRATCH_AUX, _SCRATCH_AUX4 = np.empty(6), np.empty(4)
 
 
-def _target(target: ArrayLike) -> tuple[Any, Any, bool]:
-    """(alpha_y, alpha_z, scalar) of a checked target (..., 2)."""
-    if type(target) is np.ndarray and target.dtype is _F64 and target.shape == (2,):
-        return float(target[0]), float(target[1]), True
-    t = as_input(target, "target", (2,))
-    if t.ndim == 1:
-        return float(t[0]), float(t[1]), True
-    return t[..., 0], t[..., 1], False
+# ---- ik / ik_joints: one mode (width 3: the motors, 12: every joint)
+def _ik_fast(t: np.ndarray, G: np.ndarray, mode: str, width: int) -> np.ndarray | None:
+    home, e, s = MODE_ARGS[mode]
+    out = np.empty(width)
+    ay, az = t.tolist()  # Python floats: numba dispatches them faster than numpy scalars
+    return out if _k_ik(ay, az, G, home, e, s, out, _SCRATCH_AUX) == OK else None
 
 
-def _nonfinite_target(target: ArrayLike) -> Any:
-    return lambda: as_input(target, "target", (2,))
+def _ik_batch(rows: np.ndarray, G: np.ndarray, mode: str, width: int) -> tuple[np.ndarray, np.ndarray]:
+    q, _, status = _run(*_yz(rows), G, mode, width)
+    return q[:, 0], status[:, 0] == OK
 
 
-def _legacy_call(fn: str, target: ArrayLike, args: tuple[Any, ...], legacy: dict[str, Any],
-                 geometry: Geometry | None) -> tuple[Any, Any, bool, Geometry, Any]:
-    """The deprecated ``fn(alpha_y, alpha_z, d, alpha, eta, ...)``: (alpha_y, alpha_z, scalar, geometry, bad_input)."""
-    deprecated(f"{fn}(alpha_y, alpha_z, d, alpha, eta)", f"{fn}(target, geometry=...) with target (..., 2)")
-    if len(args) > 4:
-        raise TypeError(f"{fn}() takes at most 5 positional arguments in its deprecated form")
-    alpha_z = args[0] if args else legacy.pop("alpha_z")
-    geo = {**dict(zip(_GEOMETRY_KW, args[1:])), **split_legacy(legacy, fn, _GEOMETRY_KW)}
-    g = geometry_of(geometry, geo, fn) if geo else geometry_of(geometry)
-    raw = (target, alpha_z)
-    if type(target) is float and type(alpha_z) is float:
-        return target, alpha_z, True, g, lambda: as_angles(*raw, names=("alpha_y", "alpha_z"))
-    ay, az = as_angles(target, alpha_z, names=("alpha_y", "alpha_z"))
-    if ay.ndim:
-        return ay, az, False, g, None
-    return float(ay), float(az), True, g, None
+def _ik_fail(t: np.ndarray, out: np.ndarray, ok: np.ndarray, G: np.ndarray, mode: str, width: int) -> Exception:
+    ay, az = float(t[0]), float(t[1])
+    return ik_single_error(np.float64(ay), np.float64(az), G, mode, ik_one(ay, az, G, mode)[1])
 
 
-def _new_call(fn: str, target: ArrayLike, legacy: dict[str, Any],
-              geometry: Geometry | None) -> tuple[Any, Any, bool, Geometry, Any]:
-    geo = split_legacy(legacy, fn, _GEOMETRY_KW) if legacy else legacy
-    g = geometry_of(geometry, geo, fn) if geo else geometry_of(geometry)
-    ay, az, scalar = _target(target)
-    return ay, az, scalar, g, _nonfinite_target(target)
+# ---- ik_all: every mode
+def _all_fast(t: np.ndarray, G: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray] | None:
+    q, ok = np.empty((16, width)), np.empty(16, dtype=np.bool_)
+    ay, az = t.tolist()
+    return (q, ok) if _k_ik_all(ay, az, G, q, ok) == OK else None
+
+
+def _all_batch(rows: np.ndarray, G: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray]:
+    n = rows.shape[0]
+    q, ok, status = np.empty((n, 16, width)), np.empty((n, 16), dtype=np.bool_), np.empty(n, dtype=np.int64)
+    IK_ALL_LOOP(*_yz(rows), G, q, ok, status)
+    return q, ok
+
+
+def _all_fail(t: np.ndarray, out: np.ndarray, ok: np.ndarray, G: np.ndarray, width: int) -> Exception:
+    return _ik_fail(t, out, ok, G, HOME_MODE, width)
+
+
+# ---- jacobian
+def _jac_fast(t: np.ndarray, G: np.ndarray, mode: str) -> np.ndarray | None:
+    home, e, s = MODE_ARGS[mode]
+    a = np.empty((3, 2))
+    ay, az = t.tolist()
+    return a if _k_actuation_jacobian(ay, az, G, home, e, s, a, _SCRATCH_AUX4) == OK else None
+
+
+def _jac_batch(rows: np.ndarray, G: np.ndarray, mode: str) -> tuple[np.ndarray, np.ndarray]:
+    home, e, s = MODE_ARGS[mode]
+    n = rows.shape[0]
+    a, aux, status = np.empty((n, 3, 2)), np.empty((n, 4)), np.empty(n, dtype=np.int64)
+    JACOBIAN_LOOP(*_yz(rows), G, home, e, s, a, aux, status)
+    return a, status == OK
+
+
+def _jac_fail(t: np.ndarray, out: np.ndarray, ok: np.ndarray, G: np.ndarray, mode: str) -> Exception:
+    home, e, s = MODE_ARGS[mode]
+    a, aux = np.empty((3, 2)), np.empty(4)
+    _k_actuation_jacobian(float(t[0]), float(t[1]), G, home, e, s, a, aux)
+    c2 = aux[:3].copy()
+    return _ik_error(np.float64(t[0]), np.float64(t[1]), c2, *_ik_status(c2, np.asarray(aux[3])))
 
 
 # ------------------------------------------------------------------------------------------ public
@@ -222,11 +204,8 @@ def ik(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
 @overload
 def ik(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
        return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
-@overload
-def ik(alpha_y: ArrayLike, alpha_z: ArrayLike, d: float = ..., alpha: float = ..., eta: Sequence[float] | None = ...,
-       /, *, mode: str = ..., return_mask: bool = ...) -> Any: ...
-def ik(target: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | None = None,
-       return_mask: bool = False, **legacy: Any) -> Any:
+def ik(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | None = None,
+       return_mask: bool = False) -> Any:
     """The three motor angles (q_A1, q_B1, q_C1) for the platform orientation ``target = (alpha_y, alpha_z)``.
 
     Seed eqs (98), (102) per leg K (``c_K = cos eta_K``, ``s_K = sin eta_K``), with E = (x, y, z) from
@@ -261,25 +240,11 @@ def ik(target: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry 
             ``|A_u|_F > GAIN_GUARD``.
         InvalidInputError: non-finite, complex or wrongly shaped target; InvalidParameterError: bad geometry,
             mode or return_mask.
-
-    Deprecated form (legkin 0.1, one release): ``ik(alpha_y, alpha_z, d, alpha, eta, *, mode, return_mask)``
-    returns every joint (..., 12), as :func:`ik_joints` does.
     """
-    if type(target) is np.ndarray and target.dtype is _F64 and target.shape == (2,) and not args and \
-            not legacy and type(mode) is str and (return_mask is False or return_mask is True):
-        G = _fast_g(geometry)  # the single-call fast path: straight to the kernel, the motors only
-        args_m = MODE_ARGS.get(mode)
-        if G is not None and args_m is not None:
-            out, aux = np.empty(3), np.empty(6)
-            if _k_ik(target[0], target[1], G, args_m[0], args_m[1], args_m[2], out, aux) == OK:
-                return (out, np.asarray(True)) if return_mask else out
-    mode = checked_mode(mode, allow_all=True)
-    return_mask = flag(return_mask, "return_mask")
-    if args or "alpha_z" in legacy:
-        ay, az, scalar, g, bad = _legacy_call("ik", target, args, legacy, geometry)
-        return _solve(ay, az, scalar, g, mode, return_mask, True, bad)
-    ay, az, scalar, g, bad = _new_call("ik", target, legacy, geometry)
-    return _solve(ay, az, scalar, g, mode, return_mask, False, bad)
+    mode, G, return_mask = _checked(mode, geometry, return_mask)
+    if mode == "all":
+        return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3), return_mask)
+    return dispatch(target, "target", (2,), _ik_fast, _ik_batch, _ik_fail, (G, mode, 3), return_mask)
 
 
 @overload
@@ -293,17 +258,19 @@ def ik_all(target: ArrayLike, *, geometry: Geometry | None = None, return_mask: 
     its own actuation singularities, :data:`DET_GUARD`, :data:`GAIN_GUARD`). A single call raises only when no
     mode solves the target. Equals :func:`ik` with ``mode="all"``, and row j equals ``ik(target, mode=MODES[j])``
     bit for bit: one kernel (:func:`legkin.tripod.closure._k_ik_all`) solves each leg once per side of E and sign
-    of sin q_K2 and combines the 12 leg solutions into the 16 modes; the batch is a compiled loop over it."""
-    if type(target) is np.ndarray and target.dtype is _F64 and target.shape == (2,) and \
-            (return_mask is False or return_mask is True):
-        G = _fast_g(geometry)  # the single-call fast path
-        if G is not None:
-            q, ok = np.empty((16, 3)), np.empty(16, dtype=np.bool_)
-            if _k_ik_all(target[0], target[1], G, q, ok) == OK:
-                return (q, ok) if return_mask else q
-    return_mask = flag(return_mask, "return_mask")
-    ay, az, scalar, g, bad = _new_call("ik_all", target, {}, geometry)
-    return _all_modes(ay, az, scalar, g._vector, return_mask, False, bad)
+    of sin q_K2 and combines the 12 leg solutions into the 16 modes; the batch is a compiled loop over it.
+
+    Args:
+        target: platform orientation(s) (..., 2) = (alpha_y, alpha_z) (rad).
+        geometry: the tripod's :class:`Geometry` (None: the default).
+        return_mask: also return the mask (..., 16) of the modes that solve the target.
+
+    Returns:
+        (..., 16, 3) motor angles (rad) in :data:`MODES` order, NaN rows where a mode does not solve the target;
+        then the mask, if asked.
+    """
+    _, G, return_mask = _checked(HOME_MODE, geometry, return_mask)
+    return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3), return_mask)
 
 
 @overload
@@ -316,40 +283,21 @@ def ik_joints(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | 
               return_mask: bool = False) -> Any:
     """Every joint for ``target`` (..., 2): (..., 12) ordered A_q1..A_q4, B_q1..B_q4, C_q1..C_q4 (the Pinocchio
     order: a closed configuration of ``legkin.load("tripod")``), ``q_K3 = q_K2``, ``q_K4 = q_K1``; otherwise as
-    :func:`ik` (whose motors are columns 0, 4, 8). ``mode="all"``: (..., 16, 12)."""
-    if type(target) is np.ndarray and target.dtype is _F64 and target.shape == (2,) and \
-            type(mode) is str and (return_mask is False or return_mask is True):
-        G = _fast_g(geometry)  # the single-call fast path
-        args_m = MODE_ARGS.get(mode)
-        if G is not None and args_m is not None:
-            q, aux = np.empty(12), np.empty(6)
-            if _k_ik(target[0], target[1], G, args_m[0], args_m[1], args_m[2], q, aux) == OK:
-                return (q, np.asarray(True)) if return_mask else q
-    mode = checked_mode(mode, allow_all=True)
-    return_mask = flag(return_mask, "return_mask")
-    ay, az, scalar, g, bad = _new_call("ik_joints", target, {}, geometry)
-    return _solve(ay, az, scalar, g, mode, return_mask, True, bad)
+    :func:`ik` (whose motors are columns 0, 4, 8). ``mode="all"``: (..., 16, 12).
 
+    Args:
+        target: platform orientation(s) (..., 2) = (alpha_y, alpha_z) (rad).
+        mode: assembly mode, one of :data:`MODES` or ``"all"``.
+        geometry: the tripod's :class:`Geometry` (None: the default).
+        return_mask: (batch) also return the success mask.
 
-def _jacobian(ay: Any, az: Any, scalar: bool, g: Geometry, mode: str, return_mask: bool, bad: Any) -> Any:
-    home, e, s = MODE_ARGS[mode]
-    G = g._vector
-    if not scalar:
-        shape = ay.shape
-        y, z = np.ascontiguousarray(ay).reshape(-1), np.ascontiguousarray(az).reshape(-1)
-        n = y.shape[0]
-        ab, auxb, status = np.empty((n, 3, 2)), np.empty((n, 4)), np.empty(n, dtype=np.int64)
-        JACOBIAN_LOOP(y, z, G, home, e, s, ab, auxb, status)
-        ab, ok = ab.reshape(shape + (3, 2)), (status == OK).reshape(shape)
-        return (ab, ok) if return_mask else ab
-    a, aux = np.empty((3, 2)), np.empty(4)
-    st = _k_actuation_jacobian(ay, az, G, home, e, s, a, aux)
-    if st != OK:
-        if st == ST_NONFINITE and bad is not None:
-            bad()
-        c2 = aux[:3].copy()
-        raise _ik_error(np.float64(ay), np.float64(az), c2, *_ik_status(c2, np.asarray(aux[3])))
-    return (a, np.asarray(True)) if return_mask else a
+    Returns:
+        (..., 12) joint angles (rad) (``mode="all"``: (..., 16, 12)); then the mask, if asked.
+    """
+    mode, G, return_mask = _checked(mode, geometry, return_mask)
+    if mode == "all":
+        return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 12), return_mask)
+    return dispatch(target, "target", (2,), _ik_fast, _ik_batch, _ik_fail, (G, mode, 12), return_mask)
 
 
 @overload
@@ -377,32 +325,15 @@ def jacobian(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | N
     In another assembly ``mode`` (:data:`MODES`) the chain rule through that mode's IK. Undefined where the
     pose is outside the workspace or singular (NaN / the exceptions of :func:`ik`); the actuation-singularity
     guard of :func:`ik` (:data:`DET_GUARD`) does not apply: A_u is defined there.
+
+    Args:
+        target: platform orientation(s) (..., 2) = (alpha_y, alpha_z) (rad).
+        mode: assembly mode, one of :data:`MODES`.
+        geometry: the tripod's :class:`Geometry` (None: the default).
+        return_mask: (batch) also return the success mask.
+
+    Returns:
+        (..., 3, 2) A_u (rad/rad), NaN where undefined; then the mask, if asked.
     """
-    if type(target) is np.ndarray and target.dtype is _F64 and target.shape == (2,) and \
-            type(mode) is str and (return_mask is False or return_mask is True):
-        G = _fast_g(geometry)  # the single-call fast path
-        args_m = MODE_ARGS.get(mode)
-        if G is not None and args_m is not None:
-            a, aux = np.empty((3, 2)), np.empty(4)
-            if _k_actuation_jacobian(target[0], target[1], G, args_m[0], args_m[1], args_m[2], a, aux) == OK:
-                return (a, np.asarray(True)) if return_mask else a
-    mode = checked_mode(mode)
-    return_mask = flag(return_mask, "return_mask")
-    ay, az, scalar, g, bad = _new_call("jacobian", target, {}, geometry)
-    return _jacobian(ay, az, scalar, g, mode, return_mask, bad)
-
-
-def actuation_jacobian(target: ArrayLike, *args: Any, mode: str = HOME_MODE, geometry: Geometry | None = None,
-                       return_mask: bool = False, **legacy: Any) -> Any:
-    """Deprecated alias of :func:`jacobian` (legkin 0.1, kept for one release); also in its old form
-    ``actuation_jacobian(alpha_y, alpha_z, d, alpha, eta, *, mode, return_mask)``."""
-    deprecated("actuation_jacobian", "jacobian", stacklevel=3)
-    mode = checked_mode(mode)
-    return_mask = flag(return_mask, "return_mask")
-    if args or "alpha_z" in legacy:
-        ay, az, scalar, g, bad = _legacy_call("actuation_jacobian", target, args, legacy, geometry)
-    else:
-        ay, az, scalar, g, bad = _new_call("actuation_jacobian", target, legacy, geometry)
-    return _jacobian(ay, az, scalar, g, mode, return_mask, bad)
-
-
+    mode, G, return_mask = _checked(mode, geometry, return_mask, allow_all=False)
+    return dispatch(target, "target", (2,), _jac_fast, _jac_batch, _jac_fail, (G, mode), return_mask)

@@ -27,7 +27,7 @@ from __future__ import annotations
 from ._common import DET_GUARD, GAIN_GUARD, HOME_MODE, LEGS, MODES
 from .forward import FKInfo, fk
 from .geometry import ALPHA, ETA, D, Geometry
-from .inverse import actuation_jacobian, ik, ik_all, ik_joints, jacobian
+from .inverse import ik, ik_all, ik_joints, jacobian
 from .legs import leg_transform, leg_transform_cv
 from .platform import alpha_x, orientation_from_axis, platform_axis, platform_position, platform_rotation
 from .reachable import Workspace, workspace
@@ -53,7 +53,6 @@ __all__ = [
     "ik_all",
     "ik_joints",
     "jacobian",
-    "actuation_jacobian",
     "fk",
     "FKInfo",
     "workspace",

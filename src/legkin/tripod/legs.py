@@ -8,15 +8,14 @@ Leg K (joints ``K_q1..K_q4``, ``eta = eta_K``), with ``P(eta) = Rx(eta) Rz(pi)``
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input, check_choice, real_number
+from .._batch import as_input, check_choice
 from .._kernels import OK, batch_kernel, kernel
 from .._rotations import rot_k
-from ._common import LEGS, ST_NONFINITE, deprecated, geometry_of
+from ._common import LEGS, ST_NONFINITE, geometry_of
 from .geometry import G_CA, G_D, G_SA, Geometry
 
 __all__ = ["leg_transform", "leg_transform_cv"]
@@ -106,42 +105,17 @@ _LEG_TRANSFORM_CV = batch_kernel(rows="q T", min_parallel=4096)(_leg_transform_c
 
 
 # ------------------------------------------------------------------------------------------ arguments
-def _leg_eta(fn: str, leg: Any, args: tuple[Any, ...], legacy: dict[str, Any], geometry: Geometry | None):
-    """(eta, geometry) of a call: ``leg`` a name of LEGS (new form), or the deprecated placement angle eta with
-    positional / keyword d, alpha."""
-    if type(leg) is str and not args and not legacy:
-        g = geometry_of(geometry)
-        if leg == "A":
-            return g.eta[0], g
-        check_choice(leg, "leg", LEGS)
-        return g.eta[LEGS.index(leg)], g
-    if isinstance(leg, str):
-        check_choice(leg, "leg", LEGS)
-        g = geometry_of(geometry, {**dict(zip(("d", "alpha"), args)), **legacy}, fn)
-        return g.eta[LEGS.index(leg)], g
-    deprecated(f"{fn}(q, eta, d, alpha) with a placement angle", f"{fn}(q, leg, geometry=...) with leg in {LEGS}")
-    if len(args) > 2:
-        raise TypeError(f"{fn}() takes at most 4 positional arguments")
-    eta = real_number(leg, "eta", "(-inf, inf) (rad), finite")
-    if not math.isfinite(eta):
-        from ..errors import InvalidParameterError
-
-        raise InvalidParameterError(f"eta={leg!r} is out of range: must be in (-inf, inf) (rad), finite")
-    legacy = {**dict(zip(("d", "alpha"), args)), **legacy}
-    return eta, (geometry_of(geometry, legacy, fn) if legacy else geometry_of(geometry))
-
-
-def _legacy_kw(fn: str, kw: dict[str, Any]) -> dict[str, Any]:
-    bad = set(kw) - {"d", "alpha"}
-    if bad:
-        raise TypeError(f"{fn}() got unexpected keyword argument(s) {', '.join(map(repr, sorted(bad)))}")
-    return kw
+def _leg_eta(leg: object, geometry: Geometry | None) -> tuple[float, Geometry]:
+    """(eta, geometry) of a call: the placement angle (rad) of ``leg`` (a name of LEGS) and the checked geometry."""
+    g = geometry_of(geometry)
+    if leg == "A" and type(leg) is str:
+        return g.eta[0], g
+    check_choice(leg, "leg", LEGS)
+    return g.eta[LEGS.index(leg)], g  # type: ignore[arg-type]
 
 
 # ------------------------------------------------------------------------------------------ public
-def leg_transform(
-    q: ArrayLike, leg: str, *args: float, geometry: Geometry | None = None, **legacy: float
-) -> np.ndarray:
+def leg_transform(q: ArrayLike, leg: str, *, geometry: Geometry | None = None) -> np.ndarray:
     """Placement of K_ee in the base frame for any four joint values of leg K (open chain).
 
     Math (the chain of the URDF, checked against Pinocchio):
@@ -155,14 +129,13 @@ def leg_transform(
 
     Args:
         q: joint values (..., 4) = (q1, q2, q3, q4) of the leg.
-        leg: ``"A"``, ``"B"`` or ``"C"`` (its placement angle is ``geometry.eta``). Deprecated: a placement
-            angle eta (float) in its place, with ``d``, ``alpha`` positional or keyword.
+        leg: ``"A"``, ``"B"`` or ``"C"`` (its placement angle is ``geometry.eta``).
         geometry: the tripod's :class:`Geometry` (None: the default).
 
     Returns:
         (..., 4, 4) homogeneous transforms.
     """
-    eta, g = _leg_eta("leg_transform", leg, args, _legacy_kw("leg_transform", legacy) if legacy else legacy, geometry)
+    eta, g = _leg_eta(leg, geometry)
     G = g._vector
     if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (4,):
         T = np.empty((4, 4))
@@ -176,7 +149,7 @@ def leg_transform(
     return T.reshape(shape + (4, 4))
 
 
-def leg_transform_cv(q: ArrayLike, *args: Any, geometry: Geometry | None = None, **legacy: float) -> np.ndarray:
+def leg_transform_cv(q: ArrayLike, leg: str, *, geometry: Geometry | None = None) -> np.ndarray:
     """Seed eqs (10)-(12): placement of K_ee of leg K on the constant-velocity branch (q3 = q2, q4 = q1).
 
     ``T11 = -g1``, ``T21 = -s_eta g2 + c_eta g3``, ``T31 = s_eta g3 + c_eta g2``, ``T12 = s_eta g2 - c_eta g3``,
@@ -186,32 +159,21 @@ def leg_transform_cv(q: ArrayLike, *args: Any, geometry: Geometry | None = None,
     ``T14 = -d h1``, ``T24 = -d (c_eta h2 + s_eta h3)``, ``T34 = d (c_eta h3 - s_eta h2)``, with g1..g7 of
     eq (11) and h1..h3 of eq (12), transcribed as printed.
 
-    Call: ``leg_transform_cv(q, leg, *, geometry=None)`` with ``q`` (..., 2) = (q1, q2) and ``leg`` in
-    ``("A", "B", "C")``. Deprecated: ``leg_transform_cv(q1, q2, eta, d, alpha)`` (q1, q2 broadcast together).
+    Args:
+        q: joint values (..., 2) = (q1, q2) of the leg (rad).
+        leg: ``"A"``, ``"B"`` or ``"C"``.
+        geometry: the tripod's :class:`Geometry` (None: the default).
 
     Returns:
-        (..., 4, 4) homogeneous transforms.
+        (..., 4, 4) homogeneous transforms (m for the translation).
     """
-    if len(args) == 1 and type(args[0]) is str and not legacy:
-        eta, g = _leg_eta("leg_transform_cv", args[0], (), {}, geometry)
-        if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (2,) and math.isfinite(q[0]) \
-                and math.isfinite(q[1]):
-            T = np.empty((4, 4))
-            _k_leg_transform_cv(q[0], q[1], eta, g._vector, T)
-            return T
-        qa = as_input(q, "q", (2,))
-    elif args and type(args[0]) is str:
-        eta, g = _leg_eta("leg_transform_cv", args[0], args[1:], _legacy_kw("leg_transform_cv", legacy), geometry)
-        qa = as_input(q, "q", (2,))
-    else:  # deprecated: (q1, q2, eta, d, alpha)
-        from .._batch import as_angles
-
-        if not args:
-            raise TypeError("leg_transform_cv() missing the argument leg")
-        eta, g = _leg_eta("leg_transform_cv", args[1] if len(args) > 1 else legacy.pop("eta"), args[2:],
-                          _legacy_kw("leg_transform_cv", legacy), geometry)
-        q1, q2 = as_angles(q, args[0], names=("q1", "q2"))
-        qa = np.stack([q1, q2], axis=-1)
+    eta, g = _leg_eta(leg, geometry)
+    if type(q) is np.ndarray and q.dtype == np.float64 and q.shape == (2,) and math.isfinite(q[0]) \
+            and math.isfinite(q[1]):
+        T = np.empty((4, 4))
+        _k_leg_transform_cv(q[0], q[1], eta, g._vector, T)
+        return T
+    qa = as_input(q, "q", (2,))
     shape = qa.shape[:-1]
     rows = np.ascontiguousarray(qa.reshape(-1, 2))
     T = np.empty((rows.shape[0], 4, 4))

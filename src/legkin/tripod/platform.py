@@ -158,6 +158,13 @@ def alpha_x(alpha_y: ArrayLike, alpha_z: ArrayLike, *, geometry: Geometry | None
     not the one the legs produce (rotation error up to 2 in matrix entries, see docs/tripod.md).
     The value is undefined at ``c_y + c_z = 0 = s_y s_z``, which is the singular set 1 + c_y c_z = 0.
     ``geometry`` is accepted for uniformity (alpha_x does not depend on it).
+
+    Args:
+        alpha_y, alpha_z: platform orientation angles (rad), broadcast together.
+        geometry: the tripod's :class:`Geometry` (None: the default; unused here, accepted for uniformity).
+
+    Returns:
+        alpha_x (rad), the broadcast shape (a numpy float for scalars).
     """
     _no_geometry(geometry)
     if _fast(alpha_y, alpha_z):
@@ -176,13 +183,28 @@ def platform_rotation(alpha_y: ArrayLike, alpha_z: ArrayLike, *, geometry: Geome
     This is the zero-torsion (constant-velocity) family: R is the rotation by the tilt angle theta about an
     axis perpendicular to x (the mechanism's base axis), where ``cos theta = c_y c_z``. Independent of the
     geometry (``geometry`` accepted for uniformity).
+
+    Args:
+        alpha_y, alpha_z: platform orientation angles (rad), broadcast together.
+        geometry: the tripod's :class:`Geometry` (None: the default; unused here, accepted for uniformity).
+
+    Returns:
+        (..., 3, 3) rotation matrices.
     """
     _no_geometry(geometry)
     return _uv_closed(3, alpha_y, alpha_z, (3, 3), _NO_GEOMETRY)
 
 
 def platform_axis(alpha_y: ArrayLike, alpha_z: ArrayLike, *, geometry: Geometry | None = None) -> np.ndarray:
-    """The platform axis ``R e_x = (c_z c_y, s_z c_y, -s_y)`` (first column of eq 5), shape (..., 3)."""
+    """The platform axis ``R e_x = (c_z c_y, s_z c_y, -s_y)`` (first column of eq 5), shape (..., 3).
+
+    Args:
+        alpha_y, alpha_z: platform orientation angles (rad), broadcast together.
+        geometry: the tripod's :class:`Geometry` (None: the default; unused here, accepted for uniformity).
+
+    Returns:
+        (..., 3) unit vectors R e_x.
+    """
     _no_geometry(geometry)
     return _uv_closed(1, alpha_y, alpha_z, (3,), _NO_GEOMETRY)
 
@@ -193,6 +215,13 @@ def orientation_from_axis(axis: ArrayLike, *, geometry: Geometry | None = None) 
     The platform orientation is fixed by its axis (zero torsion), so this also inverts
     :func:`platform_rotation`; at ``c_y = 0`` (axis = -+z) alpha_z is arbitrary and 0 is returned. ``axis``
     (..., 3) need not be a unit vector; a zero vector raises InvalidInputError.
+
+    Args:
+        axis: (..., 3) platform axes (any nonzero length).
+        geometry: the tripod's :class:`Geometry` (None: the default; unused here, accepted for uniformity).
+
+    Returns:
+        (alpha_y, alpha_z) (rad), each of the batch shape (numpy floats for one axis).
     """
     _no_geometry(geometry)
     if type(axis) is np.ndarray and axis.dtype == np.float64 and axis.shape == (3,):
@@ -211,8 +240,7 @@ def orientation_from_axis(axis: ArrayLike, *, geometry: Geometry | None = None) 
     return out[:, 0].reshape(shape), out[:, 1].reshape(shape)
 
 
-def platform_position(alpha_y: ArrayLike, alpha_z: ArrayLike, *args: float, geometry: Geometry | None = None,
-                      **legacy: float) -> np.ndarray:
+def platform_position(alpha_y: ArrayLike, alpha_z: ArrayLike, *, geometry: Geometry | None = None) -> np.ndarray:
     """Platform centre E for the orientation (alpha_y, alpha_z), from Appendix B (eqs 64a-64d), shape (..., 3).
 
     Derivation. With ``r = R e_x = (c_z c_y, s_z c_y, -s_y)`` and ``b = e_x + r = (1 + c_y c_z, s_z c_y, -s_y)``,
@@ -229,19 +257,14 @@ def platform_position(alpha_y: ArrayLike, alpha_z: ArrayLike, *args: float, geom
         ``L = d sqrt(2 (1 - c_alpha))`` (eq 18).
 
     Checked against Pinocchio's platform frame at configurations from :func:`ik` (``legkin check tripod``).
-    Undefined on ``1 + c_y c_z = 0`` (NaN there). ``d``, ``alpha`` (positional or keyword) are deprecated:
-    pass ``geometry=``.
+    Undefined on ``1 + c_y c_z = 0`` (NaN there).
+
+    Args:
+        alpha_y, alpha_z: platform orientation angles (rad), broadcast together.
+        geometry: the tripod's :class:`Geometry` (None: the default).
+
+    Returns:
+        (..., 3) platform centres E (m).
     """
-    if args or legacy:
-        if len(args) > 2:
-            raise TypeError(f"platform_position() takes at most 4 positional arguments ({2 + len(args)} given)")
-        legacy = {**dict(zip(("d", "alpha"), args)), **_split_kw(legacy)}
-    g = geometry_of(geometry, legacy, "platform_position", stacklevel=3)
+    g = geometry_of(geometry)
     return _uv_closed(2, alpha_y, alpha_z, (3,), g._vector)
-
-
-def _split_kw(kw: dict[str, float]) -> dict[str, float]:
-    bad = set(kw) - {"d", "alpha"}
-    if bad:
-        raise TypeError(f"platform_position() got unexpected keyword argument(s) {', '.join(map(repr, sorted(bad)))}")
-    return kw

@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 
 from .._batch import check_integer
 from .._kernels import OK, kernel
-from ._common import LEGS, deprecated, geometry_of
+from ._common import LEGS, geometry_of
 from .closure import _k_ik
 from .geometry import Geometry
 
@@ -105,7 +104,7 @@ class Workspace:
     phi: np.ndarray
 
 
-def workspace(*args: Any, geometry: Geometry | None = None, n: int = 181, m: int = 721, **legacy: Any) -> Workspace:
+def workspace(*, geometry: Geometry | None = None, n: int = 181, m: int = 721) -> Workspace:
     """Reachable orientations and singular curves, for plots.
 
     In terms of the tilt theta (angle between the base axis x and the platform axis R e_x) and its
@@ -121,22 +120,10 @@ def workspace(*args: Any, geometry: Geometry | None = None, n: int = 181, m: int
         n: grid size per axis, an integer in [2, 1001]. m: samples of phi along the curves, an integer in
             [2, 100001].
 
-    Deprecated (legkin 0.1): ``workspace(d, alpha, eta, n, m)`` positional, or ``d=``, ``alpha=``, ``eta=``.
+    Returns:
+        a :class:`Workspace` (angles in rad).
     """
-    if args:
-        deprecated("workspace(d, alpha, eta, n, m) with positional arguments", "workspace(geometry=..., n=..., m=...)",
-                   stacklevel=3)
-        if len(args) > 5:
-            raise TypeError("workspace() takes at most 5 positional arguments in its deprecated form")
-        legacy = {**dict(zip(("d", "alpha", "eta"), args[:3])), **legacy}
-        if len(args) > 3:
-            n = args[3]
-        if len(args) > 4:
-            m = args[4]
-    bad = set(legacy) - {"d", "alpha", "eta"}
-    if bad:
-        raise TypeError(f"workspace() got unexpected keyword argument(s) {', '.join(map(repr, sorted(bad)))}")
-    g = geometry_of(geometry, legacy, "workspace", stacklevel=3) if legacy else geometry_of(geometry)
+    g = geometry_of(geometry)
     if type(n) is not int or not 2 <= n <= 1001:
         n = check_integer(n, "n", 2, 1001)
     if type(m) is not int or not 2 <= m <= 100001:

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import warnings
 from typing import Literal, Union
 
 import numpy as np
@@ -83,34 +82,12 @@ Rim = Literal["continuous", "three_arc"]
 RIMS = ("continuous", "three_arc")
 
 
-def rim_name(rim: object, stacklevel: int = 3) -> str:
-    """``rim`` checked; legkin 0.1's ``"seed"`` is accepted as ``"three_arc"`` with a DeprecationWarning."""
+def rim_name(rim: object) -> str:
+    """``rim`` checked: one of :data:`RIMS`.
+
+    Raises:
+        InvalidArgumentError: any other value.
+    """
     if type(rim) is str and rim == "continuous":
         return "continuous"
-    if isinstance(rim, str) and rim == "seed":
-        warnings.warn("rim='seed' is deprecated; use rim='three_arc' (the seed's three-arc formula)",
-                      DeprecationWarning, stacklevel=stacklevel)
-        return "three_arc"
     return str(check_choice(rim, "rim", RIMS))
-
-
-def legacy_geometry(fn: str, names: tuple[str, ...], args: tuple, kwargs: dict, geometry: object,
-                    positional_geometry: bool = False) -> object:
-    """legkin 0.1's geometry arguments of ``fn`` (positional ``args`` / keywords ``kwargs`` named ``names``)
-    mapped onto a Geometry, with a DeprecationWarning; ``positional_geometry``: the one positional argument
-    is the Geometry itself."""
-    from .geometry import Geometry
-
-    if len(args) > len(names) or any(k not in names for k in kwargs):
-        bad = next((k for k in kwargs if k not in names), None)
-        raise TypeError(f"{fn}() got an unexpected argument {bad!r}" if bad else f"{fn}() got too many arguments")
-    if positional_geometry:
-        warnings.warn(f"{fn}(leg, geometry) with a positional geometry is deprecated; pass geometry=...",
-                      DeprecationWarning, stacklevel=3)
-        return args[0]
-    values = dict(zip(names, args), **kwargs)
-    warnings.warn(f"{fn}({', '.join(values)}=...) is deprecated; pass geometry=Geometry(...)",
-                  DeprecationWarning, stacklevel=3)
-    if geometry is not None:
-        raise TypeError(f"{fn}() got both geometry= and legkin 0.1's {', '.join(values)}")
-    return Geometry(**values)  # type: ignore[arg-type]

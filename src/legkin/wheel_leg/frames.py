@@ -2,19 +2,17 @@
 
 from __future__ import annotations
 
-import inspect
 import math
-import warnings
 from functools import lru_cache
-from typing import Literal, NamedTuple, overload
+from typing import Any, Literal, NamedTuple, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input, check_choice, check_flag, check_number, finish
+from .._batch import as_input, check_choice, check_flag, check_number, dispatch
 from .._kernels import OK, as_items, as_rows, batch_kernel, kernel
 from ..errors import InvalidInputError
-from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, legacy_geometry, rim_name
+from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, rim_name
 from .geometry import _DEFAULT_GEOMETRY, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry, _leg
 from .linkage import _Const, _constants, _kconst
 from .rim import _k_plane, _k_select, _Sel, _select
@@ -30,29 +28,22 @@ _R_0 = {  # columns: x_M, y_M, z_M in {R} at gamma = 0
 }
 
 
-def module_origin(leg: Leg, *args: Geometry | None, geometry: Geometry | None = None) -> np.ndarray:
+def module_origin(leg: Leg, *, geometry: Geometry | None = None) -> np.ndarray:
     """Origin of the module frame {M_i} in {R}: (+-L_body/2, +-W_body/2, d_abad) (a new array).
 
-    legkin 0.1's positional geometry, ``module_origin(leg, geo)``, still works for one release
-    (DeprecationWarning).
+    Args:
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (3,) the origin (m).
     """
-    if args:
-        geometry = legacy_geometry(  # type: ignore[assignment]
-            "module_origin", ("geometry",), args, {}, geometry, positional_geometry=True)
     geo = _geometry(geometry)
     try:
         return _origin(leg, geo).copy()
     except TypeError:  # unhashable: let _leg name it
         _leg(leg)
         raise
-
-
-def _module_origin_signature(leg: Leg, *, geometry: Geometry | None = None) -> np.ndarray:
-    raise NotImplementedError  # a signature only
-
-
-# help() and inspect show today's call form (the function also takes legkin 0.1's positional geometry)
-module_origin.__signature__ = inspect.signature(_module_origin_signature)  # type: ignore[attr-defined]
 
 
 @lru_cache(maxsize=64)
@@ -89,6 +80,15 @@ def leg_frame_to_robot(p_L: ArrayLike, gamma: ArrayLike, leg: Leg, *, geometry: 
 
     ``p_M = T_L^M p_L`` (the seed's matrices, offset d_wheel), ``p_R = o_i + R0_i Rz(gamma) p_M``; the
     seed does not print ``T_M^R``: this is the module placement of "Coord definitions".
+
+    Args:
+        p_L: (..., 3) points in the leg frame {L} (m).
+        gamma: (...) ABAD angle(s) (rad), broadcast with p_L's leading shape.
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (..., 3) the points in the robot frame {R} (m).
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     try:
@@ -220,38 +220,61 @@ def _kctx(leg, rim, radius, geo: Geometry):
         raise
 
 
-def _contact_call(q, alpha, w, leg, rim, radius, geometry, want_jac, return_mask=False):
-    """The wrapper of :func:`fk` / :func:`jacobian`: kernel for a single item (fast path: a float64 (3,) q and
-    number alpha, w), batch kernel otherwise; any failure status -> the checks' error."""
+def _contact_call(q: ArrayLike, alpha: ArrayLike, w: ArrayLike, leg: Leg, rim: str, radius: float | None,
+                  geometry: Geometry | None, want_jac: bool, return_mask: bool = False) -> Any:
+    """The wrapper of :func:`fk` / :func:`jacobian` (:func:`legkin._batch.dispatch`): number alpha, w go to the
+    kernels as they are; arrays are broadcast with q first (then q is a batch of that shape)."""
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
-    if (type(q) is np.ndarray and q.shape == (3,) and q.dtype == np.float64 and type(alpha) in _SCALARS
-            and type(w) in _SCALARS and return_mask is False):
-        try:
-            kc = _kctx(leg, rim, radius, geo)
-        except Exception:  # noqa: BLE001 - the full checks below raise the documented error in order
-            kc = None
-        if kc is not None:
-            p = np.empty(3)
-            J = np.empty(9) if want_jac else _NO_JAC
-            if _k_contact(q, float(alpha), float(w), *kc, want_jac, p, J) == OK:
-                return J.reshape(3, 3) if want_jac else p
-    return_mask = check_flag(return_mask, "return_mask")
-    q, alpha, w = _q_inputs(q, alpha, w, geo)  # raises the documented error for a bad input
+    a: Any
+    b: Any
+    if type(alpha) in _SCALARS and type(w) in _SCALARS:
+        a, b = float(alpha), float(w)  # type: ignore[arg-type]
+        checked = None
+    else:  # broadcast together (and range-checked) before the single/batch rule
+        qb, a_arr, w_arr = _q_inputs(q, alpha, w, geo)
+        q = np.array(qb)  # writeable copies: numba types read-only arrays apart (a second compilation)
+        a, b = (float(a_arr), float(w_arr)) if a_arr.ndim == 0 else (np.array(a_arr).reshape(-1),
+                                                                     np.array(w_arr).reshape(-1))
+        checked = True
+    if return_mask is not False and return_mask is not True:
+        return_mask = check_flag(return_mask, "return_mask")
     kc = _kctx(leg, rim, radius, geo)
-    shape = q.shape[:-1]
-    n = int(np.prod(shape, dtype=int))
+    return dispatch(q, "q", (3,), _contact_fast, _contact_batch, _contact_fail, (a, b, geo, kc, want_jac, checked),
+                    return_mask)
+
+
+def _contact_fast(q: np.ndarray, a: Any, b: Any, geo: Geometry, kc: tuple, want_jac: bool,
+                  checked: Any) -> np.ndarray | None:
+    """One joint vector straight to :func:`_k_contact` (None unless solved: NaN, theta / alpha / w out of range)."""
+    p = np.empty(3)
+    J = np.empty(9) if want_jac else _NO_JAC
+    if _k_contact(q, a, b, *kc, want_jac, p, J) == OK:  # type: ignore[call-arg]
+        return J.reshape(3, 3) if want_jac else p
+    return None
+
+
+def _contact_batch(rows: np.ndarray, a: Any, b: Any, geo: Geometry, kc: tuple, want_jac: bool,
+                   checked: Any) -> tuple[np.ndarray, np.ndarray]:
+    """The compiled loop on joint rows (n, 3), after the range checks (an out-of-range theta, alpha or w raises,
+    in a batch too)."""
+    n = rows.shape[0]
+    if checked is None:
+        _q_inputs(rows, a, b, geo)
+    alpha = np.full(n, a) if type(a) is float else a
+    w = np.full(n, b) if type(b) is float else b
     P = np.empty((n, 3))
     J = np.empty((n, 9) if want_jac else (n, 0))
     status = np.empty(n, dtype=np.int64)
-    _k_contact_batch(as_rows(q, 3), as_rows(alpha, 1)[:, 0], as_rows(w, 1)[:, 0], *kc, want_jac, P, J, status)
-    ok = (status == OK).reshape(shape)
-    value = J.reshape(shape + (3, 3)) if want_jac else P.reshape(shape + (3,))
+    _k_contact_batch(rows, alpha, w, *kc, want_jac, P, J, status)
+    ok = status == OK
+    value = J.reshape(n, 3, 3) if want_jac else P
     value[~ok] = np.nan
+    return value, ok
 
-    def error() -> Exception:
-        return InvalidInputError(f"the contact {'Jacobian' if want_jac else 'point'} is not finite at q={q.tolist()}")
 
-    return finish(value, ok, shape == (), return_mask, error)
+def _contact_fail(q: np.ndarray, out: np.ndarray, ok: np.ndarray, a: Any, b: Any, geo: Geometry, kc: tuple,
+                  want_jac: bool, checked: Any) -> Exception:
+    return InvalidInputError(f"the contact {'Jacobian' if want_jac else 'point'} is not finite at q={q.tolist()}")
 
 
 _NO_JAC = np.empty(0)
@@ -311,24 +334,20 @@ def jacobian(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0
     theta-derivatives are carried through every step (forward mode by hand,
     :func:`~legkin.wheel_leg.linkage._k_closed`), d/dbeta is ``i z`` in the leg plane and d/dgamma is
     ``R0 Rz(gamma) (e_z x p_M)``. Arguments as :func:`fk`.
+
+    Args:
+        q: (..., 3) (theta, beta, gamma) in rad, theta in [17 deg, 160 deg].
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        alpha: rim parameter (rad) in [-pi, pi]; w: lateral coordinate (m) in [-T/2, T/2]; broadcast with q's
+        leading shape.
+        rim, radius: the rim model and arc radius (m), as in :func:`fk`.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+        return_mask: also return the mask of successes (batch).
+
+    Returns:
+        (..., 3, 3) d(contact point, m) / d(theta, beta, gamma) (m/rad); then the mask, if asked.
     """
     return _contact_call(q, alpha, w, leg, rim_name(rim), radius, geometry, True, return_mask)
-
-
-def contact_point(q: ArrayLike, alpha: ArrayLike, w: ArrayLike, leg: Leg, *, rim: str = "continuous",
-                  radius: float | None = None, geometry: Geometry | None = None) -> np.ndarray:
-    """Deprecated (legkin 0.1): ``fk(q, leg, alpha=alpha, w=w, ...)``."""
-    warnings.warn("contact_point(q, alpha, w, leg) is deprecated; use fk(q, leg, alpha=alpha, w=w)",
-                  DeprecationWarning, stacklevel=2)
-    return _contact_call(q, alpha, w, leg, rim_name(rim, 3), radius, geometry, False)
-
-
-def contact_jacobian(q: ArrayLike, alpha: ArrayLike, w: ArrayLike, leg: Leg, *, rim: str = "continuous",
-                     radius: float | None = None, geometry: Geometry | None = None) -> np.ndarray:
-    """Deprecated (legkin 0.1): ``jacobian(q, leg, alpha=alpha, w=w, ...)``."""
-    warnings.warn("contact_jacobian(q, alpha, w, leg) is deprecated; use jacobian(q, leg, alpha=alpha, w=w)",
-                  DeprecationWarning, stacklevel=2)
-    return _contact_call(q, alpha, w, leg, rim_name(rim, 3), radius, geometry, True)
 
 
 #: Kernel status codes (besides :data:`OK`): NaN/inf input or result, theta / alpha / w out of range.

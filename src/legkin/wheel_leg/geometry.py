@@ -9,7 +9,7 @@ from typing import Mapping
 
 import numpy as np
 
-from ..errors import InvalidParameterError
+from ..errors import InvalidParameterError, JointLimitError
 
 LEGS = ("FL", "FR", "RR", "RL")
 THETA0 = math.radians(17.0)
@@ -21,11 +21,6 @@ PSI_FG = math.radians(40.0)
 #: (radius R) offset by it; it is the foot radius minus the pitch radius of the seed's rim formula
 #: (0.02225 + 0.01225 m: R + 0.0345 = 0.1345 m) and the outer radius of the rim meshes (R + TYRE_THICKNESS).
 TYRE_THICKNESS = 0.0345
-#: Deprecated alias of :data:`TYRE_THICKNESS` (the seed's foot radius minus the pitch radius); kept for one release.
-FOOT_OFFSET = TYRE_THICKNESS
-#: Deprecated alias of :data:`TYRE_THICKNESS` (was 0.035, the visual rim's outer radius minus R, before the rim
-#: meshes took the tyre thickness); kept for one release.
-TYRE_OFFSET = TYRE_THICKNESS
 
 _ARC_HF = math.radians(130.0)
 _ARC_BC = math.radians(101.0)
@@ -100,6 +95,15 @@ def _leg(leg) -> tuple[int, str, float]:
 
 #: ABAD joint limit (rad): the URDF's ``<leg>_abad`` joints range over [-ABAD_LIMIT, ABAD_LIMIT].
 ABAD_LIMIT = math.pi / 2
+
+
+def abad_limit_error(message: str, leg: object, target: np.ndarray, gamma: float,
+                     closest: np.ndarray | None = None) -> JointLimitError:
+    """The :class:`~legkin.errors.JointLimitError` of a target reached only with the ABAD angle ``gamma`` (rad)
+    outside [-ABAD_LIMIT, ABAD_LIMIT]: ``joint`` is the URDF joint ``<leg>_abad``."""
+    distance = float(np.linalg.norm(np.asarray(closest) - target)) if closest is not None else math.nan
+    return JointLimitError(message, target=target, closest=closest, distance=distance,
+                           joint=f"{LEGS[_leg(leg)[0]]}_abad", value=float(gamma), lower=-ABAD_LIMIT, upper=ABAD_LIMIT)
 #: Beyond a limit by at most this (rad) counts as on it (the answer is clipped onto the limit).
 _LIMIT_ROUNDING = 1e-12
 

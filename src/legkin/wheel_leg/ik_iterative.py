@@ -1,6 +1,6 @@
 """The iterative IK methods on the 3x3 system, per-target compiled loops with early exit.
 
-* ``method="gauss_newton_fd"`` (legkin 0.1: ``"seed"``): seed 2.2-2.3 as printed, Gauss-Newton with the
+* ``method="gauss_newton_fd"``: seed 2.2-2.3 as printed, Gauss-Newton with the
   forward-difference Jacobian, full steps, no bounds (:func:`_k_ik_gauss_newton_fd`).
 * ``method="damped"``: Gauss-Newton with the analytic Jacobian, Levenberg-Marquardt damping, theta projected
   onto its domain (:func:`_k_ik_damped`).
@@ -24,7 +24,7 @@ from .ik_radial import _arc_table
 from .linkage import _kconst
 from .rim import _k_plane
 
-#: The iterative methods by kernel id (legkin 0.1's ``"seed"`` is ``"gauss_newton_fd"``).
+#: The iterative methods by kernel id.
 METHOD_IDS = {"gauss_newton_fd": 0, "damped": 1}
 #: Default iteration bound per start.
 DEFAULT_MAX_ITER = {"gauss_newton_fd": 100, "damped": 60}

@@ -346,26 +346,26 @@ def _ik_radial(target, ctx, tol, max_iter, q0, limits=True):
     * beta rotates the leg plane about the motor axis O, so ``r = |x_L + i y_L|`` must equal ``|c|``, which
       depends on theta alone. The equation solved is ``f(theta) = |c(theta, alpha)|^2 - r^2 = 0`` on
       [17 deg, 160 deg], with the exact ``f' = 2 Re(conj(c) dc/dtheta)`` (the closed form's forward-mode
-      derivatives, as in :func:`contact_jacobian`). Then ``beta = arg((x_L + i y_L) / c) - pi/2``.
+      derivatives, as in :func:`~legkin.wheel_leg.jacobian`). Then ``beta = arg((x_L + i y_L) / c) - pi/2``.
 
-    Roots: f and f' on a 17-node grid come from tabulated theta-coefficients (:func:`_arc_table`: one
-    small matrix product for the batch). Every cell where f changes sign holds a root, found by
-    :func:`_radial_newton` (usually one evaluation of the closed form, from a start refined on a fine
-    table). A cell where f keeps its sign while f' changes sign holds an extremum of f: unless a
-    curvature bound shows that f stays above ``2 r tol`` in it, :func:`_radial_extremum` decides whether f
-    reaches 0 there (then the cell is split into two brackets, or the extremum taken as a double root if
-    ``|f| <= 2 r tol`` at it). An end of the range with ``|f| <= 2 r tol`` is a root too. This finds every
-    root if each cell holds at most one extremum of f. For the default geometry ``|c|^2`` has at most one
-    extremum in theta for any alpha, both rims (checked on 1441 alpha x 20001 theta). At alpha = +-163 deg
-    the contact point is the crank hinge B, ``|c| = R`` for every theta: f is rounding noise, every theta
-    solves the IK and the grid reports many roots.
+    Roots: f and f' on a 17-node grid come from tabulated theta-coefficients (:func:`_arc_table`: one small matrix
+    product for the batch). Every cell where f changes sign holds a root, found by
+    :func:`.radial_roots._k_radial_newton` (usually one evaluation of the closed form, from a start refined on a
+    fine table). A cell where f keeps its sign while f' changes sign holds an extremum of f: unless a curvature
+    bound shows that f stays above ``2 r tol`` in it, :func:`.radial_roots._k_radial_extremum` decides whether f
+    reaches 0 there (then the cell is split into two brackets, or the extremum taken as a double root if ``|f| <= 2
+    r tol`` at it). An end of the range with ``|f| <= 2 r tol`` is a root too. This finds every root if each cell
+    holds at most one extremum of f. For the default geometry ``|c|^2`` has at most one extremum in theta for any
+    alpha, both rims (checked on 1441 alpha x 20001 theta). At alpha = +-163 deg the contact point is the crank
+    hinge B, ``|c| = R`` for every theta: f is rounding noise, every theta solves the IK and the grid reports many
+    roots.
 
     Returns ``(q, iterations, error, converged, solutions, reason)``; ``solutions`` (n, S, 3), NaN-padded:
     for each root by increasing theta the branch ``y_L <= 0``, then the same roots on the branch ``y_L > 0``
     (absent when ``y_L = 0``). The answer is the first solution in that order whose gamma is inside the ABAD
     joint's URDF limits ``[-pi/2, pi/2]`` (``limits=False``: the first), or with ``q0`` the usable solution
     nearest ``q0``. It is checked with the forward kinematics (:func:`_k_fk`): converged means
-    ``|contact_point(q) - target| <= tol``. ``reason`` per target: 0 solved, 1 no root (out of reach),
+    ``|fk(q) - target| <= tol``. ``reason`` per target: 0 solved, 1 no root (out of reach),
     2 every root outside the ABAD limits. A target without a root gets, as its (unconverged) q, the grid
     node of smallest ``|f|`` with beta, gamma from the branch ``y_L <= 0``; one reachable only outside the
     limits, its first solution.

@@ -5,28 +5,36 @@ Methods (``method=``):
 * ``"radial"`` (default): gamma and beta in closed form, theta from the 1-D equation ``|c(theta, alpha)| = r``
   by a bracketed Newton (:mod:`legkin.wheel_leg.ik_radial`); every solution is found.
 * ``"damped"``: Gauss-Newton on the 3x3 system with the analytic Jacobian and Levenberg-Marquardt damping.
-* ``"gauss_newton_fd"`` (legkin 0.1: ``"seed"``): seed 2.2-2.3 as printed, forward-difference Jacobian, full
+* ``"gauss_newton_fd"``: seed 2.2-2.3 as printed, forward-difference Jacobian, full
   steps (the baseline). Both iterative methods are in :mod:`legkin.wheel_leg.ik_iterative`.
 """
 
 from __future__ import annotations
 
-import inspect
 import math
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Literal, NamedTuple, overload
+from typing import Any, Literal, NamedTuple, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from .._batch import as_input, check_choice, check_flag, check_integer, check_number, finish
-from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
+from ..errors import InvalidInputError, InvalidParameterError, UnreachableError
 from . import ik_iterative
 from ._common import _LIMITS, _SCALARS, _SOLVED, Leg, Rim, _check_alpha, _check_theta, _check_w, rim_name
-from ._legacy import legacy_ik_call, method_name
 from .frames import _context, _fk, _kctx_cached
-from .geometry import _DEFAULT_GEOMETRY, _LIMIT_ROUNDING, ABAD_LIMIT, THETA_MAX, THETA_MIN, Geometry, _geometry, _leg
+from .geometry import (
+    _DEFAULT_GEOMETRY,
+    _LIMIT_ROUNDING,
+    ABAD_LIMIT,
+    THETA_MAX,
+    THETA_MIN,
+    Geometry,
+    _geometry,
+    _leg,
+    abad_limit_error,
+)
 from .ik_radial import _NO_Q0, _RADIAL_SOLS, _ik_radial, _k_ik_radial, _radial_table
 from .rim import _k_select
 
@@ -219,17 +227,18 @@ def _error(run: _Run, q_raw, leg, alpha, w, method, tol) -> Exception:
     target = np.asarray(run.target).reshape(3)
     where = f"target {target.tolist()} for leg {leg!r} (alpha={float(alpha)!r}, w={float(w)!r})"
     if int(run.reason) == _LIMITS:
-        return JointLimitError(
+        return abad_limit_error(
             f"{where} is reachable only with the ABAD angle outside its limits [-pi/2, pi/2] "
             f"(gamma={float(q_raw[2]):.6g} rad); pass limits=False to accept it",
-            target=target, closest=run.closest,
+            leg, target, float(q_raw[2]), run.closest,
         )
     closest = run.closest
+    distance = math.nan if closest is None else float(np.linalg.norm(closest - target))
     return UnreachableError(
         f"{where} not reached with method {method!r}: final error {float(run.info.error):.3e} m after "
         f"{int(run.info.iterations)} iterations (tolerance {tol:.1e} m, theta in [17, 160] deg); closest point "
-        f"reached {None if closest is None else closest.tolist()}",
-        target=target, closest=closest,
+        f"reached {None if closest is None else closest.tolist()} ({distance:.3g} m away)",
+        target=target, closest=closest, distance=distance,
     )
 
 
@@ -258,9 +267,10 @@ def ik(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.
        radius: float | None = None, limits: bool = True, options: IKOptions | None = None,
        geometry: Geometry | None = None, return_mask: Literal[True],
        return_info: Literal[True]) -> tuple[np.ndarray, np.ndarray, IKInfo]: ...
-def ik(target, leg=None, /, *args, alpha=0.0, w=0.0, q_near=None, q_start=None, method="radial",  # type: ignore[misc]
-       rim="continuous", radius=None, limits=True, options=None, geometry=None, return_mask=False,
-       return_info=False, **deprecated):
+def ik(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, q_near: ArrayLike | None = None,
+       q_start: ArrayLike | None = None, method: Method = "radial", rim: Rim = "continuous",
+       radius: float | None = None, limits: bool = True, options: IKOptions | None = None,
+       geometry: Geometry | None = None, return_mask: bool = False, return_info: bool = False) -> Any:
     """(theta, beta, gamma) placing the rim point (alpha, w) of ``leg`` at ``target`` in {R} (seed 2).
 
     ``method="radial"`` (default) finds every theta in [17 deg, 160 deg] that reaches the target, for both
@@ -289,9 +299,9 @@ def ik(target, leg=None, /, *args, alpha=0.0, w=0.0, q_near=None, q_start=None, 
         return_mask: also return the mask of solved targets (batch).
         return_info: also return an :class:`IKInfo`.
 
-    legkin 0.1's call ``ik(target, alpha, w, leg, q0, tol=, max_iter=, delta=)`` (a number as second
-    argument, ``leg=`` after alpha and w, or ``q0=``, ``tol=``, ``max_iter=``, ``delta=``) still works for
-    one release and warns (DeprecationWarning); so do ``method="seed"`` and ``rim="seed"``.
+    Returns:
+        (..., 3) joint angles (theta, beta, gamma) (rad), NaN where a batch item is not solved; then the mask
+        and the :class:`IKInfo`, as asked.
 
     Raises:
         JointLimitError: single target reachable, but only with gamma outside the ABAD limits.
@@ -299,13 +309,9 @@ def ik(target, leg=None, /, *args, alpha=0.0, w=0.0, q_near=None, q_start=None, 
         InvalidInputError: NaN/inf, complex or wrong shapes, alpha or w out of range.
         InvalidParameterError: unknown ``method``, ``rim`` or ``leg``; a keyword out of its range.
     """
-    if args or deprecated or leg is None or not isinstance(leg, (str, int, np.integer)) or isinstance(leg, bool):
-        leg, alpha, w, q_near, q_start, options = legacy_ik_call(
-            leg, args, deprecated, alpha=alpha, w=w, q_near=q_near, q_start=q_start, method=method, options=options)
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     opts = _options(options)
-    method = method_name(method)
-    rim = rim_name(rim)
+    rim_ = rim_name(rim)
     if (type(target) is np.ndarray and target.shape == (3,) and target.dtype == np.float64 and type(alpha) in _SCALARS
             and type(w) in _SCALARS and type(method) is str and method in METHODS and type(limits) is bool
             and type(return_mask) is bool and type(return_info) is bool):
@@ -313,13 +319,13 @@ def ik(target, leg=None, /, *args, alpha=0.0, w=0.0, q_near=None, q_start=None, 
         both = q_near is not None and q_start is not None
         if not both and (start is None or (type(start) is np.ndarray and start.shape == (3,)
                                            and start.dtype == np.float64 and (q_start is None or method != "radial"))):
-            out = _single(target, float(alpha), float(w), leg, rim, radius, geo, method, opts, return_mask,
+            out = _single(target, float(alpha), float(w), leg, rim_, radius, geo, method, opts, return_mask,
                           return_info, limits, start)
             if out is not None:
                 return out
     return_mask = check_flag(return_mask, "return_mask")
     return_info = check_flag(return_info, "return_info")
-    run, q_raw = _run(target, alpha, w, leg, q_near, q_start, method, rim, radius, limits, opts, geo)
+    run, q_raw = _run(target, alpha, w, leg, q_near, q_start, method, rim_, radius, limits, opts, geo)
     out = finish(run.q, run.ok, run.ok.shape == (), return_mask,
                  lambda: _error(run, q_raw, leg, alpha, w, method, opts.tol))
     if return_info:
@@ -334,19 +340,6 @@ def _in_limits(sols: np.ndarray) -> np.ndarray:
         inside = np.abs(sols[..., 2]) <= ABAD_LIMIT + _LIMIT_ROUNDING
     sols[..., 2] = np.where(inside, np.clip(sols[..., 2], -ABAD_LIMIT, ABAD_LIMIT), sols[..., 2])
     return inside
-
-
-def _ik_signature(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0,
-                  q_near: ArrayLike | None = None, q_start: ArrayLike | None = None, method: Method = "radial",
-                  rim: Rim = "continuous", radius: float | None = None, limits: bool = True,
-                  options: IKOptions | None = None, geometry: Geometry | None = None, return_mask: bool = False,
-                  return_info: bool = False) -> (np.ndarray | tuple[np.ndarray, np.ndarray] | tuple[np.ndarray, IKInfo]
-                                                 | tuple[np.ndarray, np.ndarray, IKInfo]):
-    raise NotImplementedError  # a signature only
-
-
-# help() and inspect show today's call form (the implementation also takes legkin 0.1's, see _legacy)
-ik.__signature__ = inspect.signature(_ik_signature)  # type: ignore[attr-defined]
 
 
 @overload
@@ -364,9 +357,20 @@ def ik_all(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike 
 
     The radial method's solutions (:func:`ik`): for each root theta in [17 deg, 160 deg] by increasing theta
     the branch ``y_L <= 0``, then the same roots on the branch ``y_L > 0`` (absent when ``y_L = 0``); NaN
-    rows pad the batch to the largest count S. ``limits=True`` keeps only those with gamma inside the ABAD
-    limits (in the same order). A single target without any solution raises :class:`UnreachableError`; in a
-    batch its rows are all NaN (mask False). Arguments as :func:`ik`.
+    rows (mask False) pad the batch to the largest count S. ``limits=True`` keeps only those with gamma inside
+    the ABAD limits (in the same order). A single target without any solution raises :class:`UnreachableError`;
+    in a batch its rows are all NaN (mask False).
+
+    Args:
+        target: (..., 3) points in {R} (m); leg, alpha, w, rim, radius, options, geometry: as :func:`ik`.
+        limits: keep only the solutions with gamma inside the ABAD joint limits.
+        return_mask: also return the mask (..., S) of the rows that are solutions.
+
+    Returns:
+        (..., S, 3) joint angles (theta, beta, gamma) (rad); then the mask, if asked.
+
+    Raises:
+        UnreachableError: (single) the target has no solution (inside the ABAD limits, with ``limits=True``).
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     opts = _options(options)
@@ -380,7 +384,7 @@ def ik_all(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike 
             sols = out[1].solutions
             sols = sols[_in_limits(sols)] if limits else sols
             if len(sols):
-                return (sols, np.array(True)) if return_mask else sols
+                return (sols, np.ones(len(sols), dtype=bool)) if return_mask else sols
     run, _q = _run(target, alpha, w, leg, None, None, "radial", rim_, radius, False, opts, geo, True)
     sols = run.info.solutions
     assert sols is not None
@@ -390,12 +394,11 @@ def ik_all(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike 
     order = np.argsort(~keep, axis=-1, kind="stable")  # the kept ones first, in their order
     sols = np.take_along_axis(np.where(keep[..., None], sols, np.nan), order[..., None], axis=-2)
     count = keep.sum(axis=-1)
-    sols = sols[..., : int(count.max()) if count.size else 0, :]
-    ok = count > 0
-
-    def error() -> Exception:
+    width = int(count.max()) if count.size else 0
+    sols = sols[..., :width, :]
+    mask = np.take_along_axis(keep, order, axis=-1)[..., :width]
+    if count.shape == () and not count:
         t = np.asarray(run.target).reshape(3)
-        return UnreachableError(f"target {t.tolist()} for leg {leg!r} has no solution"
-                                + (" inside the ABAD limits" if limits else ""), target=t)
-
-    return finish(sols, ok, ok.shape == (), return_mask, error)
+        raise UnreachableError(f"target {t.tolist()} for leg {leg!r} has no solution"
+                               + (" inside the ABAD limits" if limits else ""), target=t)
+    return (sols, mask) if return_mask else sols

@@ -29,16 +29,14 @@ an item fails, and ``return_mask=True`` also returns the mask of successes.
 
 from __future__ import annotations
 
-from .frames import contact_jacobian, contact_point, fk, jacobian, leg_frame_to_robot, module_origin
+from .frames import fk, jacobian, leg_frame_to_robot, module_origin
 from .geometry import (
     ABAD_LIMIT,
-    FOOT_OFFSET,
     LEGS,
     PSI_FG,
     THETA0,
     THETA_MAX,
     THETA_MIN,
-    TYRE_OFFSET,
     TYRE_THICKNESS,
     Geometry,
 )
@@ -93,9 +91,4 @@ __all__ = [
     "GroundContact",
     "stance_ik",
     "stance_ik_all",
-    # deprecated (legkin 0.1), kept for one release
-    "FOOT_OFFSET",
-    "TYRE_OFFSET",
-    "contact_point",
-    "contact_jacobian",
 ]

@@ -3,7 +3,6 @@ angles, motor mapping."""
 
 from __future__ import annotations
 
-import inspect
 import math
 from functools import lru_cache
 from typing import NamedTuple
@@ -13,7 +12,7 @@ from numpy.typing import ArrayLike
 
 from .._batch import as_angles
 from .._kernels import as_rows, batch_kernel, kernel
-from ._common import _SCALARS, _check_theta, legacy_geometry
+from ._common import _SCALARS, _check_theta
 from .geometry import (
     _ARC_BC,
     _ARC_HF,
@@ -44,26 +43,20 @@ class _Const(NamedTuple):
     ang_LFG: float
 
 
-def linkage_constants(*args: float, geometry: Geometry | None = None, **kwargs: float) -> dict[str, float]:
+def linkage_constants(*, geometry: Geometry | None = None) -> dict[str, float]:
     """Link lengths (m) and fixed angles (rad) of the leg linkage for the pitch radius ``geometry.R``.
 
     ``l4 = CD`` is computed so that the rims close exactly into a circle about O at theta0 (the design
-    notes give 0.882966335 R, which this reproduces to 1e-10 R). legkin 0.1's ``linkage_constants(R)`` /
-    ``linkage_constants(R=...)`` still works for one release (DeprecationWarning): it means
-    ``geometry=Geometry(R=R)``.
+    notes give 0.882966335 R, which this reproduces to 1e-10 R).
+
+    Args:
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        the constants by name (m or rad).
     """
-    if args or kwargs:
-        geometry = legacy_geometry("linkage_constants", ("R",), args, kwargs, geometry)  # type: ignore[assignment]
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     return _constants(geo.R)._asdict()
-
-
-def _linkage_constants_signature(*, geometry: Geometry | None = None) -> dict[str, float]:
-    raise NotImplementedError  # a signature only
-
-
-# help() and inspect show today's call form (the function also takes legkin 0.1's R)
-linkage_constants.__signature__ = inspect.signature(_linkage_constants_signature)  # type: ignore[attr-defined]
 
 
 @lru_cache(maxsize=16)
@@ -376,6 +369,11 @@ def passive_angles(theta: ArrayLike, beta: ArrayLike = 0.0, *,
 
     Returns:
         dict joint name (without the ``<leg>_`` prefix, see :data:`PASSIVE_JOINTS`) -> array.
+
+    Args:
+        theta: (...) the leg's theta (rad), in [17 deg, 160 deg].
+        beta: (...) the leg's beta (rad), broadcast with theta.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     t, b, shape = _angle_pair(theta, beta)
@@ -429,6 +427,13 @@ def motor_angles(theta: ArrayLike, beta: ArrayLike, *,
 
     Broadcast together; two numbers give two 0-d arrays. It does not depend on the geometry (``geometry`` is
     checked, for a uniform signature).
+
+    Args:
+        theta, beta: (...) leg angles (rad), broadcast together; theta in [17 deg, 160 deg].
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (phi_L, phi_R) (rad), each of the broadcast shape.
     """
     if geometry is not None:
         _geometry(geometry)
@@ -441,6 +446,13 @@ def theta_beta(phi_L: ArrayLike, phi_R: ArrayLike, *,
 
     theta is not range-checked here (the motors can be commanded anywhere; the linkage cannot). Independent of
     the geometry (``geometry`` is checked, for a uniform signature).
+
+    Args:
+        phi_L, phi_R: (...) motor angles (rad), broadcast together.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (theta, beta) (rad), each of the broadcast shape.
     """
     if geometry is not None:
         _geometry(geometry)

@@ -22,6 +22,13 @@ def rim_segment(alpha: ArrayLike, *, geometry: Geometry | None = None) -> np.nda
     0: upper rim left (alpha < -50 deg), 1: lower rim left (-50 deg <= alpha < 0), 2: lower rim right
     (0 <= alpha <= 50 deg), 3: upper rim right (alpha > 50 deg). Independent of the geometry (``geometry`` is
     checked, for a uniform signature).
+
+    Args:
+        alpha: (...) rim parameter(s) (rad) in [-pi, pi].
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (...) the segment index of each alpha (an integer array).
     """
     if geometry is not None:
         _geometry(geometry)
@@ -252,6 +259,15 @@ def rim_point_seed(theta: ArrayLike, beta: ArrayLike, alpha: ArrayLike, w: Array
     The lab's code takes alpha in degrees and wraps it; here alpha is in radians, in [-pi, pi]. The formula
     leaves out the lower-rim arcs: it is discontinuous at alpha = +-psi_FG once theta > theta0
     (:func:`rim_jump_seed`), and the toe arc about O_r is not attached to any link.
+
+    Args:
+        theta, beta: leg angles (rad); alpha: rim parameter (rad) in [-pi, pi]; w: lateral
+        coordinate (m); all broadcast together.
+        radius: arc radius (m) (None: R + TYRE_THICKNESS, the seed's).
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (..., 3) points in the leg frame {L} (m).
     """
     return _rim_call(theta, beta, alpha, w, radius, geometry, True)
 
@@ -260,6 +276,14 @@ def rim_jump_seed(theta: ArrayLike, *, radius: float | None = None, geometry: Ge
     """Size (m) of the jump of :func:`rim_point_seed` at alpha = +psi_FG (equal at -psi_FG by symmetry).
 
     The distance between the toe-arc point at alpha = psi_FG and the upper-rim point at alpha -> psi_FG+.
+
+    Args:
+        theta: (...) leg angle(s) (rad).
+        radius: arc radius (m) (None: the seed's).
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (...) the jump of the three-arc formula (m).
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     rho = geo.R + TYRE_THICKNESS if radius is None else check_number(radius, "radius", 0.0, 2.0 * geo.R, low_open=True)

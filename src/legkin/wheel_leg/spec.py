@@ -16,15 +16,6 @@ LEGS = ("FL", "FR", "RR", "RL")
 RIM_INNER = 0.9
 
 
-def __getattr__(name: str) -> float:
-    """``RIM_TYRE``: deprecated alias of :data:`legkin.wheel_leg.geometry.TYRE_THICKNESS` (was 0.035), kept for
-    one release (served lazily: geometry validates against this module's SPEC)."""
-    if name == "RIM_TYRE":
-        from .geometry import TYRE_THICKNESS
-
-        return TYRE_THICKNESS
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
 SPEC = ModelSpec(
     name="wheel_leg",
     title="Corgi leg-wheel quadruped: closed-chain leg linkages (4 loops per leg), rim contact IK",

@@ -35,9 +35,19 @@ from numpy.typing import ArrayLike
 from .._batch import as_input, check_flag
 from .._kernels import as_rows, batch_kernel, kernel
 from .._rotations import wrap_k
-from ..errors import InvalidInputError, JointLimitError, UnreachableError
+from ..errors import InvalidInputError, UnreachableError
 from ._common import Leg
-from .geometry import _DEFAULT_GEOMETRY, ABAD_LIMIT, THETA_MAX, THETA_MIN, TYRE_THICKNESS, Geometry, _geometry, _leg
+from .geometry import (
+    _DEFAULT_GEOMETRY,
+    ABAD_LIMIT,
+    THETA_MAX,
+    THETA_MIN,
+    TYRE_THICKNESS,
+    Geometry,
+    _geometry,
+    _leg,
+    abad_limit_error,
+)
 from .ground import _ZERO, _k_ground, _k_normal_leg, _leg_consts, _normals
 from .linkage import _IF, _IG, _IH, _IL, _IU, _k_closed, _kconst, linkage_points
 from .tyre import _thickness
@@ -410,6 +420,17 @@ def stance_ik_all(target: ArrayLike, leg: Leg, *, normal: ArrayLike = _Z, r: flo
     The search is the module docstring's (:mod:`legkin.wheel_leg.stance`). Sorted by |gamma|, then theta.
     ``limits=True``: only |gamma| <= ABAD_LIMIT (theta is always in [17, 160] deg).
 
+    Args:
+        target: (..., 3) ground-contact points in {R} (m).
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        normal: the ground normal (3,) in {R}.
+        r: tyre thickness (m).
+        limits: keep only solutions inside the ABAD limits.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (..., S, 3) every (theta, beta, gamma) (rad), NaN rows padding a batch to the largest count S.
+
     Raises:
         InvalidInputError: NaN/inf/complex/wrong shapes, a zero normal.
         InvalidParameterError: unknown leg, r out of range, geometry not a Geometry.
@@ -452,6 +473,19 @@ def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = _Z, q_near: Ar
 
     Raises (single target): UnreachableError (no solution), JointLimitError (solutions only outside the limits),
     InvalidInputError (bad input). A batch gives NaN and mask False instead.
+
+    Args:
+        target: (..., 3) ground-contact points in {R} (m).
+        leg: "FL", "FR", "RR", "RL" or 0-3.
+        normal: the ground normal (3,) in {R} (any nonzero length).
+        q_near: (..., 3) the configuration to stay near (rad).
+        r: tyre thickness (m).
+        limits: keep only answers inside the ABAD limits.
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+        return_mask: also return the mask of solved targets (batch).
+
+    Returns:
+        (..., 3) (theta, beta, gamma) (rad), NaN where a batch item is not solved; then the mask, if asked.
     """
     TH, TAB, RUNS, NRUN, K, KC, gargs = _consts(leg, r, geometry)
     if (normal is _Z and type(limits) is bool and return_mask is False and _plain(target)
@@ -485,7 +519,8 @@ def stance_ik(target: ArrayLike, leg: Leg, *, normal: ArrayLike = _Z, q_near: Ar
         if status == 0:
             return (q[0], np.asarray(True)) if return_mask else q[0]
     if status == 2:
-        raise JointLimitError(f"target {t[0].tolist()} is reached only with |gamma| > ABAD_LIMIT", target=t[0])
+        raise abad_limit_error(f"target {t[0].tolist()} is reached only with |gamma| > ABAD_LIMIT = pi/2 "
+                               "(joint <leg>_abad)", leg, t[0], math.nan)
     if status == _OVERFLOW:
         raise _overflow()
     raise UnreachableError(f"no configuration puts the ground contact of {leg} at {t[0].tolist()}", target=t[0])

@@ -309,6 +309,10 @@ def tyre_pieces(theta: ArrayLike, beta: ArrayLike = 0.0, *, r: float = TYRE_THIC
         theta: leg opening (rad) in [17 deg, 160 deg]; beta: leg rotation (rad); broadcast together.
         r: tyre thickness (m) in (0, R).
         geometry: robot parameters.
+
+    Returns:
+        a :class:`TyrePieces` (lengths in m, angles in rad).
+
     """
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     rho = _thickness(r, geo)
@@ -328,7 +332,16 @@ def tyre_pieces(theta: ArrayLike, beta: ArrayLike = 0.0, *, r: float = TYRE_THIC
 
 
 def tyre_length(theta: ArrayLike, *, r: float = TYRE_THICKNESS, geometry: Geometry | None = None) -> np.ndarray:
-    """Length (m) of the closed tyre curve (the scale of the contact parameter s)."""
+    """Length (m) of the closed tyre curve (the scale of the contact parameter s).
+
+    Args:
+        theta: (...) leg angle(s) (rad).
+        r: tyre thickness (m).
+        geometry: the wheel-leg's :class:`Geometry` (None: the default).
+
+    Returns:
+        (...) the length of the tyre's outline (m).
+    """
     return tyre_pieces(theta, 0.0, r=r, geometry=geometry).length
 
 

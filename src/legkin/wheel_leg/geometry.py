@@ -10,6 +10,8 @@ from typing import Mapping
 import numpy as np
 
 from ..errors import InvalidParameterError, JointLimitError
+from .spec import SPEC
+from .spec import TYRE_THICKNESS as TYRE_THICKNESS  # the tyre offset, defined beside the mesh section it sizes
 
 LEGS = ("FL", "FR", "RR", "RL")
 THETA0 = math.radians(17.0)
@@ -17,10 +19,6 @@ THETA_MIN = math.radians(17.0)
 THETA_MAX = math.radians(160.0)
 #: Half-angle of the seed's toe arc (rad).
 PSI_FG = math.radians(40.0)
-#: The tyre thickness (m), one constant for one surface: the tyre surface of :mod:`.tyre` is the pitch curve
-#: (radius R) offset by it; it is the foot radius minus the pitch radius of the seed's rim formula
-#: (0.02225 + 0.01225 m: R + 0.0345 = 0.1345 m) and the outer radius of the rim meshes (R + TYRE_THICKNESS).
-TYRE_THICKNESS = 0.0345
 
 _ARC_HF = math.radians(130.0)
 _ARC_BC = math.radians(101.0)
@@ -49,8 +47,6 @@ class Geometry:
     T: float = 0.04
 
     def __post_init__(self) -> None:
-        from .spec import SPEC  # the model's parameter ranges, one source
-
         for f in fields(self):
             object.__setattr__(self, f.name, float(SPEC.params[f.name].check(f.name, getattr(self, f.name))))
         # the kernels' constants are cached per geometry: hash once (a dataclass hashes its fields every time)

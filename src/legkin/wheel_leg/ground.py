@@ -16,7 +16,7 @@ part, ``n_z`` its lateral part. So:
   contains the swept region's boundary, so this is the lowest point of the pitch curve moved by ``-r n``.
   Where ``|n_plane| <= 1e-12`` (the leg plane parallel to the ground) the whole side face is lowest: the point
   of that face toward the toe G is returned (the support point for ``n_plane = -G/|G|``).
-* **stance IK**: :func:`~legkin.wheel_leg.stance.stance_ik` (module :mod:`.stance`, also served here).
+* **stance IK**: :func:`~legkin.wheel_leg.stance.stance_ik` (module :mod:`.stance`, which builds on this one).
 * **Jacobian**: the derivative d p / d(theta, beta, gamma) of the *material point*: the point of the rim link
   that carries the contact (:data:`.tyre.PIECE_LINKS`) fixed in that link at the solution, moved with the link.
   It is not the derivative of the (rolling) contact point itself; the two differ by the rolling of the
@@ -270,12 +270,3 @@ def ground_contact(q: ArrayLike, leg: Leg, normal: ArrayLike = _Z, *, r: float =
     if shape == () and not bool(ok[0]):
         raise InvalidInputError(f"the ground contact is not finite at q={q.tolist()}")
     return (gc, ok.reshape(shape)) if return_mask else gc
-
-
-def __getattr__(name: str) -> Any:
-    """``stance_ik``, ``stance_ik_all``: served from :mod:`.stance` (which builds on this module)."""
-    if name in ("stance_ik", "stance_ik_all"):
-        from . import stance
-
-        return getattr(stance, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

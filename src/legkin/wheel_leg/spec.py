@@ -9,6 +9,11 @@ import numpy as np
 
 from .._registry import ModelSpec, Param
 
+#: The tyre thickness (m), one constant for one surface: the tyre surface of :mod:`legkin.wheel_leg.tyre` is
+#: the pitch curve (radius R) offset by it; it is the foot radius minus the pitch radius of the seed's rim formula
+#: (0.02225 + 0.01225 m: R + 0.0345 = 0.1345 m) and the outer radius of the rim meshes (R + TYRE_THICKNESS).
+TYRE_THICKNESS = 0.0345
+
 LEGS = ("FL", "FR", "RR", "RL")
 
 #: Rim section of the visual/collision meshes: inner radius 0.9 R, outer radius R + TYRE_THICKNESS (0.0345 m,
@@ -82,8 +87,6 @@ def rim_meshes(args: dict) -> dict[str, bytes]:
     Upper rim: 130 deg arc, lower rim: 50 deg arc, both centred on the arc centre and symmetric about +x
     (the URDF rotates them into place); section from ``0.9 R`` to ``R + TYRE_THICKNESS`` (0.0345 m), thickness ``T``.
     """
-    from .geometry import TYRE_THICKNESS  # here: geometry imports this module's SPEC
-
     R, T = float(args["R"]), float(args["T"])
     r1, r2 = RIM_INNER * R, R + TYRE_THICKNESS
     out = {}

@@ -222,6 +222,10 @@ def test_stance_ik_single_equals_batch_and_rules():
     # a target reached only with |gamma| > ABAD_LIMIT (the leg swung over the top, gamma ~ 2.6 rad)
     t_out = gd.ground_contact(np.array([1.2, 0.3, 2.6]), "FL").point
     sols = gd.stance_ik_all(t_out, "FL")
+    same, mask = gd.stance_ik_all(t_out, "FL", return_mask=True)
+    assert np.array_equal(same, sols, equal_nan=True) and np.array_equal(mask, ~np.isnan(sols).any(-1))
+    both, masks = gd.stance_ik_all(np.stack([t_out, t_out]), "FL", return_mask=True)
+    assert masks.shape == both.shape[:-1] and np.array_equal(masks[0], ~np.isnan(both[0]).any(-1)) and masks.any()
     assert sols.shape[0] >= 1 and np.all(np.abs(sols[:, 2]) > ABAD_LIMIT)
     with pytest.raises(JointLimitError) as info:
         gd.stance_ik(t_out, "FL")

@@ -412,8 +412,15 @@ def _overflow() -> RuntimeError:
     return RuntimeError(f"more than {CAP} stance IK solutions for one target (not expected: please report)")
 
 
+@overload
+def stance_ik_all(target: ArrayLike, leg: Leg, *, normal: ArrayLike = ..., r: float = ..., limits: bool = ...,
+                  geometry: Geometry | None = ..., return_mask: Literal[False] = False) -> np.ndarray: ...
+@overload
+def stance_ik_all(target: ArrayLike, leg: Leg, *, normal: ArrayLike = ..., r: float = ..., limits: bool = ...,
+                  geometry: Geometry | None = ..., return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
 def stance_ik_all(target: ArrayLike, leg: Leg, *, normal: ArrayLike = _Z, r: float = TYRE_THICKNESS,
-                  limits: bool = False, geometry: Geometry | None = None) -> np.ndarray:
+                  limits: bool = False, geometry: Geometry | None = None,
+                  return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Every (theta, beta, gamma) whose ground contact (:func:`~legkin.wheel_leg.ground_contact`) is ``target``,
     (..., S, 3), NaN-padded (S >= 1).
 
@@ -427,22 +434,26 @@ def stance_ik_all(target: ArrayLike, leg: Leg, *, normal: ArrayLike = _Z, r: flo
         r: tyre thickness (m).
         limits: keep only solutions inside the ABAD limits.
         geometry: the wheel-leg's :class:`Geometry` (None: the default).
+        return_mask: also return the mask (..., S) of the rows that are solutions.
 
     Returns:
-        (..., S, 3) every (theta, beta, gamma) (rad), NaN rows padding a batch to the largest count S.
+        (..., S, 3) every (theta, beta, gamma) (rad), NaN rows padding a batch to the largest count S; then the
+        mask, if asked.
 
     Raises:
         InvalidInputError: NaN/inf/complex/wrong shapes, a zero normal.
         InvalidParameterError: unknown leg, r out of range, geometry not a Geometry.
     """
     TH, TAB, RUNS, NRUN, K, KC, gargs = _consts(leg, r, geometry)
-    if normal is _Z and _plain(target) and type(limits) is bool:  # one target: the kernel directly
+    if normal is _Z and _plain(target) and type(limits) is bool and type(return_mask) is bool:  # the kernel directly
         one = np.full((CAP, 3), np.nan)
         k = _k_stance_all(target, _Z_ARRAY, TH, TAB, RUNS, NRUN, K, KC, gargs, limits, one)
         if k < 0:
             raise _overflow()
-        return one[: max(1, k)].copy()
+        sols = one[: max(1, k)].copy()
+        return (sols, np.arange(len(sols)) < k) if return_mask is True else sols
     limits = check_flag(limits, "limits")
+    return_mask = check_flag(return_mask, "return_mask")
     t, n, shape = _targets(target, normal)
     m = t.shape[0]
     out, count = np.full((m, CAP, 3), np.nan), np.empty(m, dtype=np.int64)
@@ -450,7 +461,8 @@ def stance_ik_all(target: ArrayLike, leg: Leg, *, normal: ArrayLike = _Z, r: flo
     if np.any(count < 0):
         raise _overflow()
     S = max(1, int(count.max(initial=0)))
-    return np.ascontiguousarray(out[:, :S]).reshape(shape + (S, 3))
+    sols = np.ascontiguousarray(out[:, :S]).reshape(shape + (S, 3))
+    return (sols, (np.arange(S) < count[:, None]).reshape(shape + (S,))) if return_mask else sols
 
 
 @overload

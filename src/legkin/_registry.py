@@ -193,8 +193,14 @@ def list_models(source: str | None = None) -> list[str]:
 
     Args:
         source: only the models of this source: ``"legkin"`` (the mechanisms generated from legkin's xacro,
-            with their analytic kinematics) or ``"example-robot-data"`` (the external quadrupeds of
-            :mod:`legkin.legs`); None (default): all.
+            with their analytic kinematics) or ``"example-robot-data"`` (the robots whose leg kinematics
+            :mod:`legkin.legs` measures from their URDF); None (default): all.
+
+    Returns:
+        The names, sorted.
+
+    Raises:
+        InvalidParameterError: an unknown ``source`` (the message lists the valid ones).
     """
     if source is None:
         return sorted(MODELS)

@@ -275,7 +275,15 @@ class TyrePieces:
     length: np.ndarray
 
     def point(self, k: int, u: ArrayLike) -> np.ndarray:
-        """Point (..., 2) of piece k at fraction u in [0, 1] (leg frame)."""
+        """Point of piece ``k`` at the fraction ``u`` of its arc.
+
+        Args:
+            k: the piece's index (0 to 15, in arc-length order).
+            u: fraction(s) of the piece's arc in [0, 1] (unitless), broadcast with the pieces' batch shape.
+
+        Returns:
+            The points (..., 2) in the leg frame (m).
+        """
         ang = self.start[..., k] + np.asarray(u, dtype=float) * self.span[..., k]
         return self.centre[..., k, :] + self.radius[..., k, None] * np.stack([np.cos(ang), np.sin(ang)], -1)
 

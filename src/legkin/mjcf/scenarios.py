@@ -1,0 +1,264 @@
+"""Ground scenarios of a floating mechanism in MuJoCo, measured against legkin (:func:`run_scenario`).
+
+* ``stand``: dropped from ``drop`` (1 cm) above its standing height in a pose, after ``seconds`` (2 s): the base
+  height against legkin's prediction (:meth:`~legkin.mjcf.ground.GroundModel.standing_height`), each centre of
+  pressure against legkin's contact point at MuJoCo's configuration, and the deepest penetration.
+* ``roll`` (wheels only): after 0.5 s standing, every wheel turned by ``angle`` in ``seconds``; the base travel
+  against ``rolling_radius x angle`` (relative error).
+* ``squat``: after 0.5 s standing, the base lowered by ``depth`` (5 cm) and raised back (a cosine), the joints
+  from legkin's IK holding the contacts on their ground points (:meth:`~legkin.mjcf.ground.GroundModel.hold`);
+  the slip (largest horizontal drift of a centre of pressure) and the base height against the commanded one.
+
+The controller is the export's position actuators plus an integral term on each actuator's error (time constant
+``0.1 s``), which removes the static sag of the stiff-but-finite actuators under the body's weight (the pose is
+what legkin predicts for, not the pose minus a sag). Each figure is a :class:`legkin._checkkit.CheckResult` row;
+the result also carries the real-time factor (simulated / wall-clock seconds, one core) and optional frames.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Any, Callable
+
+import numpy as np
+
+from ..errors import InvalidParameterError
+from ._base import _mujoco
+from .floating import GroundMechanism, load_ground
+
+if TYPE_CHECKING:  # pragma: no cover
+    from .._checkkit import CheckResult
+
+__all__ = ["SCENARIOS", "ScenarioResult", "run_scenario", "TOL_HEIGHT", "TOL_CONTACT", "TOL_PENETRATION",
+           "TOL_ROLL", "TOL_SLIP"]
+
+SCENARIOS = ("stand", "roll", "squat")
+TOL_HEIGHT = 2e-3
+TOL_CONTACT = 2e-3
+TOL_PENETRATION = 1e-3
+TOL_ROLL = 0.02
+TOL_SLIP = 2e-3
+#: Integral time constant (s) of the actuators' integral term.
+_TAU_I = 0.5
+#: Seconds of standing before ``roll`` and ``squat`` start moving.
+_SETTLE = 0.5
+
+
+@dataclass
+class ScenarioResult:
+    """What a scenario measured.
+
+    Attributes:
+        scenario, model: names.
+        rows: the figures as check rows (error, tolerance, pass).
+        simulated: simulated time (s); wall: wall-clock time of the stepping (s); rtf: simulated / wall.
+        frames: ``qpos`` every ``1 / fps`` s when recorded, else empty.
+    """
+
+    scenario: str
+    model: str
+    rows: list["CheckResult"]
+    simulated: float
+    wall: float
+    rtf: float
+    frames: list[np.ndarray] = field(default_factory=list, repr=False)
+
+
+class _Runner:
+    """Steps a :class:`GroundMechanism` with the PI hold, timing the steps and recording frames."""
+
+    def __init__(self, mech: GroundMechanism, fps: float | None) -> None:
+        self.mujoco = _mujoco()
+        self.mech, self.fps = mech, fps
+        self.adr = mech.model.jnt_qposadr[mech.model.actuator_trnid[:, 0]]
+        self.integral = np.zeros(mech.model.nu)
+        self.target = np.zeros(mech.model.nu)
+        self.wall, self.time, self.frames = 0.0, 0.0, []
+        self.penetration = 0.0
+
+    def start(self, key: int, drop: float) -> None:
+        m, d = self.mech.model, self.mech.data
+        self.mujoco.mj_resetDataKeyframe(m, d, key)
+        d.qpos[2] += drop
+        self.target = d.ctrl.copy()
+        self.mujoco.mj_forward(m, d)
+
+    def run(self, seconds: float, target: Callable[[float], np.ndarray] | None = None) -> None:
+        m, d = self.mech.model, self.mech.data
+        dt = m.opt.timestep
+        t0 = time.perf_counter()
+        for _ in range(int(round(seconds / dt))):
+            if target is not None:
+                self.target = target(self.time)
+            err = self.target - d.qpos[self.adr]
+            self.integral += dt / _TAU_I * err
+            d.ctrl[:] = self.target + self.integral
+            self.mujoco.mj_step(m, d)
+            self.time += dt
+            if d.ncon:
+                self.penetration = max(self.penetration, -float(d.contact.dist[: d.ncon].min()))
+            if self.fps and (len(self.frames) == 0 or self.time >= len(self.frames) / self.fps):
+                self.frames.append(d.qpos.copy())
+        self.wall += time.perf_counter() - t0
+
+    def pressure(self, points: np.ndarray) -> np.ndarray:
+        """(k, 3) force-weighted centre of MuJoCo's contacts nearest each world point (NaN: no contact)."""
+        m, d = self.mech.model, self.mech.data
+        sums, weights = np.zeros((len(points), 3)), np.zeros(len(points))
+        force = np.zeros(6)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            self.mujoco.mj_contactForce(m, d, i, force)
+            k = int(np.argmin(np.linalg.norm(points[:, :2] - c.pos[:2], axis=1)))
+            sums[k] += force[0] * c.pos
+            weights[k] += force[0]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return sums / weights[:, None]
+
+    def predicted(self) -> np.ndarray:
+        """legkin's contact points at MuJoCo's configuration, in the world (MuJoCo's base pose)."""
+        d = self.mech.data
+        q = self.mech.q(d.qpos)
+        rot = d.xmat[self.mech.body_ids[1]].reshape(3, 3)
+        return self.mech.ground.contacts(q) @ rot.T + d.qpos[:3]
+
+
+def _log3(r: np.ndarray) -> np.ndarray:
+    import pinocchio as pin
+
+    return np.asarray(pin.log3(np.asarray(r, dtype=float)))
+
+
+def _key(mech: GroundMechanism, pose: str | None) -> tuple[int, np.ndarray]:
+    mujoco = _mujoco()
+    robot = mech.robot
+    pose = robot.spec.reference_pose if pose is None else pose
+    key = mujoco.mj_name2id(mech.model, mujoco.mjtObj.mjOBJ_KEY, pose)
+    if key < 0:
+        raise InvalidParameterError(f"{robot.name} has no pose {pose!r}; poses: {', '.join(robot.poses)}")
+    return key, {**robot.poses, robot.spec.reference_pose: robot.q0}[pose]
+
+
+def _stand(run: _Runner, pose: str | None, seconds: float, drop: float) -> list["CheckResult"]:
+    from .._checkkit import compare
+
+    mech = run.mech
+    key, q = _key(mech, pose)
+    run.start(key, drop)
+    run.run(seconds)
+    height = mech.ground.standing_height(q)
+    pred = run.predicted()
+    cop = run.pressure(pred)
+    name = mech.robot.name
+    return [
+        compare(f"{name} stand: dropped {drop:g} m, base height after {seconds:g} s - legkin's (m)",
+                np.array([run.mech.data.qpos[2] - height]), TOL_HEIGHT),
+        compare(f"{name} stand: centre of pressure - legkin's contact point, per contact (m)",
+                np.linalg.norm(cop - pred, axis=1), TOL_CONTACT),
+        compare(f"{name} stand: deepest penetration over the run (m)", np.array([run.penetration]), TOL_PENETRATION),
+    ]
+
+
+def _roll(run: _Runner, pose: str | None, seconds: float, angle: float) -> list["CheckResult"]:
+    from .._checkkit import compare
+
+    mech = run.mech
+    radius = mech.ground.rolling_radius
+    if radius is None:
+        raise InvalidParameterError(f"{mech.robot.name} has no wheels: scenarios stand and squat only")
+    key, q = _key(mech, pose)
+    run.start(key, 0.0)
+    run.run(_SETTLE)
+    x0, t0 = mech.data.qpos[:2].copy(), run.time
+    ticks = np.linspace(0.0, seconds, 201)
+    ctrl = np.array([mech.ctrl(mech.ground.roll(q, angle * t / seconds)) for t in ticks])
+
+    def target(t: float) -> np.ndarray:
+        return np.array([np.interp(t - t0, ticks, c) for c in ctrl.T])
+
+    run.run(seconds, target)
+    run.run(0.3, target)
+    travel = float(np.linalg.norm(mech.data.qpos[:2] - x0)) * np.sign(mech.data.qpos[0] - x0[0])
+    want = radius * angle
+    return [compare(f"{mech.robot.name} roll: rims turned {angle:g} rad, travel / (rolling radius {radius:g} m "
+                    f"x angle) - 1", np.array([travel / want - 1.0]), TOL_ROLL)]
+
+
+def _squat(run: _Runner, pose: str | None, seconds: float, depth: float) -> list["CheckResult"]:
+    from .._checkkit import compare
+
+    mech = run.mech
+    key, q = _key(mech, pose)
+    run.start(key, 0.0)
+    run.run(_SETTLE)
+    base0 = mech.data.qpos[:3].copy()
+    ground = mech.ground.contacts(q)  # base frame, at the standing height
+    cop0 = run.pressure(run.predicted())
+    t0 = run.time
+    slip, height = [], []
+
+    def lowered(t: float) -> float:
+        return 0.5 * depth * (1.0 - np.cos(2.0 * np.pi * min(1.0, (t - t0) / seconds)))
+
+    ticks = np.linspace(0.0, seconds, 201)  # legkin's IK every 10 ms of a 2 s squat, interpolated between
+    ctrl = np.array([mech.ctrl(mech.ground.hold_rolling(q, ground + np.array([0.0, 0.0, lowered(t0 + t)])))
+                     for t in ticks])
+    frames = mech.ground.contact_frames(q)
+    sites = [mech.model.site(f).id for f, _ in frames]
+    rho = np.array([r for _, r in frames])
+    rot0 = mech.data.site_xmat[sites].reshape(-1, 3, 3).copy()
+
+    def target(t: float) -> np.ndarray:
+        return np.array([np.interp(t - t0, ticks, c) for c in ctrl.T])
+
+    for _ in range(20):
+        run.run(seconds / 20, target)
+        rot = mech.data.site_xmat[sites].reshape(-1, 3, 3)
+        a = np.array([_log3(r @ r0.T) for r, r0 in zip(rot, rot0)])
+        rolled = np.stack([rho * a[:, 1], -rho * a[:, 0]], axis=1)
+        slip.append(np.linalg.norm((run.pressure(run.predicted()) - cop0)[:, :2] - rolled, axis=1))
+        height.append(mech.data.qpos[2] - (base0[2] - lowered(run.time)))
+    run.run(1.0, target)
+    name = mech.robot.name
+    return [
+        compare(f"{name} squat: base {depth:g} m down and up in {seconds:g} s, slip of each contact (m)",
+                np.array(slip), TOL_SLIP),
+        compare(f"{name} squat: base height - commanded, 1 s after (m)",
+                np.array([mech.data.qpos[2] - base0[2]]), TOL_HEIGHT),
+        compare(f"{name} squat: base height - commanded during the squat (m)", np.array(height), np.inf),
+    ]
+
+
+def run_scenario(model: "str | GroundMechanism", scenario: str, *, seconds: float = 2.0, pose: str | None = None,
+                 fps: float | None = None, **options: Any) -> ScenarioResult:
+    """Run one ground scenario (module docstring) and measure it.
+
+    Args:
+        model: a model name or a :class:`~legkin.mjcf.floating.GroundMechanism` (:func:`load_ground`).
+        scenario: ``"stand"``, ``"roll"`` or ``"squat"``.
+        seconds: the scenario's length (s): standing time, rolling time, squat period.
+        pose: the SRDF pose to start from (default: the reference pose; the wheel-leg squats from ``"leg"``).
+        fps: record ``qpos`` frames at this rate (for :func:`legkin.mjcf.record.write_video`).
+        **options: :func:`~legkin.mjcf.floating.to_ground_mjcf` options (with a model name).
+
+    Returns:
+        :class:`ScenarioResult` (rows, real-time factor, frames).
+
+    Raises:
+        InvalidParameterError: an unknown scenario or pose, ``roll`` on a model without wheels.
+    """
+    if scenario not in SCENARIOS:
+        raise InvalidParameterError(f"unknown scenario {scenario!r}; scenarios: {', '.join(SCENARIOS)}")
+    mech = load_ground(model, **options) if isinstance(model, str) else model
+    if scenario == "squat" and pose is None:
+        pose = mech.ground.squat_pose
+    run = _Runner(mech, fps)
+    if scenario == "stand":
+        rows = _stand(run, pose, seconds, 0.01)
+    elif scenario == "roll":
+        rows = _roll(run, pose, seconds, 2.0 * np.pi)
+    else:
+        rows = _squat(run, pose, seconds, 0.05)
+    return ScenarioResult(scenario, mech.robot.name, rows, run.time, run.wall, run.time / max(run.wall, 1e-9),
+                          run.frames)

@@ -1,0 +1,146 @@
+"""The wheel-leg's ground model (:func:`ground_model`, found by :func:`legkin.mjcf.ground.ground_model`).
+
+Contact geometry: the tyre (:mod:`.tyre`: the pitch curve swept by a disk of radius ``r`` = 0.0345 m, extruded over
+the width T) as cylinders of radius ``r`` and length T whose axes are the leg-plane normal, centred on the pitch
+arcs of the four rim links (:data:`.tyre.PIECE_LINKS`) at most ``step`` apart, both ends of every arc included.
+The union of these cylinders is the swept tyre sampled along the pitch curve: it is exact at the samples, the
+caps at the tips and the fillets at the hinges (those are the end cylinders), and between two samples it lies
+under the true surface by at most ``r - sqrt(r^2 - step^2/4)`` (2.3e-4 m for the default 8 mm, 5.8e-5 m for 4 mm).
+The arcs are read from the URDF's frames (centre U or L, ends H, F, G) at the reference pose.
+
+Predicted contacts: :func:`.ground.ground_contact` per leg; holding them: :func:`.stance.stance_ik`; rolling:
+every leg's beta turned (:func:`.linkage.motor_angles`: phi_L and phi_R together).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from ..mjcf.ground import ContactGeom, GroundModel
+from .configuration import configuration
+from .geometry import LEGS, THETA_MAX, THETA_MIN, TYRE_THICKNESS
+from .ground import ground_contact
+from .linkage import theta_beta
+from .stance import stance_ik
+from .tyre import LINK_NAMES, tyre_pieces
+
+__all__ = ["ground_model", "WheelGround", "TYRE_STEP"]
+
+#: Largest distance (m) between two tyre cylinders along the pitch curve (module docstring).
+TYRE_STEP = 0.008
+#: The pitch arcs of a leg: (rim link, centre frame, first end, second end), ``<leg>_`` omitted; the lower rims'
+#: hinge end F is their link frame.
+_ARCS = (
+    ("rim_upper_L", "U_L", "H_L", "F_L"),
+    ("rim_lower_L", "L_L", "rim_lower_L", "G"),
+    ("rim_lower_R", "L_R", "rim_lower_R", "G_cut"),
+    ("rim_upper_R", "U_R", "H_R", "F_R"),
+)
+
+
+def _rotation_z(axis: np.ndarray) -> np.ndarray:
+    """A rotation whose third column is the unit ``axis``."""
+    z = axis / np.linalg.norm(axis)
+    x = np.cross([0.0, 1.0, 0.0] if abs(z[1]) < 0.9 else [1.0, 0.0, 0.0], z)
+    x /= np.linalg.norm(x)
+    return np.column_stack([x, np.cross(z, x), z])
+
+
+class WheelGround(GroundModel):
+    """The wheel-leg's tyres, contacts, stance IK and rolling (module docstring).
+
+    Args:
+        robot: ``legkin.load("wheel_leg", floating=True)``.
+        step: largest distance (m) between tyre cylinders along the pitch curve.
+    """
+
+    def __init__(self, robot: Any, step: float = TYRE_STEP) -> None:
+        self.robot, self.step = robot, float(step)
+        self.geometry = robot.geometry
+        self.rolling_radius = self.geometry.R + TYRE_THICKNESS
+        self.squat_pose = "leg"  # theta = 160 deg: the reference pose ("wheel") cannot go 5 cm lower
+        self.collision_skip = frozenset(
+            g.name for g in robot.collision_model.geometryObjects if "_rim_" in g.name
+        )
+
+    def leg_q(self, q: np.ndarray) -> np.ndarray:
+        """(4, 3) (theta, beta, gamma) of the legs (:data:`LEGS` order) in ``q``; theta clipped to its range (a
+        simulated wheel closes a few 1e-4 rad past 17 deg under load)."""
+        r = self.robot
+        out = np.empty((4, 3))
+        for k, leg in enumerate(LEGS):
+            th, be = theta_beta(q[r.idx_q(f"{leg}_phi_L")], q[r.idx_q(f"{leg}_phi_R")])
+            out[k] = float(th), float(be), q[r.idx_q(f"{leg}_abad")]
+        out[:, 0] = np.clip(out[:, 0], THETA_MIN, THETA_MAX)
+        return out
+
+    def _q(self, q: np.ndarray, leg_q: np.ndarray) -> np.ndarray:
+        out = configuration(self.robot, leg_q)
+        out[:7] = q[:7]
+        return out
+
+    def geoms(self) -> list[ContactGeom]:
+        """The tyre cylinders of every leg (module docstring)."""
+        model = self.robot.model
+        data = model.createData()
+        pin.framesForwardKinematics(model, data, self.robot.q0)
+        half = 0.5 * self.geometry.T
+        out = []
+        for leg in LEGS:
+            for link, centre, a, b in _ARCS:
+                fid = model.getFrameId(f"{leg}_{link}")
+                joint = model.frames[fid].parentJoint
+                to_joint = data.oMi[joint].inverse()
+                c, pa, pb = (to_joint.act(data.oMf[model.getFrameId(f"{leg}_{n}")].translation) for n in (centre, a, b))
+                u, v = pa - c, pb - c
+                normal = np.cross(u, v)
+                span = float(np.arctan2(np.linalg.norm(normal), u @ v))
+                radius = float(np.linalg.norm(u))
+                rot = _rotation_z(normal)
+                n = max(1, int(np.ceil(span * radius / self.step)))
+                for i in range(n + 1):
+                    p = c + pin.AngleAxis(span * i / n, normal / np.linalg.norm(normal)).matrix() @ u
+                    out.append(ContactGeom(f"{leg}_{link}_tyre{i}", joint, "cylinder", (TYRE_THICKNESS, half),
+                                           pin.SE3(rot, p)))
+        return out
+
+    def contacts(self, q: np.ndarray) -> np.ndarray:
+        """:func:`.ground.ground_contact` of every leg (robot frame)."""
+        lq = self.leg_q(q)
+        return np.array([ground_contact(lq[k], leg, geometry=self.geometry).point for k, leg in enumerate(LEGS)])
+
+    def contact_frames(self, q: np.ndarray) -> list[tuple[str, float]]:
+        """The rim link carrying each leg's ground contact and the radius of its tyre piece there."""
+        lq = self.leg_q(q)
+        out = []
+        for k, leg in enumerate(LEGS):
+            gc = ground_contact(lq[k], leg, geometry=self.geometry)
+            radius = tyre_pieces(lq[k, 0], lq[k, 1], geometry=self.geometry).radius[int(gc.piece)]
+            out.append((f"{leg}_{LINK_NAMES[int(gc.link)]}", float(radius)))
+        return out
+
+    def hold(self, q: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """:func:`.stance.stance_ik` of every leg, nearest to its angles in ``q``."""
+        lq = self.leg_q(q)
+        new = np.array([stance_ik(np.asarray(t, dtype=float), leg, q_near=lq[k], geometry=self.geometry)
+                        for k, (leg, t) in enumerate(zip(LEGS, targets))])
+        return self._q(q, new)
+
+    def roll(self, q: np.ndarray, angle: float) -> np.ndarray:
+        """Every leg's beta increased by ``angle`` (rad)."""
+        lq = self.leg_q(q)
+        lq[:, 1] += angle
+        return self._q(q, lq)
+
+
+def ground_model(robot: Any, step: float = TYRE_STEP) -> WheelGround:
+    """The :class:`WheelGround` of a floating wheel-leg.
+
+    Args:
+        robot: ``legkin.load("wheel_leg", floating=True)``.
+        step: largest distance (m) between tyre cylinders along the pitch curve.
+    """
+    return WheelGround(robot, step)

@@ -310,6 +310,9 @@ def build_parser() -> argparse.ArgumentParser:
     from .mjcf.cli import add_export_command
 
     add_export_command(sub)  # legkin mjcf MODEL [-o FILE] [--floating] [--timestep S] [--png FILE]
+    from .mjcf.sim_cli import add_sim_command
+
+    add_sim_command(sub)  # legkin sim MODEL --scenario stand|roll|squat [--video PATH | --html PATH]
     p = sub.add_parser("export", help="export a model to another format: --mjcf PATH (MuJoCo, loops as equalities)")
     p.add_argument("model")
     p.add_argument("--mjcf", metavar="PATH", type=output_file, required=True, help="write a MuJoCo MJCF to PATH")

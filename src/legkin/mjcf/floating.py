@@ -18,7 +18,7 @@ import numpy as np
 
 from ..errors import InvalidParameterError
 from ..loops import check_real
-from ._base import _MESH_EXTENSIONS, DEFAULTS, _num, _options, _robot, _set_pose, _vec
+from ._base import _MESH_EXTENSIONS, DEFAULTS, _options, _robot, _set_pose, _vec
 from .ground import GroundModel, ground_model
 from .mechanism import MujocoMechanism, load_mujoco
 from .writer import _build_xml, _geom

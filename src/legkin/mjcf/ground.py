@@ -57,12 +57,15 @@ class GroundModel(ABC):
             meshes, which MuJoCo would convexify).
         rolling_radius: the radius (m) of a rolling wheel in the reference pose, or None (legs).
         squat_pose: the SRDF pose the ``squat`` scenario starts from (None: the reference pose).
+        line_half_width: half the length (m) of a line contact across the base's y axis (a tyre lying flat: its
+            centre of pressure anywhere on it is legkin's contact); 0 for point contacts.
     """
 
     robot: "Robot"
     collision_skip: frozenset[str] = frozenset()
     rolling_radius: float | None = None
     squat_pose: str | None = None
+    line_half_width: float = 0.0
 
     @abstractmethod
     def geoms(self) -> list[ContactGeom]:

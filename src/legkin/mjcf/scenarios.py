@@ -151,11 +151,13 @@ def _stand(run: _Runner, pose: str | None, seconds: float, drop: float) -> list[
     pred = run.predicted()
     cop = run.pressure(pred)
     name = mech.robot.name
+    gap = cop - pred
+    gap[:, 1] = np.sign(gap[:, 1]) * np.maximum(np.abs(gap[:, 1]) - mech.ground.line_half_width, 0.0)
     return [
         compare(f"{name} stand: dropped {drop:g} m, base height after {seconds:g} s - legkin's (m)",
                 np.array([run.mech.data.qpos[2] - height]), TOL_HEIGHT),
-        compare(f"{name} stand: centre of pressure - legkin's contact point, per contact (m)",
-                np.linalg.norm(cop - pred, axis=1), TOL_CONTACT),
+        compare(f"{name} stand: centre of pressure - legkin's contact point (or line), per contact (m)",
+                np.linalg.norm(gap, axis=1), TOL_CONTACT),
         compare(f"{name} stand: deepest penetration over the run (m)", np.array([run.penetration]), TOL_PENETRATION),
     ]
 
@@ -262,3 +264,21 @@ def run_scenario(model: "str | GroundMechanism", scenario: str, *, seconds: floa
         rows = _squat(run, pose, seconds, 0.05)
     return ScenarioResult(scenario, mech.robot.name, rows, run.time, run.wall, run.time / max(run.wall, 1e-9),
                           run.frames)
+
+
+def ground_rows(name: str) -> list["CheckResult"]:
+    """The ``legkin check`` rows of the ground scenarios of ``name``: ``stand``, ``roll`` (wheels) and ``squat``
+    (none for a model without a ground model)."""
+    from ..robot import load
+    from .ground import has_ground_model
+
+    robot = load(name, floating=True)
+    if not has_ground_model(robot):
+        return []
+    mech = load_ground(robot)
+    rows: list["CheckResult"] = []
+    for scenario in SCENARIOS:
+        if scenario == "roll" and mech.ground.rolling_radius is None:
+            continue
+        rows += run_scenario(mech, scenario).rows
+    return rows

@@ -31,6 +31,8 @@ __all__ = ["ground_model", "WheelGround", "TYRE_STEP"]
 
 #: Largest distance (m) between two tyre cylinders along the pitch curve (module docstring).
 TYRE_STEP = 0.008
+#: |gamma| (rad) under which a tyre counts as flat across its width (:meth:`WheelGround.contacts`).
+_LEVEL = 1e-3
 #: The pitch arcs of a leg: (rim link, centre frame, first end, second end), ``<leg>_`` omitted; the lower rims'
 #: hinge end F is their link frame.
 _ARCS = (
@@ -61,6 +63,7 @@ class WheelGround(GroundModel):
         self.robot, self.step = robot, float(step)
         self.geometry = robot.geometry
         self.rolling_radius = self.geometry.R + TYRE_THICKNESS
+        self.line_half_width = 0.5 * self.geometry.T
         self.squat_pose = "leg"  # theta = 160 deg: the reference pose ("wheel") cannot go 5 cm lower
         self.collision_skip = frozenset(
             g.name for g in robot.collision_model.geometryObjects if "_rim_" in g.name
@@ -108,9 +111,16 @@ class WheelGround(GroundModel):
         return out
 
     def contacts(self, q: np.ndarray) -> np.ndarray:
-        """:func:`.ground.ground_contact` of every leg (robot frame)."""
+        """:func:`.ground.ground_contact` of every leg (robot frame); where the tyre lies flat across its width
+        (|gamma| < :data:`_LEVEL`) the centre of that line contact (the lowest point is then an edge only by a
+        tilt of under 4e-5 m across the width, which a loaded contact does not resolve)."""
         lq = self.leg_q(q)
-        return np.array([ground_contact(lq[k], leg, geometry=self.geometry).point for k, leg in enumerate(LEGS)])
+        out = []
+        for k, leg in enumerate(LEGS):
+            gc = ground_contact(lq[k], leg, geometry=self.geometry)
+            flat = abs(lq[k, 2]) < _LEVEL
+            out.append(gc.point - (float(gc.w) if flat else 0.0) * np.array([0.0, 1.0, 0.0]))  # z_L = y_R at gamma 0
+        return np.array(out)
 
     def contact_frames(self, q: np.ndarray) -> list[tuple[str, float]]:
         """The rim link carrying each leg's ground contact and the radius of its tyre piece there."""

@@ -100,7 +100,7 @@ def _add_geoms(root: ET.Element, robot: "Robot", ground: GroundModel) -> int:
         el.set("class", "contact")
         _set_pose(el, g.placement)
         n += 1
-    meshes = {(m.get("file"), tuple(float(x) for x in m.get("scale", "1 1 1").split())): m.get("name")
+    meshes = {(str(m.get("file")), tuple(float(x) for x in m.get("scale", "1 1 1").split())): str(m.get("name"))
               for m in asset.findall("mesh")}  # the visuals' meshes, reused
     for gobj in robot.collision_model.geometryObjects:
         if gobj.name in ground.collision_skip or gobj.parentJoint == 0:

@@ -74,7 +74,8 @@ class _Runner:
         self.adr = mech.model.jnt_qposadr[mech.model.actuator_trnid[:, 0]]
         self.integral = np.zeros(mech.model.nu)
         self.target = np.zeros(mech.model.nu)
-        self.wall, self.time, self.frames = 0.0, 0.0, []
+        self.wall, self.time = 0.0, 0.0
+        self.frames: list[np.ndarray] = []
         self.penetration = 0.0
 
     def start(self, key: int, drop: float) -> None:

@@ -57,15 +57,19 @@ class GroundModel(ABC):
             meshes, which MuJoCo would convexify).
         rolling_radius: the radius (m) of a rolling wheel in the reference pose, or None (legs).
         squat_pose: the SRDF pose the ``squat`` scenario starts from (None: the reference pose).
+        squat_start: how far (m) below that pose the squat starts (the contacts held by :meth:`hold`).
         line_half_width: half the length (m) of a line contact across the base's y axis (a tyre lying flat: its
             centre of pressure anywhere on it is legkin's contact); 0 for point contacts.
+        rolls_sideways: whether a contact rolls about the base x axis too (a sphere) or only about y (a tyre).
     """
 
     robot: "Robot"
     collision_skip: frozenset[str] = frozenset()
     rolling_radius: float | None = None
     squat_pose: str | None = None
+    squat_start: float = 0.0
     line_half_width: float = 0.0
+    rolls_sideways: bool = True
 
     @abstractmethod
     def geoms(self) -> list[ContactGeom]:
@@ -84,25 +88,32 @@ class GroundModel(ABC):
         """
 
     @abstractmethod
-    def contact_frames(self, q: np.ndarray) -> list[tuple[str, float]]:
-        """Per contact of :meth:`contacts`, the frame of the body carrying it and the radius (m) of the circle or
-        sphere of that body touching the ground there (its rolling radius)."""
+    def contact_frames(self, q: np.ndarray) -> list[tuple[tuple[str, ...], float]]:
+        """Per contact of :meth:`contacts`, the frames of the bodies carrying it (two for a tyre fillet about a
+        hinge, which two links carry half each) and the radius (m) of the circle or sphere touching the ground
+        there (its rolling radius)."""
+
+    def rolled(self, rho: float, a: np.ndarray) -> np.ndarray:
+        """How far (m, base frame) a contact of rolling radius ``rho`` rolls when its body turns by the rotation
+        vector ``a`` (rad): ``rho (a_y, -a_x, 0)`` for a sphere; a tyre (:attr:`rolls_sideways` False) rolls only
+        about its axis (base y), ``rho (a_y, 0, 0)``."""
+        return np.array([rho * a[1], -rho * a[0] if self.rolls_sideways else 0.0, 0.0])
 
     def rolling(self, q_ref: np.ndarray, q: np.ndarray) -> np.ndarray:
-        """(k, 3) how far each contact rolls on the ground (no slip) from ``q_ref`` to ``q``: ``rho (a_y, -a_x, 0)``
-        with ``a`` the rotation vector of its body (:meth:`contact_frames`) from ``q_ref`` to ``q`` (Pinocchio FK,
-        level base)."""
+        """(k, 3) how far each contact rolls on the ground (no slip) from ``q_ref`` to ``q`` (:meth:`rolled` of the
+        mean rotation vector of its bodies, :meth:`contact_frames`; Pinocchio FK, level base)."""
         model = self.robot.model
-        rot = []
+        datas = []
         for x in (q_ref, q):
             data = model.createData()
             pin.framesForwardKinematics(model, data, x)
-            rot.append(data)
-        out = np.zeros((len(self.contact_frames(q_ref)), 3))
-        for k, (frame, rho) in enumerate(self.contact_frames(q_ref)):
-            fid = model.getFrameId(frame)
-            a = pin.log3(rot[1].oMf[fid].rotation @ rot[0].oMf[fid].rotation.T)
-            out[k] = rho * a[1], -rho * a[0], 0.0
+            datas.append(data)
+        frames = self.contact_frames(q_ref)
+        out = np.zeros((len(frames), 3))
+        for k, (names, rho) in enumerate(frames):
+            fids = [model.getFrameId(n) for n in names]
+            a = np.mean([pin.log3(datas[1].oMf[f].rotation @ datas[0].oMf[f].rotation.T) for f in fids], axis=0)
+            out[k] = self.rolled(rho, a)
         return out
 
     def hold_rolling(self, q_ref: np.ndarray, targets: np.ndarray, iterations: int = 4) -> np.ndarray:
@@ -161,9 +172,9 @@ class FootGround(GroundModel):
         down = np.array([0.0, 0.0, 1.0])
         return np.array([self._fk(f.leg, q[list(f.idx_q)]) - f.radius * down for f in self.feet])
 
-    def contact_frames(self, q: np.ndarray) -> list[tuple[str, float]]:
+    def contact_frames(self, q: np.ndarray) -> list[tuple[tuple[str, ...], float]]:
         """Each foot frame and sphere radius."""
-        return [(f.frame, f.radius) for f in self.feet]
+        return [((f.frame,), f.radius) for f in self.feet]
 
     def hold(self, q: np.ndarray, targets: np.ndarray) -> np.ndarray:
         """Leg IK (nearest to ``q``) putting each foot's lowest point on its target."""

@@ -41,6 +41,8 @@ TOL_ROLL = 0.02
 TOL_SLIP = 2e-3
 #: Integral time constant (s) of the actuators' integral term.
 _TAU_I = 0.5
+#: Steps between two updates of the slip tracking (:meth:`_Runner.track_slip`).
+_SLIP_EVERY = 2
 #: Seconds of standing before ``roll`` and ``squat`` start moving.
 _SETTLE = 0.5
 
@@ -77,10 +79,19 @@ class _Runner:
         self.wall, self.time = 0.0, 0.0
         self.frames: list[np.ndarray] = []
         self.penetration = 0.0
+        self.slip_points: np.ndarray | None = None  # world points grouping the contacts whose slip is tracked
+        self.slip = np.zeros((0, 2))
+        self.slip_max = np.zeros(0)
+        self._material: dict[int, list[tuple[float, int, np.ndarray, np.ndarray]]] = {}
 
-    def start(self, key: int, drop: float) -> None:
+    def start(self, key: int, drop: float, q: np.ndarray | None = None) -> None:
+        """Keyframe ``key`` (or configuration ``q`` standing on the floor), the base raised by ``drop`` (m)."""
         m, d = self.mech.model, self.mech.data
         self.mujoco.mj_resetDataKeyframe(m, d, key)
+        if q is not None:
+            d.qpos[:] = self.mech.qpos(q)
+            d.qpos[2] = self.mech.ground.standing_height(q)
+            d.ctrl[:] = self.mech.ctrl(q)
         d.qpos[2] += drop
         self.target = d.ctrl.copy()
         self.mujoco.mj_forward(m, d)
@@ -99,9 +110,44 @@ class _Runner:
             self.time += dt
             if d.ncon:
                 self.penetration = max(self.penetration, -float(d.contact.dist[: d.ncon].min()))
+            if self.slip_points is not None and int(round(self.time / dt)) % _SLIP_EVERY == 0:
+                self._track_slip()
             if self.fps and (len(self.frames) == 0 or self.time >= len(self.frames) / self.fps):
                 self.frames.append(d.qpos.copy())
         self.wall += time.perf_counter() - t0
+
+    def track_slip(self, points: np.ndarray) -> None:
+        """Start tracking the slip of the contacts nearest each world point (:meth:`_track_slip`)."""
+        self.slip_points = np.asarray(points, dtype=float)
+        self.slip = np.zeros((len(points), 2))
+        self.slip_max = np.zeros(len(points))
+        self._material = {}
+        self._track_slip()
+
+    def _track_slip(self) -> None:
+        """Every ``_SLIP_EVERY`` steps: move the material points (robot-body points) under the previous call's
+        contacts with their bodies and add each group's force-weighted mean horizontal displacement to its slip (a
+        rolling contact's material point moves only to second order over the interval; the two halves of the
+        wheel-leg's toe, on two links turning opposite ways, slide opposite ways and cancel: the contact stays),
+        then take the new contacts' material points."""
+        m, d = self.mech.model, self.mech.data
+        assert self.slip_points is not None
+        for k, points in self._material.items():
+            total = sum(w for w, _, _, _ in points)
+            if total <= 0.0:
+                continue
+            moved = sum(w * (d.xpos[b] + d.xmat[b].reshape(3, 3) @ loc - pos) for w, b, loc, pos in points)
+            self.slip[k] += moved[:2] / total
+            self.slip_max[k] = max(self.slip_max[k], float(np.linalg.norm(self.slip[k])))
+        self._material = {}
+        force = np.zeros(6)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            self.mujoco.mj_contactForce(m, d, i, force)
+            k = int(np.argmin(np.linalg.norm(self.slip_points[:, :2] - c.pos[:2], axis=1)))
+            b = int(max(m.geom_bodyid[c.geom[0]], m.geom_bodyid[c.geom[1]]))  # the floor is the world body 0
+            local = d.xmat[b].reshape(3, 3).T @ (c.pos - d.xpos[b])
+            self._material.setdefault(k, []).append((float(force[0]), b, local, c.pos.copy()))
 
     def pressure(self, points: np.ndarray) -> np.ndarray:
         """(k, 3) force-weighted centre of MuJoCo's contacts nearest each world point (NaN: no contact)."""
@@ -123,12 +169,6 @@ class _Runner:
         q = self.mech.q(d.qpos)
         rot = d.xmat[self.mech.body_ids[1]].reshape(3, 3)
         return self.mech.ground.contacts(q) @ rot.T + d.qpos[:3]
-
-
-def _log3(r: np.ndarray) -> np.ndarray:
-    import pinocchio as pin
-
-    return np.asarray(pin.log3(np.asarray(r, dtype=float)))
 
 
 def _key(mech: GroundMechanism, pose: str | None) -> tuple[int, np.ndarray]:
@@ -193,11 +233,12 @@ def _squat(run: _Runner, pose: str | None, seconds: float, depth: float) -> list
 
     mech = run.mech
     key, q = _key(mech, pose)
-    run.start(key, 0.0)
+    if mech.ground.squat_start > 0.0:  # start that far below the pose (the wheel-leg's full stretch)
+        q = mech.ground.hold(q, mech.ground.contacts(q) + np.array([0.0, 0.0, mech.ground.squat_start]))
+    run.start(key, 0.0, q)
     run.run(_SETTLE)
     base0 = mech.data.qpos[:3].copy()
     ground = mech.ground.contacts(q)  # base frame, at the standing height
-    cop0 = run.pressure(run.predicted())
     t0 = run.time
     slip, height = [], []
 
@@ -207,20 +248,14 @@ def _squat(run: _Runner, pose: str | None, seconds: float, depth: float) -> list
     ticks = np.linspace(0.0, seconds, 201)  # legkin's IK every 10 ms of a 2 s squat, interpolated between
     ctrl = np.array([mech.ctrl(mech.ground.hold_rolling(q, ground + np.array([0.0, 0.0, lowered(t0 + t)])))
                      for t in ticks])
-    frames = mech.ground.contact_frames(q)
-    sites = [mech.model.site(f).id for f, _ in frames]
-    rho = np.array([r for _, r in frames])
-    rot0 = mech.data.site_xmat[sites].reshape(-1, 3, 3).copy()
+    run.track_slip(run.predicted())
 
     def target(t: float) -> np.ndarray:
         return np.array([np.interp(t - t0, ticks, c) for c in ctrl.T])
 
     for _ in range(20):
         run.run(seconds / 20, target)
-        rot = mech.data.site_xmat[sites].reshape(-1, 3, 3)
-        a = np.array([_log3(r @ r0.T) for r, r0 in zip(rot, rot0)])
-        rolled = np.stack([rho * a[:, 1], -rho * a[:, 0]], axis=1)
-        slip.append(np.linalg.norm((run.pressure(run.predicted()) - cop0)[:, :2] - rolled, axis=1))
+        slip.append(run.slip_max.copy())
         height.append(mech.data.qpos[2] - (base0[2] - lowered(run.time)))
     run.run(1.0, target)
     name = mech.robot.name

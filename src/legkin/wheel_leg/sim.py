@@ -24,8 +24,8 @@ from .configuration import configuration
 from .geometry import LEGS, THETA_MAX, THETA_MIN, TYRE_THICKNESS
 from .ground import ground_contact
 from .linkage import theta_beta
-from .stance import stance_ik
-from .tyre import LINK_NAMES, tyre_pieces
+from .stance import stance_ik, stance_ik_all
+from .tyre import PIECE_LINKS, tyre_pieces
 
 __all__ = ["ground_model", "WheelGround", "TYRE_STEP"]
 
@@ -64,7 +64,9 @@ class WheelGround(GroundModel):
         self.geometry = robot.geometry
         self.rolling_radius = self.geometry.R + TYRE_THICKNESS
         self.line_half_width = 0.5 * self.geometry.T
+        self.rolls_sideways = False
         self.squat_pose = "leg"  # theta = 160 deg: the reference pose ("wheel") cannot go 5 cm lower
+        self.squat_start = 0.02  # the leg pose is at full stretch, where d theta / d height is unbounded
         self.collision_skip = frozenset(
             g.name for g in robot.collision_model.geometryObjects if "_rim_" in g.name
         )
@@ -122,21 +124,32 @@ class WheelGround(GroundModel):
             out.append(gc.point - (float(gc.w) if flat else 0.0) * np.array([0.0, 1.0, 0.0]))  # z_L = y_R at gamma 0
         return np.array(out)
 
-    def contact_frames(self, q: np.ndarray) -> list[tuple[str, float]]:
-        """The rim link carrying each leg's ground contact and the radius of its tyre piece there."""
+    def contact_frames(self, q: np.ndarray) -> list[tuple[tuple[str, ...], float]]:
+        """The rim links carrying each leg's ground contact (:data:`.tyre.PIECE_LINKS` of its piece: both lower
+        rims for the toe fillet about G) and the radius of that tyre piece."""
         lq = self.leg_q(q)
         out = []
         for k, leg in enumerate(LEGS):
             gc = ground_contact(lq[k], leg, geometry=self.geometry)
             radius = tyre_pieces(lq[k, 0], lq[k, 1], geometry=self.geometry).radius[int(gc.piece)]
-            out.append((f"{leg}_{LINK_NAMES[int(gc.link)]}", float(radius)))
+            links = dict.fromkeys(PIECE_LINKS[str(gc.piece_name)])
+            out.append((tuple(f"{leg}_{n}" for n in links), float(radius)))
         return out
 
     def hold(self, q: np.ndarray, targets: np.ndarray) -> np.ndarray:
-        """:func:`.stance.stance_ik` of every leg, nearest to its angles in ``q``."""
+        """Per leg, the :func:`.stance.stance_ik_all` solution (in the joint limits) whose ABAD angle gamma is
+        nearest to its value in ``q``, then nearest in (theta, beta): the tyres keep their tilt (level stays
+        level). Plain nearest (:func:`.stance.stance_ik` with ``q_near``) would rather tilt a fully stretched leg
+        (theta = 160 deg) by 0.05 rad than bend it, putting the contact on the tyre's edge."""
         lq = self.leg_q(q)
-        new = np.array([stance_ik(np.asarray(t, dtype=float), leg, q_near=lq[k], geometry=self.geometry)
-                        for k, (leg, t) in enumerate(zip(LEGS, targets))])
+        new = np.empty((4, 3))
+        for k, (leg, t) in enumerate(zip(LEGS, targets)):
+            sols = stance_ik_all(np.asarray(t, dtype=float), leg, geometry=self.geometry)
+            sols = sols[np.all(np.isfinite(sols), axis=1)]
+            if not len(sols):
+                stance_ik(np.asarray(t, dtype=float), leg, geometry=self.geometry)  # raises why
+            d = np.abs(sols - lq[k])
+            new[k] = sols[np.lexsort((d[:, :2].max(axis=1), np.round(d[:, 2], 9)))[0]]
         return self._q(q, new)
 
     def roll(self, q: np.ndarray, angle: float) -> np.ndarray:

@@ -57,9 +57,58 @@ def test_quadruped_squats(quad):
     _passed(run_scenario(quad, "squat", seconds=1.0))
 
 
-def test_wheel_leg_stands_and_rolls(wheel):
+def test_wheel_leg_stands_rolls_and_squats(wheel):
     _passed(run_scenario(wheel, "stand", seconds=1.0))
     _passed(run_scenario(wheel, "roll", seconds=1.0))
+    _passed(run_scenario(wheel, "squat", seconds=1.0))
+
+
+def test_go2_stands():
+    _passed(run_scenario("go2", "stand", seconds=1.0))
+
+
+def test_tyre_lies_inside_legkins_within_the_sampling_bound(wheel):
+    """MuJoCo's lowest tyre point against ground_contact on sampled leg angles: never outside legkin's tyre, at
+    most R (1 - cos(phi / 2)) inside (phi: the largest angle between two cylinders), at most half the spacing
+    along the ground."""
+    from legkin.wheel_leg.sim import TYRE_STEP, tyre_contact_errors
+
+    rng = np.random.default_rng(3)
+    n = 24
+    lq = np.column_stack([rng.uniform(np.radians(17), np.radians(160), n), rng.uniform(-np.pi, np.pi, n),
+                          rng.uniform(-0.3, 0.3, n)])
+    lq[: n // 2, 0] = np.radians(17)  # wheel mode: the lowest point on a pitch arc
+    err = tyre_contact_errors(wheel, lq)
+    R = wheel.robot.geometry.R
+    phi = 2 * wheel.ground.stand_angle * 2  # the largest spacing is the upper arcs' <= step / R
+    assert err[:, 0].min() > -1e-9
+    assert err[:, 0].max() <= R * (1 - np.cos(max(phi, TYRE_STEP / R) / 2)) + 1e-9
+    assert np.abs(err[:, 1]).max() <= TYRE_STEP / 2 + 1e-9
+
+
+def test_sim_command(tmp_path, capsys):
+    from legkin.__main__ import main
+
+    code = main(["sim", "quadruped", "--scenario", "stand", "--seconds", "0.5"])
+    out = capsys.readouterr().out
+    assert code == 0 and "real-time factor" in out and "quadruped stand" in out
+    assert main(["sim", "quadruped", "--scenario", "roll"]) != 0
+    assert "quadruped has no wheels" in capsys.readouterr().err
+
+
+def test_sim_html(tmp_path, capsys):
+    from legkin.mjcf.sim_cli import render_frames
+
+    mech = load_ground("quadruped")
+    try:
+        render_frames(mech, [mech.data.qpos.copy()], width=32, height=24)
+    except legkin.errors.LegkinError as exc:
+        pytest.skip(f"no OpenGL here: {exc}")
+    from legkin.__main__ import main
+
+    page = tmp_path / "stand.html"
+    assert main(["sim", "quadruped", "--seconds", "0.5", "--html", str(page)]) == 0
+    assert page.read_text().count("data:image/jpeg;base64,") > 10
 
 
 def test_without_contacts_it_falls_through(quad):

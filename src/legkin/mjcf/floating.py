@@ -128,11 +128,13 @@ def _floor_and_key(root: ET.Element, robot: "Robot", ground: GroundModel, c: Map
     return ground.standing_height(robot.q0)
 
 
-def to_ground_mjcf(robot_or_name: "Robot | str", **options: Any) -> str:
+def to_ground_mjcf(robot_or_name: "Robot | str", *, ground: GroundModel | None = None, **options: Any) -> str:
     """The MJCF of a floating mechanism that stands on a floor (module docstring).
 
     Args:
         robot_or_name: ``legkin.load(name, floating=True)`` or a model name (loaded floating).
+        ground: the ground model (default :func:`~legkin.mjcf.ground.ground_model` of the robot; e.g.
+            ``legkin.wheel_leg.sim.ground_model(robot, step=0.004)`` for finer tyre cylinders).
         **options: the exporter's (:data:`~legkin.mjcf.DEFAULTS`) and the contact options of
             :data:`GROUND_DEFAULTS`: ``friction`` (sliding, torsional, rolling), ``condim``, ``contact_solref``
             (s, damping ratio), ``contact_solimp``; the ground defaults replace ``timestep`` (1 ms) and
@@ -147,7 +149,7 @@ def to_ground_mjcf(robot_or_name: "Robot | str", **options: Any) -> str:
     """
     robot = _floating(robot_or_name)
     o, c = _split(options)
-    ground = ground_model(robot)
+    ground = ground_model(robot) if ground is None else ground
     root = ET.fromstring(_build_xml(_visual_robot(robot), {**o, "floor": True}))
     _contact_class(root, c)
     n = _add_geoms(root, robot, ground)
@@ -172,18 +174,20 @@ class GroundMechanism(MujocoMechanism):
     height: float
 
 
-def load_ground(robot_or_name: "Robot | str", **options: Any) -> GroundMechanism:
+def load_ground(robot_or_name: "Robot | str", *, ground: GroundModel | None = None,
+                **options: Any) -> GroundMechanism:
     """Compile :func:`to_ground_mjcf` in MuJoCo (arguments as there).
 
     Raises:
         LegkinError: MuJoCo is not installed or refused the model.
     """
     robot = _floating(robot_or_name)
-    xml = to_ground_mjcf(robot, **options)
+    ground = ground_model(robot) if ground is None else ground
+    xml = to_ground_mjcf(robot, ground=ground, **options)
     mech = load_mujoco(robot, xml=xml)
     out = GroundMechanism.__new__(GroundMechanism)
     out.__dict__.update(mech.__dict__)
-    out.ground = ground_model(robot)
+    out.ground = ground
     out.height = out.ground.standing_height(robot.q0)
     return out
 

@@ -58,6 +58,8 @@ class GroundModel(ABC):
         rolling_radius: the radius (m) of a rolling wheel in the reference pose, or None (legs).
         squat_pose: the SRDF pose the ``squat`` scenario starts from (None: the reference pose).
         squat_start: how far (m) below that pose the squat starts (the contacts held by :meth:`hold`).
+        stand_angle: the ``stand`` scenario's wheels turned by this angle (rad, :meth:`roll`) from the pose (the
+            wheel-leg: half the angle between two tyre cylinders, where MuJoCo's tyre is farthest from legkin's).
         line_half_width: half the length (m) of a line contact across the base's y axis (a tyre lying flat: its
             centre of pressure anywhere on it is legkin's contact); 0 for point contacts.
         rolls_sideways: whether a contact rolls about the base x axis too (a sphere) or only about y (a tyre).
@@ -68,6 +70,7 @@ class GroundModel(ABC):
     rolling_radius: float | None = None
     squat_pose: str | None = None
     squat_start: float = 0.0
+    stand_angle: float = 0.0
     line_half_width: float = 0.0
     rolls_sideways: bool = True
 

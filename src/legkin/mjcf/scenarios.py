@@ -12,7 +12,7 @@
 The controller is the export's position actuators plus an integral term on each actuator's error (time constant
 ``0.1 s``), which removes the static sag of the stiff-but-finite actuators under the body's weight (the pose is
 what legkin predicts for, not the pose minus a sag). Each figure is a :class:`legkin._checkkit.CheckResult` row;
-the result also carries the real-time factor (simulated / wall-clock seconds, one core) and optional frames.
+the result also carries the real-time factor (simulated / CPU seconds, one core) and optional frames.
 """
 
 from __future__ import annotations
@@ -41,8 +41,13 @@ TOL_ROLL = 0.02
 TOL_SLIP = 2e-3
 #: Integral time constant (s) of the actuators' integral term.
 _TAU_I = 0.5
-#: Steps between two updates of the slip tracking (:meth:`_Runner.track_slip`).
-_SLIP_EVERY = 2
+#: Steps between two samples (:meth:`_Runner._sample`: slip tracking, frames): 5 ms at the ground
+#: export's 1 ms step; the slip over 2 s did not change (3.442e-4 m, wheel-leg squat) from 2 steps to 5.
+_SAMPLE_EVERY = 5
+#: Seconds of holding after the squat before the base height is compared with the start. go2 is 1.99e-3 m lower
+#: after 1 s and still 1.94e-3 m after 2 s: not the integral term settling but the feet, which slid 0.7 mm and
+#: stay where friction holds them (the same joint angles on a slightly different stance).
+_SETTLE_AFTER = 1.0
 #: Seconds of standing before ``roll`` and ``squat`` start moving.
 _SETTLE = 0.5
 
@@ -54,7 +59,9 @@ class ScenarioResult:
     Attributes:
         scenario, model: names.
         rows: the figures as check rows (error, tolerance, pass).
-        simulated: simulated time (s); wall: wall-clock time of the stepping (s); rtf: simulated / wall.
+        simulated: simulated time (s); wall: CPU time of the stepping and the controller (s; one core: MuJoCo is
+            single-threaded, and CPU time does not count the other processes of a shared machine); rtf:
+            simulated / wall, the real-time factor on one core.
         frames: ``qpos`` every ``1 / fps`` s when recorded, else empty.
     """
 
@@ -76,7 +83,7 @@ class _Runner:
         self.adr = mech.model.jnt_qposadr[mech.model.actuator_trnid[:, 0]]
         self.integral = np.zeros(mech.model.nu)
         self.target = np.zeros(mech.model.nu)
-        self.wall, self.time = 0.0, 0.0
+        self.wall, self.time, self.steps = 0.0, 0.0, 0
         self.frames: list[np.ndarray] = []
         self.penetration = 0.0
         self.slip_points: np.ndarray | None = None  # world points grouping the contacts whose slip is tracked
@@ -99,22 +106,29 @@ class _Runner:
     def run(self, seconds: float, target: Callable[[float], np.ndarray] | None = None) -> None:
         m, d = self.mech.model, self.mech.data
         dt = m.opt.timestep
-        t0 = time.perf_counter()
+        gain, adr, step = dt / _TAU_I, self.adr, self.mujoco.mj_step
+        t0 = time.process_time()
         for _ in range(int(round(seconds / dt))):
             if target is not None:
                 self.target = target(self.time)
-            err = self.target - d.qpos[self.adr]
-            self.integral += dt / _TAU_I * err
+            self.integral += gain * (self.target - d.qpos[adr])
             d.ctrl[:] = self.target + self.integral
-            self.mujoco.mj_step(m, d)
+            step(m, d)
             self.time += dt
+            self.steps += 1
             if d.ncon:
                 self.penetration = max(self.penetration, -float(d.contact.dist[: d.ncon].min()))
-            if self.slip_points is not None and int(round(self.time / dt)) % _SLIP_EVERY == 0:
-                self._track_slip()
-            if self.fps and (len(self.frames) == 0 or self.time >= len(self.frames) / self.fps):
-                self.frames.append(d.qpos.copy())
-        self.wall += time.perf_counter() - t0
+            if self.steps % _SAMPLE_EVERY == 0:
+                self._sample()
+        self.wall += time.process_time() - t0
+
+    def _sample(self) -> None:
+        """Every ``_SAMPLE_EVERY`` steps: the slip tracking, a video frame."""
+        d = self.mech.data
+        if self.slip_points is not None:
+            self._track_slip()
+        if self.fps and (len(self.frames) == 0 or self.time >= len(self.frames) / self.fps):
+            self.frames.append(d.qpos.copy())
 
     def track_slip(self, points: np.ndarray) -> None:
         """Start tracking the slip of the contacts nearest each world point (:meth:`_track_slip`)."""
@@ -125,7 +139,7 @@ class _Runner:
         self._track_slip()
 
     def _track_slip(self) -> None:
-        """Every ``_SLIP_EVERY`` steps: move the material points (robot-body points) under the previous call's
+        """Every ``_SAMPLE_EVERY`` steps: move the material points (robot-body points) under the previous call's
         contacts with their bodies and add each group's force-weighted mean horizontal displacement to its slip (a
         rolling contact's material point moves only to second order over the interval; the two halves of the
         wheel-leg's toe, on two links turning opposite ways, slide opposite ways and cancel: the contact stays),
@@ -171,6 +185,20 @@ class _Runner:
         return self.mech.ground.contacts(q) @ rot.T + d.qpos[:3]
 
 
+def _interpolator(t0: float, ticks: np.ndarray, values: list[np.ndarray]) -> Callable[[float], np.ndarray]:
+    """The actuator targets at time t: ``values`` (at the evenly spaced ``ticks`` after ``t0``) interpolated
+    linearly, the last one after the end."""
+    v = np.array(values)
+    step = float(ticks[1] - ticks[0])
+
+    def target(t: float) -> np.ndarray:
+        x = min(max((t - t0) / step, 0.0), len(ticks) - 1.0)
+        i = min(int(x), len(ticks) - 2)
+        return v[i] + (x - i) * (v[i + 1] - v[i])
+
+    return target
+
+
 def _key(mech: GroundMechanism, pose: str | None) -> tuple[int, np.ndarray]:
     mujoco = _mujoco()
     robot = mech.robot
@@ -186,7 +214,9 @@ def _stand(run: _Runner, pose: str | None, seconds: float, drop: float) -> list[
 
     mech = run.mech
     key, q = _key(mech, pose)
-    run.start(key, drop)
+    if mech.ground.stand_angle:
+        q = mech.ground.roll(q, mech.ground.stand_angle)
+    run.start(key, drop, q)
     run.run(seconds)
     height = mech.ground.standing_height(q)
     pred = run.predicted()
@@ -215,10 +245,7 @@ def _roll(run: _Runner, pose: str | None, seconds: float, angle: float) -> list[
     run.run(_SETTLE)
     x0, t0 = mech.data.qpos[:2].copy(), run.time
     ticks = np.linspace(0.0, seconds, 201)
-    ctrl = np.array([mech.ctrl(mech.ground.roll(q, angle * t / seconds)) for t in ticks])
-
-    def target(t: float) -> np.ndarray:
-        return np.array([np.interp(t - t0, ticks, c) for c in ctrl.T])
+    target = _interpolator(t0, ticks, [mech.ctrl(mech.ground.roll(q, angle * t / seconds)) for t in ticks])
 
     run.run(seconds, target)
     run.run(0.3, target)
@@ -240,7 +267,7 @@ def _squat(run: _Runner, pose: str | None, seconds: float, depth: float) -> list
     base0 = mech.data.qpos[:3].copy()
     ground = mech.ground.contacts(q)  # base frame, at the standing height
     t0 = run.time
-    slip, height = [], []
+    slip = []
 
     def lowered(t: float) -> float:
         return 0.5 * depth * (1.0 - np.cos(2.0 * np.pi * min(1.0, (t - t0) / seconds)))
@@ -256,15 +283,13 @@ def _squat(run: _Runner, pose: str | None, seconds: float, depth: float) -> list
     for _ in range(20):
         run.run(seconds / 20, target)
         slip.append(run.slip_max.copy())
-        height.append(mech.data.qpos[2] - (base0[2] - lowered(run.time)))
-    run.run(1.0, target)
+    run.run(_SETTLE_AFTER, target)
     name = mech.robot.name
     return [
         compare(f"{name} squat: base {depth:g} m down and up in {seconds:g} s, slip of each contact (m)",
                 np.array(slip), TOL_SLIP),
-        compare(f"{name} squat: base height - commanded, 1 s after (m)",
+        compare(f"{name} squat: base height {_SETTLE_AFTER:g} s after - before (m)",
                 np.array([mech.data.qpos[2] - base0[2]]), TOL_HEIGHT),
-        compare(f"{name} squat: base height - commanded during the squat (m)", np.array(height), np.inf),
     ]
 
 

@@ -107,7 +107,7 @@ def run_sim(args: "argparse.Namespace") -> int:
     width = max(len(r.name) for r in res.rows)
     for r in res.rows:
         print(f"{r.name:<{width}}  {r.max_error:10.3e}  tol {r.tolerance:7.0e}  {'pass' if r.passed else 'FAIL'}")
-    print(f"{res.simulated:.2f} s simulated in {res.wall:.2f} s: real-time factor {res.rtf:.1f}")
+    print(f"{res.simulated:.2f} s simulated in {res.wall:.2f} s of CPU: real-time factor {res.rtf:.1f} (one core)")
     if record:
         images = render_frames(mech, res.frames)
         kw: dict[str, Any] = {}

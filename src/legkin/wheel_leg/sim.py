@@ -5,7 +5,9 @@ the width T) as cylinders of radius ``r`` and length T whose axes are the leg-pl
 arcs of the four rim links (:data:`.tyre.PIECE_LINKS`) at most ``step`` apart, both ends of every arc included.
 The union of these cylinders is the swept tyre sampled along the pitch curve: it is exact at the samples, the
 caps at the tips and the fillets at the hinges (those are the end cylinders), and between two samples it lies
-under the true surface by at most ``r - sqrt(r^2 - step^2/4)`` (2.3e-4 m for the default 8 mm, 5.8e-5 m for 4 mm).
+inside the true surface by at most ``R (1 - cos(phi/2))``, phi the angle between two neighbours on the pitch circle
+of radius R (2.0e-5 m for the default 4 mm), and its lowest point is off legkin's by up to half the spacing along
+the ground (1.99e-3 m measured; docs/mujoco.md has the table of scripts/mujoco_tyre_fit.py).
 The arcs are read from the URDF's frames (centre U or L, ends H, F, G) at the reference pose.
 
 Predicted contacts: :func:`.ground.ground_contact` per leg; holding them: :func:`.stance.stance_ik`; rolling:
@@ -29,8 +31,10 @@ from .tyre import PIECE_LINKS, tyre_pieces
 
 __all__ = ["ground_model", "WheelGround", "TYRE_STEP"]
 
-#: Largest distance (m) between two tyre cylinders along the pitch curve (module docstring).
-TYRE_STEP = 0.008
+#: Largest distance (m) between two tyre cylinders along the pitch curve (module docstring): 4 mm keeps MuJoCo's
+#: lowest point within 2 mm (half the spacing) of legkin's along the ground and 2e-5 m in height
+#: (scripts/mujoco_tyre_fit.py; 8 mm: 3.96e-3 m and 7.8e-5 m, and a loaded centre of pressure 3.1e-3 m off).
+TYRE_STEP = 0.004
 #: |gamma| (rad) under which a tyre counts as flat across its width (:meth:`WheelGround.contacts`).
 _LEVEL = 1e-3
 #: The pitch arcs of a leg: (rim link, centre frame, first end, second end), ``<leg>_`` omitted; the lower rims'
@@ -65,6 +69,8 @@ class WheelGround(GroundModel):
         self.rolling_radius = self.geometry.R + TYRE_THICKNESS
         self.line_half_width = 0.5 * self.geometry.T
         self.rolls_sideways = False
+        self.stand_angle = 0.0
+        self.geoms()  # sets stand_angle
         self.squat_pose = "leg"  # theta = 160 deg: the reference pose ("wheel") cannot go 5 cm lower
         self.squat_start = 0.02  # the leg pose is at full stretch, where d theta / d height is unbounded
         self.collision_skip = frozenset(
@@ -106,6 +112,8 @@ class WheelGround(GroundModel):
                 radius = float(np.linalg.norm(u))
                 rot = _rotation_z(normal)
                 n = max(1, int(np.ceil(span * radius / self.step)))
+                if link == "rim_lower_L":
+                    self.stand_angle = 0.5 * span / n  # the contact between two cylinders: the worst case
                 for i in range(n + 1):
                     p = c + pin.AngleAxis(span * i / n, normal / np.linalg.norm(normal)).matrix() @ u
                     out.append(ContactGeom(f"{leg}_{link}_tyre{i}", joint, "cylinder", (TYRE_THICKNESS, half),
@@ -167,3 +175,48 @@ def ground_model(robot: Any, step: float = TYRE_STEP) -> WheelGround:
         step: largest distance (m) between tyre cylinders along the pitch curve.
     """
     return WheelGround(robot, step)
+
+
+def tyre_contact_errors(mech: Any, leg_q: np.ndarray, leg: str = "FL") -> np.ndarray:
+    """MuJoCo's tyre against :func:`.ground.ground_contact` at the leg angles ``leg_q`` (n, 3).
+
+    For each row, the other legs stay in the reference pose, the base level at the origin; MuJoCo's smallest
+    distance (``mj_geomDistance``) from the floor plane lowered 1 m to the leg's tyre cylinders gives the tyre's
+    lowest height and the point where it is reached.
+
+    Args:
+        mech: :func:`legkin.mjcf.floating.load_ground` of the wheel-leg.
+        leg_q: (n, 3) (theta, beta, gamma) of ``leg``.
+        leg: the leg.
+
+    Returns:
+        (n, 2): MuJoCo's lowest height - legkin's (m; >= 0: the cylinders lie inside the tyre), and the
+        horizontal distance between the two lowest points along the leg's x (m; the lateral coordinate of a flat
+        tyre's line contact is arbitrary and left out).
+    """
+    import mujoco
+
+    ground: WheelGround = mech.ground
+    robot = mech.robot
+    floor = mech.model.geom("floor").id
+    geoms = [g for g in range(mech.model.ngeom)
+             if str(mech.model.geom(g).name).startswith(f"{leg}_rim_") and "_tyre" in str(mech.model.geom(g).name)]
+    k = LEGS.index(leg)
+    out = np.empty((len(leg_q), 2))
+    fromto = np.zeros(6)
+    for i, lq in enumerate(np.asarray(leg_q, dtype=float)):
+        all_q = ground.leg_q(robot.q0)
+        all_q[k] = lq
+        q = ground._q(robot.q0, all_q)
+        q[:3] = 0.0
+        mech.data.qpos[:] = mech.qpos(q)
+        mech.data.qpos[2] = 1.0  # the floor 1 m below the base
+        mujoco.mj_forward(mech.model, mech.data)
+        best, point = np.inf, np.zeros(3)
+        for g in geoms:
+            dist = mujoco.mj_geomDistance(mech.model, mech.data, floor, g, 2.0, fromto)
+            if dist < best:
+                best, point = dist, fromto[3:].copy()
+        want = ground_contact(lq, leg, geometry=ground.geometry).point + np.array([0.0, 0.0, 1.0])
+        out[i] = best - want[2], point[0] - want[0]
+    return out

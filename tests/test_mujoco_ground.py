@@ -127,3 +127,18 @@ def test_without_contacts_it_falls_through(quad):
 def test_ground_model_needs_floating():
     with pytest.raises(legkin.errors.InvalidParameterError):
         ground_model(legkin.load("quadruped"))
+
+
+def test_floating_export_has_contacts_and_a_colliding_floor(tmp_path, capsys):
+    from legkin.__main__ import main
+
+    out = tmp_path / "go2.xml"
+    assert main(["mjcf", "go2", "--floating", "-o", str(out)]) == 0  # go2's .dae visuals: its collision shapes shown
+    model = mujoco.MjModel.from_xml_path(str(out))
+    floor = model.geom("floor")
+    assert floor.conaffinity[0] == 1 and floor.contype[0] == 0
+    assert model.opt.timestep == pytest.approx(1e-3)
+    feet = [model.geom(f"{leg}_foot_contact") for leg in ("FL", "FR", "RL", "RR")]
+    assert all(f.contype[0] == 1 and f.conaffinity[0] == 0 for f in feet)
+    assert main(["export", "quadruped", "--mjcf", str(tmp_path / "q.xml")]) == 0  # fixed base: no contacts
+    assert "contact" not in (tmp_path / "q.xml").read_text()

@@ -235,12 +235,9 @@ def _cmd_view(args) -> int:
 
 
 def _cmd_export(args) -> int:
-    from .mjcf._base import DEFAULTS
     from .mjcf.cli import run_export
 
     args.output = str(args.mjcf)
-    if args.timestep is None:
-        args.timestep = DEFAULTS["timestep"]
     return run_export(args)
 
 
@@ -317,7 +314,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("model")
     p.add_argument("--mjcf", metavar="PATH", type=output_file, required=True, help="write a MuJoCo MJCF to PATH")
     p.add_argument("--floating", action="store_true", help="a free base (models that walk only)")
-    p.add_argument("--timestep", type=positive_float, default=None, help="simulation step, s (default 0.0002)")
+    p.add_argument("--timestep", type=positive_float, default=None,
+                   help="simulation step, s (default 0.0002; 0.001 with --floating)")
     p.add_argument("--png", metavar="PATH", type=output_file, help="also render q0 with MuJoCo (MUJOCO_GL=egl)")
     p.set_defaults(func=_cmd_export)
     return parser

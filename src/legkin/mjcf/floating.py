@@ -116,6 +116,10 @@ def _add_geoms(root: ET.Element, robot: "Robot", ground: GroundModel) -> int:
 
 def _floor_and_key(root: ET.Element, robot: "Robot", ground: GroundModel, c: Mapping[str, Any]) -> float:
     """The floor at z = 0 made to collide; keyframe 0 standing on it; returns the standing height (m)."""
+    asset = root.find("asset")
+    assert asset is not None
+    ET.SubElement(asset, "texture", name="sky", type="skybox", builtin="gradient", rgb1="0.75 0.82 0.9",
+                  rgb2="1 1 1", width="256", height="256")
     floor = next(g for g in root.iter("geom") if g.get("name") == "floor")
     floor.attrib.update(pos="0 0 0", contype="0", conaffinity="1", condim=str(c["condim"]),
                         friction=_vec(c["friction"]), solref=_vec(c["contact_solref"]),

@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping
 
 import numpy as np
+import pinocchio as pin
 
 from ..errors import InvalidParameterError
 from ..loops import check_real
@@ -56,17 +57,30 @@ def _split(options: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
     return o, c
 
 
+def _unreadable(g: Any) -> bool:
+    """Whether a geometry object is a mesh in a format MuJoCo does not read (``.dae``)."""
+    return bool(g.meshPath) and type(g.geometry).__name__.startswith("BVH") and not g.meshPath.lower().endswith(
+        _MESH_EXTENSIONS)
+
+
+def _readable(model: pin.GeometryModel) -> pin.GeometryModel:
+    """A copy of a geometry model without the objects MuJoCo cannot read."""
+    out = pin.GeometryModel()
+    for g in model.geometryObjects:
+        if not _unreadable(g):
+            out.addGeometryObject(g)
+    return out
+
+
 def _visual_robot(robot: "Robot") -> "Robot":
-    """``robot``, or a shallow copy whose visuals are its collision shapes when a visual mesh is a format MuJoCo
-    does not read (the example-robot-data robots' ``.dae``)."""
-    unreadable = any(
-        g.meshPath and not g.meshPath.lower().endswith(_MESH_EXTENSIONS)
-        and type(g.geometry).__name__.startswith("BVH") for g in robot.visual_model.geometryObjects
-    )
-    if not unreadable:
+    """``robot``, or a shallow copy whose visuals MuJoCo reads when some visual mesh is a format it does not (the
+    example-robot-data robots' ``.dae``): the collision shapes it reads (go2's ``.stl``), else the readable
+    visuals (hyq: only its primitives)."""
+    if not any(_unreadable(g) for g in robot.visual_model.geometryObjects):
         return robot
     out = copy.copy(robot)
-    out.visual_model = robot.collision_model
+    collision = _readable(robot.collision_model)
+    out.visual_model = collision if collision.ngeoms else _readable(robot.visual_model)
     return out
 
 
@@ -103,7 +117,7 @@ def _add_geoms(root: ET.Element, robot: "Robot", ground: GroundModel) -> int:
     meshes = {(str(m.get("file")), tuple(float(x) for x in m.get("scale", "1 1 1").split())): str(m.get("name"))
               for m in asset.findall("mesh")}  # the visuals' meshes, reused
     for gobj in robot.collision_model.geometryObjects:
-        if gobj.name in ground.collision_skip or gobj.parentJoint == 0:
+        if gobj.name in ground.collision_skip or gobj.parentJoint == 0 or _unreadable(gobj):
             continue
         el = _geom(gobj, meshes, asset)
         el.set("name", f"{gobj.name}_collision")

@@ -127,6 +127,11 @@ class GroundModel(ABC):
             q = self.hold(q, np.asarray(targets, dtype=float) + self.rolling(q_ref, q))
         return q
 
+    def static_torques(self, q: np.ndarray) -> np.ndarray | None:
+        """(nv,) joint torques (N m) holding ``q`` standing, the weight shared equally by the contacts, or None
+        (not known: the integral term of the scenarios finds them)."""
+        return None
+
     def roll(self, q: np.ndarray, angle: float) -> np.ndarray:
         """``q`` with every wheel turned forward by ``angle`` (rad): only for mechanisms with wheels."""
         raise InvalidParameterError(f"{self.robot.name} has no wheels to roll")
@@ -178,6 +183,26 @@ class FootGround(GroundModel):
     def contact_frames(self, q: np.ndarray) -> list[tuple[tuple[str, ...], float]]:
         """Each foot frame and sphere radius."""
         return [((f.frame,), f.radius) for f in self.feet]
+
+    def static_torques(self, q: np.ndarray) -> np.ndarray:
+        """``g(q) - sum_k J_k^T f_k``: gravity and vertical foot forces ``f_k`` carrying the weight with no moment
+        about the centre of mass (the least-norm solution of the three balance equations; Pinocchio, level
+        base); the base rows are not used."""
+        model = self.robot.model
+        data = model.createData()
+        tau = np.array(pin.computeGeneralizedGravity(model, data, q))
+        com = np.array(pin.centerOfMass(model, data, q))
+        pin.computeJointJacobians(model, data, q)
+        pin.updateFramePlacements(model, data)
+        weight = -float(model.gravity.linear[2]) * sum(i.mass for i in model.inertias)
+        fids = [model.getFrameId(f.frame) for f in self.feet]
+        xy = np.array([data.oMf[i].translation[:2] for i in fids])
+        balance = np.vstack([np.ones(len(fids)), xy.T])
+        forces = np.linalg.lstsq(balance, weight * np.array([1.0, com[0], com[1]]), rcond=None)[0]
+        for fid, fz in zip(fids, forces):
+            jac = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
+            tau -= jac.T @ np.array([0.0, 0.0, fz])
+        return tau
 
     def hold(self, q: np.ndarray, targets: np.ndarray) -> np.ndarray:
         """Leg IK (nearest to ``q``) putting each foot's lowest point on its target."""

@@ -9,10 +9,13 @@
   from legkin's IK holding the contacts on their ground points (:meth:`~legkin.mjcf.ground.GroundModel.hold`);
   the slip (largest horizontal drift of a centre of pressure) and the base height against the commanded one.
 
-The controller is the export's position actuators plus an integral term on each actuator's error (time constant
-``0.1 s``), which removes the static sag of the stiff-but-finite actuators under the body's weight (the pose is
-what legkin predicts for, not the pose minus a sag). Each figure is a :class:`legkin._checkkit.CheckResult` row;
-the result also carries the real-time factor (simulated / CPU seconds, one core) and optional frames.
+The controller is the export's position actuators with an offset holding the weight: where the ground model
+knows the static joint torques (:meth:`~legkin.mjcf.ground.GroundModel.static_torques`: legs), ``tau / kp`` is
+added to every target (feedforward); otherwise (the wheel-leg, whose loops carry the load) an integral term on
+each actuator's error (time constant 0.5 s) finds it. Either removes the static sag of the actuators under the
+body's weight (the pose is the one legkin predicts for, not that pose minus a sag). Each figure is a
+:class:`legkin._checkkit.CheckResult` row; the result also carries the real-time factor (simulated / CPU seconds,
+one core) and optional frames.
 """
 
 from __future__ import annotations
@@ -82,6 +85,7 @@ class _Runner:
         self.mech, self.fps = mech, fps
         self.adr = mech.model.jnt_qposadr[mech.model.actuator_trnid[:, 0]]
         self.integral = np.zeros(mech.model.nu)
+        self.integrate = True
         self.target = np.zeros(mech.model.nu)
         self.wall, self.time, self.steps = 0.0, 0.0, 0
         self.frames: list[np.ndarray] = []
@@ -101,12 +105,17 @@ class _Runner:
             d.ctrl[:] = self.mech.ctrl(q)
         d.qpos[2] += drop
         self.target = d.ctrl.copy()
+        tau = self.mech.ground.static_torques(self.mech.q(d.qpos))
+        if tau is not None:  # a fixed offset holding the weight (feedforward) instead of the integral term
+            vadr = m.jnt_dofadr[m.actuator_trnid[:, 0]]
+            self.integral = tau[vadr] / m.actuator_gainprm[:, 0]
+            self.integrate = False
         self.mujoco.mj_forward(m, d)
 
     def run(self, seconds: float, target: Callable[[float], np.ndarray] | None = None) -> None:
         m, d = self.mech.model, self.mech.data
         dt = m.opt.timestep
-        gain, adr, step = dt / _TAU_I, self.adr, self.mujoco.mj_step
+        gain, adr, step = dt / _TAU_I if self.integrate else 0.0, self.adr, self.mujoco.mj_step
         t0 = time.process_time()
         for _ in range(int(round(seconds / dt))):
             if target is not None:

@@ -148,12 +148,6 @@ def _run_models(names: list[str], *, samples: int, seed: int, ik_targets: int | 
     return out
 
 
-#: The models whose MuJoCo ground scenarios (:func:`legkin.mjcf.scenarios.ground_rows`) are check rows: those of
-#: issue 28 and the registry's quadrupeds that pass them (anymal, anymal_c and hyq stand 2.9-4.3 mm high after the
-#: 1 cm drop: their feet splay on landing and friction holds them there; docs/mujoco.md).
-GROUND_MODELS = ("quadruped", "go2", "wheel_leg", "a1", "b1", "go1", "laikago", "solo12")
-
-
 def _mujoco_rows(name: str, samples: int, seed: int) -> list[CheckResult]:
     """The MuJoCo export's rows (:func:`legkin.mjcf.check_rows`) when mujoco is installed, else none (the CLI
     says so: :func:`mujoco_note`). At most 20 samples: each is a loop solve, the simulation rows need no more."""
@@ -165,8 +159,7 @@ def _mujoco_rows(name: str, samples: int, seed: int) -> list[CheckResult]:
     rows = []
     if get_spec(name).mjcf:  # the export covers legkin's own models (their loops); the robots of legs have .dae meshes
         rows = list(check_rows(name, samples=min(samples, 20), rng=np.random.default_rng(seed + 2)))
-    if name in GROUND_MODELS:  # the ground scenarios (issue 28), on the models they are measured for
-        rows += ground_rows(name)
+    rows += ground_rows(name)  # the ground scenarios (issue 28) of the models with a ground model
     return rows
 
 

@@ -237,9 +237,12 @@ def sphere_radius(robot: "Robot", frame: str, default: float = 0.02) -> float:
     return default
 
 
-def has_ground_model(robot: "Robot") -> bool:
-    """Whether the robot's package provides a ``sim`` module (:func:`ground_model`)."""
-    return importlib.util.find_spec(f"{robot.spec.package}.sim") is not None
+def has_ground_model(robot: "Robot | str") -> bool:
+    """Whether the package of a robot (or registered model name) provides a ``sim`` module (:func:`ground_model`)."""
+    from .._registry import get_spec
+
+    spec = get_spec(robot) if isinstance(robot, str) else robot.spec
+    return importlib.util.find_spec(f"{spec.package}.sim") is not None
 
 
 def ground_model(robot: "Robot") -> GroundModel:

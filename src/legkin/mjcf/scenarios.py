@@ -51,6 +51,9 @@ _SAMPLE_EVERY = 5
 #: after 1 s and still 1.94e-3 m after 2 s: not the integral term settling but the feet, which slid 0.7 mm and
 #: stay where friction holds them (the same joint angles on a slightly different stance).
 _SETTLE_AFTER = 1.0
+#: Seconds over which the feedforward comes in once every contact touches (in the air it would bend the legs
+#: away from the pose they land in: anymal's feet then splayed and stood 3 mm high).
+_RAMP = 0.05
 #: Seconds of standing before ``roll`` and ``squat`` start moving.
 _SETTLE = 0.5
 
@@ -86,6 +89,9 @@ class _Runner:
         self.adr = mech.model.jnt_qposadr[mech.model.actuator_trnid[:, 0]]
         self.integral = np.zeros(mech.model.nu)
         self.integrate = True
+        self.feedforward = np.zeros(mech.model.nu)
+        self.feet = 0
+        self.landed = 0.0  # the feedforward's share: 0 in the air, ramped to 1 over _RAMP s once every foot touches
         self.target = np.zeros(mech.model.nu)
         self.wall, self.time, self.steps = 0.0, 0.0, 0
         self.frames: list[np.ndarray] = []
@@ -104,11 +110,12 @@ class _Runner:
             d.qpos[2] = self.mech.ground.standing_height(q)
             d.ctrl[:] = self.mech.ctrl(q)
         d.qpos[2] += drop
+        self.landed = 0.0 if drop > 0.0 else 1.0  # standing on the floor from the start: the full feedforward
         self.target = d.ctrl.copy()
         tau = self.mech.ground.static_torques(self.mech.q(d.qpos))
         if tau is not None:  # a fixed offset holding the weight (feedforward) instead of the integral term
             vadr = m.jnt_dofadr[m.actuator_trnid[:, 0]]
-            self.integral = tau[vadr] / m.actuator_gainprm[:, 0]
+            self.feedforward = tau[vadr] / m.actuator_gainprm[:, 0]
             self.integrate = False
         self.mujoco.mj_forward(m, d)
 
@@ -116,12 +123,16 @@ class _Runner:
         m, d = self.mech.model, self.mech.data
         dt = m.opt.timestep
         gain, adr, step = dt / _TAU_I if self.integrate else 0.0, self.adr, self.mujoco.mj_step
+        if self.feet == 0:
+            self.feet = len(self.mech.ground.contact_frames(self.mech.robot.q0))
         t0 = time.process_time()
         for _ in range(int(round(seconds / dt))):
             if target is not None:
                 self.target = target(self.time)
             self.integral += gain * (self.target - d.qpos[adr])
-            d.ctrl[:] = self.target + self.integral
+            if self.landed < 1.0 and d.ncon >= self.feet:
+                self.landed = min(1.0, self.landed + dt / _RAMP)
+            d.ctrl[:] = self.target + self.integral + self.landed * self.feedforward
             step(m, d)
             self.time += dt
             self.steps += 1
@@ -342,10 +353,9 @@ def ground_rows(name: str) -> list["CheckResult"]:
     from ..robot import load
     from .ground import has_ground_model
 
-    robot = load(name, floating=True)
-    if not has_ground_model(robot):
+    if not has_ground_model(name):
         return []
-    mech = load_ground(robot)
+    mech = load_ground(load(name, floating=True))
     rows: list["CheckResult"] = []
     for scenario in SCENARIOS:
         if scenario == "roll" and mech.ground.rolling_radius is None:

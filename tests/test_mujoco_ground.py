@@ -157,3 +157,9 @@ def test_static_torques_are_what_mujoco_needs(quad):
     force = quad.data.actuator_force
     assert np.abs(tau - force).max() < 0.01 * np.abs(force).max()
     assert np.abs(-tau - force).max() > 0.5 * np.abs(force).max()
+
+
+@pytest.mark.parametrize("name", ["solo12", "anymal", "anymal_c", "hyq", "go1", "a1", "b1", "laikago"])
+def test_every_registry_quadruped_stands(name):
+    """Generated per robot of legkin.legs: the ground model needs nothing robot-specific."""
+    _passed(run_scenario(name, "stand", seconds=1.0))

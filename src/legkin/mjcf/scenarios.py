@@ -81,7 +81,8 @@ class ScenarioResult:
 
 
 class _Runner:
-    """Steps a :class:`GroundMechanism` with the PI hold, timing the steps and recording frames."""
+    """Steps a :class:`GroundMechanism` with its actuators holding the targets (feedforward or integral term,
+    module docstring), timing the steps (CPU time), tracking penetration and slip, recording frames."""
 
     def __init__(self, mech: GroundMechanism, fps: float | None) -> None:
         self.mujoco = _mujoco()
@@ -120,6 +121,7 @@ class _Runner:
         self.mujoco.mj_forward(m, d)
 
     def run(self, seconds: float, target: Callable[[float], np.ndarray] | None = None) -> None:
+        """Step ``seconds``, the actuated joints' targets from ``target(time)`` (default: kept)."""
         m, d = self.mech.model, self.mech.data
         dt = m.opt.timestep
         gain, adr, step = dt / _TAU_I if self.integrate else 0.0, self.adr, self.mujoco.mj_step
@@ -164,7 +166,7 @@ class _Runner:
         rolling contact's material point moves only to second order over the interval; the two halves of the
         wheel-leg's toe, on two links turning opposite ways, slide opposite ways and cancel: the contact stays),
         then take the new contacts' material points."""
-        m, d = self.mech.model, self.mech.data
+        d = self.mech.data
         assert self.slip_points is not None
         for k, points in self._material.items():
             total = sum(w for w, _, _, _ in points)
@@ -174,26 +176,30 @@ class _Runner:
             self.slip[k] += moved[:2] / total
             self.slip_max[k] = max(self.slip_max[k], float(np.linalg.norm(self.slip[k])))
         self._material = {}
-        force = np.zeros(6)
-        for i in range(d.ncon):
-            c = d.contact[i]
-            self.mujoco.mj_contactForce(m, d, i, force)
-            k = int(np.argmin(np.linalg.norm(self.slip_points[:, :2] - c.pos[:2], axis=1)))
-            b = int(max(m.geom_bodyid[c.geom[0]], m.geom_bodyid[c.geom[1]]))  # the floor is the world body 0
-            local = d.xmat[b].reshape(3, 3).T @ (c.pos - d.xpos[b])
-            self._material.setdefault(k, []).append((float(force[0]), b, local, c.pos.copy()))
+        for k, fz, b, pos in self._contacts(self.slip_points):
+            local = d.xmat[b].reshape(3, 3).T @ (pos - d.xpos[b])
+            self._material.setdefault(k, []).append((fz, b, local, pos))
 
-    def pressure(self, points: np.ndarray) -> np.ndarray:
-        """(k, 3) force-weighted centre of MuJoCo's contacts nearest each world point (NaN: no contact)."""
+    def _contacts(self, points: np.ndarray) -> list[tuple[int, float, int, np.ndarray]]:
+        """MuJoCo's contacts as ``(index of the nearest world point (horizontally), normal force (N), robot body,
+        position)``."""
         m, d = self.mech.model, self.mech.data
-        sums, weights = np.zeros((len(points), 3)), np.zeros(len(points))
+        out = []
         force = np.zeros(6)
         for i in range(d.ncon):
             c = d.contact[i]
             self.mujoco.mj_contactForce(m, d, i, force)
             k = int(np.argmin(np.linalg.norm(points[:, :2] - c.pos[:2], axis=1)))
-            sums[k] += force[0] * c.pos
-            weights[k] += force[0]
+            body = int(max(m.geom_bodyid[c.geom[0]], m.geom_bodyid[c.geom[1]]))  # the floor is the world body 0
+            out.append((k, float(force[0]), body, c.pos.copy()))
+        return out
+
+    def pressure(self, points: np.ndarray) -> np.ndarray:
+        """(k, 3) force-weighted centre of MuJoCo's contacts nearest each world point (NaN: no contact)."""
+        sums, weights = np.zeros((len(points), 3)), np.zeros(len(points))
+        for k, fz, _, pos in self._contacts(points):
+            sums[k] += fz * pos
+            weights[k] += fz
         with np.errstate(invalid="ignore", divide="ignore"):
             return sums / weights[:, None]
 

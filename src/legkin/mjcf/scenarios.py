@@ -184,14 +184,18 @@ class _Runner:
         """MuJoCo's contacts as ``(index of the nearest world point (horizontally), normal force (N), robot body,
         position)``."""
         m, d = self.mech.model, self.mech.data
-        out = []
+        n = d.ncon
+        if n == 0:
+            return []
+        contact = d.contact  # one view of the arrays (d.contact[i] builds a struct per call)
+        pos = np.array(contact.pos[:n])
+        bodies = m.geom_bodyid[np.asarray(contact.geom[:n])].max(axis=1)  # the floor is the world body 0
+        nearest = np.argmin(np.linalg.norm(points[None, :, :2] - pos[:, None, :2], axis=2), axis=1)
         force = np.zeros(6)
-        for i in range(d.ncon):
-            c = d.contact[i]
+        out = []
+        for i in range(n):
             self.mujoco.mj_contactForce(m, d, i, force)
-            k = int(np.argmin(np.linalg.norm(points[:, :2] - c.pos[:2], axis=1)))
-            body = int(max(m.geom_bodyid[c.geom[0]], m.geom_bodyid[c.geom[1]]))  # the floor is the world body 0
-            out.append((k, float(force[0]), body, c.pos.copy()))
+            out.append((int(nearest[i]), float(force[0]), int(bodies[i]), pos[i]))
         return out
 
     def pressure(self, points: np.ndarray) -> np.ndarray:

@@ -235,12 +235,9 @@ def _cmd_view(args) -> int:
 
 
 def _cmd_export(args) -> int:
-    from .mjcf._base import DEFAULTS
     from .mjcf.cli import run_export
 
     args.output = str(args.mjcf)
-    if args.timestep is None:
-        args.timestep = DEFAULTS["timestep"]
     return run_export(args)
 
 
@@ -310,11 +307,15 @@ def build_parser() -> argparse.ArgumentParser:
     from .mjcf.cli import add_export_command
 
     add_export_command(sub)  # legkin mjcf MODEL [-o FILE] [--floating] [--timestep S] [--png FILE]
+    from .mjcf.sim_cli import add_sim_command
+
+    add_sim_command(sub)  # legkin sim MODEL --scenario stand|roll|squat [--video PATH | --html PATH]
     p = sub.add_parser("export", help="export a model to another format: --mjcf PATH (MuJoCo, loops as equalities)")
     p.add_argument("model")
     p.add_argument("--mjcf", metavar="PATH", type=output_file, required=True, help="write a MuJoCo MJCF to PATH")
     p.add_argument("--floating", action="store_true", help="a free base (models that walk only)")
-    p.add_argument("--timestep", type=positive_float, default=None, help="simulation step, s (default 0.0002)")
+    p.add_argument("--timestep", type=positive_float, default=None,
+                   help="simulation step, s (default 0.0002; 0.001 with --floating)")
     p.add_argument("--png", metavar="PATH", type=output_file, help="also render q0 with MuJoCo (MUJOCO_GL=egl)")
     p.set_defaults(func=_cmd_export)
     return parser

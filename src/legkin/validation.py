@@ -152,10 +152,15 @@ def _mujoco_rows(name: str, samples: int, seed: int) -> list[CheckResult]:
     """The MuJoCo export's rows (:func:`legkin.mjcf.check_rows`) when mujoco is installed, else none (the CLI
     says so: :func:`mujoco_note`). At most 20 samples: each is a loop solve, the simulation rows need no more."""
     from .mjcf import check_rows, unavailable_reason
+    from .mjcf.scenarios import ground_rows
 
-    if not get_spec(name).mjcf or unavailable_reason() is not None:
-        return []  # the export covers legkin's own models (their loops); the robots of legs have .dae meshes
-    return list(check_rows(name, samples=min(samples, 20), rng=np.random.default_rng(seed + 2)))
+    if unavailable_reason() is not None:
+        return []
+    rows = []
+    if get_spec(name).mjcf:  # the export covers legkin's own models (their loops); the robots of legs have .dae meshes
+        rows = list(check_rows(name, samples=min(samples, 20), rng=np.random.default_rng(seed + 2)))
+    rows += ground_rows(name)  # the ground scenarios (issue 28) of the models with a ground model
+    return rows
 
 
 def mujoco_note() -> str | None:

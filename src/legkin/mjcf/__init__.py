@@ -38,6 +38,10 @@ A MuJoCo equality is soft: under a load its violation scales as ``timeconst^2`` 
 squared), which is why the time step is 0.2 ms (docs/mujoco.md has the measurements).
 
 :func:`check_rows` returns the ``legkin check`` rows comparing the MuJoCo model with Pinocchio.
+
+On the ground (docs/mujoco.md): :func:`load_ground` / :func:`to_ground_mjcf` export a floating model with contact
+geometry from the mechanism's :class:`GroundModel` and a floor that collides; :func:`run_scenario` runs ``stand``,
+``roll`` and ``squat`` and measures them against legkin (:func:`ground_rows`: their ``legkin check`` rows).
 """
 
 from ._base import DEFAULTS, unavailable_reason
@@ -56,8 +60,11 @@ from .checks import (
     placement_errors,
 )
 from .cli import add_export_command, run_export
+from .floating import GROUND_DEFAULTS, GroundMechanism, load_ground, to_ground_mjcf
+from .ground import ContactGeom, FootGround, GroundModel, ground_model
 from .mechanism import MujocoMechanism, load_mujoco
 from .render import render_png
+from .scenarios import SCENARIOS, ScenarioResult, ground_rows, run_scenario
 from .writer import to_mjcf
 
 __all__ = [
@@ -81,4 +88,17 @@ __all__ = [
     "TOL_EQUALITY",
     "TOL_GRAVITY",
     "TOL_CLIP",
+    # on the ground (issue 28): docs/mujoco.md
+    "GROUND_DEFAULTS",
+    "GroundMechanism",
+    "load_ground",
+    "to_ground_mjcf",
+    "GroundModel",
+    "FootGround",
+    "ContactGeom",
+    "ground_model",
+    "SCENARIOS",
+    "ScenarioResult",
+    "run_scenario",
+    "ground_rows",
 ]

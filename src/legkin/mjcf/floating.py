@@ -17,8 +17,8 @@ from typing import TYPE_CHECKING, Any, Mapping
 import numpy as np
 import pinocchio as pin
 
+from .._batch import check_number
 from ..errors import InvalidParameterError
-from ..loops import check_real
 from ._base import _MESH_EXTENSIONS, DEFAULTS, _options, _robot, _set_pose, _vec
 from .ground import GroundModel, ground_model
 from .mechanism import MujocoMechanism, load_mujoco
@@ -49,11 +49,11 @@ def _split(options: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
         )
     c = {**GROUND_DEFAULTS, **options}
     o = _options({k: c[k] for k in set(c) & set(DEFAULTS)})
-    c["friction"] = tuple(check_real(f"friction[{i}]", v, 0.0) for i, v in enumerate(c["friction"]))
+    c["friction"] = tuple(check_number(v, f"friction[{i}]", 0.0) for i, v in enumerate(c["friction"]))
     if c["condim"] not in (1, 3, 4, 6) or len(c["friction"]) != 3:
         raise InvalidParameterError(f"condim must be 1, 3, 4 or 6 and friction 3 numbers, got {c['condim']!r}")
-    c["contact_solref"] = tuple(check_real("contact_solref", v) for v in c["contact_solref"])
-    c["contact_solimp"] = tuple(check_real("contact_solimp", v) for v in c["contact_solimp"])
+    c["contact_solref"] = tuple(check_number(v, "contact_solref") for v in c["contact_solref"])
+    c["contact_solimp"] = tuple(check_number(v, "contact_solimp") for v in c["contact_solimp"])
     return o, c
 
 

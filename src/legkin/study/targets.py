@@ -1,0 +1,205 @@
+"""What a study samples and solves, per mechanism: :class:`StudyTarget` and the registry :data:`TARGETS`.
+
+A target declares a set of outputs of known measure (a box of foot positions, the sphere of platform axes), draws
+uniform samples from it, and solves them with the mechanism's own compiled batches (``ik``/``jacobian`` with
+``geometry=`` and ``return_mask=True``). The mechanisms are imported by name on first use (the framework never
+imports a mechanism package statically: see the layers in CONTRIBUTING.md).
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from .._registry import ModelSpec, Param, get_spec
+from ._kernels import PLANAR, TWIST
+
+__all__ = ["Solved", "StudyTarget", "TARGETS", "get_target", "PLANAR_SPEC"]
+
+
+@dataclass(frozen=True)
+class Solved:
+    """One block of samples, solved.
+
+    Attributes:
+        ok: (n,) bool, the targets the default IK solved (inside the joint limits).
+        jac: (n, m * k) Jacobians, row-major, NaN rows where not solved.
+        shape: (m, k) of one Jacobian.
+        extras: per-sample values of the target's own metrics (name -> (n,) array, NaN where undefined).
+    """
+
+    ok: np.ndarray
+    jac: np.ndarray
+    shape: tuple[int, int]
+    extras: Mapping[str, np.ndarray] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class StudyTarget:
+    """A mechanism as a study sees it.
+
+    Attributes:
+        name: the model's registry name (or ``"planar_2link"``).
+        spec: its registry entry (the parameters and their ranges).
+        measure: ``measure(params)``, the measure of the declared target set (box volume in m^3, m^2, or the
+            sphere's 4 pi sr): the workspace estimate is ``measure x reachable fraction``.
+        unit: the unit of :attr:`measure`.
+        sample: ``sample(rng, n, params)`` -> (n, d) targets uniform in the declared set.
+        solve: ``solve(targets, params, extras)`` -> :class:`Solved` (``extras``: the names of its own metrics
+            to compute).
+        jacobian: what the Jacobian is (the docs' metric table), e.g. "d(foot position)/dq (m/rad)".
+        extras: the names of the target's own metrics (see docs/study.md).
+    """
+
+    name: str
+    spec: ModelSpec
+    measure: Callable[[Mapping[str, Any]], float]
+    unit: str
+    sample: Callable[[np.random.Generator, int, Mapping[str, Any]], np.ndarray]
+    solve: Callable[[np.ndarray, Mapping[str, Any], tuple[str, ...]], Solved]
+    jacobian: str
+    extras: tuple[str, ...] = ()
+
+
+def _geometry(name: str, params: Mapping[str, Any]) -> Any:
+    """The mechanism's ``Geometry`` for resolved parameters (no URDF, no Pinocchio)."""
+    return importlib.import_module(f"legkin.{name}").Geometry.from_params(dict(params))
+
+
+def _rows(a: np.ndarray, n: int) -> np.ndarray:
+    return np.ascontiguousarray(a.reshape(n, -1), dtype=np.float64)
+
+
+# ------------------------------------------------------------------ planar 2-link leg (known answers)
+#: The known-answer mechanism: a planar 2-link leg, joints unlimited, lengths l1, l2 (m). Its reachable set is
+#: the annulus |l1 - l2| <= r <= l1 + l2, of area 4 pi l1 l2.
+PLANAR_SPEC = ModelSpec(
+    name="planar_2link",
+    title="planar 2-link leg (the study's known-answer case)",
+    seed="",
+    params={
+        "l1": Param(0.3, "thigh length (m)", 0.0, 10.0, low_open=True),
+        "l2": Param(0.2, "shank length (m)", 0.0, 10.0, low_open=True),
+    },
+)
+
+
+def _planar_half(params: Mapping[str, Any]) -> float:
+    return float(params["l1"]) + float(params["l2"])
+
+
+def _planar_sample(rng: np.random.Generator, n: int, params: Mapping[str, Any]) -> np.ndarray:
+    h = _planar_half(params)
+    return rng.uniform(-h, h, (n, 2))
+
+
+def _planar_solve(target: np.ndarray, params: Mapping[str, Any], extras: tuple[str, ...]) -> Solved:
+    n = target.shape[0]
+    q, jac, ok = np.empty((n, 2)), np.empty((n, 4)), np.empty(n, dtype=np.bool_)
+    PLANAR(np.ascontiguousarray(target), float(params["l1"]), float(params["l2"]), q, jac, ok)
+    return Solved(ok, jac, (2, 2))
+
+
+# ------------------------------------------------------------------ the tripod (seed 000)
+def _tripod_sample(rng: np.random.Generator, n: int, params: Mapping[str, Any]) -> np.ndarray:
+    """Platform axes uniform on the unit sphere (normalised Gaussians), as (alpha_y, alpha_z) (rad)."""
+    r = rng.standard_normal((n, 3))
+    r /= np.linalg.norm(r, axis=1, keepdims=True)
+    return np.stack([-np.arcsin(np.clip(r[:, 2], -1.0, 1.0)), np.arctan2(r[:, 1], r[:, 0])], -1)
+
+
+def _tripod_cv_error(tp: Any, target: np.ndarray, ok: np.ndarray, g: Any) -> np.ndarray:
+    """Per sample: the largest twist (rad) of the three legs' output rotations, each computed along its own chain
+    (``leg_transform`` of the joints of ``ik_joints``); NaN where not solved."""
+    n = target.shape[0]
+    out = np.full(n, np.nan)
+    idx = np.flatnonzero(ok)
+    if idx.size == 0:
+        return out
+    joints = tp.ik_joints(target[idx], geometry=g, return_mask=True)[0]
+    worst = np.zeros(idx.size)
+    tw = np.empty(idx.size)
+    for k, leg in enumerate(tp.LEGS):
+        T = tp.leg_transform(joints[:, 4 * k:4 * k + 4], leg, geometry=g)
+        TWIST(np.ascontiguousarray(T[:, :3, :3].reshape(idx.size, 9)), tw)
+        worst = np.maximum(worst, tw)
+    out[idx] = worst
+    return out
+
+
+def _tripod_solve(target: np.ndarray, params: Mapping[str, Any], extras: tuple[str, ...]) -> Solved:
+    tp = importlib.import_module("legkin.tripod")
+    g = _geometry("tripod", params)
+    n = target.shape[0]
+    _, ok = tp.ik(target, geometry=g, return_mask=True)
+    jac, _ = tp.jacobian(target, geometry=g, return_mask=True)
+    jac = np.where(ok[:, None, None], jac, np.nan)
+    more = {"cv_error": _tripod_cv_error(tp, target, ok, g)} if "cv_error" in extras else {}
+    return Solved(ok, _rows(jac, n), (3, 2), more)
+
+
+# ------------------------------------------------------------------ the quadruped's LF leg (seeds 004 + 002)
+#: Foot positions of the LF leg in the base frame (m): the bounding box of fk over the joint limits for foot_z in
+#: {-0.1, 0, 0.1} (2 x 10^5 samples: x [-0.216, 0.948], y [0.035, 0.511], z [-0.677, 0.318]), rounded outward
+#: to 0.05 m. The same box for every foot_z, so that volumes compare.
+QUADRUPED_BOX = np.array([[-0.25, 0.95], [0.0, 0.55], [-0.70, 0.35]])
+
+
+def _box_measure(box: np.ndarray) -> Callable[[Mapping[str, Any]], float]:
+    return lambda params: float(np.prod(box[:, 1] - box[:, 0]))
+
+
+def _box_sample(box: np.ndarray) -> Callable[[np.random.Generator, int, Mapping[str, Any]], np.ndarray]:
+    return lambda rng, n, params: rng.uniform(box[:, 0], box[:, 1], (n, box.shape[0]))
+
+
+def _quadruped_solve(target: np.ndarray, params: Mapping[str, Any], extras: tuple[str, ...]) -> Solved:
+    qd = importlib.import_module("legkin.quadruped")
+    g = _geometry("quadruped", params)
+    n = target.shape[0]
+    q, ok = qd.ik(target, "LF", geometry=g, return_mask=True)
+    jac = np.full((n, 3, 3), np.nan)
+    if ok.any():
+        jac[ok] = qd.jacobian(q[ok], "LF", geometry=g)
+    return Solved(ok, _rows(jac, n), (3, 3))
+
+
+TARGETS: Mapping[str, StudyTarget] = {
+    "planar_2link": StudyTarget(
+        "planar_2link", PLANAR_SPEC, lambda p: (2.0 * _planar_half(p)) ** 2, "m^2", _planar_sample, _planar_solve,
+        "d(x, y)/d(q1, q2) (m/rad)",
+    ),
+    "tripod": StudyTarget(
+        "tripod", get_spec("tripod"), lambda p: 4.0 * math.pi, "sr", _tripod_sample, _tripod_solve,
+        "A_u = d(q_A1, q_B1, q_C1)/d(alpha_y, alpha_z) (rad/rad), the IK Jacobian", ("cv_error",),
+    ),
+    "quadruped": StudyTarget(
+        "quadruped", get_spec("quadruped"), _box_measure(QUADRUPED_BOX), "m^3", _box_sample(QUADRUPED_BOX),
+        _quadruped_solve, "d(LF foot position)/d(HAA, HFE, KFE) (m/rad)",
+    ),
+}
+
+
+def get_target(name: str) -> StudyTarget:
+    """The study target of a model.
+
+    Args:
+        name: a key of :data:`TARGETS`.
+
+    Returns:
+        Its :class:`StudyTarget`.
+
+    Raises:
+        UnknownModelError: no study target of that name (the message lists them).
+    """
+    from ..errors import UnknownModelError
+
+    if name not in TARGETS:
+        raise UnknownModelError(
+            f"no study target {name!r}; known: {', '.join(sorted(TARGETS))}", name=name, known=sorted(TARGETS)
+        )
+    return TARGETS[name]

@@ -62,7 +62,7 @@ def _grid(params: Mapping[str, Any]) -> tuple[tuple[str, ...], list[tuple[Any, .
     for name in names:
         axis = np.atleast_1d(np.asarray(params[name], dtype=object if isinstance(params[name], str) else None))
         if axis.ndim != 1 or axis.size == 0:
-            raise InvalidParameterError(f"study parameter {name!r}: give a 1-D sequence of values, got {params[name]!r}")
+            raise InvalidParameterError(f"study parameter {name!r}: give 1-D values, got {params[name]!r}")
         axes.append([v.item() if hasattr(v, "item") else v for v in axis])
     return names, list(itertools.product(*axes))
 

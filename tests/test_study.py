@@ -106,6 +106,32 @@ def test_tripod_and_quadruped_rows():
     assert (quad.reach_fraction > 0.05).all() and (quad.cond_p50 >= 1).all()
 
 
+def test_tripod_reach_known_answer():
+    """The tripod's reachable orientations in closed form (docs/tripod.md, ``workspace``): tilt theta below
+    min_K 2 asin(cos(alpha/2) / |sin(phi - eta_K)|); solid angle = integral over phi of (1 - cos theta_max)."""
+    alpha = 0.8
+    row = study("tripod", {"alpha": [alpha]}, samples=200_000, seed=2).iloc[0]
+    m = 400_000
+    phi = (np.arange(m) + 0.5) * 2 * np.pi / m
+    s = np.abs(np.sin(phi[:, None] - np.array([0.0, 2 * np.pi / 3, 4 * np.pi / 3])))
+    theta = (2 * np.arcsin(np.minimum(1.0, np.cos(alpha / 2) / np.maximum(s, 1e-300)))).min(1)
+    exact = float(np.sum(1 - np.cos(theta)) * 2 * np.pi / m)
+    _, lo, hi = wilson(int(row.reached), int(row.samples), Z_TEST)
+    assert 4 * np.pi * lo <= exact <= 4 * np.pi * hi, (row.volume, exact)
+
+
+def test_wheel_leg_rim_links_add_up_to_the_reach():
+    """alpha is uniform on [-pi, pi], so the links carry 130, 50, 50 and 130 degrees of it: the overall reachable
+    fraction is the links' fractions weighted by those shares (to the sampling error)."""
+    row = study("wheel_leg", {"R": [0.1]}, samples=40_000, metrics=("reach", "rim_contact")).iloc[0]
+    links, share = ("upper_L", "lower_L", "lower_R", "upper_R"), np.array([130, 50, 50, 130]) / 360
+    frac = np.array([row[f"rim_contact_{k}"] for k in links])
+    half = np.array([row[f"rim_contact_{k}_hi"] - row[f"rim_contact_{k}_lo"] for k in links]) / 2
+    assert (frac > 0).all() and (frac < 1).all()
+    assert abs(share @ frac - row.reach_fraction) <= 2 * share @ half, (share @ frac, row.reach_fraction)
+    assert row.volume == pytest.approx(row.reach_fraction * (2 * (0.35 + 0.091675 + 0.02)) ** 3, rel=1e-12)
+
+
 def test_chunking_does_not_change_the_result():
     args = ("planar_2link", {"l1": [0.2, 0.3], "l2": [0.25]}, 50_000)
     a = study(*args, seed=7, block_size=4096, chunk_blocks=1)

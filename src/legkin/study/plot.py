@@ -16,6 +16,7 @@ PANELS = {
     "Jacobian condition number kappa": ("cond_p50", "cond_p90", "cond_p99"),
     "singular fraction (1/kappa < eps)": ("singular_fraction",),
     "constant-velocity error, max (rad)": ("cv_error_max",),
+    "reachable fraction per rim link": tuple(f"rim_contact_{k}" for k in ("upper_L", "lower_L", "lower_R", "upper_R")),
 }
 
 
@@ -72,8 +73,12 @@ def plot_study(frame: Any, params: list[str], path: str | Path, title: str = "")
     panels = _panels(frame)
     if len(params) == 2:
         panels = [(t, (c,)) for t, cols in panels for c in cols]
-    fig, axes = plt.subplots(1, len(panels), figsize=(4.2 * len(panels), 3.6), squeeze=False)
-    for ax, (t, cols) in zip(axes[0], panels):
+    ncols = min(len(panels), 3)
+    nrows = -(-len(panels) // ncols)
+    fig, axes = plt.subplots(nrows, ncols, figsize=(4.6 * ncols, 3.6 * nrows), squeeze=False)
+    for ax in axes.flat[len(panels):]:
+        ax.set_visible(False)
+    for ax, (t, cols) in zip(axes.flat, panels):
         if len(params) == 1:
             _line_panel(ax, frame.sort_values(params[0]), params[0], t, cols, frame.attrs.get("unit", ""))
         else:

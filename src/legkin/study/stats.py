@@ -36,8 +36,9 @@ def block_stats(solved: Solved, n: int, threshold: float, extras: tuple[str, ...
         extras: the target's own metrics to reduce (their maxima).
 
     Returns:
-        ``{"n", "reached", "singular", "hist", <extra>_max}``: counts (int), the (HIST_BINS + 1,) int64 histogram
-        of log10 kappa over the reached samples, and the maxima of the extras (float, -inf if none).
+        ``{"n", "reached", "singular", "conditioned", "hist", <extra>_max, <count>_k, <count>_n}``: counts (int),
+        the (HIST_BINS + 1,) int64 histogram of log10 kappa over the reached samples, the maxima of the extras
+        (float, -inf if none) and the target's own proportions (successes, trials).
     """
     m, k = solved.shape
     kappa = np.empty(n)
@@ -53,7 +54,11 @@ def block_stats(solved: Solved, n: int, threshold: float, extras: tuple[str, ...
         "conditioned": int(kap.size),
         "hist": np.bincount(bins, minlength=HIST_BINS + 1).astype(np.int64),
     }
+    for name, (k, total) in solved.counts.items():
+        out[f"{name}_k"], out[f"{name}_n"] = k, total
     for name in extras:
+        if name not in solved.extras:
+            continue
         v = solved.extras[name][solved.ok]
         v = v[np.isfinite(v)]
         out[f"{name}_max"] = float(v.max()) if v.size else -math.inf
@@ -139,4 +144,7 @@ def metrics_row(stats: Mapping[str, Any], measure: float, metrics: tuple[str, ..
     for key, value in stats.items():
         if key.endswith("_max") and key[:-4] in metrics:
             row[key] = value if math.isfinite(value) else math.nan
+        elif key.endswith("_k"):
+            p, lo, hi = wilson(value, stats[key[:-2] + "_n"])
+            row.update({key[:-2]: p, key[:-2] + "_lo": lo, key[:-2] + "_hi": hi})
     return row

@@ -29,13 +29,16 @@ class Solved:
         ok: (n,) bool, the targets the default IK solved (inside the joint limits).
         jac: (n, m * k) Jacobians, row-major, NaN rows where not solved.
         shape: (m, k) of one Jacobian.
-        extras: per-sample values of the target's own metrics (name -> (n,) array, NaN where undefined).
+        extras: per-sample values of the target's own metrics whose maximum is reported (name -> (n,) array, NaN
+            where undefined).
+        counts: the target's own proportions: name -> (successes, trials) in this block.
     """
 
     ok: np.ndarray
     jac: np.ndarray
     shape: tuple[int, int]
     extras: Mapping[str, np.ndarray] = field(default_factory=dict)
+    counts: Mapping[str, tuple[int, int]] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -168,6 +171,44 @@ def _quadruped_solve(target: np.ndarray, params: Mapping[str, Any], extras: tupl
     return Solved(ok, _rows(jac, n), (3, 3))
 
 
+# ------------------------------------------------------------------ the wheel-leg's FL leg (seed 001)
+#: The rim links of :func:`legkin.wheel_leg.rim_segment`, in its order (rim parameter alpha < -50 deg, [-50, 0),
+#: [0, 50], > 50 deg).
+RIM_LINKS = ("upper_L", "lower_L", "lower_R", "upper_R")
+
+
+def _wheel_box(params: Mapping[str, Any]) -> np.ndarray:
+    """A cube about the FL module origin (+L_body/2, +W_body/2, d_abad), half-width 3.5 R + d_wheel + T/2 (m): every
+    rim point of the leg lies inside (measured: 3.4 R from the origin in x at R = 0.1, 2 x 10^5 joint samples)."""
+    h = 3.5 * float(params["R"]) + float(params["d_wheel"]) + 0.5 * float(params["T"])
+    o = np.array([0.5 * float(params["L_body"]), 0.5 * float(params["W_body"]), float(params["d_abad"])])
+    return np.stack([o - h, o + h], -1)
+
+
+def _wheel_sample(rng: np.random.Generator, n: int, params: Mapping[str, Any]) -> np.ndarray:
+    """(n, 4): a target uniform in :func:`_wheel_box` and the rim parameter alpha uniform in [-pi, pi] (rad)."""
+    box = _wheel_box(params)
+    return np.concatenate([rng.uniform(box[:, 0], box[:, 1], (n, 3)), rng.uniform(-math.pi, math.pi, (n, 1))], 1)
+
+
+def _wheel_solve(sample: np.ndarray, params: Mapping[str, Any], extras: tuple[str, ...]) -> Solved:
+    wl = importlib.import_module("legkin.wheel_leg")
+    g = _geometry("wheel_leg", params)
+    n = sample.shape[0]
+    target, alpha = np.ascontiguousarray(sample[:, :3]), np.ascontiguousarray(sample[:, 3])
+    q, ok = wl.ik(target, "FL", alpha=alpha, geometry=g, return_mask=True)
+    jac = np.full((n, 3, 3), np.nan)
+    if ok.any():
+        jac[ok] = wl.jacobian(q[ok], "FL", alpha=alpha[ok], geometry=g, return_mask=True)[0]
+    counts = {}
+    if "rim_contact" in extras:
+        link = wl.rim_segment(alpha, geometry=g)
+        for k, name in enumerate(RIM_LINKS):
+            on = link == k
+            counts[f"rim_contact_{name}"] = (int(np.count_nonzero(ok & on)), int(np.count_nonzero(on)))
+    return Solved(ok, _rows(jac, n), (3, 3), counts=counts)
+
+
 TARGETS: Mapping[str, StudyTarget] = {
     "planar_2link": StudyTarget(
         "planar_2link", PLANAR_SPEC, lambda p: (2.0 * _planar_half(p)) ** 2, "m^2", _planar_sample, _planar_solve,
@@ -180,6 +221,10 @@ TARGETS: Mapping[str, StudyTarget] = {
     "quadruped": StudyTarget(
         "quadruped", get_spec("quadruped"), _box_measure(QUADRUPED_BOX), "m^3", _box_sample(QUADRUPED_BOX),
         _quadruped_solve, "d(LF foot position)/d(HAA, HFE, KFE) (m/rad)",
+    ),
+    "wheel_leg": StudyTarget(
+        "wheel_leg", get_spec("wheel_leg"), lambda p: float(np.prod(np.diff(_wheel_box(p), axis=1))), "m^3",
+        _wheel_sample, _wheel_solve, "d(FL rim point)/d(theta, beta, gamma) (m/rad)", ("rim_contact",),
     ),
 }
 

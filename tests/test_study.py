@@ -141,6 +141,25 @@ def test_chunking_does_not_change_the_result():
     assert not a.equals(c)
 
 
+def test_cli_writes_the_table_and_the_plot(tmp_path, capsys):
+    from legkin.__main__ import main
+
+    out, png = tmp_path / "s.parquet", tmp_path / "s.png"
+    pytest.importorskip("pyarrow")
+    pytest.importorskip("matplotlib")
+    argv = ["study", "planar_2link", "--param", "l1=0.2:0.3:2", "--param", "l2=0.1,0.2", "--samples", "5000",
+            "--seed", "4", "--out", str(out), "--plot", str(png), "--quiet"]
+    assert main(argv) == 0
+    table = pd.read_parquet(out)
+    expected = study("planar_2link", {"l1": np.linspace(0.2, 0.3, 2), "l2": [0.1, 0.2]}, samples=5000, seed=4)
+    pd.testing.assert_frame_equal(table, expected, check_exact=True)
+    assert png.stat().st_size > 10_000
+    assert main(["study", "tripod", "--param", "alpha=0.5:3.5:3", "--out", str(tmp_path / "bad.parquet")]) == 2
+    assert "alpha=3.5 is out of range" in capsys.readouterr().err
+    assert not (tmp_path / "bad.parquet").exists()
+    assert main(["study", "tripod", "--param", "alpha=0.5:1"]) == 2  # malformed
+
+
 # ------------------------------------------------------------------ dask
 distributed = pytest.importorskip("distributed")
 

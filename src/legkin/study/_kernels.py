@@ -43,24 +43,25 @@ def _k_condition(J, m, k):  # type: ignore[no-untyped-def]
     """Condition number kappa = sigma_max / sigma_min of the m x k matrix J (row-major, k in 1..3) from the
     eigenvalues of its Gram matrix G = J^T J (sigma^2): 2 x 2 in closed form (lambda = t/2 +- sqrt(t^2/4 - det)),
     3 x 3 by :func:`_k_sym3_eig_extremes`. Capped at :data:`COND_CAP`; NaN when J has a NaN."""
-    g = [0.0] * 6  # G's upper triangle: 00 01 02 11 12 22
-    idx = ((0, 0), (0, 1), (0, 2), (1, 1), (1, 2), (2, 2))
-    for t in range(6):
-        a, b = idx[t]
-        if a < k and b < k:
-            s = 0.0
-            for r in range(m):
-                s += J[r * k + a] * J[r * k + b]
-            g[t] = s
+    g00 = g01 = g02 = g11 = g12 = g22 = 0.0
+    for r in range(m):
+        a = J[r * k]
+        b = J[r * k + 1] if k > 1 else 0.0
+        c = J[r * k + 2] if k > 2 else 0.0
+        g00 += a * a
+        g01 += a * b
+        g02 += a * c
+        g11 += b * b
+        g12 += b * c
+        g22 += c * c
     if k == 1:
-        return 1.0 if g[0] == g[0] else math.nan
+        return 1.0 if g00 == g00 else math.nan
     if k == 2:
-        half = 0.5 * (g[0] + g[3])
-        det = g[0] * g[3] - g[1] * g[1]
-        disc = math.sqrt(max(half * half - det, 0.0))
+        half = 0.5 * (g00 + g11)
+        disc = math.sqrt(max(half * half - (g00 * g11 - g01 * g01), 0.0))
         low, top = max(half - disc, 0.0), half + disc
     else:
-        low, top = _k_sym3_eig_extremes(g[0], g[1], g[2], g[3], g[4], g[5])
+        low, top = _k_sym3_eig_extremes(g00, g01, g02, g11, g12, g22)
     if not (top == top and low == low):
         return math.nan
     if low * COND_CAP * COND_CAP <= top:

@@ -55,7 +55,7 @@ def main() -> None:
     ap.add_argument("--param", default="foot_z")
     ap.add_argument("--value", type=float, default=0.0)
     ap.add_argument("--n", type=int, default=10**7, help="samples of the raw / in-process runs")
-    ap.add_argument("--cluster-n", type=int, default=10**8, help="samples of the 1- and 2-worker runs")
+    ap.add_argument("--cluster-n", type=int, default=10**8, help="samples of the 1- and 2-worker runs (0: skip them)")
     ap.add_argument("--repeat", type=int, default=3, help="interleaved repeats of the raw / in-process runs (best)")
     a = ap.parse_args()
     params = {a.param: a.value}
@@ -70,7 +70,8 @@ def main() -> None:
     rows = [("raw batch kernels (sample + ik + jacobian)", a.n, raw), ("study, in-process", a.n, local)]
 
     grid = {a.param: [a.value] * 4}  # 4 points: chunks for both workers from the start
-    for k in (1, 2):
+    per_task = float("nan")
+    for k in (1, 2) if a.cluster_n else ():
         with scheduler_client(f"local:{k}") as client:
             client.wait_for_workers(k)
             study(a.model, grid, samples=BLOCK_SIZE, client=client)  # each worker loads the kernels
@@ -82,9 +83,11 @@ def main() -> None:
     print(f"\n{'run':<44} {'samples':>12} {'seconds':>9} {'evaluations/s':>14}")
     for name, n, t in rows:
         print(f"{name:<44} {n:>12.3g} {t:>9.2f} {n / t:>14.4g}")
+    print(f"\nin-process / raw throughput: {raw / local:.3f} (study overhead {100 * (local / raw - 1):.1f} %)")
+    if not a.cluster_n:
+        return
     rate1 = rows[2][1] / rows[2][2]
     chunk_s = CHUNK_BLOCKS * BLOCK_SIZE / rate1
-    print(f"\nin-process / raw throughput: {raw / local:.3f} (study overhead {100 * (local / raw - 1):.1f} %)")
     print(f"2 workers / 1 worker: {rows[2][2] / rows[3][2]:.2f}x")
     print(f"chunk size: {CHUNK_BLOCKS} blocks x {BLOCK_SIZE} samples = {CHUNK_BLOCKS * BLOCK_SIZE} samples, "
           f"{chunk_s:.3f} s of one worker's compute; dask's cost a task {1e3 * per_task:.2f} ms "

@@ -39,10 +39,10 @@ def _k_sym3_eig_extremes(a00, a01, a02, a11, a12, a22):  # type: ignore[no-untyp
 
 
 @kernel
-def _k_condition(J, m, k):  # type: ignore[no-untyped-def]
-    """Condition number kappa = sigma_max / sigma_min of the m x k matrix J (row-major, k in 1..3) from the
-    eigenvalues of its Gram matrix G = J^T J (sigma^2): 2 x 2 in closed form (lambda = t/2 +- sqrt(t^2/4 - det)),
-    3 x 3 by :func:`_k_sym3_eig_extremes`. Capped at :data:`COND_CAP`; NaN when J has a NaN."""
+def _k_gram_extremes(J, m, k):  # type: ignore[no-untyped-def]
+    """Smallest and largest eigenvalue (sigma_min^2, sigma_max^2) of the Gram matrix G = J^T J of the m x k matrix J
+    (row-major, k in 1..3): 2 x 2 in closed form (lambda = t/2 -+ sqrt(t^2/4 - det)), 3 x 3 by
+    :func:`_k_sym3_eig_extremes`. NaN when J has a NaN."""
     g00 = g01 = g02 = g11 = g12 = g22 = 0.0
     for r in range(m):
         a = J[r * k]
@@ -55,27 +55,36 @@ def _k_condition(J, m, k):  # type: ignore[no-untyped-def]
         g12 += b * c
         g22 += c * c
     if k == 1:
-        return 1.0 if g00 == g00 else math.nan
+        return g00, g00
     if k == 2:
         half = 0.5 * (g00 + g11)
         disc = math.sqrt(max(half * half - (g00 * g11 - g01 * g01), 0.0))
-        low, top = max(half - disc, 0.0), half + disc
-    else:
-        low, top = _k_sym3_eig_extremes(g00, g01, g02, g11, g12, g22)
-    if not (top == top and low == low):
-        return math.nan
-    if low * COND_CAP * COND_CAP <= top:
-        return COND_CAP
-    return math.sqrt(top / low)
+        return max(half - disc, 0.0), half + disc
+    return _k_sym3_eig_extremes(g00, g01, g02, g11, g12, g22)
 
 
-def _condition_loop(J, m, k, out):  # type: ignore[no-untyped-def]
-    """kappa of each row of J (n, m * k) into out (n,) (:func:`_k_condition`)."""
+def _stats_loop(J, m, k, ok, eps, step, top_bin, bins):  # type: ignore[no-untyped-def]
+    """The histogram bin of log10 kappa (kappa = sqrt(lambda_max / lambda_min), :func:`_k_gram_extremes`) of each
+    row of J (n, m * k) into bins (n,): floor(log10 kappa / step), capped at top_bin - 1, top_bin where kappa >=
+    COND_CAP, top_bin + 1 where the row is not reached (ok False) or J is not finite. Returns the number of reached
+    rows with 1/kappa <= eps (lambda_min <= eps^2 lambda_max)."""
+    singular = 0
+    cap2 = COND_CAP * COND_CAP
     for i in range(J.shape[0]):
-        out[i] = _k_condition(J[i], m, k)
+        low, top = _k_gram_extremes(J[i], m, k)
+        if not ok[i] or not (top == top and low == low):
+            bins[i] = top_bin + 1
+            continue
+        if low <= eps * eps * top:
+            singular += 1
+        if low * cap2 <= top:
+            bins[i] = top_bin
+        else:
+            bins[i] = min(int(0.5 * math.log10(top / low) / step), top_bin - 1)
+    return singular
 
 
-CONDITION = batch_kernel(rows="J out", min_parallel=16384)(_condition_loop)
+STATS = batch_kernel(rows="J ok bins", min_parallel=16384)(_stats_loop)
 
 
 @kernel

@@ -14,7 +14,7 @@ __all__ = ["plot_study", "PANELS"]
 PANELS = {
     "workspace volume": ("volume",),
     "Jacobian condition number kappa": ("cond_p50", "cond_p90", "cond_p99"),
-    "singular fraction (1/kappa < eps)": ("singular_fraction",),
+    "singular fraction (1/kappa <= eps)": ("singular_fraction",),
     "constant-velocity error, max (rad)": ("cv_error_max",),
     "reachable fraction per rim link": tuple(f"rim_contact_{k}" for k in ("upper_L", "lower_L", "lower_R", "upper_R")),
 }

@@ -169,7 +169,7 @@ def study(model: str, params: Mapping[str, Any], samples: int = 10**6, metrics: 
             their product. Units: the registry's (``legkin list``; m, rad).
         samples: Monte-Carlo samples per point.
         metrics: any of "reach" (reachable fraction, workspace volume), "conditioning" (kappa percentiles),
-            "singularity" (fraction with 1/kappa < eps) and the target's own ("cv_error" for the tripod).
+            "singularity" (fraction with 1/kappa <= eps) and the target's own ("cv_error" for the tripod).
         seed: root seed; block (point i, block b) uses ``SeedSequence(seed, spawn_key=(i, b))``.
         client: None: in-process (the compiled batches on every numba thread); a ``dask.distributed.Client``: one
             task per chunk on its workers. The table is identical bit for bit either way.

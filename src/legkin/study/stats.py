@@ -12,7 +12,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ._kernels import COND_CAP, CONDITION
+from ._kernels import COND_CAP, STATS
 from .targets import Solved
 
 __all__ = ["HIST_BINS", "HIST_STEP", "PERCENTILES", "Z95", "block_stats", "merge", "metrics_row", "wilson"]
@@ -41,18 +41,16 @@ def block_stats(solved: Solved, n: int, threshold: float, extras: tuple[str, ...
         (float, -inf if none) and the target's own proportions (successes, trials).
     """
     m, k = solved.shape
-    kappa = np.empty(n)
-    CONDITION(np.ascontiguousarray(solved.jac), m, k, kappa)
-    reached = solved.ok & np.isfinite(kappa)
-    kap = kappa[reached]
-    bins = np.minimum((np.log10(kap) / HIST_STEP).astype(np.int64), HIST_BINS - 1)
-    bins[kap >= COND_CAP] = HIST_BINS
+    bins = np.empty(n, dtype=np.int64)
+    singular = STATS(np.ascontiguousarray(solved.jac), m, k, np.ascontiguousarray(solved.ok), threshold, HIST_STEP,
+                     HIST_BINS, bins)
+    hist = np.bincount(bins, minlength=HIST_BINS + 2)[:HIST_BINS + 1]
     out: dict[str, Any] = {
         "n": int(n),
         "reached": int(np.count_nonzero(solved.ok)),
-        "singular": int(np.count_nonzero(kap * threshold >= 1.0)),
-        "conditioned": int(kap.size),
-        "hist": np.bincount(bins, minlength=HIST_BINS + 1).astype(np.int64),
+        "singular": int(singular),
+        "conditioned": int(hist.sum()),
+        "hist": hist.astype(np.int64),
     }
     for name, (k, total) in solved.counts.items():
         out[f"{name}_k"], out[f"{name}_n"] = k, total

@@ -16,6 +16,7 @@ from typing import Any, Callable, Mapping
 import numpy as np
 
 from .._registry import ModelSpec, Param, get_spec
+from ..errors import UnknownModelError
 from ._kernels import PLANAR, TWIST
 
 __all__ = ["Solved", "StudyTarget", "TARGETS", "get_target", "PLANAR_SPEC"]
@@ -241,8 +242,6 @@ def get_target(name: str) -> StudyTarget:
     Raises:
         UnknownModelError: no study target of that name (the message lists them).
     """
-    from ..errors import UnknownModelError
-
     if name not in TARGETS:
         raise UnknownModelError(
             f"no study target {name!r}; known: {', '.join(sorted(TARGETS))}", name=name, known=sorted(TARGETS)

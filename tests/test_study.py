@@ -161,11 +161,9 @@ def test_cli_writes_the_table_and_the_plot(tmp_path, capsys):
 
 
 # ------------------------------------------------------------------ dask
-distributed = pytest.importorskip("distributed")
-
-
 @pytest.fixture(scope="module")
 def cluster():
+    pytest.importorskip("distributed")  # the study extra; the tests above run without it
     from distributed import Client, LocalCluster
 
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as lc:

@@ -20,21 +20,24 @@ from legkin.study.cli import scheduler_client
 from legkin.study.run import plan
 
 
-def _raw(model: str, params: dict, n: int) -> float:
-    """Seconds of the raw batches alone (sampling, IK, Jacobian) over n samples in blocks of BLOCK_SIZE."""
+def _raw(model: str, params: dict, n: int) -> None:
+    """The raw batches alone (sampling, IK, Jacobian) over n samples in blocks of BLOCK_SIZE."""
     target = get_target(model)
     resolved = plan(model, {k: [v] for k, v in params.items()}, 1).resolved[0]
     rng = np.random.default_rng(0)
-    t0 = time.perf_counter()
     for lo in range(0, n, BLOCK_SIZE):
         target.solve(target.sample(rng, min(BLOCK_SIZE, n - lo), resolved), resolved, ())
-    return time.perf_counter() - t0
 
 
 def _timed(fn, *args, **kw) -> float:
-    t0 = time.perf_counter()
+    return _timed2(fn, *args, **kw)[0]
+
+
+def _timed2(fn, *args, **kw) -> tuple[float, float]:
+    """(wall seconds, CPU seconds of this process, all its threads) of one call."""
+    t0, c0 = time.perf_counter(), time.process_time()
     fn(*args, **kw)
-    return time.perf_counter() - t0
+    return time.perf_counter() - t0, time.process_time() - c0
 
 
 def _noop(x: int) -> int:
@@ -63,10 +66,12 @@ def main() -> None:
           f"threads {_kernels.threads()} in-process, 1 per dask worker (NUMBA_NUM_THREADS=1); model {a.model}, "
           f"{a.param}={a.value}, metrics reach+conditioning+singularity")
     study(a.model, {a.param: [a.value]}, samples=BLOCK_SIZE)  # compile / load the kernels
-    raw = local = float("inf")
+    raw = local = raw_cpu = local_cpu = float("inf")
     for _ in range(a.repeat):  # interleaved, best of each: the machine is shared
-        raw = min(raw, _raw(a.model, params, a.n))
-        local = min(local, _timed(study, a.model, {a.param: [a.value]}, samples=a.n))
+        wall, cpu = _timed2(_raw, a.model, params, a.n)
+        raw, raw_cpu = min(raw, wall), min(raw_cpu, cpu)
+        wall, cpu = _timed2(study, a.model, {a.param: [a.value]}, samples=a.n)
+        local, local_cpu = min(local, wall), min(local_cpu, cpu)
     rows = [("raw batch kernels (sample + ik + jacobian)", a.n, raw), ("study, in-process", a.n, local)]
 
     grid = {a.param: [a.value] * 4}  # 4 points: chunks for both workers from the start
@@ -83,7 +88,9 @@ def main() -> None:
     print(f"\n{'run':<44} {'samples':>12} {'seconds':>9} {'evaluations/s':>14}")
     for name, n, t in rows:
         print(f"{name:<44} {n:>12.3g} {t:>9.2f} {n / t:>14.4g}")
-    print(f"\nin-process / raw throughput: {raw / local:.3f} (study overhead {100 * (local / raw - 1):.1f} %)")
+    print(f"\nin-process / raw throughput: {raw / local:.3f} by wall time (overhead {100 * (local / raw - 1):.1f} %)"
+          f", {raw_cpu / local_cpu:.3f} by CPU time ({1e9 * raw_cpu / a.n:.0f} vs {1e9 * local_cpu / a.n:.0f} CPU-ns a "
+          f"sample; overhead {100 * (local_cpu / raw_cpu - 1):.1f} %: CPU time is what other processes disturb least)")
     if not a.cluster_n:
         return
     rate1 = rows[2][1] / rows[2][2]

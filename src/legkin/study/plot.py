@@ -73,7 +73,7 @@ def plot_study(frame: Any, params: list[str], path: str | Path, title: str = "")
     panels = _panels(frame)
     if len(params) == 2:
         panels = [(t, (c,)) for t, cols in panels for c in cols]
-    ncols = min(len(panels), 3)
+    ncols = 2 if len(panels) in (2, 4) else min(len(panels), 3)
     nrows = -(-len(panels) // ncols)
     fig, axes = plt.subplots(nrows, ncols, figsize=(4.6 * ncols, 3.6 * nrows), squeeze=False)
     for ax in axes.flat[len(panels):]:

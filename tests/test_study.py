@@ -221,3 +221,15 @@ def test_dask_killed_worker_is_rerun(cluster):
     assert "frame" in out
     assert victim not in client.scheduler_info()["workers"]  # the worker did die
     pd.testing.assert_frame_equal(local, out["frame"], check_exact=True)
+
+
+def test_cli_local_scheduler_gives_the_in_process_table(tmp_path):
+    """``--scheduler local:1``: a LocalCluster of one process (one numba thread), the same table bit for bit."""
+    pytest.importorskip("distributed")
+    from legkin.__main__ import main
+
+    out = tmp_path / "s.csv"
+    argv = ["study", "planar_2link", "--param", "l1=0.25,0.3", "--samples", "70000", "--out", str(out), "--quiet"]
+    assert main([*argv, "--scheduler", "local:1"]) == 0
+    expected = study("planar_2link", {"l1": [0.25, 0.3]}, samples=70_000)
+    pd.testing.assert_frame_equal(pd.read_csv(out), expected, check_exact=True)

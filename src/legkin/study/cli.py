@@ -87,6 +87,8 @@ def run_study_cli(args: argparse.Namespace) -> int:
         The exit status (0).
     """
     _need(("pandas",) + (("pyarrow",) if args.out and not args.out.endswith(".csv") else ()), "legkin study")
+    import pandas as pd
+
     from .plot import plot_study
     from .run import plan, study
 
@@ -98,10 +100,13 @@ def run_study_cli(args: argparse.Namespace) -> int:
     plan(args.model, params, args.samples, **kw)  # every parameter checked before a cluster starts
     with scheduler_client(args.scheduler) as client:
         frame = study(args.model, params, args.samples, client=client, progress=args.progress, **kw)
-    with __import__("pandas").option_context("display.width", 200, "display.max_columns", 40):
+    with pd.option_context("display.width", 200, "display.max_columns", 40):
         print(frame.to_string(index=False, float_format=lambda v: f"{v:.6g}"))
     if args.out:
-        frame.to_csv(args.out, index=False) if args.out.endswith(".csv") else frame.to_parquet(args.out)
+        if args.out.endswith(".csv"):
+            frame.to_csv(args.out, index=False)
+        else:
+            frame.to_parquet(args.out)
         print(f"wrote {args.out}")
     if args.plot:
         _need(("matplotlib",), "--plot")
@@ -119,12 +124,13 @@ def add_study_command(sub: Any, output_file: Callable[[str], str], positive_int:
         show_progress: ``show_progress(args)``, whether to draw a progress bar.
     """
     p = sub.add_parser("study", help="workspace, dexterity and singularity metrics over geometry parameters")
-    p.add_argument("model", help="planar_2link, quadruped or tripod")
+    p.add_argument("model", help="planar_2link, quadruped, tripod or wheel_leg")
     p.add_argument("--param", type=parse_param, action="append", required=True, metavar="NAME=START:STOP:N",
                    help="a swept parameter (repeat for a grid); NAME=V1,V2,... for a list")
     p.add_argument("--samples", type=positive_int, default=10**6, help="Monte-Carlo samples a point (default 1e6)")
     p.add_argument("--metrics", default=None,
-                   help="comma-separated: reach,conditioning,singularity (default) and the model's own (cv_error)")
+                   help="comma-separated: reach,conditioning,singularity (default) and the model's own (tripod: "
+                        "cv_error, wheel_leg: rim_contact)")
     p.add_argument("--seed", type=nonnegative_int, default=0, help="root seed (default 0)")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS|local[:K]",
                    help="run on dask: a scheduler's address, or a LocalCluster of K processes (default 2)")

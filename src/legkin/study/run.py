@@ -26,8 +26,8 @@ __all__ = ["study", "BLOCK_SIZE", "CHUNK_BLOCKS", "DEFAULT_METRICS", "plan", "Pl
 #: Samples per block (the unit of seeding and of reduction): large enough that the compiled batches run at full
 #: speed on every numba thread (> 0.2 ms a thread), small enough that a block's arrays stay in cache-sized MBs.
 BLOCK_SIZE = 1 << 16
-#: Blocks per dask task by default: ~10^6 samples, 0.2-1 s of work for the targets here, against dask's ~1-3 ms
-#: per task (docs/study.md, "Chunk size"); fewer when a point has fewer blocks.
+#: Blocks per dask task by default: ~10^6 samples, 0.5-1.3 s of one worker's work for the cheapest target (the
+#: quadruped), against dask's 4-6 ms a task measured (docs/study.md, "Chunk size"); fewer when a point has fewer.
 CHUNK_BLOCKS = 16
 DEFAULT_METRICS = ("reach", "conditioning", "singularity")
 
@@ -164,12 +164,13 @@ def study(model: str, params: Mapping[str, Any], samples: int = 10**6, metrics: 
     """The metrics of ``model`` at every point of a parameter grid: one row per point (docs/study.md).
 
     Args:
-        model: a study target: "tripod", "quadruped" or "planar_2link" (:data:`legkin.study.TARGETS`).
+        model: a study target: "tripod", "quadruped", "wheel_leg" or "planar_2link" (:data:`legkin.study.TARGETS`).
         params: parameter name -> 1-D values, e.g. ``{"alpha": np.linspace(0.5, 1.2, 36)}``; several names sweep
             their product. Units: the registry's (``legkin list``; m, rad).
         samples: Monte-Carlo samples per point.
         metrics: any of "reach" (reachable fraction, workspace volume), "conditioning" (kappa percentiles),
-            "singularity" (fraction with 1/kappa <= eps) and the target's own ("cv_error" for the tripod).
+            "singularity" (fraction with 1/kappa <= eps) and the target's own ("cv_error" for the tripod,
+            "rim_contact" for the wheel-leg).
         seed: root seed; block (point i, block b) uses ``SeedSequence(seed, spawn_key=(i, b))``.
         client: None: in-process (the compiled batches on every numba thread); a ``dask.distributed.Client``: one
             task per chunk on its workers. The table is identical bit for bit either way.
@@ -202,5 +203,3 @@ def study(model: str, params: Mapping[str, Any], samples: int = 10**6, metrics: 
     frame.attrs.update(model=model, unit=p.target.unit, seed=p.seed, block_size=block_size,
                        singular_threshold=p.threshold, measure=[p.target.measure(r) for r in p.resolved])
     return frame
-
-

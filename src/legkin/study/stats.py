@@ -52,8 +52,8 @@ def block_stats(solved: Solved, n: int, threshold: float, extras: tuple[str, ...
         "conditioned": int(hist.sum()),
         "hist": hist.astype(np.int64),
     }
-    for name, (k, total) in solved.counts.items():
-        out[f"{name}_k"], out[f"{name}_n"] = k, total
+    for name, (hits, total) in solved.counts.items():
+        out[f"{name}_k"], out[f"{name}_n"] = hits, total
     for name in extras:
         if name not in solved.extras:
             continue

@@ -69,7 +69,7 @@ def scheduler_client(spec: str | None) -> Iterator[Any]:
         k = spec.partition(":")[2] or "2"
         if not k.isdigit() or int(k) < 1:
             raise LegkinError(f"--scheduler local:K needs K >= 1 workers, got {spec!r}")
-        with LocalCluster(n_workers=int(k), threads_per_worker=1, processes=True, dashboard_address=None,
+        with LocalCluster(n_workers=int(k), threads_per_worker=1, processes=True, dashboard_address=":0",
                           env={"NUMBA_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
             yield client
         return

@@ -20,13 +20,16 @@ from legkin.study.cli import scheduler_client
 from legkin.study.run import plan
 
 
-def _raw(model: str, params: dict, n: int) -> None:
-    """The raw batches alone (sampling, IK, Jacobian) over n samples in blocks of BLOCK_SIZE."""
+def _raw(model: str, params: dict, n: int, cond: bool = False) -> None:
+    """The raw batches alone (sampling, IK, Jacobian) over n samples in blocks of BLOCK_SIZE; ``cond``: also numpy's
+    condition number of each reached Jacobian (what a hand-written loop measuring dexterity would add)."""
     target = get_target(model)
     resolved = plan(model, {k: [v] for k, v in params.items()}, 1).resolved[0]
     rng = np.random.default_rng(0)
     for lo in range(0, n, BLOCK_SIZE):
-        target.solve(target.sample(rng, min(BLOCK_SIZE, n - lo), resolved), resolved, ())
+        solved = target.solve(target.sample(rng, min(BLOCK_SIZE, n - lo), resolved), resolved, ())
+        if cond:
+            np.linalg.cond(solved.jac[solved.ok].reshape(-1, *solved.shape))
 
 
 def _timed(fn, *args, **kw) -> float:
@@ -72,7 +75,9 @@ def main() -> None:
         raw, raw_cpu = min(raw, wall), min(raw_cpu, cpu)
         wall, cpu = _timed2(study, a.model, {a.param: [a.value]}, samples=a.n)
         local, local_cpu = min(local, wall), min(local_cpu, cpu)
-    rows = [("raw batch kernels (sample + ik + jacobian)", a.n, raw), ("study, in-process", a.n, local)]
+    numpy_cond = _timed(_raw, a.model, params, a.n, True)
+    rows = [("raw batch kernels (sample + ik + jacobian)", a.n, raw),
+            ("raw + np.linalg.cond of the reached", a.n, numpy_cond), ("study, in-process", a.n, local)]
 
     grid = {a.param: [a.value] * 4}  # 4 points: chunks for both workers from the start
     per_task = float("nan")
@@ -93,9 +98,9 @@ def main() -> None:
           f"sample; overhead {100 * (local_cpu / raw_cpu - 1):.1f} %: CPU time is what other processes disturb least)")
     if not a.cluster_n:
         return
-    rate1 = rows[2][1] / rows[2][2]
+    rate1 = rows[3][1] / rows[3][2]
     chunk_s = CHUNK_BLOCKS * BLOCK_SIZE / rate1
-    print(f"2 workers / 1 worker: {rows[2][2] / rows[3][2]:.2f}x")
+    print(f"2 workers / 1 worker: {rows[3][2] / rows[4][2]:.2f}x")
     print(f"chunk size: {CHUNK_BLOCKS} blocks x {BLOCK_SIZE} samples = {CHUNK_BLOCKS * BLOCK_SIZE} samples, "
           f"{chunk_s:.3f} s of one worker's compute; dask's cost a task {1e3 * per_task:.2f} ms "
           f"(trivial tasks on 1 worker): per-chunk overhead {100 * per_task / chunk_s:.2f} %")

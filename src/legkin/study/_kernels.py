@@ -71,8 +71,11 @@ def _stats_loop(J, m, k, ok, eps, step, top_bin, bins):  # type: ignore[no-untyp
     singular = 0
     cap2 = COND_CAP * COND_CAP
     for i in range(J.shape[0]):
+        if not ok[i]:  # unreached: no Jacobian to condition
+            bins[i] = top_bin + 1
+            continue
         low, top = _k_gram_extremes(J[i], m, k)
-        if not ok[i] or not (top == top and low == low):
+        if not (top == top and low == low):
             bins[i] = top_bin + 1
             continue
         if low <= eps * eps * top:

@@ -27,7 +27,7 @@ __all__ = ["study", "BLOCK_SIZE", "CHUNK_BLOCKS", "DEFAULT_METRICS", "plan", "Pl
 #: speed on every numba thread (> 0.2 ms a thread), small enough that a block's arrays stay in cache-sized MBs.
 BLOCK_SIZE = 1 << 16
 #: Blocks per dask task by default: ~10^6 samples, 0.5-1.3 s of one worker's work for the cheapest target (the
-#: quadruped), against dask's 4-6 ms a task measured (docs/study.md, "Chunk size"); fewer when a point has fewer.
+#: quadruped), against dask's 4-7 ms a task measured (docs/study.md, "Chunk size"); fewer when a point has fewer.
 CHUNK_BLOCKS = 16
 DEFAULT_METRICS = ("reach", "conditioning", "singularity")
 

@@ -6,11 +6,12 @@ from __future__ import annotations
 import argparse
 import contextlib
 import importlib.util
-from typing import Any, Callable, Iterator
-
-import numpy as np
+from typing import TYPE_CHECKING, Any, Callable, Iterator
 
 from ..errors import LegkinError
+
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = ["add_study_command", "parse_param", "run_study_cli"]
 
@@ -27,6 +28,8 @@ def parse_param(text: str) -> tuple[str, np.ndarray]:
     Raises:
         argparse.ArgumentTypeError: malformed.
     """
+    import numpy as np
+
     name, sep, spec = text.partition("=")
     try:
         if not sep or not name:

@@ -110,10 +110,10 @@ def _planar_solve(target: np.ndarray, params: Mapping[str, Any], extras: tuple[s
 
 # ------------------------------------------------------------------ the tripod (seed 000)
 def _tripod_sample(rng: np.random.Generator, n: int, params: Mapping[str, Any]) -> np.ndarray:
-    """Platform axes uniform on the unit sphere (normalised Gaussians), as (alpha_y, alpha_z) (rad)."""
-    r = rng.standard_normal((n, 3))
-    r /= np.linalg.norm(r, axis=1, keepdims=True)
-    return np.stack([-np.arcsin(np.clip(r[:, 2], -1.0, 1.0)), np.arctan2(r[:, 1], r[:, 0])], -1)
+    """Platform axes uniform on the unit sphere (isotropic Gaussians), as (alpha_y, alpha_z) (rad):
+    :func:`legkin.tripod.orientation_from_axis`."""
+    ay, az = importlib.import_module("legkin.tripod").orientation_from_axis(rng.standard_normal((n, 3)))
+    return np.stack([ay, az], -1)
 
 
 def _tripod_cv_error(tp: Any, target: np.ndarray, ok: np.ndarray, g: Any) -> np.ndarray:

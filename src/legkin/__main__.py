@@ -1,4 +1,4 @@
-"""The ``legkin`` command line: list, generate, check, view, bench.
+"""The ``legkin`` command line: list, generate, check, view, bench, study.
 
 Every error ends the command with one line on stderr (``legkin: error: ...``) and a non-zero exit status:
 1 when checks fail or files are stale, 2 for a bad command line or a legkin error, 3 for an unexpected
@@ -310,6 +310,9 @@ def build_parser() -> argparse.ArgumentParser:
     from .mjcf.sim_cli import add_sim_command
 
     add_sim_command(sub)  # legkin sim MODEL --scenario stand|roll|squat [--video PATH | --html PATH]
+    from .study.cli import add_study_command
+
+    add_study_command(sub, output_file, positive_int, nonnegative_int, _show_progress)  # legkin study (docs/study.md)
     p = sub.add_parser("export", help="export a model to another format: --mjcf PATH (MuJoCo, loops as equalities)")
     p.add_argument("model")
     p.add_argument("--mjcf", metavar="PATH", type=output_file, required=True, help="write a MuJoCo MJCF to PATH")

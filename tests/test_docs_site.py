@@ -1,7 +1,7 @@
 """The documentation site: ``mkdocs build --strict`` builds it, and each API page, opened in headless Chromium,
 lists every public function of the modules it documents (their ``__all__``).
 
-Needs the ``dev`` extra (mkdocs-material, mkdocstrings); skipped without it outside CI. ``.ci/run`` installs it and
+Needs the ``dev`` extra (mkdocs-material, mkdocstrings) and skips without it; ``.ci/run`` installs it and then
 runs this file.
 """
 

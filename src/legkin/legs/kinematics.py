@@ -56,7 +56,7 @@ from .._batch import as_input, check_flag, finish
 from .._kernels import OK, as_rows
 from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
 from ._fk_kernels import _fk_batch, _fk_k, _jacobian_batch, _jacobian_k
-from ._ik_kernels import _ik_all_batch, _ik_batch, _ik_k
+from ._ik_kernels import _ik_all_batch, _ik_all_k, _ik_batch, _ik_k
 from ._layout import (
     _A1,
     _A2,
@@ -434,7 +434,7 @@ class Leg:
             return UnreachableError(f"target {tgt} is out of reach of leg {self.name} by {miss:.6g} m: {text}",
                                     target=p)
         if status == _JOINT_LIMIT:
-            branches = self.ik_all(p)[0]
+            branches = self.ik_all(p)
             return JointLimitError(
                 f"target {tgt} of leg {self.name} is reachable only outside the joint limits "
                 f"[{self.lower.tolist()}, {self.upper.tolist()}] (by {float(info[0]):.6g} rad at least); "
@@ -443,7 +443,7 @@ class Leg:
             )
         return InvalidInputError(f"p must be finite, got {tgt}")  # pragma: no cover - as_input caught it
 
-    def ik_all(self, p, *, q_near=None) -> tuple[np.ndarray, np.ndarray]:
+    def ik_all(self, p, *, q_near=None, return_mask: bool = False):
         """Every IK branch of the target(s) ``p`` (m, root frame), joint limits ignored.
 
         Branches in :data:`BRANCHES` order ``(s_a, s_k)``: ``u3 = s_a sqrt(y^2 + z^2 - d^2)`` (abduction) and
@@ -454,15 +454,27 @@ class Leg:
         Args:
             p: targets (3,) or (..., 3).
             q_near: reference joint values (3,) or broadcastable with ``p``.
+            return_mask: also return the boolean mask of the branches that exist (legkin 0.2.0 convention).
 
         Returns:
-            ``(q_all, mask)``: (4, 3) or (..., 4, 3) with NaN rows for absent branches, and the (4,) or (..., 4)
-            boolean mask of the branches that exist.
+            ``q_all`` (4, 3) or (..., 4, 3) (rad) with NaN rows for absent branches; with ``return_mask=True``
+            ``(q_all, mask)``, the mask (4,) or (..., 4).
 
         Raises:
             UnreachableError: a single target with no branch (the message says by how much it misses).
             InvalidInputError: ``p`` or ``q_near`` not finite real arrays (..., 3), or not broadcastable.
+            InvalidParameterError: ``return_mask`` not a bool.
         """
+        if return_mask is not False and return_mask is not True:
+            return_mask = check_flag(return_mask, "return_mask")
+        if q_near is None and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast
+            out = np.empty((4, 3))
+            info = np.zeros(2)
+            st = _ik_all_k(p, self.params, self.q_ref, out, info)
+            if st == OK:
+                return (out, np.isfinite(out[:, 0])) if return_mask else out
+            if st != _BAD_INPUT:
+                raise self._error(st, info, p.copy())
         rows, ref, batch, single = self._prepare(p, q_near)
         n = rows.shape[0]
         out = np.empty((n, 4, 3))
@@ -471,8 +483,10 @@ class Leg:
         _ik_all_batch(rows, self.params, ref, out, status, info)
         if single and status[0] != OK:
             raise self._error(int(status[0]), info[0], rows[0])
-        mask = np.isfinite(out[..., 0])
-        return out.reshape(batch + (4, 3)), mask.reshape(batch + (4,))
+        q_all = out.reshape(batch + (4, 3))
+        if not return_mask:
+            return q_all
+        return q_all, np.isfinite(q_all[..., 0])
 
     def ik(self, p, *, q_near=None, return_mask: bool = False):
         """Joint values placing the foot at ``p``: the branch inside the URDF limits nearest ``q_near``.

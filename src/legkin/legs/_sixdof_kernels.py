@@ -1,0 +1,372 @@
+"""Kernels of a 6-DOF leg (:mod:`legkin.legs.sixdof`): forward map, Jacobian, Newton polish, every IK solution of
+a leg with intersecting hip axes (subproblems 3, 2, 2, 1 of :mod:`.subproblems`), the solution inside the limits.
+
+Poses travel as 16 floats (a 4x4 homogeneous matrix, row-major); the leg's geometry as the float64 array of
+:mod:`._sixdof_layout`. The forward map is the product of exponentials about the neutral configuration with the
+measured axes ``a_j`` through the measured origins ``o_j`` (root frame), which is what Pinocchio computes::
+
+    T(q) = E_1(q_1) ... E_6(q_6) M_0,    E_j(t) = (R(a_j, t), o_j - R(a_j, t) o_j)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._kernels import OK, batch_kernel, kernel
+from ._ik_kernels import _in_limits_k, _near_k
+from ._sixdof_layout import (
+    _ANK,
+    _AX,
+    _BAD_INPUT,
+    _HI6,
+    _HIP,
+    _JOINT_LIMIT,
+    _LO6,
+    _M0,
+    _NSOL,
+    _OR,
+    _UNREACHABLE,
+    POLISH_BELOW6,
+    POLISH_DAMPING6,
+    POLISH_STEPS6,
+)
+from .subproblems import cross, dot, rot, sp1, sp2, sp3
+
+_NAN = math.nan
+
+
+@kernel
+def _axis(g, j):
+    return g[_AX + 3 * j], g[_AX + 3 * j + 1], g[_AX + 3 * j + 2]
+
+
+@kernel
+def _origin(g, j):
+    return g[_OR + 3 * j], g[_OR + 3 * j + 1], g[_OR + 3 * j + 2]
+
+
+@kernel
+def _rodrigues(k, t, m) -> None:
+    """``m`` (3, 3) = ``R(k, t)``."""
+    c, s = math.cos(t), math.sin(t)
+    v = 1.0 - c
+    m[0, 0], m[0, 1], m[0, 2] = c + v * k[0] * k[0], v * k[0] * k[1] - s * k[2], v * k[0] * k[2] + s * k[1]
+    m[1, 0], m[1, 1], m[1, 2] = v * k[0] * k[1] + s * k[2], c + v * k[1] * k[1], v * k[1] * k[2] - s * k[0]
+    m[2, 0], m[2, 1], m[2, 2] = v * k[0] * k[2] - s * k[1], v * k[1] * k[2] + s * k[0], c + v * k[2] * k[2]
+
+
+@kernel
+def _pose6(q, g, rot_out, pos_out, axes_w, orig_w) -> None:
+    """Foot rotation ``rot_out`` (3, 3) and position ``pos_out`` (3,) of ``T(q) = E_1 ... E_6 M_0``; with the world
+    axes ``axes_w`` (6, 3) and points ``orig_w`` (6, 3) of the joints at ``q`` (for the Jacobian)."""
+    r = np.eye(3)
+    t = np.zeros(3)
+    m = np.empty((3, 3))
+    tmp = np.empty((3, 3))
+    for j in range(6):
+        a, o = _axis(g, j), _origin(g, j)
+        for i in range(3):  # the joint's axis and a point of it, in the root frame at q
+            axes_w[j, i] = r[i, 0] * a[0] + r[i, 1] * a[1] + r[i, 2] * a[2]
+            orig_w[j, i] = r[i, 0] * o[0] + r[i, 1] * o[1] + r[i, 2] * o[2] + t[i]
+        _rodrigues(a, q[j], m)
+        # (r, t) <- (r, t) E_j = (r m, r (o - m o) + t)
+        mo = (m[0, 0] * o[0] + m[0, 1] * o[1] + m[0, 2] * o[2], m[1, 0] * o[0] + m[1, 1] * o[1] + m[1, 2] * o[2],
+              m[2, 0] * o[0] + m[2, 1] * o[1] + m[2, 2] * o[2])
+        d = (o[0] - mo[0], o[1] - mo[1], o[2] - mo[2])
+        for i in range(3):
+            t[i] += r[i, 0] * d[0] + r[i, 1] * d[1] + r[i, 2] * d[2]
+            for c in range(3):
+                tmp[i, c] = r[i, 0] * m[0, c] + r[i, 1] * m[1, c] + r[i, 2] * m[2, c]
+        for i in range(3):
+            for c in range(3):
+                r[i, c] = tmp[i, c]
+    for i in range(3):
+        pos_out[i] = t[i] + r[i, 0] * g[_M0 + 9] + r[i, 1] * g[_M0 + 10] + r[i, 2] * g[_M0 + 11]
+        for c in range(3):
+            rot_out[i, c] = r[i, 0] * g[_M0 + c] + r[i, 1] * g[_M0 + 3 + c] + r[i, 2] * g[_M0 + 6 + c]
+
+
+@kernel
+def _finite(x, n) -> bool:
+    for i in range(n):
+        if not np.isfinite(x[i]):
+            return False
+    return True
+
+
+@kernel(entry=True)
+def _fk6_k(q, g, out) -> int:
+    """The foot pose ``T(q)`` (16 floats, row-major 4x4) in the root frame."""
+    if not _finite(q, 6):
+        return _BAD_INPUT
+    rm, p = np.empty((3, 3)), np.empty(3)
+    aw, ow = np.empty((6, 3)), np.empty((6, 3))
+    _pose6(q, g, rm, p, aw, ow)
+    for i in range(3):
+        for c in range(3):
+            out[4 * i + c] = rm[i, c]
+        out[4 * i + 3] = p[i]
+        out[12 + i] = 0.0
+    out[15] = 1.0
+    return OK
+
+
+@kernel
+def _jac6(q, g, jac, rm, p) -> None:
+    """Pinocchio's LOCAL_WORLD_ALIGNED foot Jacobian (6, 6): column j = ``(w_j x (p - o_j), w_j)`` with the joint's
+    axis ``w_j`` and point ``o_j`` at ``q`` (root frame); also the foot rotation ``rm`` and position ``p``."""
+    aw, ow = np.empty((6, 3)), np.empty((6, 3))
+    _pose6(q, g, rm, p, aw, ow)
+    for j in range(6):
+        w = (aw[j, 0], aw[j, 1], aw[j, 2])
+        lin = cross(w, (p[0] - ow[j, 0], p[1] - ow[j, 1], p[2] - ow[j, 2]))
+        for i in range(3):
+            jac[i, j] = lin[i]
+            jac[3 + i, j] = w[i]
+
+
+@kernel(entry=True)
+def _jacobian6_k(q, g, out) -> int:
+    """The (6, 6) foot Jacobian, linear rows then angular (LOCAL_WORLD_ALIGNED at the foot frame)."""
+    if not _finite(q, 6):
+        return _BAD_INPUT
+    _jac6(q, g, out, np.empty((3, 3)), np.empty(3))
+    return OK
+
+
+@kernel
+def _pose_error(tg, rm, p, e) -> float:
+    """``e`` (6,) = ``(p_target - p, log(R_target R^T))`` (m, rad; root frame) and its norm."""
+    for i in range(3):
+        e[i] = tg[4 * i + 3] - p[i]
+    # m = R_target R^T
+    m = np.empty((3, 3))
+    for i in range(3):
+        for c in range(3):
+            m[i, c] = tg[4 * i] * rm[c, 0] + tg[4 * i + 1] * rm[c, 1] + tg[4 * i + 2] * rm[c, 2]
+    vx, vy, vz = 0.5 * (m[2, 1] - m[1, 2]), 0.5 * (m[0, 2] - m[2, 0]), 0.5 * (m[1, 0] - m[0, 1])
+    sn = math.sqrt(vx * vx + vy * vy + vz * vz)
+    ang = math.atan2(sn, 0.5 * (m[0, 0] + m[1, 1] + m[2, 2] - 1.0))
+    f = ang / sn if sn > 1e-300 else 1.0
+    e[3], e[4], e[5] = f * vx, f * vy, f * vz
+    return math.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2 + e[3] ** 2 + e[4] ** 2 + e[5] ** 2)
+
+
+@kernel
+def _solve6(a, b, x) -> bool:
+    """Solve the symmetric positive definite ``a x = b`` (6, 6) by Cholesky (``a`` overwritten); False if not SPD."""
+    for j in range(6):
+        s = a[j, j]
+        for k in range(j):
+            s -= a[j, k] * a[j, k]
+        if not s > 0.0:
+            return False
+        a[j, j] = math.sqrt(s)
+        for i in range(j + 1, 6):
+            s = a[i, j]
+            for k in range(j):
+                s -= a[i, k] * a[j, k]
+            a[i, j] = s / a[j, j]
+    for i in range(6):
+        s = b[i]
+        for k in range(i):
+            s -= a[i, k] * x[k]
+        x[i] = s / a[i, i]
+    for i in range(5, -1, -1):
+        s = x[i]
+        for k in range(i + 1, 6):
+            s -= a[k, i] * x[k]
+        x[i] = s / a[i, i]
+    return True
+
+
+@kernel
+def _polish6(tg, g, q) -> float:
+    """Damped Newton steps ``dq = (J^T J + lambda^2 I)^-1 J^T e`` on the exact forward map (at most
+    :data:`POLISH_STEPS6`, each kept only if it reduces ``|e|``) while ``|e|`` exceeds :data:`POLISH_BELOW6`.
+    Returns the final ``|e|`` (m and rad combined)."""
+    jac, rm, p = np.empty((6, 6)), np.empty((3, 3)), np.empty(3)
+    e, a, b, dq, qn = np.empty(6), np.empty((6, 6)), np.empty(6), np.empty(6), np.empty(6)
+    _jac6(q, g, jac, rm, p)
+    err = _pose_error(tg, rm, p, e)
+    lam2 = POLISH_DAMPING6 * POLISH_DAMPING6
+    for _ in range(POLISH_STEPS6):
+        if err <= POLISH_BELOW6:
+            break
+        for i in range(6):
+            b[i] = 0.0
+            for k in range(6):
+                b[i] += jac[k, i] * e[k]
+            for c in range(6):
+                s = lam2 if i == c else 0.0
+                for k in range(6):
+                    s += jac[k, i] * jac[k, c]
+                a[i, c] = s
+        if not _solve6(a, b, dq):
+            break
+        for i in range(6):
+            qn[i] = q[i] + dq[i]
+        _jac6(qn, g, jac, rm, p)
+        new = _pose_error(tg, rm, p, e)
+        if not new < err:
+            break
+        err = new
+        for i in range(6):
+            q[i] = qn[i]
+    return err
+
+
+@kernel
+def _hip_candidates(tg, g, cand) -> int:
+    """The closed-form solutions (rows of ``cand`` (8, 6)) of a leg whose hip axes 1-3 meet at the hip centre
+    ``c`` and whose ankle axes 5, 6 meet at the ankle centre ``a``; returns how many rows are filled.
+
+    With ``G = T M_0^-1`` and ``d = G^-1 c``: ``E_4 E_5 E_6 d = c``. Then (i) SP3: ``|E_4^-1 c - a| = |d - a|``
+    gives ``q_4``; (ii) SP2: ``R(a_5, -q_5)(E_4^-1 c - a) = R(a_6, q_6)(d - a)`` gives ``(q_5, q_6)``; (iii) the hip
+    rotation ``R_h = R_G R_6^T R_5^T R_4^T``: SP2 ``R(a_1, -q_1) R_h a_3 = R(a_2, q_2) a_3`` gives ``(q_1, q_2)``,
+    SP1 ``R(a_3, q_3) v = R_2^T R_1^T R_h v`` (``v`` normal to ``a_3``) gives ``q_3``. Branches that the
+    subproblems find absent are filled with their least-squares angles (the polish and the residual decide)."""
+    gr = np.empty((3, 3))
+    for i in range(3):
+        for c in range(3):  # R_G = R_T R_0^T
+            gr[i, c] = tg[4 * i] * g[_M0 + 3 * c] + tg[4 * i + 1] * g[_M0 + 3 * c + 1] + tg[4 * i + 2] * g[_M0 + 3 * c + 2]
+    p0 = (g[_M0 + 9], g[_M0 + 10], g[_M0 + 11])
+    gt = (tg[3] - (gr[0, 0] * p0[0] + gr[0, 1] * p0[1] + gr[0, 2] * p0[2]),
+          tg[7] - (gr[1, 0] * p0[0] + gr[1, 1] * p0[1] + gr[1, 2] * p0[2]),
+          tg[11] - (gr[2, 0] * p0[0] + gr[2, 1] * p0[1] + gr[2, 2] * p0[2]))
+    c = (g[_HIP], g[_HIP + 1], g[_HIP + 2])
+    an = (g[_ANK], g[_ANK + 1], g[_ANK + 2])
+    x = (c[0] - gt[0], c[1] - gt[1], c[2] - gt[2])
+    d = (gr[0, 0] * x[0] + gr[1, 0] * x[1] + gr[2, 0] * x[2], gr[0, 1] * x[0] + gr[1, 1] * x[1] + gr[2, 1] * x[2],
+         gr[0, 2] * x[0] + gr[1, 2] * x[1] + gr[2, 2] * x[2])
+    a1, a2, a3, a4, a5, a6 = _axis(g, 0), _axis(g, 1), _axis(g, 2), _axis(g, 3), _axis(g, 4), _axis(g, 5)
+    o4 = _origin(g, 3)
+    da = (d[0] - an[0], d[1] - an[1], d[2] - an[2])
+    _, t4a, t4b, _ = sp3((c[0] - o4[0], c[1] - o4[1], c[2] - o4[2]), (an[0] - o4[0], an[1] - o4[1], an[2] - o4[2]),
+                         a4, math.sqrt(dot(da, da)))
+    v = cross(a3, a2)
+    nv = math.sqrt(dot(v, v))
+    v = (v[0] / nv, v[1] / nv, v[2] / nv)
+    n = 0
+    for i4 in range(2):
+        q4 = -(t4a if i4 == 0 else t4b)
+        e = rot(a4, -q4, (c[0] - o4[0], c[1] - o4[1], c[2] - o4[2]))
+        ea = (e[0] + o4[0] - an[0], e[1] + o4[1] - an[1], e[2] + o4[2] - an[2])
+        _, t5a, t6a, t5b, t6b, _ = sp2(ea, da, a5, a6)
+        for i56 in range(2):
+            q5, q6 = -(t5a if i56 == 0 else t5b), (t6a if i56 == 0 else t6b)
+            # R_h y = R_G R_6^T R_5^T R_4^T y
+            h3 = rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, a3)))
+            h3 = (gr[0, 0] * h3[0] + gr[0, 1] * h3[1] + gr[0, 2] * h3[2], gr[1, 0] * h3[0] + gr[1, 1] * h3[1]
+                  + gr[1, 2] * h3[2], gr[2, 0] * h3[0] + gr[2, 1] * h3[1] + gr[2, 2] * h3[2])
+            hv = rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, v)))
+            hv = (gr[0, 0] * hv[0] + gr[0, 1] * hv[1] + gr[0, 2] * hv[2], gr[1, 0] * hv[0] + gr[1, 1] * hv[1]
+                  + gr[1, 2] * hv[2], gr[2, 0] * hv[0] + gr[2, 1] * hv[1] + gr[2, 2] * hv[2])
+            _, t1a, t2a, t1b, t2b, _ = sp2(h3, a3, a1, a2)
+            for i12 in range(2):
+                q1, q2 = -(t1a if i12 == 0 else t1b), (t2a if i12 == 0 else t2b)
+                q3 = sp1(v, rot(a2, -q2, rot(a1, -q1, hv)), a3)
+                cand[n, 0], cand[n, 1], cand[n, 2] = q1, q2, q3
+                cand[n, 3], cand[n, 4], cand[n, 5] = q4, q5, q6
+                n += 1
+    return n
+
+
+@kernel(entry=True)
+def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
+    """Every solution (rows of ``out`` (8, 6), NaN rows for absent ones) of the foot pose ``tg`` (16 floats): the
+    closed form's candidates, each polished (:func:`_polish6`) and kept if it reproduces ``tg`` to ``tol``, each
+    angle moved to its 2 pi representative nearest ``ref``. ``info[0]``: on failure the least residual."""
+    for b in range(_NSOL):
+        for j in range(6):
+            out[b, j] = _NAN
+    if not _finite(tg, 16):
+        return _BAD_INPUT
+    cand = np.empty((_NSOL, 6))
+    n = _hip_candidates(tg, g, cand)
+    best, found = math.inf, 0
+    qb = np.empty(6)
+    for b in range(n):
+        for j in range(6):
+            qb[j] = cand[b, j]
+        res = _polish6(tg, g, qb)
+        if res <= tol:
+            for j in range(6):
+                out[b, j] = _near_k(qb[j], ref[j])
+            found += 1
+        elif res < best:
+            best = res
+    if found == 0:
+        info[0], info[1] = best, 0.0
+        return _UNREACHABLE
+    return OK
+
+
+@kernel(entry=True)
+def _ik6_k(tg, g, ref, tol, out, info) -> int:
+    """The solution of :func:`_ik_all6_k` inside the limits nearest ``ref`` (least sum of squared differences;
+    ties to the earlier row). ``info``: the least residual, or the least limit violation (rad) and the count of
+    solutions."""
+    qa = np.empty((_NSOL, 6))
+    status = _ik_all6_k(tg, g, ref, tol, qa, info)
+    for j in range(6):
+        out[j] = _NAN
+    if status != OK:
+        return status
+    best, viol, nb = math.inf, math.inf, 0
+    x = np.empty(6)
+    for b in range(_NSOL):
+        if not np.isfinite(qa[b, 0]):
+            continue
+        nb += 1
+        worst, inside = 0.0, True
+        for j in range(6):
+            x[j], m = _in_limits_k(qa[b, j], ref[j], g[_LO6 + j], g[_HI6 + j])
+            worst = max(worst, m)
+            inside = inside and np.isfinite(x[j])
+        viol = min(viol, worst)
+        if not inside:
+            continue
+        cost = 0.0
+        for j in range(6):
+            cost += (x[j] - ref[j]) ** 2
+        if cost < best:
+            best = cost
+            for j in range(6):
+                out[j] = x[j]
+    if best == math.inf:
+        info[0], info[1] = viol, nb
+        return _JOINT_LIMIT
+    return OK
+
+
+@batch_kernel(rows="q out", min_parallel=2048)
+def _fk6_batch(q, g, out) -> int:
+    n, bad = q.shape[0], 0
+    for i in range(n):
+        bad += _fk6_k(q[i], g, out[i]) != OK
+    return bad
+
+
+@batch_kernel(rows="q out", min_parallel=1024)
+def _jacobian6_batch(q, g, out) -> int:
+    n, bad = q.shape[0], 0
+    for i in range(n):
+        bad += _jacobian6_k(q[i], g, out[i]) != OK
+    return bad
+
+
+@batch_kernel(rows="tg ref out status info", min_parallel=256)
+def _ik_all6_batch(tg, g, ref, tol, out, status, info) -> None:
+    n, m = tg.shape[0], ref.shape[0]
+    for i in range(n):
+        status[i] = _ik_all6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])
+
+
+@batch_kernel(rows="tg ref out status info", min_parallel=256)
+def _ik6_batch(tg, g, ref, tol, out, status, info) -> None:
+    n, m = tg.shape[0], ref.shape[0]
+    for i in range(n):
+        status[i] = _ik6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])

@@ -12,7 +12,7 @@ import pytest
 from hypothesis import assume, example, given
 from hypothesis import strategies as st
 
-from legkin import legs
+from legkin import errors, legs
 from legkin.errors import (
     InvalidInputError,
     InvalidParameterError,
@@ -240,7 +240,7 @@ def test_tilted_pitch_axis_raises_clear_error():
         legs.from_model(build_leg(tilt_hfe_deg=2.0))
     with pytest.raises(LegStructureError, match="off parallel"):
         legs.from_model(build_leg(tilt_kfe_deg=1e-6))  # 1.7e-8 rad > 1e-9
-    assert issubclass(LegStructureError, InvalidParameterError) and issubclass(LegStructureError, LegkinError)
+    assert LegStructureError is errors.LegStructureError and issubclass(LegStructureError, (LegkinError, ValueError))
     legs.from_model(build_leg(tilt_kfe_deg=1e-9))  # 1.7e-11 rad: within the 1e-9 tolerance
     with pytest.raises(LegStructureError, match="foot.*lies on the KFE axis"):
         legs.from_model(build_leg(foot=(0.0, 0.0, 0.0), t=((0.2, 0.1, 0.0), (0.05, 0.08, -0.02), (0.0, 0.0, -0.25))))
@@ -250,8 +250,10 @@ def test_no_leg_found():
     model = pin.Model()
     j = model.addJoint(0, pin.JointModelRY(), pin.SE3.Identity(), "only")
     model.addJointFrame(j, -1)
-    with pytest.raises(InvalidParameterError, match="no HAA-HFE-KFE leg found"):
+    with pytest.raises(LegStructureError, match=r"no leg found.*Found: only \(RY\): 1 joints.*Supported: HAA") as info:
         legs.from_model(model)
+    assert info.value.found == ["only (RY): 1 joints, ends at a leaf, foot frame 'only'"]
+    assert any("HAA-HFE-KFE" in e for e in info.value.expected) and any("6R" in e for e in info.value.expected)
 
 
 angles = st.floats(-math.pi, math.pi, allow_nan=False)

@@ -1,4 +1,4 @@
-"""Closed-form IK of any HAA-HFE-KFE quadruped leg, measured from its URDF (issue 13).
+"""Exact leg kinematics measured from any URDF: HAA-HFE-KFE legs (issue 13) and 6-DOF humanoid legs (issue 26).
 
 >>> from legkin import legs
 >>> model, urdf, dirs = legs.load_erd("go2")
@@ -21,15 +21,18 @@ if TYPE_CHECKING:  # at run time the names load on first use: `import legkin` (i
     from .extract import find_chains, from_model, from_urdf
     from .kinematics import BRANCHES, Leg, LegStructureError
     from .registry import erd_spec
+    from .sixdof import Leg6
 
 _WHERE = {
     "ERD_ROBOTS": "erd", "ErdRobot": "erd", "erd_files": "erd", "external_models": "erd", "load_erd": "erd",
     "reference_configuration": "erd", "find_chains": "extract", "from_model": "extract", "from_urdf": "extract",
     "BRANCHES": "kinematics", "Leg": "kinematics", "LegStructureError": "kinematics", "erd_spec": "registry",
+    "Leg6": "sixdof",
 }
 
 __all__ = [
     "Leg",
+    "Leg6",
     "LegStructureError",
     "BRANCHES",
     "from_model",

@@ -219,6 +219,20 @@ def _polish6(tg, g, q) -> float:
 
 
 @kernel
+def _mat_vec(m, v):
+    """``m v`` for a (3, 3) array ``m``."""
+    return (m[0, 0] * v[0] + m[0, 1] * v[1] + m[0, 2] * v[2], m[1, 0] * v[0] + m[1, 1] * v[1] + m[1, 2] * v[2],
+            m[2, 0] * v[0] + m[2, 1] * v[1] + m[2, 2] * v[2])
+
+
+@kernel
+def _mat_t_vec(m, v):
+    """``m^T v`` for a (3, 3) array ``m``."""
+    return (m[0, 0] * v[0] + m[1, 0] * v[1] + m[2, 0] * v[2], m[0, 1] * v[0] + m[1, 1] * v[1] + m[2, 1] * v[2],
+            m[0, 2] * v[0] + m[1, 2] * v[1] + m[2, 2] * v[2])
+
+
+@kernel
 def _hip_candidates(tg, g, cand) -> int:
     """The closed-form solutions (rows of ``cand`` (8, 6)) of a leg whose hip axes 1-3 meet at the hip centre
     ``c`` and whose ankle axes 5, 6 meet at the ankle centre ``a``; returns how many rows are filled.
@@ -230,17 +244,14 @@ def _hip_candidates(tg, g, cand) -> int:
     subproblems find absent are filled with their least-squares angles (the polish and the residual decide)."""
     gr = np.empty((3, 3))
     for i in range(3):
-        for c in range(3):  # R_G = R_T R_0^T
-            gr[i, c] = tg[4 * i] * g[_M0 + 3 * c] + tg[4 * i + 1] * g[_M0 + 3 * c + 1] + tg[4 * i + 2] * g[_M0 + 3 * c + 2]
-    p0 = (g[_M0 + 9], g[_M0 + 10], g[_M0 + 11])
-    gt = (tg[3] - (gr[0, 0] * p0[0] + gr[0, 1] * p0[1] + gr[0, 2] * p0[2]),
-          tg[7] - (gr[1, 0] * p0[0] + gr[1, 1] * p0[1] + gr[1, 2] * p0[2]),
-          tg[11] - (gr[2, 0] * p0[0] + gr[2, 1] * p0[1] + gr[2, 2] * p0[2]))
+        for k in range(3):  # R_G = R_T R_0^T
+            j = _M0 + 3 * k
+            gr[i, k] = tg[4 * i] * g[j] + tg[4 * i + 1] * g[j + 1] + tg[4 * i + 2] * g[j + 2]
+    gp0 = _mat_vec(gr, (g[_M0 + 9], g[_M0 + 10], g[_M0 + 11]))
+    gt = (tg[3] - gp0[0], tg[7] - gp0[1], tg[11] - gp0[2])
     c = (g[_HIP], g[_HIP + 1], g[_HIP + 2])
     an = (g[_ANK], g[_ANK + 1], g[_ANK + 2])
-    x = (c[0] - gt[0], c[1] - gt[1], c[2] - gt[2])
-    d = (gr[0, 0] * x[0] + gr[1, 0] * x[1] + gr[2, 0] * x[2], gr[0, 1] * x[0] + gr[1, 1] * x[1] + gr[2, 1] * x[2],
-         gr[0, 2] * x[0] + gr[1, 2] * x[1] + gr[2, 2] * x[2])
+    d = _mat_t_vec(gr, (c[0] - gt[0], c[1] - gt[1], c[2] - gt[2]))
     a1, a2, a3, a4, a5, a6 = _axis(g, 0), _axis(g, 1), _axis(g, 2), _axis(g, 3), _axis(g, 4), _axis(g, 5)
     o4 = _origin(g, 3)
     da = (d[0] - an[0], d[1] - an[1], d[2] - an[2])
@@ -258,12 +269,8 @@ def _hip_candidates(tg, g, cand) -> int:
         for i56 in range(2):
             q5, q6 = -(t5a if i56 == 0 else t5b), (t6a if i56 == 0 else t6b)
             # R_h y = R_G R_6^T R_5^T R_4^T y
-            h3 = rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, a3)))
-            h3 = (gr[0, 0] * h3[0] + gr[0, 1] * h3[1] + gr[0, 2] * h3[2], gr[1, 0] * h3[0] + gr[1, 1] * h3[1]
-                  + gr[1, 2] * h3[2], gr[2, 0] * h3[0] + gr[2, 1] * h3[1] + gr[2, 2] * h3[2])
-            hv = rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, v)))
-            hv = (gr[0, 0] * hv[0] + gr[0, 1] * hv[1] + gr[0, 2] * hv[2], gr[1, 0] * hv[0] + gr[1, 1] * hv[1]
-                  + gr[1, 2] * hv[2], gr[2, 0] * hv[0] + gr[2, 1] * hv[1] + gr[2, 2] * hv[2])
+            h3 = _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, a3))))
+            hv = _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, v))))
             _, t1a, t2a, t1b, t2b, _ = sp2(h3, a3, a1, a2)
             for i12 in range(2):
                 q1, q2 = -(t1a if i12 == 0 else t1b), (t2a if i12 == 0 else t2b)
@@ -274,6 +281,23 @@ def _hip_candidates(tg, g, cand) -> int:
     return n
 
 
+@kernel
+def _valid_pose(tg) -> bool:
+    """``tg`` (16) is a finite homogeneous transform: bottom row ``0 0 0 1`` (to 1e-12), ``R^T R = I`` and
+    ``det R = 1`` to 1e-6 (the same test as :func:`legkin.legs.sixdof._pose_input`)."""
+    if not _finite(tg, 16):
+        return False
+    if abs(tg[12]) > 1e-12 or abs(tg[13]) > 1e-12 or abs(tg[14]) > 1e-12 or abs(tg[15] - 1.0) > 1e-12:
+        return False
+    for i in range(3):
+        for c in range(3):
+            s = tg[i] * tg[c] + tg[4 + i] * tg[4 + c] + tg[8 + i] * tg[8 + c]
+            if abs(s - (1.0 if i == c else 0.0)) > 1e-6:
+                return False
+    det = dot((tg[0], tg[4], tg[8]), cross((tg[1], tg[5], tg[9]), (tg[2], tg[6], tg[10])))
+    return abs(det - 1.0) <= 1e-6
+
+
 @kernel(entry=True)
 def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
     """Every solution (rows of ``out`` (8, 6), NaN rows for absent ones) of the foot pose ``tg`` (16 floats): the
@@ -282,7 +306,7 @@ def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
     for b in range(_NSOL):
         for j in range(6):
             out[b, j] = _NAN
-    if not _finite(tg, 16):
+    if not _valid_pose(tg):
         return _BAD_INPUT
     cand = np.empty((_NSOL, 6))
     n = _hip_candidates(tg, g, cand)

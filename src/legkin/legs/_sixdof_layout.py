@@ -18,8 +18,8 @@ IK_TOL = 1e-9
 POLISH_STEPS6 = 12
 #: Damping of the polish steps (m): bounds a step near a singularity.
 POLISH_DAMPING6 = 1e-9
-#: Pose error (m and rad) below which the polish stops (a few ulps of a 1 m leg).
-POLISH_BELOW6 = 4e-15
+#: Pose error (m and rad) below which the polish stops (the closed form of an exact structure lands at ~1e-15).
+POLISH_BELOW6 = 1e-13
 #: Solutions of the closed forms (the rows of :meth:`Leg6.ik_all`).
 _NSOL = 8
 

@@ -54,7 +54,8 @@ import numpy as np
 
 from .._batch import as_input, check_flag, finish
 from .._kernels import OK, as_rows
-from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
+from ..errors import InvalidInputError, JointLimitError, UnreachableError
+from ..errors import LegStructureError as _LegStructureError
 from ._fk_kernels import _fk_batch, _fk_k, _jacobian_batch, _jacobian_k
 from ._ik_kernels import _ik_all_batch, _ik_all_k, _ik_batch, _ik_k
 from ._layout import (
@@ -107,8 +108,8 @@ __all__ = [
 ]
 
 
-class LegStructureError(InvalidParameterError):
-    """A kinematic chain that is not an HAA-HFE-KFE leg (the message names the deviation)."""
+#: A kinematic chain that is not a supported leg (the message names the deviation): legkin.errors' class.
+LegStructureError = _LegStructureError
 
 
 _S3SHAPE = (3,)
@@ -191,6 +192,10 @@ class Leg:
     idx_q: tuple[int, int, int] = (-1, -1, -1)
     idx_v: tuple[int, int, int] = (-1, -1, -1)
     params: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # always set by from_geometry
+
+    #: The leg's structure (see :data:`legkin.legs.extract.EXPECTED`) and its number of joints.
+    structure = "HAA-HFE-KFE"
+    dof = 3
 
     # ------------------------------------------------------------ construction
     @classmethod

@@ -38,10 +38,20 @@ import numpy as np
 from .._batch import as_input, check_flag, check_number, finish
 from .._kernels import OK, as_rows
 from ..errors import InvalidInputError, JointLimitError, LegStructureError, UnreachableError
-from ._sixdof_kernels import _fk6_batch, _ik6_batch, _ik_all6_batch, _jacobian6_batch
+from ._sixdof_kernels import (
+    _fk6_batch,
+    _fk6_k,
+    _ik6_batch,
+    _ik6_k,
+    _ik_all6_batch,
+    _ik_all6_k,
+    _jacobian6_batch,
+    _jacobian6_k,
+)
 from ._sixdof_layout import (
     _ANK,
     _AX,
+    _BAD_INPUT,
     _HI6,
     _HIP,
     _JOINT_LIMIT,
@@ -62,6 +72,7 @@ __all__ = ["Leg6", "AXIS_TOL", "IK_TOL", "STRUCTURES", "nearest_point"]
 STRUCTURES = ("6R-spherical-hip", "6R-general")
 _Q6 = (6,)
 _T44 = (4, 4)
+_F64 = np.dtype(np.float64)
 
 
 def nearest_point(origins, axes) -> tuple[np.ndarray, float]:
@@ -203,6 +214,10 @@ class Leg6:
         Raises:
             InvalidInputError: ``q`` not a finite real array (..., 6).
         """
+        if q.__class__ is np.ndarray and q.shape == _Q6 and q.dtype is _F64 and return_mask is False:
+            one = np.empty(16)  # a single call: straight to the kernel
+            if _fk6_k(q, self.params, one) == OK:
+                return one.reshape(4, 4)
         arr = as_input(q, "q", _Q6)
         rows = as_rows(arr, 6)
         out = np.empty((rows.shape[0], 16))
@@ -220,6 +235,10 @@ class Leg6:
         Raises:
             InvalidInputError: ``q`` not a finite real array (..., 6).
         """
+        if q.__class__ is np.ndarray and q.shape == _Q6 and q.dtype is _F64 and return_mask is False:
+            one = np.empty((6, 6))  # a single call: straight to the kernel
+            if _jacobian6_k(q, self.params, one) == OK:
+                return one
         arr = as_input(q, "q", _Q6)
         rows = as_rows(arr, 6)
         out = np.empty((rows.shape[0], 6, 6))
@@ -286,6 +305,14 @@ class Leg6:
             LegStructureError: a leg without a closed form (:attr:`structure` ``"6R-general"``).
             InvalidInputError, InvalidArgumentError: bad ``target`` / ``q_near`` / ``tol`` / ``return_mask``.
         """
+        if q_near is None and tol is IK_TOL and return_mask is False and target.__class__ is np.ndarray \
+                and target.shape == _T44 and target.dtype is _F64 and self.params[_KIND] == HIP_SPHERICAL:
+            fast, info1 = np.empty((_NSOL, 6)), np.zeros(2)  # a single target: straight to the kernel
+            st = _ik_all6_k(target.reshape(16), self.params, self.q_ref, IK_TOL, fast, info1)
+            if st == OK:
+                return fast
+            if st != _BAD_INPUT:
+                raise self._error(st, info1, target, IK_TOL)
         rows, ref, batch, single, tol = self._prepare(target, q_near, tol)
         flag = check_flag(return_mask, "return_mask")
         n = rows.shape[0]
@@ -315,6 +342,14 @@ class Leg6:
             UnreachableError: a single target out of reach; JointLimitError: reachable only outside the limits.
             LegStructureError, InvalidInputError, InvalidArgumentError: as :meth:`ik_all`.
         """
+        if q_near is None and tol is IK_TOL and return_mask is False and target.__class__ is np.ndarray \
+                and target.shape == _T44 and target.dtype is _F64 and self.params[_KIND] == HIP_SPHERICAL:
+            fast, info1 = np.empty(6), np.zeros(2)  # a single target: straight to the kernel
+            st = _ik6_k(target.reshape(16), self.params, self.q_ref, IK_TOL, fast, info1)
+            if st == OK:
+                return fast
+            if st != _BAD_INPUT:
+                raise self._error(st, info1, target, IK_TOL)
         rows, ref, batch, single, tol = self._prepare(target, q_near, tol)
         flag = check_flag(return_mask, "return_mask")
         n = rows.shape[0]

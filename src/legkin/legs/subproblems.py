@@ -103,32 +103,31 @@ def sp3(p1, p2, k, d):
 def sp2(p1, p2, k1, k2):
     """Subproblem 2: ``(t1, t2)`` with ``R(k1, t1) p1 = R(k2, t2) p2`` (``k1`` not parallel to ``k2``).
 
-    Both sides are the point ``x`` where the cone of ``p1`` about ``k1`` meets the cone of ``p2`` about ``k2``:
-    ``x = a k1 + b k2 + c (k1 x k2)`` with ``k1 . x = k1 . p1``, ``k2 . x = k2 . p2`` (so, with ``g = k1 . k2``,
-    ``a = (k1.p1 - g k2.p2) / (1 - g^2)``, ``b = (k2.p2 - g k1.p1) / (1 - g^2)``) and ``|x| = |p1|`` (so
-    ``c^2 |k1 x k2|^2 = |p1|^2 - a^2 - b^2 - 2 a b g``); then ``t1 = -SP1(x -> p1)`` about ``k1`` and
-    ``t2 = -SP1(x -> p2)`` about ``k2``, i.e. ``t1 = sp1(p1, x, k1)`` reversed: ``R(k1, t1) p1 = x``.
+    Solved on the directions ``u_i = p_i / |p_i|`` (exact when ``|p1| = |p2|``, else the directions align and
+    ``miss`` reports ``| |p1| - |p2| |``): both sides are the unit vector ``x`` where the cone of ``u1`` about ``k1``
+    meets the cone of ``u2`` about ``k2``, ``x = a k1 + b k2 + c (k1 x k2)`` with ``k1 . x = k1 . u1``,
+    ``k2 . x = k2 . u2`` (so, with ``g = k1 . k2``, ``a = (k1.u1 - g k2.u2) / (1 - g^2)``,
+    ``b = (k2.u2 - g k1.u1) / (1 - g^2)``) and ``|x| = 1`` (``c^2 (1 - g^2) = 1 - a^2 - b^2 - 2 a b g``); then
+    ``t1 = SP1(u1 -> x)`` about ``k1`` and ``t2 = SP1(u2 -> x)`` about ``k2``.
 
     Returns:
         ``(n, t1_a, t2_a, t1_b, t2_b, miss)``: ``n`` = 2 (``c = -+ sqrt``), 0 when the cones do not meet
-        (``c = 0``: the least-squares pair, ``miss`` = ``sqrt(-c^2) |k1 x k2|`` > 0).
+        (``c = 0``: the least-squares pair, ``miss`` = ``sqrt(-c^2 (1 - g^2))`` > 0, in units of ``|x|``).
     """
+    n1, n2 = math.sqrt(dot(p1, p1)), math.sqrt(dot(p2, p2))
+    u1 = (p1[0] / n1, p1[1] / n1, p1[2] / n1)
+    u2 = (p2[0] / n2, p2[1] / n2, p2[2] / n2)
     g = dot(k1, k2)
     s2 = 1.0 - g * g
-    kp1, kp2 = dot(k1, p1), dot(k2, p2)
-    a = (kp1 - g * kp2) / s2
-    b = (kp2 - g * kp1) / s2
+    ku1, ku2 = dot(k1, u1), dot(k2, u2)
+    a = (ku1 - g * ku2) / s2
+    b = (ku2 - g * ku1) / s2
     n = cross(k1, k2)
-    c2 = (dot(p1, p1) - a * a - b * b - 2.0 * a * b * g) / s2  # |k1 x k2|^2 = 1 - g^2
-    miss = 0.0
-    count = 2
+    c2 = (1.0 - a * a - b * b - 2.0 * a * b * g) / s2
+    miss, count = abs(n1 - n2), 2
     if c2 < 0.0:
-        miss, c2, count = math.sqrt(-c2 * s2), 0.0, 0
+        miss, c2, count = max(miss, math.sqrt(-c2 * s2)), 0.0, 0
     c = math.sqrt(c2)
-    out = [0.0, 0.0, 0.0, 0.0]
-    for i in range(2):
-        ci = -c if i == 0 else c
-        x = (a * k1[0] + b * k2[0] + ci * n[0], a * k1[1] + b * k2[1] + ci * n[1], a * k1[2] + b * k2[2] + ci * n[2])
-        out[2 * i] = sp1(p1, x, k1)
-        out[2 * i + 1] = sp1(p2, x, k2)
-    return count, out[0], out[1], out[2], out[3], miss
+    xa = (a * k1[0] + b * k2[0] - c * n[0], a * k1[1] + b * k2[1] - c * n[1], a * k1[2] + b * k2[2] - c * n[2])
+    xb = (a * k1[0] + b * k2[0] + c * n[0], a * k1[1] + b * k2[1] + c * n[1], a * k1[2] + b * k2[2] + c * n[2])
+    return count, sp1(u1, xa, k1), sp1(u2, xa, k2), sp1(u1, xb, k1), sp1(u2, xb, k2), miss

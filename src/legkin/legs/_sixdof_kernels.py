@@ -48,44 +48,39 @@ def _origin(g, j):
 
 
 @kernel
-def _rodrigues(k, t, m) -> None:
-    """``m`` (3, 3) = ``R(k, t)``."""
-    c, s = math.cos(t), math.sin(t)
-    v = 1.0 - c
-    m[0, 0], m[0, 1], m[0, 2] = c + v * k[0] * k[0], v * k[0] * k[1] - s * k[2], v * k[0] * k[2] + s * k[1]
-    m[1, 0], m[1, 1], m[1, 2] = v * k[0] * k[1] + s * k[2], c + v * k[1] * k[1], v * k[1] * k[2] - s * k[0]
-    m[2, 0], m[2, 1], m[2, 2] = v * k[0] * k[2] - s * k[1], v * k[1] * k[2] + s * k[0], c + v * k[2] * k[2]
-
-
-@kernel
 def _pose6(q, g, rot_out, pos_out, axes_w, orig_w) -> None:
     """Foot rotation ``rot_out`` (3, 3) and position ``pos_out`` (3,) of ``T(q) = E_1 ... E_6 M_0``; with the world
-    axes ``axes_w`` (6, 3) and points ``orig_w`` (6, 3) of the joints at ``q`` (for the Jacobian)."""
-    r = np.eye(3)
-    t = np.zeros(3)
-    m = np.empty((3, 3))
-    tmp = np.empty((3, 3))
-    for j in range(6):
-        a, o = _axis(g, j), _origin(g, j)
-        for i in range(3):  # the joint's axis and a point of it, in the root frame at q
-            axes_w[j, i] = r[i, 0] * a[0] + r[i, 1] * a[1] + r[i, 2] * a[2]
-            orig_w[j, i] = r[i, 0] * o[0] + r[i, 1] * o[1] + r[i, 2] * o[2] + t[i]
-        _rodrigues(a, q[j], m)
-        # (r, t) <- (r, t) E_j = (r m, r (o - m o) + t)
-        mo = (m[0, 0] * o[0] + m[0, 1] * o[1] + m[0, 2] * o[2], m[1, 0] * o[0] + m[1, 1] * o[1] + m[1, 2] * o[2],
-              m[2, 0] * o[0] + m[2, 1] * o[1] + m[2, 2] * o[2])
-        d = (o[0] - mo[0], o[1] - mo[1], o[2] - mo[2])
-        for i in range(3):
-            t[i] += r[i, 0] * d[0] + r[i, 1] * d[1] + r[i, 2] * d[2]
-            for c in range(3):
-                tmp[i, c] = r[i, 0] * m[0, c] + r[i, 1] * m[1, c] + r[i, 2] * m[2, c]
-        for i in range(3):
-            for c in range(3):
-                r[i, c] = tmp[i, c]
+    axes ``axes_w`` (6, 3) and points ``orig_w`` (6, 3) of the joints at ``q`` (for the Jacobian). No allocation:
+    the running product ``(r, t)`` lives in ``rot_out`` and ``pos_out``."""
+    r, t = rot_out, pos_out
     for i in range(3):
-        pos_out[i] = t[i] + r[i, 0] * g[_M0 + 9] + r[i, 1] * g[_M0 + 10] + r[i, 2] * g[_M0 + 11]
+        t[i] = 0.0
         for c in range(3):
-            rot_out[i, c] = r[i, 0] * g[_M0 + c] + r[i, 1] * g[_M0 + 3 + c] + r[i, 2] * g[_M0 + 6 + c]
+            r[i, c] = 1.0 if i == c else 0.0
+    for j in range(6):
+        a0, a1, a2 = g[_AX + 3 * j], g[_AX + 3 * j + 1], g[_AX + 3 * j + 2]
+        o = (g[_OR + 3 * j], g[_OR + 3 * j + 1], g[_OR + 3 * j + 2])
+        for i in range(3):  # the joint's axis and a point of it, in the root frame at q
+            axes_w[j, i] = r[i, 0] * a0 + r[i, 1] * a1 + r[i, 2] * a2
+            orig_w[j, i] = r[i, 0] * o[0] + r[i, 1] * o[1] + r[i, 2] * o[2] + t[i]
+        # (r, t) <- (r, t) E_j = (r m, t + r (o - m o)) = (r m, t + r o - (r m) o), m = R(a_j, q_j)
+        cq, sq = math.cos(q[j]), math.sin(q[j])
+        v = 1.0 - cq
+        m00, m01, m02 = cq + v * a0 * a0, v * a0 * a1 - sq * a2, v * a0 * a2 + sq * a1
+        m10, m11, m12 = v * a0 * a1 + sq * a2, cq + v * a1 * a1, v * a1 * a2 - sq * a0
+        m20, m21, m22 = v * a0 * a2 - sq * a1, v * a1 * a2 + sq * a0, cq + v * a2 * a2
+        for i in range(3):
+            r0, r1, r2 = r[i, 0], r[i, 1], r[i, 2]
+            n0 = r0 * m00 + r1 * m10 + r2 * m20
+            n1 = r0 * m01 + r1 * m11 + r2 * m21
+            n2 = r0 * m02 + r1 * m12 + r2 * m22
+            t[i] = orig_w[j, i] - (n0 * o[0] + n1 * o[1] + n2 * o[2])
+            r[i, 0], r[i, 1], r[i, 2] = n0, n1, n2
+    for i in range(3):  # (r, t) M_0
+        r0, r1, r2 = r[i, 0], r[i, 1], r[i, 2]
+        t[i] += r0 * g[_M0 + 9] + r1 * g[_M0 + 10] + r2 * g[_M0 + 11]
+        for c in range(3):
+            r[i, c] = r0 * g[_M0 + c] + r1 * g[_M0 + 3 + c] + r2 * g[_M0 + 6 + c]
 
 
 @kernel
@@ -114,10 +109,10 @@ def _fk6_k(q, g, out) -> int:
 
 
 @kernel
-def _jac6(q, g, jac, rm, p) -> None:
+def _jac6(q, g, jac, rm, p, aw, ow) -> None:
     """Pinocchio's LOCAL_WORLD_ALIGNED foot Jacobian (6, 6): column j = ``(w_j x (p - o_j), w_j)`` with the joint's
-    axis ``w_j`` and point ``o_j`` at ``q`` (root frame); also the foot rotation ``rm`` and position ``p``."""
-    aw, ow = np.empty((6, 3)), np.empty((6, 3))
+    axis ``w_j`` and point ``o_j`` at ``q`` (root frame); also the foot rotation ``rm`` and position ``p``
+    (``aw``, ``ow``: (6, 3) work arrays)."""
     _pose6(q, g, rm, p, aw, ow)
     for j in range(6):
         w = (aw[j, 0], aw[j, 1], aw[j, 2])
@@ -132,7 +127,7 @@ def _jacobian6_k(q, g, out) -> int:
     """The (6, 6) foot Jacobian, linear rows then angular (LOCAL_WORLD_ALIGNED at the foot frame)."""
     if not _finite(q, 6):
         return _BAD_INPUT
-    _jac6(q, g, out, np.empty((3, 3)), np.empty(3))
+    _jac6(q, g, out, np.empty((3, 3)), np.empty(3), np.empty((6, 3)), np.empty((6, 3)))
     return OK
 
 
@@ -141,14 +136,20 @@ def _pose_error(tg, rm, p, e) -> float:
     """``e`` (6,) = ``(p_target - p, log(R_target R^T))`` (m, rad; root frame) and its norm."""
     for i in range(3):
         e[i] = tg[4 * i + 3] - p[i]
-    # m = R_target R^T
-    m = np.empty((3, 3))
-    for i in range(3):
-        for c in range(3):
-            m[i, c] = tg[4 * i] * rm[c, 0] + tg[4 * i + 1] * rm[c, 1] + tg[4 * i + 2] * rm[c, 2]
-    vx, vy, vz = 0.5 * (m[2, 1] - m[1, 2]), 0.5 * (m[0, 2] - m[2, 0]), 0.5 * (m[1, 0] - m[0, 1])
+
+    # the entries of R_target R^T that the axis-angle needs
+    m00 = tg[0] * rm[0, 0] + tg[1] * rm[0, 1] + tg[2] * rm[0, 2]
+    m11 = tg[4] * rm[1, 0] + tg[5] * rm[1, 1] + tg[6] * rm[1, 2]
+    m22 = tg[8] * rm[2, 0] + tg[9] * rm[2, 1] + tg[10] * rm[2, 2]
+    m21 = tg[8] * rm[1, 0] + tg[9] * rm[1, 1] + tg[10] * rm[1, 2]
+    m12 = tg[4] * rm[2, 0] + tg[5] * rm[2, 1] + tg[6] * rm[2, 2]
+    m02 = tg[0] * rm[2, 0] + tg[1] * rm[2, 1] + tg[2] * rm[2, 2]
+    m20 = tg[8] * rm[0, 0] + tg[9] * rm[0, 1] + tg[10] * rm[0, 2]
+    m10 = tg[4] * rm[0, 0] + tg[5] * rm[0, 1] + tg[6] * rm[0, 2]
+    m01 = tg[0] * rm[1, 0] + tg[1] * rm[1, 1] + tg[2] * rm[1, 2]
+    vx, vy, vz = 0.5 * (m21 - m12), 0.5 * (m02 - m20), 0.5 * (m10 - m01)
     sn = math.sqrt(vx * vx + vy * vy + vz * vz)
-    ang = math.atan2(sn, 0.5 * (m[0, 0] + m[1, 1] + m[2, 2] - 1.0))
+    ang = math.atan2(sn, 0.5 * (m00 + m11 + m22 - 1.0))
     f = ang / sn if sn > 1e-300 else 1.0
     e[3], e[4], e[5] = f * vx, f * vy, f * vz
     return math.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2 + e[3] ** 2 + e[4] ** 2 + e[5] ** 2)
@@ -183,18 +184,19 @@ def _solve6(a, b, x) -> bool:
 
 
 @kernel
-def _polish6(tg, g, q) -> float:
+def _polish6(tg, g, q, ws) -> float:
     """Damped Newton steps ``dq = (J^T J + lambda^2 I)^-1 J^T e`` on the exact forward map (at most
     :data:`POLISH_STEPS6`, each kept only if it reduces ``|e|``) while ``|e|`` exceeds :data:`POLISH_BELOW6`.
-    Returns the final ``|e|`` (m and rad combined)."""
-    jac, rm, p = np.empty((6, 6)), np.empty((3, 3)), np.empty(3)
-    e, a, b, dq, qn = np.empty(6), np.empty((6, 6)), np.empty(6), np.empty(6), np.empty(6)
-    _jac6(q, g, jac, rm, p)
+    ``ws``: a work array of at least 32 rows of 6. Returns the final ``|e|`` (m and rad combined)."""
+    jac, a, aw, ow = ws[0:6], ws[6:12], ws[12:18, 0:3], ws[18:24, 0:3]
+    rm, p, e, b, dq, qn = ws[24:27, 0:3], ws[27, 0:3], ws[28], ws[29], ws[30], ws[31]
+    _pose6(q, g, rm, p, aw, ow)
     err = _pose_error(tg, rm, p, e)
     lam2 = POLISH_DAMPING6 * POLISH_DAMPING6
     for _ in range(POLISH_STEPS6):
         if err <= POLISH_BELOW6:
             break
+        _jac6(q, g, jac, rm, p, aw, ow)
         for i in range(6):
             b[i] = 0.0
             for k in range(6):
@@ -208,7 +210,7 @@ def _polish6(tg, g, q) -> float:
             break
         for i in range(6):
             qn[i] = q[i] + dq[i]
-        _jac6(qn, g, jac, rm, p)
+        _pose6(qn, g, rm, p, aw, ow)
         new = _pose_error(tg, rm, p, e)
         if not new < err:
             break
@@ -266,11 +268,12 @@ def _hip_candidates(tg, g, cand) -> int:
         e = rot(a4, -q4, (c[0] - o4[0], c[1] - o4[1], c[2] - o4[2]))
         ea = (e[0] + o4[0] - an[0], e[1] + o4[1] - an[1], e[2] + o4[2] - an[2])
         _, t5a, t6a, t5b, t6b, _ = sp2(ea, da, a5, a6)
+        r4a3, r4v = rot(a4, -q4, a3), rot(a4, -q4, v)
         for i56 in range(2):
             q5, q6 = -(t5a if i56 == 0 else t5b), (t6a if i56 == 0 else t6b)
             # R_h y = R_G R_6^T R_5^T R_4^T y
-            h3 = _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, a3))))
-            hv = _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, v))))
+            h3 = _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, r4a3)))
+            hv = _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, r4v)))
             _, t1a, t2a, t1b, t2b, _ = sp2(h3, a3, a1, a2)
             for i12 in range(2):
                 q1, q2 = -(t1a if i12 == 0 else t1b), (t2a if i12 == 0 else t2b)
@@ -308,14 +311,14 @@ def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
             out[b, j] = _NAN
     if not _valid_pose(tg):
         return _BAD_INPUT
-    cand = np.empty((_NSOL, 6))
+    ws = np.empty((41, 6))  # rows 0-31: the polish's work space, 32: the polished row, 33-40: the candidates
+    cand, qb = ws[33:41], ws[32]
     n = _hip_candidates(tg, g, cand)
     best, found = math.inf, 0
-    qb = np.empty(6)
     for b in range(n):
         for j in range(6):
             qb[j] = cand[b, j]
-        res = _polish6(tg, g, qb)
+        res = _polish6(tg, g, qb, ws)
         if res <= tol:
             for j in range(6):
                 out[b, j] = _near_k(qb[j], ref[j])

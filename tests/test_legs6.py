@@ -26,12 +26,12 @@ HUMANOIDS = {
     "icub": ("icub_description/robots/icub_reduced.urdf", "6R-spherical-hip", ("l_sole", "r_sole")),
     "simple_humanoid": ("simple_humanoid_description/urdf/simple_humanoid.urdf", "6R-spherical-hip",
                         ("l_ankle", "r_ankle")),
-    "alexander": ("alexander_description/urdf/alexander_v1.lowerBodyOnly.urdf", "6R-general",
+    "alexander": ("alexander_description/urdf/alexander_v1.lowerBodyOnly.urdf", "6R-three-parallel",
                   ("LEFT_FOOT", "RIGHT_FOOT")),
     "g1": ("g1_description/urdf/g1_29dof_rev_1_0.urdf", "6R-general",
            ("left_ankle_roll_link", "right_ankle_roll_link")),
 }
-CLOSED = [n for n, (_, s, _) in HUMANOIDS.items() if s == "6R-spherical-hip"]
+CLOSED = [n for n, (_, s, _) in HUMANOIDS.items() if s != "6R-general"]
 #: FK and Jacobian agree with Pinocchio to this (measured: <= 1.1e-15 on 2000 configurations per leg).
 TOL_FK = 1e-12
 #: IK round trip (position m, rotation matrix entries); measured <= 5e-15.
@@ -203,12 +203,13 @@ def test_fk_and_jacobian_equal_pinocchio(humanoids, name):
 
 @pytest.mark.parametrize("name", CLOSED)
 def test_ik_round_trip_and_every_sample_among_ik_all(humanoids, name):
-    """2000 random in-limit configurations per leg: every foot pose solved inside the limits, reproduced by
-    Pinocchio to 1e-12; the sampled configuration is one of ik_all's rows (mod 2 pi, to 1e-9 rad)."""
+    """2000 random in-limit configurations per leg (500 for alexander's search): every foot pose solved inside the
+    limits, reproduced by Pinocchio to 1e-12; the sampled configuration is one of ik_all's rows (mod 2 pi, to
+    1e-9 rad). (``legkin check`` and the issue's 10^4 per leg: see docs/legs.md.)"""
     model, found = humanoids[name]
     rng = np.random.default_rng(2026)
     for leg in found.values():
-        qs = rng.uniform(leg.lower, leg.upper, (2000, 6))
+        qs = rng.uniform(leg.lower, leg.upper, (500 if leg.structure == "6R-three-parallel" else 2000, 6))
         poses, _ = _pin_feet(model, leg, qs)
         q, ok = leg.ik(poses, return_mask=True)
         assert ok.all() and leg.within_limits(q).all()
@@ -217,6 +218,7 @@ def test_ik_round_trip_and_every_sample_among_ik_all(humanoids, name):
         q_all, mask = leg.ik_all(poses, return_mask=True)
         gap = np.abs(np.angle(np.exp(1j * (q_all - qs[:, None])))).max(axis=-1)
         assert (np.nanmin(gap, axis=-1) < 1e-9).all(), f"{name} {leg.name}: {np.nanmax(np.nanmin(gap, axis=-1))}"
+        assert q_all.shape[1] == leg.n_solutions
         rows = np.where(mask[..., None, None], leg.fk(np.where(mask[..., None], q_all, 0.0)), poses[:, None])
         assert np.abs(rows - poses[:, None]).max() <= TOL_IK
 
@@ -303,6 +305,6 @@ def test_bad_options_and_no_closed_form(talos_left, humanoids):
     with pytest.raises(InvalidInputError, match="q_near"):
         talos_left.ik(t, q_near=[0.0] * 3)
     g1 = humanoids["g1"][1]["left"]
-    with pytest.raises(LegStructureError, match="no closed-form IK") as info:
+    with pytest.raises(LegStructureError, match="no IK for its structure") as info:
         g1.ik(g1.fk(np.zeros(6)))
     assert info.value.found == "6R-general"

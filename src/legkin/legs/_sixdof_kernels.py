@@ -15,19 +15,13 @@ import math
 import numpy as np
 
 from .._kernels import OK, batch_kernel, kernel
-from ._ik_kernels import _in_limits_k, _near_k
 from ._sixdof_layout import (
     _ANK,
     _AX,
     _BAD_INPUT,
-    _HI6,
     _HIP,
-    _JOINT_LIMIT,
-    _LO6,
     _M0,
-    _NSOL,
     _OR,
-    _UNREACHABLE,
     POLISH_BELOW6,
     POLISH_DAMPING6,
     POLISH_STEPS6,
@@ -235,6 +229,17 @@ def _mat_t_vec(m, v):
 
 
 @kernel
+def _target_motion(tg, g, gr):
+    """``G = T M_0^-1`` of the target ``T`` (16 floats): its rotation into ``gr`` (3, 3), its translation returned."""
+    for i in range(3):
+        for k in range(3):  # R_G = R_T R_0^T
+            j = _M0 + 3 * k
+            gr[i, k] = tg[4 * i] * g[j] + tg[4 * i + 1] * g[j + 1] + tg[4 * i + 2] * g[j + 2]
+    gp0 = _mat_vec(gr, (g[_M0 + 9], g[_M0 + 10], g[_M0 + 11]))
+    return tg[3] - gp0[0], tg[7] - gp0[1], tg[11] - gp0[2]
+
+
+@kernel
 def _hip_candidates(tg, g, cand) -> int:
     """The closed-form solutions (rows of ``cand`` (8, 6)) of a leg whose hip axes 1-3 meet at the hip centre
     ``c`` and whose ankle axes 5, 6 meet at the ankle centre ``a``; returns how many rows are filled.
@@ -245,12 +250,7 @@ def _hip_candidates(tg, g, cand) -> int:
     SP1 ``R(a_3, q_3) v = R_2^T R_1^T R_h v`` (``v`` normal to ``a_3``) gives ``q_3``. Branches that the
     subproblems find absent are filled with their least-squares angles (the polish and the residual decide)."""
     gr = np.empty((3, 3))
-    for i in range(3):
-        for k in range(3):  # R_G = R_T R_0^T
-            j = _M0 + 3 * k
-            gr[i, k] = tg[4 * i] * g[j] + tg[4 * i + 1] * g[j + 1] + tg[4 * i + 2] * g[j + 2]
-    gp0 = _mat_vec(gr, (g[_M0 + 9], g[_M0 + 10], g[_M0 + 11]))
-    gt = (tg[3] - gp0[0], tg[7] - gp0[1], tg[11] - gp0[2])
+    gt = _target_motion(tg, g, gr)
     c = (g[_HIP], g[_HIP + 1], g[_HIP + 2])
     an = (g[_ANK], g[_ANK + 1], g[_ANK + 2])
     d = _mat_t_vec(gr, (c[0] - gt[0], c[1] - gt[1], c[2] - gt[2]))
@@ -301,74 +301,6 @@ def _valid_pose(tg) -> bool:
     return abs(det - 1.0) <= 1e-6
 
 
-@kernel(entry=True)
-def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
-    """Every solution (rows of ``out`` (8, 6), NaN rows for absent ones) of the foot pose ``tg`` (16 floats): the
-    closed form's candidates, each polished (:func:`_polish6`) and kept if it reproduces ``tg`` to ``tol``, each
-    angle moved to its 2 pi representative nearest ``ref``. ``info[0]``: on failure the least residual."""
-    for b in range(_NSOL):
-        for j in range(6):
-            out[b, j] = _NAN
-    if not _valid_pose(tg):
-        return _BAD_INPUT
-    ws = np.empty((41, 6))  # rows 0-31: the polish's work space, 32: the polished row, 33-40: the candidates
-    cand, qb = ws[33:41], ws[32]
-    n = _hip_candidates(tg, g, cand)
-    best, found = math.inf, 0
-    for b in range(n):
-        for j in range(6):
-            qb[j] = cand[b, j]
-        res = _polish6(tg, g, qb, ws)
-        if res <= tol:
-            for j in range(6):
-                out[b, j] = _near_k(qb[j], ref[j])
-            found += 1
-        elif res < best:
-            best = res
-    if found == 0:
-        info[0], info[1] = best, 0.0
-        return _UNREACHABLE
-    return OK
-
-
-@kernel(entry=True)
-def _ik6_k(tg, g, ref, tol, out, info) -> int:
-    """The solution of :func:`_ik_all6_k` inside the limits nearest ``ref`` (least sum of squared differences;
-    ties to the earlier row). ``info``: the least residual, or the least limit violation (rad) and the count of
-    solutions."""
-    qa = np.empty((_NSOL, 6))
-    status = _ik_all6_k(tg, g, ref, tol, qa, info)
-    for j in range(6):
-        out[j] = _NAN
-    if status != OK:
-        return status
-    best, viol, nb = math.inf, math.inf, 0
-    x = np.empty(6)
-    for b in range(_NSOL):
-        if not np.isfinite(qa[b, 0]):
-            continue
-        nb += 1
-        worst, inside = 0.0, True
-        for j in range(6):
-            x[j], m = _in_limits_k(qa[b, j], ref[j], g[_LO6 + j], g[_HI6 + j])
-            worst = max(worst, m)
-            inside = inside and np.isfinite(x[j])
-        viol = min(viol, worst)
-        if not inside:
-            continue
-        cost = 0.0
-        for j in range(6):
-            cost += (x[j] - ref[j]) ** 2
-        if cost < best:
-            best = cost
-            for j in range(6):
-                out[j] = x[j]
-    if best == math.inf:
-        info[0], info[1] = viol, nb
-        return _JOINT_LIMIT
-    return OK
-
-
 @batch_kernel(rows="q out", min_parallel=2048)
 def _fk6_batch(q, g, out) -> int:
     n, bad = q.shape[0], 0
@@ -383,17 +315,3 @@ def _jacobian6_batch(q, g, out) -> int:
     for i in range(n):
         bad += _jacobian6_k(q[i], g, out[i]) != OK
     return bad
-
-
-@batch_kernel(rows="tg ref out status info", min_parallel=256)
-def _ik_all6_batch(tg, g, ref, tol, out, status, info) -> None:
-    n, m = tg.shape[0], ref.shape[0]
-    for i in range(n):
-        status[i] = _ik_all6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])
-
-
-@batch_kernel(rows="tg ref out status info", min_parallel=256)
-def _ik6_batch(tg, g, ref, tol, out, status, info) -> None:
-    n, m = tg.shape[0], ref.shape[0]
-    for i in range(n):
-        status[i] = _ik6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])

@@ -20,11 +20,20 @@ POLISH_STEPS6 = 12
 POLISH_DAMPING6 = 1e-9
 #: Pose error (m and rad) below which the polish stops (the closed form of an exact structure lands at ~1e-15).
 POLISH_BELOW6 = 1e-13
-#: Solutions of the closed forms (the rows of :meth:`Leg6.ik_all`).
+#: Rows of :meth:`Leg6.ik_all` by structure: the closed form of a spherical hip has at most 8 solutions; the
+#: one-dimensional search of three parallel axes keeps at most 16 (a 6R chain has at most 16).
 _NSOL = 8
+_NSOL_SEARCH = 16
+#: Grid of the one-dimensional search (points over a full turn of the searched joint): every sign change of the
+#: residual between two grid points is bracketed, then refined (see :mod:`._parallel_kernels`).
+SEARCH_GRID = 720
+#: A dip of the search residual to within this (m) of zero without a sign change is kept as a tangential root (the
+#: polish then decides).
+TANGENT_TOL = 1e-9
 
 #: Structure codes (params[_KIND]).
 HIP_SPHERICAL = 1.0
+THREE_PARALLEL = 2.0
 
 # ---------------------------------------------------------------- layout of the geometry array (Leg6.params)
 _AX = 0  # the six unit axes a_j at the neutral configuration (root frame), 3 each
@@ -34,4 +43,5 @@ _HIP = 48  # the hip centre c (the point nearest axes 1-3)
 _ANK = 51  # the ankle centre a (the point nearest axes 5, 6)
 _LO6, _HI6 = 54, 60  # the URDF limits (6 each)
 _KIND = 66  # the structure code
-_NP6 = 67
+_NSOLS = 67  # the rows of ik_all
+_NP6 = 68

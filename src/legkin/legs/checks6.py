@@ -6,7 +6,7 @@ if any, at the neutral configuration: the world frame is then the root frame). R
 * ``feet FK vs oMf``: max |Leg6.fk(q) - oMf[foot]| over the 4x4 entries;
 * ``feet Jacobian vs getFrameJacobian``: max |Leg6.jacobian(q) - J| over the 6x6 block (LOCAL_WORLD_ALIGNED, the
   leg's six columns);
-* for legs with a closed form (``6R-spherical-hip``): ``IK round trip`` (max entry of Pinocchio's foot at
+* for legs with an IK (``6R-spherical-hip``, ``6R-three-parallel``): ``IK round trip`` (max entry of Pinocchio's foot at
   ``Leg6.ik(T)`` minus ``T``; unsolved or outside the limits counts as infinite), ``IK all solutions``
   (the same for every row of ``ik_all``), ``sampled q among ik_all`` (rad: the distance, mod 2 pi, from the sampled
   configuration to the nearest row).
@@ -61,26 +61,27 @@ def _with(model, legs: dict, qleg: np.ndarray) -> np.ndarray:
 
 
 def _ik_rows(model, legs: dict, qleg: np.ndarray, poses: np.ndarray) -> list[CheckResult]:
-    closed = [k for k, leg in enumerate(legs.values()) if leg.structure == "6R-spherical-hip"]
+    closed = [k for k, leg in enumerate(legs.values()) if leg.n_solutions > 0]
     if not closed:
         return []
     items = list(legs.values())
     q_ik = np.zeros_like(qleg)
     ok = np.ones(qleg.shape[:2], dtype=bool)
-    q_all = np.zeros(qleg.shape[:1] + (len(items), 8, 6))
-    mask = np.zeros(qleg.shape[:1] + (len(items), 8), dtype=bool)
+    rows = max(leg.n_solutions for leg in items)
+    q_all = np.zeros(qleg.shape[:1] + (len(items), rows, 6))
+    mask = np.zeros(qleg.shape[:1] + (len(items), rows), dtype=bool)
     among = []
     for k in closed:
         leg = items[k]
         q_ik[:, k], ok[:, k] = leg.ik(poses[:, k], return_mask=True)
         ok[:, k] &= np.asarray(leg.within_limits(np.nan_to_num(q_ik[:, k])))
-        q_all[:, k], mask[:, k] = leg.ik_all(poses[:, k], return_mask=True)
+        q_all[:, k, :leg.n_solutions], mask[:, k, :leg.n_solutions] = leg.ik_all(poses[:, k], return_mask=True)
         gap = np.abs(np.angle(np.exp(1j * (q_all[:, k] - qleg[:, k, None])))).max(axis=-1)
         among.append(np.nanmin(np.where(mask[:, k], gap, np.inf), axis=-1))
     back, _ = _pin_poses(model, legs, _with(model, legs, np.where(ok[..., None], q_ik, 0.0)), False)
     err = np.where(ok, np.abs(back - poses).max(axis=(-1, -2)), np.inf)[:, closed]
     errs = []
-    for b in range(8):
+    for b in range(rows):
         qb = np.where(mask[:, :, b, None], q_all[:, :, b], 0.0)
         back_b, _ = _pin_poses(model, legs, _with(model, legs, qb), False)
         errs.append(np.abs(back_b - poses).max(axis=(-1, -2))[:, closed][mask[:, closed, b]])

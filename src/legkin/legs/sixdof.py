@@ -38,16 +38,8 @@ import numpy as np
 from .._batch import as_input, check_flag, check_number, finish
 from .._kernels import OK, as_rows
 from ..errors import InvalidInputError, JointLimitError, LegStructureError, UnreachableError
-from ._sixdof_kernels import (
-    _fk6_batch,
-    _fk6_k,
-    _ik6_batch,
-    _ik6_k,
-    _ik_all6_batch,
-    _ik_all6_k,
-    _jacobian6_batch,
-    _jacobian6_k,
-)
+from ._ik6_kernels import _ik6_batch, _ik6_k, _ik_all6_batch, _ik_all6_k
+from ._sixdof_kernels import _fk6_batch, _fk6_k, _jacobian6_batch, _jacobian6_k
 from ._sixdof_layout import (
     _ANK,
     _AX,
@@ -60,16 +52,21 @@ from ._sixdof_layout import (
     _M0,
     _NP6,
     _NSOL,
+    _NSOL_SEARCH,
+    _NSOLS,
     _OR,
     AXIS_TOL,
     HIP_SPHERICAL,
     IK_TOL,
+    THREE_PARALLEL,
 )
 
 __all__ = ["Leg6", "AXIS_TOL", "IK_TOL", "STRUCTURES", "nearest_point"]
 
-#: The structures a 6-DOF leg is classified into (the first has a closed-form IK).
-STRUCTURES = ("6R-spherical-hip", "6R-general")
+#: The structures a 6-DOF leg is classified into (the first two have an IK: closed form, one-dimensional search).
+STRUCTURES = ("6R-spherical-hip", "6R-three-parallel", "6R-general")
+_KINDS = {STRUCTURES[0]: HIP_SPHERICAL, STRUCTURES[1]: THREE_PARALLEL, STRUCTURES[2]: 0.0}
+_ROWS = {STRUCTURES[0]: _NSOL, STRUCTURES[1]: _NSOL_SEARCH, STRUCTURES[2]: 0}
 _Q6 = (6,)
 _T44 = (4, 4)
 _F64 = np.dtype(np.float64)
@@ -90,6 +87,15 @@ def nearest_point(origins, axes) -> tuple[np.ndarray, float]:
     x = np.linalg.solve(m, rhs)
     gap = float(np.linalg.norm(np.einsum("kij,kj->ki", proj, x[None] - o), axis=-1).max())
     return x, gap
+
+
+def _classify(a: np.ndarray, hip_gap: float, ankle_gap: float) -> str:
+    """The structure of unit axes ``a`` (6, 3) with the given gaps (m): :data:`STRUCTURES`, within :data:`AXIS_TOL`."""
+    if hip_gap <= AXIS_TOL and ankle_gap <= AXIS_TOL:
+        return STRUCTURES[0]
+    par = max(np.linalg.norm(np.cross(a[2], a[3])), np.linalg.norm(np.cross(a[2], a[4])))
+    apart = min(np.linalg.norm(np.cross(a[0], a[1])), np.linalg.norm(np.cross(a[2], a[5])))
+    return STRUCTURES[1] if par <= AXIS_TOL and apart > 0.1 else STRUCTURES[2]
 
 
 def _frozen(a) -> np.ndarray:
@@ -154,7 +160,11 @@ class Leg6:
     params: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # always set by from_geometry
 
     dof = 6
-    n_solutions = _NSOL
+
+    @property
+    def n_solutions(self) -> int:
+        """The rows of :meth:`ik_all`: 8 (spherical hip), 16 (three parallel axes), 0 (no IK)."""
+        return int(self.params[_NSOLS])
 
     @classmethod
     def from_geometry(
@@ -182,19 +192,20 @@ class Leg6:
             raise LegStructureError(f"leg {name}: bad joint limits lower={lo.tolist()}, upper={hi.tolist()}")
         hip, hip_gap = nearest_point(o[:3], a[:3])
         ank, ank_gap = nearest_point(o[4:], a[4:])
-        spherical = hip_gap <= AXIS_TOL and ank_gap <= AXIS_TOL
+        structure = _classify(a, hip_gap, ank_gap)
         g = np.zeros(_NP6)
         g[_AX:_AX + 18], g[_OR:_OR + 18] = a.ravel(), o.ravel()
         g[_M0:_M0 + 9], g[_M0 + 9:_M0 + 12] = m0[:3, :3].ravel(), m0[:3, 3]
+        spherical = structure == STRUCTURES[0]
         g[_HIP:_HIP + 3] = hip if spherical else 0.0
         g[_ANK:_ANK + 3] = ank if spherical else 0.0
         g[_LO6:_LO6 + 6], g[_HI6:_HI6 + 6] = lo, hi
-        g[_KIND] = HIP_SPHERICAL if spherical else 0.0
+        g[_KIND], g[_NSOLS] = _KINDS[structure], _ROWS[structure]
         mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), np.clip(0.0, lo, hi))
         return cls(
             name=str(name), joint_names=tuple(str(j) for j in joint_names), foot_frame=str(foot_frame),
             lower=_frozen(lo), upper=_frozen(hi), axes=_frozen(a), origins=_frozen(o), foot_pose=_frozen(m0),
-            structure=STRUCTURES[0] if spherical else STRUCTURES[1], hip_centre=_frozen(hip),
+            structure=structure, hip_centre=_frozen(hip),
             ankle_centre=_frozen(ank), hip_gap=hip_gap, ankle_gap=ank_gap, q_ref=_frozen(mid),
             idx_q=tuple(int(i) for i in idx_q), idx_v=tuple(int(i) for i in idx_v), params=_frozen(g),
         )
@@ -249,11 +260,11 @@ class Leg6:
 
     # ------------------------------------------------------------ inverse
     def _prepare(self, target, q_near, tol):
-        if self.params[_KIND] != HIP_SPHERICAL:
+        if self.params[_KIND] == 0.0:
             raise LegStructureError(
-                f"leg {self.name}: no closed-form IK for its structure {self.structure!r} (hip axes meet within "
-                f"{self.hip_gap:.3g} m, ankle axes within {self.ankle_gap:.3g} m; tolerance {AXIS_TOL:g} m)",
-                found=self.structure, expected=[STRUCTURES[0]],
+                f"leg {self.name}: no IK for its structure {self.structure!r} (hip axes meet within "
+                f"{self.hip_gap:.3g} m, ankle axes within {self.ankle_gap:.3g} m; axes 3-5 not parallel; tolerance "
+                f"{AXIS_TOL:g})", found=self.structure, expected=list(STRUCTURES[:2]),
             )
         tol = check_number(tol, "tol", 0.0, 1e-3, low_open=True)
         arr = _pose_input(target)
@@ -306,8 +317,8 @@ class Leg6:
             InvalidInputError, InvalidArgumentError: bad ``target`` / ``q_near`` / ``tol`` / ``return_mask``.
         """
         if q_near is None and tol is IK_TOL and return_mask is False and target.__class__ is np.ndarray \
-                and target.shape == _T44 and target.dtype is _F64 and self.params[_KIND] == HIP_SPHERICAL:
-            fast, info1 = np.empty((_NSOL, 6)), np.zeros(2)  # a single target: straight to the kernel
+                and target.shape == _T44 and target.dtype is _F64 and self.params[_KIND] != 0.0:
+            fast, info1 = np.empty((self.n_solutions, 6)), np.zeros(2)  # a single target: straight to the kernel
             st = _ik_all6_k(target.reshape(16), self.params, self.q_ref, IK_TOL, fast, info1)
             if st == OK:
                 return fast
@@ -316,11 +327,12 @@ class Leg6:
         rows, ref, batch, single, tol = self._prepare(target, q_near, tol)
         flag = check_flag(return_mask, "return_mask")
         n = rows.shape[0]
-        out, status, info = np.empty((n, _NSOL, 6)), np.empty(n, dtype=np.int64), np.zeros((n, 2))
+        k = self.n_solutions
+        out, status, info = np.empty((n, k, 6)), np.empty(n, dtype=np.int64), np.zeros((n, 2))
         _ik_all6_batch(rows, self.params, ref, tol, out, status, info)
         if single and status[0] != OK:
             raise self._error(int(status[0]), info[0], rows[0], tol)
-        q_all = out.reshape(batch + (_NSOL, 6))
+        q_all = out.reshape(batch + (k, 6))
         return (q_all, np.isfinite(q_all[..., 0])) if flag else q_all
 
     def ik(self, target, *, q_near=None, tol: float = IK_TOL, return_mask: bool = False):
@@ -343,7 +355,7 @@ class Leg6:
             LegStructureError, InvalidInputError, InvalidArgumentError: as :meth:`ik_all`.
         """
         if q_near is None and tol is IK_TOL and return_mask is False and target.__class__ is np.ndarray \
-                and target.shape == _T44 and target.dtype is _F64 and self.params[_KIND] == HIP_SPHERICAL:
+                and target.shape == _T44 and target.dtype is _F64 and self.params[_KIND] != 0.0:
             fast, info1 = np.empty(6), np.zeros(2)  # a single target: straight to the kernel
             st = _ik6_k(target.reshape(16), self.params, self.q_ref, IK_TOL, fast, info1)
             if st == OK:

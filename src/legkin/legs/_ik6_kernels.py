@@ -31,7 +31,8 @@ _NAN = math.nan
 def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
     """Every solution (rows of ``out`` (K, 6), NaN rows for absent ones) of the foot pose ``tg`` (16 floats): the
     candidates of the leg's structure (closed form or search), each polished (:func:`_polish6`) and kept if it
-    reproduces ``tg`` to ``tol``, each angle moved to its 2 pi representative nearest ``ref``. ``info[0]``: on failure the least residual."""
+    reproduces ``tg`` to ``tol``, each angle moved to its 2 pi representative nearest ``ref``. ``info[0]``: on
+    failure the least residual."""
     k = out.shape[0]
     for b in range(k):
         for j in range(6):

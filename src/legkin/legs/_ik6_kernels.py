@@ -10,7 +10,7 @@ import numpy as np
 
 from .._kernels import OK, batch_kernel, kernel
 from ._ik_kernels import _in_limits_k, _near_k
-from ._parallel_kernels import _parallel_candidates
+from ._search_kernels import _search_candidates
 from ._sixdof_kernels import _hip_candidates, _polish6, _valid_pose
 from ._sixdof_layout import (
     _BAD_INPUT,
@@ -21,7 +21,6 @@ from ._sixdof_layout import (
     _NSOLS,
     _UNREACHABLE,
     HIP_SPHERICAL,
-    THREE_PARALLEL,
 )
 
 _NAN = math.nan
@@ -43,8 +42,8 @@ def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
     cand, qb = ws[33:], ws[32]
     if g[_KIND] == HIP_SPHERICAL:
         n = _hip_candidates(tg, g, cand)
-    elif g[_KIND] == THREE_PARALLEL:
-        n = _parallel_candidates(tg, g, cand)
+    elif g[_KIND] != 0.0:
+        n = _search_candidates(tg, g, cand)
     else:
         n = 0
     best, found = math.inf, 0

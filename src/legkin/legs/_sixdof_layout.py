@@ -34,6 +34,7 @@ TANGENT_TOL = 1e-9
 #: Structure codes (params[_KIND]).
 HIP_SPHERICAL = 1.0
 THREE_PARALLEL = 2.0
+OFFSET_HIP = 3.0
 
 # ---------------------------------------------------------------- layout of the geometry array (Leg6.params)
 _AX = 0  # the six unit axes a_j at the neutral configuration (root frame), 3 each

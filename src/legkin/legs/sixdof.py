@@ -214,7 +214,8 @@ class Leg6:
         g[_ANK:_ANK + 3] = ank if spherical else 0.0
         g[_LO6:_LO6 + 6], g[_HI6:_HI6 + 6] = lo, hi
         g[_KIND], g[_NSOLS] = _KINDS[structure], _ROWS[structure]
-        mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), np.clip(0.0, lo, hi))
+        finite = np.isfinite(lo) & np.isfinite(hi)
+        mid = np.where(finite, 0.5 * (np.where(finite, lo, 0.0) + np.where(finite, hi, 0.0)), np.clip(0.0, lo, hi))
         return cls(
             name=str(name), joint_names=tuple(str(j) for j in joint_names), foot_frame=str(foot_frame),
             lower=_frozen(lo), upper=_frozen(hi), axes=_frozen(a), origins=_frozen(o), foot_pose=_frozen(m0),

@@ -94,11 +94,12 @@ def _add_row(cand, n, q1, q2, q3, q4, q5, q6) -> int:
 
 @kernel
 def _par_eval(t, gr, gt, g, ok, r) -> None:
-    n, o3 = _axis(g, 2), _origin(g, 2)
-    for b in range(2):
-        ok[b], q1, q2 = _par_hip(t, b, gr, g)
-        r[b] = dot(n, _sub(_h_point(o3, t, q1, q2, gr, gt, g), o3))
-    ok[2], ok[3] = False, False
+    """Both branches at ``q_6 = t``, sharing the SP2 solve."""
+    n, a1, a2, a6, o3 = _axis(g, 2), _axis(g, 0), _axis(g, 1), _axis(g, 5), _origin(g, 2)
+    cnt, t1a, t2a, t1b, t2b, _ = sp2(_mat_vec(gr, rot(a6, -t, n)), n, a1, a2)
+    ok[0], ok[1], ok[2], ok[3] = cnt == 2, cnt == 2, False, False
+    r[0] = dot(n, _sub(_h_point(o3, t, -t1a, t2a, gr, gt, g), o3))
+    r[1] = dot(n, _sub(_h_point(o3, t, -t1b, t2b, gr, gt, g), o3))
 
 
 @kernel
@@ -123,30 +124,63 @@ def _par_rows(t, b, gr, gt, g, cand, n) -> int:
 
 # ---------------------------------------------------------------- offset hip (search over q1)
 @kernel
-def _off_chain(t, b, gr, gt, g):
-    """``(exists, q4, q5, q6, r)`` of branch ``b`` (``q_6`` branch ``b // 2``, ``q_4`` branch ``b % 2``) at
-    ``q_1 = t``."""
-    a1, a2, a3, a4, a5, a6 = _axis(g, 0), _axis(g, 1), _axis(g, 2), _axis(g, 3), _axis(g, 4), _axis(g, 5)
-    o1, o4, o5, o6 = _origin(g, 0), _origin(g, 3), _origin(g, 4), _origin(g, 5)
+def _off_q6(t, gr, gt, g):
+    """``(count, q6_a, q6_b, d)``: SP4 for the ankle roll at ``q_1 = t``, with ``d = G^-1 E_1(t) h``."""
+    a1, a4, a6 = _axis(g, 0), _axis(g, 3), _axis(g, 5)
+    o1, o6 = _origin(g, 0), _origin(g, 5)
     h = (g[_HIP], g[_HIP + 1], g[_HIP + 2])
-    d = _mat_t_vec(gr, _sub(_add(rot(a1, t, _sub(h, o1)), o1), gt))  # G^-1 E_1(t) h
+    d = _mat_t_vec(gr, _sub(_add(rot(a1, t, _sub(h, o1)), o1), gt))
     c6, t6a, t6b, _ = sp4(a4, _sub(d, o6), a6, dot(a4, _sub(h, o6)))
-    q6 = t6a if b < 2 else t6b
+    return c6, t6a, t6b, d
+
+
+@kernel
+def _off_q4(d, q6, g):
+    """``(count, q4_a, q4_b, y)``: SP3 for the knee, with ``y = E_6(q6) d``."""
+    a4, a6 = _axis(g, 3), _axis(g, 5)
+    o4, o5, o6 = _origin(g, 3), _origin(g, 4), _origin(g, 5)
+    h = (g[_HIP], g[_HIP + 1], g[_HIP + 2])
     y = _add(rot(a6, q6, _sub(d, o6)), o6)
     ry = math.sqrt(dot(_sub(y, o5), _sub(y, o5)))
     c4, t4a, t4b, _ = sp3(_sub(h, o4), _sub(o5, o4), a4, ry)
-    q4 = -(t4a if b % 2 == 0 else t4b)
+    return c4, -t4a, -t4b, y
+
+
+@kernel
+def _off_r(t, q4, q6, y, gr, g):
+    """``(q5, r)``: SP1 for the ankle pitch and the hip residual ``a_2 . (R_23 a_3) - a_2 . a_3``."""
+    a1, a2, a3, a4, a5, a6 = _axis(g, 0), _axis(g, 1), _axis(g, 2), _axis(g, 3), _axis(g, 4), _axis(g, 5)
+    o4, o5 = _origin(g, 3), _origin(g, 4)
+    h = (g[_HIP], g[_HIP + 1], g[_HIP + 2])
     e = _add(rot(a4, -q4, _sub(h, o4)), o4)
     q5 = sp1(_sub(y, o5), _sub(e, o5), a5)
-    # R_23 a_3 = R(a1, -t) R_G R_6^T R_5^T R_4^T a_3
-    w = rot(a1, -t, _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, a3)))))
-    return c6 == 2 and c4 == 2, q4, q5, q6, dot(a2, w) - dot(a2, a3)
+    w = rot(a1, -t, _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, a3)))))  # R_23 a_3
+    return q5, dot(a2, w) - dot(a2, a3)
+
+
+@kernel
+def _off_chain(t, b, gr, gt, g):
+    """``(exists, q4, q5, q6, r)`` of branch ``b`` (``q_6`` branch ``b // 2``, ``q_4`` branch ``b % 2``) at
+    ``q_1 = t``."""
+    c6, t6a, t6b, d = _off_q6(t, gr, gt, g)
+    q6 = t6a if b < 2 else t6b
+    c4, q4a, q4b, y = _off_q4(d, q6, g)
+    q4 = q4a if b % 2 == 0 else q4b
+    q5, r = _off_r(t, q4, q6, y, gr, g)
+    return c6 == 2 and c4 == 2, q4, q5, q6, r
 
 
 @kernel
 def _off_eval(t, gr, gt, g, ok, r) -> None:
-    for b in range(4):
-        ok[b], _, _, _, r[b] = _off_chain(t, b, gr, gt, g)
+    """All four branches at ``q_1 = t``, sharing the SP4 and SP3 solves."""
+    c6, t6a, t6b, d = _off_q6(t, gr, gt, g)
+    for i6 in range(2):
+        q6 = t6a if i6 == 0 else t6b
+        c4, q4a, q4b, y = _off_q4(d, q6, g)
+        for i4 in range(2):
+            b = 2 * i6 + i4
+            ok[b] = c6 == 2 and c4 == 2
+            r[b] = _off_r(t, q4a if i4 == 0 else q4b, q6, y, gr, g)[1]
 
 
 @kernel

@@ -592,7 +592,7 @@ def test_continuous_joints_are_legs_with_unbounded_limits(tmp_path):
 
 
 @pytest.mark.parametrize("name", ["go2", "anymal_c", "solo12"])
-def test_float32_targets_are_solved_with_the_default_tol(erd, name):
+def test_float32_targets_are_solved_within_tol(erd, name):
     """Feet of in-limit joints rounded to float32 (a simulator's): none refused with tol=1e-9 ... unless the rounding
     pushed them out of reach by more (then tol=1e-7 solves them at the nearest point, 1e-7 m away at most)."""
     _, found = erd[name]

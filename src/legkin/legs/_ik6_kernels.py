@@ -105,12 +105,12 @@ def _ik6_k(tg, g, ref, tol, out, info) -> int:
         cost[b] = c if inside else math.inf
     best, viol, nb = math.inf, math.inf, 0
     for _ in range(n):  # the in-limit candidates, cheapest first
-        b = np.argmin(cost[:n])
-        if cost[b] == math.inf:
+        i = int(np.argmin(cost[:n]))
+        if cost[i] == math.inf:
             break
-        cost[b] = math.inf
+        cost[i] = math.inf
         for j in range(6):
-            qb[j] = lim[b, j]
+            qb[j] = lim[i, j]
         res = _polish6(tg, g, qb, ws)
         if res <= tol:
             c, inside = _limited(qb, ref, g, out)

@@ -618,3 +618,23 @@ def test_tol_bounds_the_nearest_point_solution(erd):
     assert 1e-9 < miss <= 1e-6
     with pytest.raises(InvalidParameterError, match="tol"):
         fl.ik(out, tol=-1.0)
+
+
+def test_quadruped_legs_named_by_hip_position_when_joint_names_share_no_prefix():
+    """Joints named '0' ... '11' (no common prefix): the legs are FL, FR, RL, RR from the hips' signs of x and y."""
+    model = pin.Model()
+    hips = {"RR": (-0.2, -0.1), "FL": (0.2, 0.1), "RL": (-0.2, 0.1), "FR": (0.2, -0.1)}
+    k = 0
+    for x, y in hips.values():
+        parent = 0
+        for jm, place in ((pin.JointModelRX(), (x, y, 0.0)), (pin.JointModelRY(), (0.0, 0.05 * np.sign(y), 0.0)),
+                          (pin.JointModelRY(), (0.0, 0.0, -0.2))):
+            parent = model.addJoint(parent, jm, pin.SE3(np.eye(3), np.array(place)), str(k))
+            model.addJointFrame(parent, -1)
+            k += 1
+        model.addFrame(pin.Frame(f"f{k}", parent, 0, pin.SE3(np.eye(3), np.array([0.0, 0.0, -0.2])),
+                                 pin.FrameType.OP_FRAME))
+    found = legs.from_model(model)
+    assert list(found) == list(hips)
+    for name, leg in found.items():
+        assert np.sign(leg.origin[:2]).tolist() == np.sign(hips[name]).tolist()

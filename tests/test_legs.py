@@ -12,7 +12,7 @@ import pytest
 from hypothesis import assume, example, given
 from hypothesis import strategies as st
 
-from legkin import legs
+from legkin import errors, legs
 from legkin._registry import get_spec
 from legkin.errors import (
     InvalidInputError,
@@ -64,6 +64,7 @@ def test_erd_files_come_from_the_installed_distribution():
     base = Path(dist.locate_file("")).resolve()
     assert len(ROBOTS) == 9
     assert set(ROBOTS) == {"solo12", "anymal", "anymal_c", "hyq", "go1", "go2", "a1", "b1", "laikago"}
+    assert set(ROBOTS) < set(legs.ERD_ALL) and all(get_spec(n).package == "legkin.legs" for n in legs.ERD_ALL)
     for name in ROBOTS:
         spec = get_spec(name)  # a first-class registry entry of the shared package legkin.legs
         assert spec.package == "legkin.legs" and spec.shared_package and not spec.generated
@@ -124,7 +125,7 @@ def test_ik_round_trip_10k_per_robot(erd, name):
         assert ok.all(), f"{name} {leg.name}: {int((~ok).sum())} targets unsolved"
         assert np.all((q >= leg.lower) & (q <= leg.upper))
         answers[:, k] = q
-        q_all, mask = leg.ik_all(feet[:300, k])
+        q_all, mask = leg.ik_all(feet[:300, k], return_mask=True)
         assert mask.any(axis=-1).all()
         for b in range(4):
             rows = mask[:, b]
@@ -240,7 +241,7 @@ def test_tilted_pitch_axis_raises_clear_error():
         legs.from_model(build_leg(tilt_hfe_deg=2.0))
     with pytest.raises(LegStructureError, match="off parallel"):
         legs.from_model(build_leg(tilt_kfe_deg=1e-6))  # 1.7e-8 rad > 1e-9
-    assert issubclass(LegStructureError, InvalidParameterError) and issubclass(LegStructureError, LegkinError)
+    assert LegStructureError is errors.LegStructureError and issubclass(LegStructureError, (LegkinError, ValueError))
     legs.from_model(build_leg(tilt_kfe_deg=1e-9))  # 1.7e-11 rad: within the 1e-9 tolerance
     with pytest.raises(LegStructureError, match="foot.*lies on the KFE axis"):
         legs.from_model(build_leg(foot=(0.0, 0.0, 0.0), t=((0.2, 0.1, 0.0), (0.05, 0.08, -0.02), (0.0, 0.0, -0.25))))
@@ -250,8 +251,10 @@ def test_no_leg_found():
     model = pin.Model()
     j = model.addJoint(0, pin.JointModelRY(), pin.SE3.Identity(), "only")
     model.addJointFrame(j, -1)
-    with pytest.raises(InvalidParameterError, match="no HAA-HFE-KFE leg found"):
+    with pytest.raises(LegStructureError, match=r"no leg found.*Found: only \(RY\): 1 joints.*Supported: HAA") as info:
         legs.from_model(model)
+    assert info.value.found == ["only (RY): 1 joints, ends at a leaf, foot frame 'only'"]
+    assert any("HAA-HFE-KFE" in e for e in info.value.expected) and any("6R" in e for e in info.value.expected)
 
 
 angles = st.floats(-math.pi, math.pi, allow_nan=False)
@@ -293,7 +296,7 @@ def test_general_leg_matches_pinocchio(rpy, t, foot, a1, perp, s3, floating, til
     assert ok.all()
     back = pin_feet(model, found, sol[:, None])[:, 0]
     assert np.linalg.norm(back - feet, axis=-1).max() <= TOL
-    q_all, mask = leg.ik_all(feet)
+    q_all, mask = leg.ik_all(feet, return_mask=True)
     # the sampled q is one of the branches (mod 2 pi), unless a singularity merges them
     d = np.abs(np.angle(np.exp(1j * (q_all - q[:, None, :])))).max(axis=-1)
     assert (np.nanmin(d, axis=-1) < 1e-6).mean() > 0.9
@@ -350,7 +353,7 @@ def test_single_call_equals_batch_row(erd, rows, i, name):
     np.testing.assert_array_equal(leg.fk(q[i]), leg.fk(q)[i])
     np.testing.assert_array_equal(leg.jacobian(q[i]), leg.jacobian(q)[i])
     sol, ok = leg.ik(p, return_mask=True)
-    all_b, mask = leg.ik_all(p)
+    all_b, mask = leg.ik_all(p, return_mask=True)
     if ok[i]:
         np.testing.assert_array_equal(leg.ik(p[i]), sol[i])
         np.testing.assert_array_equal(leg.ik(p[i], q_near=q[i]), leg.ik(p, q_near=q)[i])
@@ -359,7 +362,7 @@ def test_single_call_equals_batch_row(erd, rows, i, name):
         with pytest.raises(UnreachableError):
             leg.ik(p[i])
     if mask[i].any():
-        one, one_mask = leg.ik_all(p[i])
+        one, one_mask = leg.ik_all(p[i], return_mask=True)
         np.testing.assert_array_equal(one, all_b[i])
         np.testing.assert_array_equal(one_mask, mask[i])
 
@@ -379,7 +382,7 @@ def test_big_batch_equals_single_calls_and_shapes(fl):
     assert fl.jacobian(q[:1000].reshape(10, 100, 3)).shape == (10, 100, 3, 3)
     s, ok = fl.ik(p[:1000].reshape(10, 100, 3), return_mask=True)
     assert s.shape == (10, 100, 3) and ok.shape == (10, 100)
-    a, m = fl.ik_all(p[:1000].reshape(10, 100, 3))
+    a, m = fl.ik_all(p[:1000].reshape(10, 100, 3), return_mask=True)
     assert a.shape == (10, 100, 4, 3) and m.shape == (10, 100, 4)
     assert fl.ik(np.empty((0, 3))).shape == (0, 3)
     one, ok1 = fl.ik(p[0], return_mask=True)
@@ -396,14 +399,14 @@ def test_unreachable_nan_mask_and_error(fl):
     q, ok = fl.ik(p, return_mask=True)
     assert ok.tolist() == [True, False, False]
     assert np.isfinite(q[0]).all() and np.isnan(q[1:]).all()
-    q_all, mask = fl.ik_all(p)
+    q_all, mask = fl.ik_all(p, return_mask=True)
     assert mask[0].any() and not mask[1:].any() and np.isnan(q_all[1:]).all()
     with pytest.raises(UnreachableError, match=r"out of reach of leg FL by 0\.5.* m: .*beyond the leg's full stretch"):
         fl.ik(far)
     with pytest.raises(UnreachableError, match=r"by 0\.0955 m: .*inside the abduction cylinder"):
         fl.ik(inside)
     with pytest.raises(UnreachableError):
-        fl.ik_all(far)
+        fl.ik_all(far, return_mask=True)
     try:
         fl.ik(far)
     except UnreachableError as exc:
@@ -416,7 +419,7 @@ def test_joint_limit_error(fl):
     q = rng.uniform(-math.pi, math.pi, (2000, 3))
     p = fl.fk(q)
     _, ok = fl.ik(p, return_mask=True)
-    q_all, mask = fl.ik_all(p)
+    q_all, mask = fl.ik_all(p, return_mask=True)
     only_outside = ~ok & mask.any(axis=-1)
     assert only_outside.sum() > 10
     for i in np.flatnonzero(only_outside)[:5]:
@@ -431,7 +434,7 @@ def test_joint_limit_error(fl):
 def test_q_near_picks_the_branch(erd):
     leg = erd["solo12"][1]["FL"]  # limits +-10 rad: every branch is inside
     p = leg.fk(np.array([0.2, 0.7, -1.4]))
-    q_all, mask = leg.ik_all(p)
+    q_all, mask = leg.ik_all(p, return_mask=True)
     assert mask.all()
     for b in range(4):
         near = q_all[b] + 0.01
@@ -550,3 +553,89 @@ def test_quadruped_check_has_the_generic_leg_rows():
     assert len(generic) == 4 and all(r.passed for r in generic), [(r.name, r.max_error) for r in generic]
     assert "400/400 solved" in generic[2].name
     assert len(rows) > len(generic)  # the quadruped's own rows are all still there
+
+
+def test_ik_all_returns_solutions_and_mask_only_when_asked(fl):
+    """legkin 0.2.0: ``ik_all`` returns the solutions; ``(solutions, mask)`` only with ``return_mask=True``; the
+    single-target fast path gives the batch row bit for bit."""
+    rng = np.random.default_rng(11)
+    p = fl.fk(rng.uniform(fl.lower, fl.upper, (50, 3)))
+    q_all = fl.ik_all(p)
+    assert isinstance(q_all, np.ndarray) and q_all.shape == (50, 4, 3)
+    both, mask = fl.ik_all(p, return_mask=True)
+    np.testing.assert_array_equal(both, q_all)
+    np.testing.assert_array_equal(mask, np.isfinite(q_all[..., 0]))
+    for i in range(0, 50, 7):
+        np.testing.assert_array_equal(fl.ik_all(p[i]), q_all[i])
+        one, m1 = fl.ik_all(p[i], return_mask=True)
+        assert m1.shape == (4,) and m1.dtype == bool
+        np.testing.assert_array_equal(m1, mask[i])
+    with pytest.raises(InvalidParameterError, match="return_mask"):
+        fl.ik_all(p[0], return_mask=1)
+
+
+# ------------------------------------------------------------------------------------------- issue 26: URDF gaps
+def test_continuous_joints_are_legs_with_unbounded_limits(tmp_path):
+    """go1's URDF with every joint ``continuous`` (as public aliengo / mini_cheetah descriptions write them): the same
+    legs, infinite limits, the same forward map, and IK answers nearest q_near with no limit to respect."""
+    text = legs.erd_files("go1")[0].read_text()
+    urdf = tmp_path / "go1_continuous.urdf"
+    urdf.write_text(text.replace('type="revolute"', 'type="continuous"'))
+    cont, orig = legs.from_urdf(urdf), legs.from_urdf(legs.erd_files("go1")[0])
+    assert list(cont) == list(orig)
+    rng = np.random.default_rng(12)
+    for name, leg in cont.items():
+        assert np.isinf(leg.lower).all() and np.isinf(leg.upper).all() and (leg.q_ref == 0).all()
+        q = rng.uniform(-3, 3, (200, 3))
+        np.testing.assert_allclose(leg.fk(q), orig[name].fk(q), atol=1e-15, rtol=0)
+        sol, ok = leg.ik(leg.fk(q), q_near=q, return_mask=True)
+        assert ok.all() and np.abs(sol - q).max() < 1e-9
+
+
+@pytest.mark.parametrize("name", ["go2", "anymal_c", "solo12"])
+def test_float32_targets_are_solved_within_tol(erd, name):
+    """Feet of in-limit joints rounded to float32 (a simulator's): none refused with tol=1e-9 ... unless the rounding
+    pushed them out of reach by more (then tol=1e-7 solves them at the nearest point, 1e-7 m away at most)."""
+    _, found = erd[name]
+    rng = np.random.default_rng(32)
+    for leg in found.values():
+        q = rng.uniform(leg.lower, leg.upper, (20_000, 3))
+        p32 = leg.fk(q).astype(np.float32).astype(float)
+        _, ok = leg.ik(p32, return_mask=True)
+        sol, ok7 = leg.ik(p32, tol=1e-7, return_mask=True)
+        assert ok7.all(), f"{name} {leg.name}: {int((~ok7).sum())} refused with tol=1e-7"
+        assert np.linalg.norm(leg.fk(sol) - p32, axis=-1).max() <= 1e-7
+        assert (~ok).sum() <= 20, f"{name} {leg.name}: {int((~ok).sum())} of 20000 refused with tol=1e-9"
+
+
+def test_tol_bounds_the_nearest_point_solution(erd):
+    fl = erd["solo12"][1]["FL"]  # limits +-10 rad: the straight knee is inside them
+    stretched = fl.fk(np.array([0.0, 0.0, 0.0]))  # knee straight: the full stretch
+    out = fl.origin + 1.0000001 * (stretched - fl.origin)  # ~4e-8 m beyond
+    with pytest.raises(UnreachableError):
+        fl.ik(out, tol=1e-9)
+    q = fl.ik(out, tol=1e-6)
+    miss = float(np.linalg.norm(fl.fk(q) - out))
+    assert 1e-9 < miss <= 1e-6
+    with pytest.raises(InvalidParameterError, match="tol"):
+        fl.ik(out, tol=-1.0)
+
+
+def test_quadruped_legs_named_by_hip_position_when_joint_names_share_no_prefix():
+    """Joints named '0' ... '11' (no common prefix): the legs are FL, FR, RL, RR from the hips' signs of x and y."""
+    model = pin.Model()
+    hips = {"RR": (-0.2, -0.1), "FL": (0.2, 0.1), "RL": (-0.2, 0.1), "FR": (0.2, -0.1)}
+    k = 0
+    for x, y in hips.values():
+        parent = 0
+        for jm, place in ((pin.JointModelRX(), (x, y, 0.0)), (pin.JointModelRY(), (0.0, 0.05 * np.sign(y), 0.0)),
+                          (pin.JointModelRY(), (0.0, 0.0, -0.2))):
+            parent = model.addJoint(parent, jm, pin.SE3(np.eye(3), np.array(place)), str(k))
+            model.addJointFrame(parent, -1)
+            k += 1
+        model.addFrame(pin.Frame(f"f{k}", parent, 0, pin.SE3(np.eye(3), np.array([0.0, 0.0, -0.2])),
+                                 pin.FrameType.OP_FRAME))
+    found = legs.from_model(model)
+    assert list(found) == list(hips)
+    for name, leg in found.items():
+        assert np.sign(leg.origin[:2]).tolist() == np.sign(hips[name]).tolist()

@@ -102,15 +102,17 @@ def _near_k(a, r):
     return a + _TWO_PI * math.floor((r - a) / _TWO_PI + 0.5)
 
 
-@kernel
-def _ik_all_k(p, g, ref, out, info) -> int:
+@kernel(entry=True)
+def _ik_all_k(p, g, ref, tol, out, info) -> int:
     """Every branch (rows in :data:`BRANCHES` order, NaN rows for absent ones) of the target ``p``.
 
     ``r^2 = y^2 + z^2``, ``u3 = s_a sqrt(r^2 - d^2)``, ``q1 = atan2(z, y) - atan2(u3, d)``;
     ``w = (u3, x1) - h``, ``cos beta = (|w|^2 - |k|^2 - |l|^2) / (2 |k||l|)``, ``beta = s_k acos(.)``,
-    ``q3 = s3 (beta - phi_l + phi_k)``, ``q2 = atan2(w) - atan2(k + Rot(s3 q3) l)``. Each angle is moved to
-    Each branch is then polished on the exact forward map (:func:`_polish_k`) and each angle moved to its
-    2 pi representative nearest ``ref``. ``info`` (2,): on failure the miss (m) and its reason.
+    ``q3 = s3 (beta - phi_l + phi_k)``, ``q2 = atan2(w) - atan2(k + Rot(s3 q3) l)``. Each branch is then
+    polished on the exact forward map (:func:`_polish_k`) and each angle moved to its
+    2 pi representative nearest ``ref``. A target up to ``tol`` (m) outside the reachable set is solved at its
+    nearest reachable point (the clamped closed form, polished). ``info`` (2,): on failure the miss (m) and its
+    reason.
     """
     for b in range(4):
         for j in range(3):
@@ -124,7 +126,7 @@ def _ik_all_k(p, g, ref, out, info) -> int:
     d = g[_D]
     ad = abs(d)
     r = math.hypot(y, z)
-    slack = g[_SLACK]
+    slack = g[_SLACK] - REACH_TOL + tol  # the ideal structure's deviation bound, plus tol
     cyl = ad - r
     if cyl > slack:
         info[0], info[1] = cyl, _IN_CYLINDER
@@ -135,7 +137,7 @@ def _ik_all_k(p, g, ref, out, info) -> int:
     kn, ln = g[_KN], g[_LN]
     s3 = g[_S3]
     best, why = math.inf, 0.0
-    if cyl > REACH_TOL:
+    if cyl > tol:
         best, why = cyl, _IN_CYLINDER
     found = 0
     qb = np.empty(3)
@@ -153,8 +155,8 @@ def _ik_all_k(p, g, ref, out, info) -> int:
             if miss < best:
                 best, why = miss, (_TOO_FAR if far > near else _TOO_NEAR)
             continue
-        # within the slack of the ideal structure's boundary: kept only if the exact foot error is <= REACH_TOL
-        check = cyl > REACH_TOL or miss > REACH_TOL
+        # within the slack of the ideal structure's boundary: kept only if the exact foot error is <= tol
+        check = cyl > tol or miss > tol
         c = (wn * wn - kn * kn - ln * ln) / (2.0 * kn * ln)
         c = 1.0 if c > 1.0 else (-1.0 if c < -1.0 else c)
         acb = math.acos(c)
@@ -181,8 +183,8 @@ def _ik_all_k(p, g, ref, out, info) -> int:
                     if res <= REACH_TOL:
                         break
             # a branch clamped onto the ideal structure's boundary is kept only if it reaches the target
-            if check and res > REACH_TOL:
-                if cyl <= REACH_TOL and res < best:
+            if check and res > tol:
+                if cyl <= tol and res < best:
                     best, why = res, (_TOO_FAR if far > near else _TOO_NEAR)
                 continue
             out[b, 0] = _near_k(qb[0], ref[0])
@@ -215,12 +217,12 @@ def _in_limits_k(a, r, lo, hi):
 
 
 @kernel(entry=True)
-def _ik_k(p, g, ref, out, info) -> int:
+def _ik_k(p, g, ref, tol, out, info) -> int:
     """The branch of :func:`_ik_all_k` inside the limits nearest ``ref`` (least sum of squared joint differences;
     ties to the earlier branch). ``info``: the miss (m) and reason, or the least limit violation (rad) and the
     number of geometric branches."""
     qa = np.empty((4, 3))
-    status = _ik_all_k(p, g, ref, qa, info)
+    status = _ik_all_k(p, g, ref, tol, qa, info)
     for j in range(3):
         out[j] = _NAN
     if status != OK:
@@ -249,15 +251,15 @@ def _ik_k(p, g, ref, out, info) -> int:
 
 
 @batch_kernel(rows="p ref out status info", min_parallel=4096)
-def _ik_all_batch(p, g, ref, out, status, info) -> None:
+def _ik_all_batch(p, g, ref, tol, out, status, info) -> None:
     # ref: one row for all targets (m = 1) or one per target; ``i - i`` keeps the index type of i
     n, m = p.shape[0], ref.shape[0]
     for i in range(n):
-        status[i] = _ik_all_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])
+        status[i] = _ik_all_k(p[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])
 
 
 @batch_kernel(rows="p ref out status info", min_parallel=4096)
-def _ik_batch(p, g, ref, out, status, info) -> None:
+def _ik_batch(p, g, ref, tol, out, status, info) -> None:
     n, m = p.shape[0], ref.shape[0]
     for i in range(n):
-        status[i] = _ik_k(p[i], g, ref[i if m > 1 else i - i], out[i], info[i])
+        status[i] = _ik_k(p[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])

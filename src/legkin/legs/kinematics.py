@@ -52,11 +52,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._batch import as_input, check_flag, finish
+from .._batch import as_input, check_flag, check_number, finish
 from .._kernels import OK, as_rows
-from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
+from ..errors import InvalidInputError, JointLimitError, UnreachableError
+from ..errors import LegStructureError as _LegStructureError
 from ._fk_kernels import _fk_batch, _fk_k, _jacobian_batch, _jacobian_k
-from ._ik_kernels import _ik_all_batch, _ik_batch, _ik_k
+from ._ik_kernels import _ik_all_batch, _ik_all_k, _ik_batch, _ik_k
 from ._layout import (
     _A1,
     _A2,
@@ -87,6 +88,7 @@ from ._layout import (
     _V21,
     _V32,
     BRANCHES,
+    IK_TOL,
     LIMIT_TOL,
     PARALLEL_TOL,
     PERPENDICULAR_TOL,
@@ -103,12 +105,13 @@ __all__ = [
     "PERPENDICULAR_TOL",
     "PARALLEL_TOL",
     "REACH_TOL",
+    "IK_TOL",
     "LIMIT_TOL",
 ]
 
 
-class LegStructureError(InvalidParameterError):
-    """A kinematic chain that is not an HAA-HFE-KFE leg (the message names the deviation)."""
+#: A kinematic chain that is not a supported leg (the message names the deviation): legkin.errors' class.
+LegStructureError = _LegStructureError
 
 
 _S3SHAPE = (3,)
@@ -192,6 +195,10 @@ class Leg:
     idx_v: tuple[int, int, int] = (-1, -1, -1)
     params: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # always set by from_geometry
 
+    #: The leg's structure (see :data:`legkin.legs.extract.EXPECTED`) and its number of joints.
+    structure = "HAA-HFE-KFE"
+    dof = 3
+
     # ------------------------------------------------------------ construction
     @classmethod
     def from_geometry(
@@ -264,7 +271,8 @@ class Leg:
         hi = np.asarray(upper, dtype=float).reshape(3)
         if np.any(np.isnan(lo)) or np.any(np.isnan(hi)) or np.any(lo > hi):
             raise LegStructureError(f"leg {name}: bad joint limits lower={lo.tolist()}, upper={hi.tolist()}")
-        mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), np.clip(0.0, lo, hi))
+        finite = np.isfinite(lo) & np.isfinite(hi)
+        mid = np.where(finite, 0.5 * (np.where(finite, lo, 0.0) + np.where(finite, hi, 0.0)), np.clip(0.0, lo, hi))
         g = np.zeros(_NPARAMS)
         g[_O:_O + 3], g[_E1:_E1 + 3], g[_E2:_E2 + 3], g[_E3:_E3 + 3] = o[0], e1, e2, e3
         g[_D] = d
@@ -396,7 +404,7 @@ class Leg:
         _jacobian_batch(rows, self.params, out)
         return out.reshape(arr.shape + (3,))
 
-    def _prepare(self, p, q_near):
+    def _prepare(self, p, q_near, tol):
         """Checked target rows and reference rows (m = 1 or n), the batch shape and whether it is a single call."""
         arr = as_input(p, "p", _S3SHAPE)
         if q_near is None:
@@ -417,9 +425,9 @@ class Leg:
                 ref = as_rows(np.broadcast_to(r, batch + _S3SHAPE), 3)
             if arr.shape[:-1] != batch:
                 arr = np.broadcast_to(arr, batch + _S3SHAPE)
-        return as_rows(arr, 3), ref, batch, len(batch) == 0
+        return as_rows(arr, 3), ref, batch, len(batch) == 0, check_number(tol, "tol", 0.0, 1e-3, low_open=True)
 
-    def _error(self, status: int, info: np.ndarray, p: np.ndarray):
+    def _error(self, status: int, info: np.ndarray, p: np.ndarray, tol: float = IK_TOL):
         tgt = [float(x) for x in p]
         if status == _UNREACHABLE:
             miss, why = float(info[0]), info[1]
@@ -434,7 +442,7 @@ class Leg:
             return UnreachableError(f"target {tgt} is out of reach of leg {self.name} by {miss:.6g} m: {text}",
                                     target=p)
         if status == _JOINT_LIMIT:
-            branches = self.ik_all(p)[0]
+            branches = self.ik_all(p, tol=tol)
             return JointLimitError(
                 f"target {tgt} of leg {self.name} is reachable only outside the joint limits "
                 f"[{self.lower.tolist()}, {self.upper.tolist()}] (by {float(info[0]):.6g} rad at least); "
@@ -443,7 +451,7 @@ class Leg:
             )
         return InvalidInputError(f"p must be finite, got {tgt}")  # pragma: no cover - as_input caught it
 
-    def ik_all(self, p, *, q_near=None) -> tuple[np.ndarray, np.ndarray]:
+    def ik_all(self, p, *, q_near=None, tol: float = IK_TOL, return_mask: bool = False):
         """Every IK branch of the target(s) ``p`` (m, root frame), joint limits ignored.
 
         Branches in :data:`BRANCHES` order ``(s_a, s_k)``: ``u3 = s_a sqrt(y^2 + z^2 - d^2)`` (abduction) and
@@ -454,27 +462,44 @@ class Leg:
         Args:
             p: targets (3,) or (..., 3).
             q_near: reference joint values (3,) or broadcastable with ``p``.
+            tol: a target up to ``tol`` (m; (0, 1e-3], default :data:`IK_TOL` = 1e-9) outside the reachable set
+                is solved at its nearest reachable point (a float32-rounded target, say); farther out it is not.
+            return_mask: also return the boolean mask of the branches that exist (legkin 0.2.0 convention).
 
         Returns:
-            ``(q_all, mask)``: (4, 3) or (..., 4, 3) with NaN rows for absent branches, and the (4,) or (..., 4)
-            boolean mask of the branches that exist.
+            ``q_all`` (4, 3) or (..., 4, 3) (rad) with NaN rows for absent branches; with ``return_mask=True``
+            ``(q_all, mask)``, the mask (4,) or (..., 4).
 
         Raises:
             UnreachableError: a single target with no branch (the message says by how much it misses).
             InvalidInputError: ``p`` or ``q_near`` not finite real arrays (..., 3), or not broadcastable.
+            InvalidParameterError: ``return_mask`` not a bool.
         """
-        rows, ref, batch, single = self._prepare(p, q_near)
+        if return_mask is not False and return_mask is not True:
+            return_mask = check_flag(return_mask, "return_mask")
+        if q_near is None and tol is IK_TOL and p.__class__ is np.ndarray and p.shape == _S3SHAPE \
+                and p.dtype is _F64:  # fast
+            out = np.empty((4, 3))
+            info = np.zeros(2)
+            st = _ik_all_k(p, self.params, self.q_ref, IK_TOL, out, info)
+            if st == OK:
+                return (out, np.isfinite(out[:, 0])) if return_mask else out
+            if st != _BAD_INPUT:
+                raise self._error(st, info, p.copy())
+        rows, ref, batch, single, tol = self._prepare(p, q_near, tol)
         n = rows.shape[0]
         out = np.empty((n, 4, 3))
         status = np.empty(n, dtype=np.int64)
         info = np.zeros((n, 2))
-        _ik_all_batch(rows, self.params, ref, out, status, info)
+        _ik_all_batch(rows, self.params, ref, tol, out, status, info)
         if single and status[0] != OK:
-            raise self._error(int(status[0]), info[0], rows[0])
-        mask = np.isfinite(out[..., 0])
-        return out.reshape(batch + (4, 3)), mask.reshape(batch + (4,))
+            raise self._error(int(status[0]), info[0], rows[0], tol)
+        q_all = out.reshape(batch + (4, 3))
+        if not return_mask:
+            return q_all
+        return q_all, np.isfinite(q_all[..., 0])
 
-    def ik(self, p, *, q_near=None, return_mask: bool = False):
+    def ik(self, p, *, q_near=None, tol: float = IK_TOL, return_mask: bool = False):
         """Joint values placing the foot at ``p``: the branch inside the URDF limits nearest ``q_near``.
 
         For each branch of :meth:`ik_all`, each joint takes its 2 pi representative inside ``[lower, upper]``
@@ -497,23 +522,24 @@ class Leg:
         """
         if return_mask is not False and return_mask is not True:
             return_mask = check_flag(return_mask, "return_mask")
-        if q_near is None and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast
+        if q_near is None and tol is IK_TOL and p.__class__ is np.ndarray and p.shape == _S3SHAPE \
+                and p.dtype is _F64:  # fast
             out = np.empty(3)
             info = np.zeros(2)
-            st = _ik_k(p, self.params, self.q_ref, out, info)
+            st = _ik_k(p, self.params, self.q_ref, IK_TOL, out, info)
             if st == OK:
                 return (out, np.array(True)) if return_mask else out
             if st != _BAD_INPUT:
                 raise self._error(st, info, p.copy())
-        rows, ref, batch, single = self._prepare(p, q_near)
+        rows, ref, batch, single, tol = self._prepare(p, q_near, tol)
         n = rows.shape[0]
         out = np.empty((n, 3))
         status = np.empty(n, dtype=np.int64)
         info = np.zeros((n, 2))
-        _ik_batch(rows, self.params, ref, out, status, info)
+        _ik_batch(rows, self.params, ref, tol, out, status, info)
         ok = status == OK
         if single:
-            return finish(out[0], ok[0], True, return_mask, lambda: self._error(int(status[0]), info[0], rows[0]))
+            return finish(out[0], ok[0], True, return_mask, lambda: self._error(int(status[0]), info[0], rows[0], tol))
         return finish(out.reshape(batch + (3,)), ok.reshape(batch), False, return_mask, _never)
 
     def within_limits(self, q, tol: float = 0.0) -> np.ndarray | bool:

@@ -10,7 +10,7 @@ from __future__ import annotations
 from typing import Any
 
 from .._registry import ModelSpec
-from .erd import ERD_ROBOTS, erd_files, standing_pose
+from .erd import ERD_ALL, erd_files, standing_pose
 
 __all__ = ["SPECS"]
 
@@ -32,7 +32,7 @@ def _foot_frame(robot: Any) -> str:
 SPECS = [
     ModelSpec(
         name=r.name,
-        title=f"{r.title}: closed-form leg IK measured from its URDF (legkin.legs)",
+        title=f"{r.title}: leg kinematics measured from its URDF (legkin.legs)",
         seed="",
         actuated_joints=None,
         floating=True,
@@ -45,5 +45,5 @@ SPECS = [
         yardstick_frame=_foot_frame,
         mjcf=False,  # their meshes are .dae, which MuJoCo does not read
     )
-    for r in ERD_ROBOTS.values()
+    for r in ERD_ALL.values()
 ]

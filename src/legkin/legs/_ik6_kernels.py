@@ -1,0 +1,148 @@
+"""The inverse kinematics kernels of a 6-DOF leg (:mod:`legkin.legs.sixdof`): every solution (the closed form's or
+the one-dimensional search's candidates, each polished on the exact forward map and kept if it reproduces the
+target), and the solution inside the limits nearest a reference; scalar and batch."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._kernels import OK, batch_kernel, kernel
+from ._ik_kernels import _in_limits_k, _near_k
+from ._search_kernels import _search_candidates
+from ._sixdof_kernels import _hip_candidates, _polish6, _valid_pose
+from ._sixdof_layout import (
+    _BAD_INPUT,
+    _HI6,
+    _JOINT_LIMIT,
+    _KIND,
+    _LO6,
+    _NSOLS,
+    _UNREACHABLE,
+    HIP_SPHERICAL,
+)
+
+_NAN = math.nan
+
+
+@kernel
+def _candidates(tg, g, cand) -> int:
+    """The candidate rows of the leg's structure (closed form or search) in ``cand``; returns how many."""
+    if g[_KIND] == HIP_SPHERICAL:
+        return _hip_candidates(tg, g, cand)
+    if g[_KIND] != 0.0:
+        return _search_candidates(tg, g, cand)
+    return 0
+
+
+@kernel(entry=True)
+def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
+    """Every solution (rows of ``out`` (K, 6), NaN rows for absent ones) of the foot pose ``tg`` (16 floats): the
+    candidates of the leg's structure (closed form or search), each polished (:func:`_polish6`) and kept if it
+    reproduces ``tg`` to ``tol``, each angle moved to its 2 pi representative nearest ``ref``. ``info[0]``: on
+    failure the least residual."""
+    k = out.shape[0]
+    for b in range(k):
+        for j in range(6):
+            out[b, j] = _NAN
+    if not _valid_pose(tg):
+        return _BAD_INPUT
+    ws = np.empty((33 + k, 6))  # rows 0-31: the polish's work space, 32: the polished row, then the candidates
+    cand, qb = ws[33:], ws[32]
+    n = _candidates(tg, g, cand)
+    best, found = math.inf, 0
+    for b in range(n):
+        for j in range(6):
+            qb[j] = cand[b, j]
+        res = _polish6(tg, g, qb, ws)
+        if res <= tol:
+            for j in range(6):
+                out[b, j] = _near_k(qb[j], ref[j])
+            found += 1
+        elif res < best:
+            best = res
+    if found == 0:
+        info[0], info[1] = best, 0.0
+        return _UNREACHABLE
+    return OK
+
+
+@kernel
+def _limited(q, ref, g, x) -> tuple[float, bool]:
+    """``x`` = each angle of ``q`` at its 2 pi representative inside the limits nearest ``ref``; returns the cost
+    ``|x - ref|^2`` and whether every angle has one (else the cost is the worst limit violation, rad)."""
+    worst, inside = 0.0, True
+    for j in range(6):
+        x[j], m = _in_limits_k(q[j], ref[j], g[_LO6 + j], g[_HI6 + j])
+        worst = max(worst, m)
+        inside = inside and np.isfinite(x[j])
+    if not inside:
+        return worst, False
+    cost = 0.0
+    for j in range(6):
+        cost += (x[j] - ref[j]) ** 2
+    return cost, True
+
+
+@kernel(entry=True)
+def _ik6_k(tg, g, ref, tol, out, info) -> int:
+    """The solution inside the limits nearest ``ref`` (least sum of squared differences): the candidates are ranked
+    by that cost first and polished in that order until one reproduces ``tg`` to ``tol`` (its angles then moved
+    inside the limits again), so a single answer costs one polish, not one per candidate. ``info``: the least
+    residual, or the least limit violation (rad) and the count of solutions."""
+    for j in range(6):
+        out[j] = _NAN
+    if not _valid_pose(tg):
+        return _BAD_INPUT
+    k = int(g[_NSOLS])
+    ws = np.empty((33 + 2 * k, 6))  # polish work space, polished row, candidates, their in-limit representatives
+    cand, lim, qb = ws[33:33 + k], ws[33 + k:], ws[32]
+    n = _candidates(tg, g, cand)
+    cost = np.empty(k)
+    for b in range(n):
+        c, inside = _limited(cand[b], ref, g, lim[b])
+        cost[b] = c if inside else math.inf
+    best, viol, nb = math.inf, math.inf, 0
+    for _ in range(n):  # the in-limit candidates, cheapest first
+        i = int(np.argmin(cost[:n]))
+        if cost[i] == math.inf:
+            break
+        cost[i] = math.inf
+        for j in range(6):
+            qb[j] = lim[i, j]
+        res = _polish6(tg, g, qb, ws)
+        if res <= tol:
+            c, inside = _limited(qb, ref, g, out)
+            if inside:
+                return OK
+            for j in range(6):
+                out[j] = _NAN
+        best = min(best, res)
+    for b in range(n):  # none inside the limits: is any candidate a solution at all?
+        for j in range(6):
+            qb[j] = cand[b, j]
+        if _polish6(tg, g, qb, ws) <= tol:
+            nb += 1
+            viol = min(viol, _limited(qb, ref, g, lim[b])[0])
+        else:
+            best = min(best, _polish6(tg, g, qb, ws))
+    if nb == 0:
+        info[0], info[1] = best, 0.0
+        return _UNREACHABLE
+    info[0], info[1] = viol, nb
+    return _JOINT_LIMIT
+
+
+@batch_kernel(rows="tg ref out status info", min_parallel=256)
+def _ik_all6_batch(tg, g, ref, tol, out, status, info) -> None:
+    n, m = tg.shape[0], ref.shape[0]
+    for i in range(n):
+        status[i] = _ik_all6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])
+
+
+@batch_kernel(rows="tg ref out status info", min_parallel=256)
+def _ik6_batch(tg, g, ref, tol, out, status, info) -> None:
+    n, m = tg.shape[0], ref.shape[0]
+    for i in range(n):
+        status[i] = _ik6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])

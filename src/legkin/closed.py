@@ -1,0 +1,208 @@
+"""Closed-loop kinematics of a robot given by its motors: ``closed_fk``, ``closed_jacobian``, ``closed_ik``.
+
+The loops (``robot.loops``, residual ``r(q)``, Jacobian ``J_c = dr/dv``) tie the passive joints to the
+actuated ones (``robot.actuated_joints``, one coordinate each). Split the velocity ``v`` into motor and
+passive coordinates, ``J_c = [J_m  J_p]``:
+
+* ``closed_fk(motors, q_near)``: ``q`` with the motor coordinates set to ``motors`` exactly and the passive
+  ones solving ``r(q) = 0`` by Gauss-Newton from ``q_near`` with minimum-norm steps ``dq_p = -pinv(J_p) r``
+  (:func:`legkin.loops.levenberg_marquardt`), so the solution is the one continuous with ``q_near`` and the
+  idle mobility (a rod spinning about its axis between two ball joints: the null space of ``J_p``) does not
+  move; if that does not close, the motors are moved from their ``q_near`` values in 2, 4, ... 64 steps.
+* ``closed_jacobian(q, frame)``: ``J_p v_p = -J_m v_m``, ``v_p = -pinv(J_p) J_m v_m`` (minimum norm: the idle
+  motion set to zero), so the frame's twist is ``(J_f,m - J_f,p pinv(J_p) J_m) v_m``, 6 x n_motors.
+* ``closed_ik(frame, pose, q_near)``: the loops and the frame's error (``log6(pose^-1 oMf)``, or the position
+  error for a 3-vector target) stacked, all joints free, minimum-norm Gauss-Newton from ``q_near``.
+
+Every answer is checked on the frames themselves (:func:`legkin.closing.loop_errors`): loops to
+:data:`legkin.closing.CLOSED_TOL` (1e-10 m and rad).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pinocchio as pin
+
+from ._batch import as_input
+from .closing import CLOSED_TOL, loop_errors
+from .errors import InvalidInputError, LoopClosureError, UnreachableError
+from .loops import levenberg_marquardt
+
+__all__ = ["ClosedLoopMixin"]
+
+_STEPS = (1, 2, 4, 8, 16, 32, 64)
+_MAX_ITER = 50
+
+
+class ClosedLoopMixin:
+    """Closed-loop kinematics through the motors, for :class:`legkin.Robot` (needs ``model``, ``_loopset``,
+    ``actuated_joints``, ``q0``, ``check_q``, ``frame_id``, ``idx_q``, ``idx_v``)."""
+
+    model: pin.Model
+    _loopset: Any
+    actuated_joints: Any
+    q0: np.ndarray
+
+    # ------------------------------------------------------------------ helpers
+    def _motor_index(self) -> tuple[np.ndarray, np.ndarray]:
+        """The motors' ``q`` and ``v`` indices (each motor one coordinate)."""
+        iq, iv = [], []
+        for name in self.actuated_joints:
+            j = self.model.joints[self.joint_id(name)]  # type: ignore[attr-defined]
+            if j.nq != 1 or j.nv != 1:
+                raise InvalidInputError(f"motor {name!r} has {j.nq} coordinates: closed_fk drives 1-coordinate motors")
+            iq.append(j.idx_q)
+            iv.append(j.idx_v)
+        return np.array(iq, dtype=int), np.array(iv, dtype=int)
+
+    def _closed(self, q: np.ndarray) -> bool:
+        errs = loop_errors(self.model, self._loopset.data, self._loopset.loops, q)
+        return max((e.worst for e in errs), default=0.0) <= CLOSED_TOL
+
+    def _near(self, q_near) -> np.ndarray:
+        return self.check_q(self.q0 if q_near is None else q_near, "q_near").copy()  # type: ignore[attr-defined]
+
+    def idle_mobility(self, q=None, tol: float = 1e-9) -> int:
+        """Degrees of freedom left with every motor held (0 for a fully actuated robot; a rod spinning about its
+        own axis between two ball joints counts 1).
+
+        Args:
+            q: a closed configuration (default ``q0``).
+            tol: relative singular-value threshold of the rank, in [0, 1).
+        """
+        return int(self.mobility(self.q0 if q is None else q, locked=self.actuated_joints, tol=tol))  # type: ignore
+
+    # ------------------------------------------------------------------ closed_fk
+    def _fk_step(self, motors: np.ndarray, q: np.ndarray) -> np.ndarray:
+        """Gauss-Newton (minimum-norm steps) on the passive coordinates from ``q`` with the motors set."""
+        iq, iv = self._motor_index()
+        free = np.ones(self.model.nv, dtype=bool)
+        free[iv] = False
+        q = q.copy()
+        q[iq] = motors
+        return levenberg_marquardt(self.model, self._loopset.residual_and_jacobian, q, free, 1e-14, _MAX_ITER)[0]
+
+    def _fk_once(self, motors: np.ndarray, q: np.ndarray) -> np.ndarray | None:
+        q = self._fk_step(motors, q)
+        return q if self._closed(q) else None
+
+    def closed_fk(self, motors, q_near=None) -> np.ndarray:
+        """The closed configuration with the motors at ``motors``, continuous with ``q_near``.
+
+        Args:
+            motors: the actuated joints' values, in ``robot.actuated_joints`` order (rad or m), shape
+                ``(n_motors,)``.
+            q_near: the configuration the answer is continuous with (default ``q0``): the branch a controller is
+                on. Warm-start it with the last answer.
+
+        Returns:
+            ``q`` (``model.nq``): motors exactly as given, every loop closed to 1e-10 m and rad.
+
+        Raises:
+            InvalidInputError: ``motors`` of the wrong shape or not finite, a bad ``q_near``.
+            LoopClosureError: the loops do not close with these motor values (out of the workspace, or across
+                a singularity from ``q_near``).
+        """
+        iq, _ = self._motor_index()
+        m = as_input(motors, "motors")
+        if m.shape != (len(iq),):
+            raise InvalidInputError(f"motors must have shape ({len(iq)},) ({', '.join(self.actuated_joints)}), "
+                                    f"got shape {m.shape}")
+        q = self._near(q_near)
+        start = q[iq].copy()
+        for n in _STEPS:
+            qk: np.ndarray | None = q
+            for t in np.linspace(0.0, 1.0, n + 1)[1:]:
+                qk = self._fk_once(start + t * (m - start), qk)
+                if qk is None:
+                    break
+            if qk is not None:
+                return qk
+        errs = loop_errors(self.model, self._loopset.data, self._loopset.loops, self._fk_step(m, q))
+        raise LoopClosureError(
+            f"closed_fk: the loops do not close with motors {np.array2string(m, precision=4)} from q_near "
+            f"(worst loop {max(errs, key=lambda e: e.worst).name}: {max(e.worst for e in errs):.3g} m or rad)",
+            residual=max(e.worst for e in errs), open_loops=errs,
+        )
+
+    # ------------------------------------------------------------------ closed_jacobian
+    def closed_jacobian(self, q, frame: str, reference=pin.LOCAL_WORLD_ALIGNED) -> np.ndarray:
+        """The twist of ``frame`` per motor velocity through the loops, 6 x n_motors.
+
+        ``(J_f,m - J_f,p pinv(J_p) J_m)``: the passive velocities are the minimum-norm solution of the loops'
+        velocity equation (idle motions set to zero).
+
+        Args:
+            q: a closed configuration (``model.nq``).
+            frame: a frame name.
+            reference: as :meth:`legkin.Robot.frame_jacobian` (default ``LOCAL_WORLD_ALIGNED``: linear part the
+                frame origin's velocity in world axes, m per rad; angular part rad/s per rad/s, world axes).
+
+        Raises:
+            InvalidInputError: a bad ``q`` or frame name.
+        """
+        q = self.check_q(q)  # type: ignore[attr-defined]
+        _, iv = self._motor_index()
+        jf = self.frame_jacobian(q, frame, reference)  # type: ignore[attr-defined]
+        jc = self._loopset.residual_and_jacobian(q)[1]
+        passive = np.ones(self.model.nv, dtype=bool)
+        passive[iv] = False
+        dvp = -np.linalg.pinv(jc[:, passive], rcond=1e-10) @ jc[:, iv]
+        return np.asarray(jf[:, iv] + jf[:, passive] @ dvp)
+
+    # ------------------------------------------------------------------ closed_ik
+    def _pose_target(self, pose) -> tuple[pin.SE3 | None, np.ndarray]:
+        if isinstance(pose, pin.SE3):
+            return pose, pose.translation
+        x = as_input(pose, "pose")
+        if x.shape == (3,):
+            return None, x
+        if x.shape == (4, 4):
+            return pin.SE3(x), x[:3, 3]
+        raise InvalidInputError(f"pose must be a pinocchio.SE3, a 4 x 4 matrix or a position (3,), got shape {x.shape}")
+
+    def closed_ik(self, frame: str, pose, q_near=None) -> np.ndarray:
+        """A closed configuration placing ``frame`` at ``pose``, continuous with ``q_near``.
+
+        Args:
+            frame: a frame name.
+            pose: the target: a ``pinocchio.SE3`` or 4 x 4 matrix (placement), or a 3-vector (position only, m).
+            q_near: the start (default ``q0``); the answer is the one Gauss-Newton reaches from it.
+
+        Returns:
+            ``q`` (``model.nq``) with every loop closed to 1e-10 and the frame on the target to 1e-10 m / rad;
+            the motors are ``q`` at ``robot.actuated_joints``.
+
+        Raises:
+            InvalidInputError: a bad frame, pose or ``q_near``.
+            UnreachableError: no closed configuration reached from ``q_near`` places the frame there (``closest``:
+                the configuration reached, ``distance``: its position error, m).
+        """
+        fid = self.frame_id(frame)  # type: ignore[attr-defined]
+        target, position = self._pose_target(pose)
+        model, data = self.model, self._loopset.data
+        free = np.ones(model.nv, dtype=bool)
+
+        def fun(q):
+            r, jc = self._loopset.residual_and_jacobian(q)
+            pin.updateFramePlacements(model, data)
+            om = data.oMf[fid]
+            jf = pin.getFrameJacobian(model, data, fid, pin.LOCAL if target is not None else pin.LOCAL_WORLD_ALIGNED)
+            if target is None:
+                return np.concatenate([r, om.translation - position]), np.vstack([jc, jf[:3]])
+            err = pin.log6(target.actInv(om)).vector
+            return np.concatenate([r, err]), np.vstack([jc, pin.Jlog6(target.actInv(om)) @ jf])
+
+        q, _, _, _, _ = levenberg_marquardt(model, fun, self._near(q_near), free, 1e-14, 4 * _MAX_ITER)
+        pin.framesForwardKinematics(model, data, q)
+        om = data.oMf[fid]
+        dist = float(np.linalg.norm(om.translation - position))
+        angle = 0.0 if target is None else float(np.linalg.norm(pin.log3(target.rotation.T @ om.rotation)))
+        if self._closed(q) and max(dist, angle) <= CLOSED_TOL:
+            return q
+        raise UnreachableError(
+            f"closed_ik: frame {frame!r} does not reach the target from q_near: {dist:.3g} m and {angle:.3g} rad "
+            "off at the closest closed configuration found", target=pose, closest=q, distance=dist,
+        )

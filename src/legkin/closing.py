@@ -87,10 +87,13 @@ def _lm(ls: LoopSet, q: np.ndarray, free: np.ndarray, shift: np.ndarray | None =
     return q, it
 
 
-def _attempts(ls: LoopSet, q0: np.ndarray, free: np.ndarray, seed: int, restarts: int = RESTARTS):
+def _attempts(ls: LoopSet, q0: np.ndarray, free: np.ndarray, seed: int, restarts: int = RESTARTS,
+              homotopy: bool = True):
     """The strategies in turn: yields (name, configuration reached, iterations)."""
     q, it = _lm(ls, q0, free)
     yield "direct", q, it
+    if not homotopy:
+        return
     r0 = ls.residual(q0)
     q, total = q0.copy(), 0
     for t in np.linspace(0.0, 1.0, HOMOTOPY_STEPS + 1)[1:]:
@@ -106,7 +109,7 @@ def _attempts(ls: LoopSet, q0: np.ndarray, free: np.ndarray, seed: int, restarts
 
 
 def close_loops(ls: LoopSet, q0: np.ndarray, free: np.ndarray, *, tol: float = CLOSED_TOL, seed: int = 0,
-                restarts: int = RESTARTS, diagnose_failure: bool = True) -> tuple[np.ndarray, ClosingInfo]:
+                restarts: int = RESTARTS, homotopy: bool = True, diagnose_failure: bool = True) -> tuple[np.ndarray, ClosingInfo]:
     """Close every loop of ``ls`` from ``q0``, moving only the velocity coordinates ``free``.
 
     Args:
@@ -116,6 +119,7 @@ def close_loops(ls: LoopSet, q0: np.ndarray, free: np.ndarray, *, tol: float = C
         tol: the largest frame error accepted (m and rad).
         seed: seed of the restarts.
         restarts: random starts tried after the direct and homotopy attempts.
+        homotopy: try the homotopy (and the restarts) after the direct attempt.
         diagnose_failure: on failure, try each open loop alone to say why (:func:`diagnose`).
 
     Returns:
@@ -127,7 +131,7 @@ def close_loops(ls: LoopSet, q0: np.ndarray, free: np.ndarray, *, tol: float = C
     """
     data = ls.model.createData()
     best_q, best_err, iterations = q0, np.inf, 0
-    for name, q, it in _attempts(ls, q0, free, seed, restarts):
+    for name, q, it in _attempts(ls, q0, free, seed, restarts, homotopy):
         iterations += it
         err = _worst(loop_errors(ls.model, data, ls.loops, q))
         if err <= tol:
@@ -139,10 +143,14 @@ def close_loops(ls: LoopSet, q0: np.ndarray, free: np.ndarray, *, tol: float = C
     parts = [f"{e.name} ({e.distance:.3g} m, {e.angle:.3g} rad{': ' + verdicts[e.name] if e.name in verdicts else ''})"
              for e in errors if e.worst > tol]
     raise LoopClosureError(
-        f"could not close the loops from this start (direct, homotopy and {restarts} restarts, {iterations} "
+        f"could not close the loops from this start ({_tried(homotopy, restarts)}, {iterations} "
         f"iterations): {len(parts)} of {len(errors)} stay open: " + "; ".join(parts),
         residual=best_err, iterations=iterations, q=best_q, open_loops=errors,
     )
+
+
+def _tried(homotopy: bool, restarts: int) -> str:
+    return f"direct, homotopy and {restarts} random starts" if homotopy else "direct Levenberg-Marquardt"
 
 
 def _alone(ls: LoopSet, loop: LoopSpec, q0, free, seed) -> list[LoopError]:

@@ -55,7 +55,8 @@ class FileRobot(Robot):
         missing_meshes: mesh files the URDF names that are not there (left out of the visual model).
         closing: how ``q0`` was closed (:class:`legkin.closing.ClosingInfo`), or the
             :class:`~legkin.errors.LoopClosureError` raised when it could not be (then ``q0`` is neutral;
-            the load tries the direct and homotopy starts only: ``solve_loops()`` adds restarts and says why).
+            the load tries a direct Levenberg-Marquardt only: ``solve_loops()`` adds a homotopy and restarts, and
+            says why a loop stays open).
         load_seconds: wall time of the model's construction, s (the closing of ``q0`` excluded).
     """
 
@@ -88,7 +89,7 @@ class FileRobot(Robot):
         self.closing: ClosingInfo | LoopClosureError
         try:
             self.q0, self.closing = close_loops(self._loopset, self.q0, np.ones(model.nv, dtype=bool),
-                                                restarts=0, diagnose_failure=False)
+                                                homotopy=False, diagnose_failure=False)
             self.poses[REFERENCE_POSE] = self.q0.copy()
         except LoopClosureError as exc:
             self.closing = exc

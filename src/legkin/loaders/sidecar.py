@@ -9,8 +9,9 @@ Keys (BSD-3 format of Gepetto's ``example-parallel-robots``; semantics only, no 
 * ``name_mot``: the actuated joints;
 * ``joint_name`` / ``joint_type`` (optional, same length): joints replaced before the model is built,
   ``SPHERICAL`` (a ball joint at the joint's origin), ``UJOINT_XY`` (a universal joint: rotation about the
-  joint frame's x axis, then about the rotated y axis; ``UJOINT_YX`` the other order; ``CARDAN`` is Gepetto's
-  older name of ``UJOINT_XY``) or ``FIXED`` (the joint is locked at 0).
+  joint frame's x axis, then about the rotated y axis, as two revolute joints ``<name>`` and ``<name>_y``;
+  ``UJOINT_YX`` the other order, ``<name>`` and ``<name>_x``; ``CARDAN`` is Gepetto's older name of
+  ``UJOINT_XY``) or ``FIXED`` (the joint is locked at 0).
 
 legkin's :class:`~legkin.loops.LoopSpec` names a 6d loop ``type="frame"`` and a 3d loop ``type="point"``.
 """

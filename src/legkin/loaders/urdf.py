@@ -84,19 +84,37 @@ def _strip_missing(root: ET.Element, urdf_dir: Path) -> list[str]:
     return sorted(missing)
 
 
-def _replacement(kind: str) -> pin.JointModel:
+def _add(new: pin.Model, model: pin.Model, jid: int, parent: int, joint, placement: pin.SE3, name: str,
+         keep_limits: bool) -> int:
+    if not keep_limits:
+        return int(new.addJoint(parent, joint, placement, name))
+    j = model.joints[jid]
+    sl, vs = slice(j.idx_q, j.idx_q + j.nq), slice(j.idx_v, j.idx_v + j.nv)
+    return int(new.addJoint(parent, joint, placement, name, model.effortLimit[vs], model.velocityLimit[vs],
+                            model.lowerPositionLimit[sl], model.upperPositionLimit[sl]))
+
+
+def _add_replaced(new: pin.Model, model: pin.Model, jid: int, parent: int, kind: str) -> int:
+    """Add joint ``jid`` of ``model`` to ``new`` as ``kind``; returns the id of the joint carrying its body.
+
+    ``UJOINT_XY`` is two revolute joints at the same origin: ``<name>`` about x, then ``<name>_y`` about the
+    rotated y (``UJOINT_YX``: ``<name>`` about y, ``<name>_x`` about x), the body on the second, so that every
+    joint stays a plain revolute (the MJCF export writes two hinges).
+    """
+    name, placement = model.names[jid], model.jointPlacements[jid]
+    if kind in ("KEEP", "FIXED"):  # FIXED: kept here, locked by build_urdf_models
+        return _add(new, model, jid, parent, model.joints[jid], placement, name, True)
     if kind == "SPHERICAL":
-        return pin.JointModelSpherical()
-    first, second = (pin.JointModelRX(), pin.JointModelRY()) if kind == "UJOINT_XY" else (
-        pin.JointModelRY(), pin.JointModelRX())
-    comp = pin.JointModelComposite(first)
-    comp.addJoint(second)
-    return comp
+        return _add(new, model, jid, parent, pin.JointModelSpherical(), placement, name, False)
+    first, second, suffix = ((pin.JointModelRX(), pin.JointModelRY(), "_y") if kind == "UJOINT_XY"
+                             else (pin.JointModelRY(), pin.JointModelRX(), "_x"))
+    mid = _add(new, model, jid, parent, first, placement, name, False)
+    return _add(new, model, jid, mid, second, pin.SE3.Identity(), name + suffix, False)
 
 
 def replace_joints(model: pin.Model, joint_types: dict[str, str], where: str) -> pin.Model:
     """``model`` with the named joints replaced (``SPHERICAL``, ``UJOINT_XY``, ``UJOINT_YX``; ``FIXED`` is
-    applied by :func:`build_urdf_models`), joint ids, names, frames and inertias kept.
+    applied by :func:`build_urdf_models`), names, frames and inertias kept (frames re-attached to the new ids).
 
     Raises:
         InvalidInputError: a joint name that the model does not have (naming ``where``, the key and the name).
@@ -108,20 +126,13 @@ def replace_joints(model: pin.Model, joint_types: dict[str, str], where: str) ->
             )
     new = pin.Model()
     new.name = model.name
+    ids = {0: 0}
     for jid in range(1, model.njoints):
-        name, joint = model.names[jid], model.joints[jid]
-        kind = joint_types.get(name, "KEEP")
-        if kind in ("KEEP", "FIXED"):  # FIXED: kept here, locked by build_urdf_models
-            lo, hi = model.lowerPositionLimit, model.upperPositionLimit
-            sl = slice(joint.idx_q, joint.idx_q + joint.nq)
-            vs = slice(joint.idx_v, joint.idx_v + joint.nv)
-            new.addJoint(model.parents[jid], joint, model.jointPlacements[jid], name, model.effortLimit[vs],
-                         model.velocityLimit[vs], lo[sl], hi[sl])
-        else:
-            new.addJoint(model.parents[jid], _replacement(kind), model.jointPlacements[jid], name)
-        new.appendBodyToJoint(jid, model.inertias[jid], pin.SE3.Identity())
+        ids[jid] = _add_replaced(new, model, jid, ids[model.parents[jid]], joint_types.get(model.names[jid], "KEEP"))
+        new.appendBodyToJoint(ids[jid], model.inertias[jid], pin.SE3.Identity())
     for f in list(model.frames)[1:]:
-        new.addFrame(pin.Frame(f.name, f.parentJoint, f.parentFrame, f.placement, f.type, f.inertia), False)
+        parent_frame = new.getFrameId(model.frames[f.parentFrame].name) if f.parentFrame else 0
+        new.addFrame(pin.Frame(f.name, ids[f.parentJoint], parent_frame, f.placement, f.type, f.inertia), False)
     return new
 
 
@@ -152,12 +163,12 @@ def build_urdf_models(text: str, path: Path, joint_types: dict[str, str] | None 
     text = ET.tostring(root, encoding="unicode")
     try:
         model = (pin.buildModelFromXML(text, pin.JointModelFreeFlyer()) if floating else pin.buildModelFromXML(text))
-        visual = _geometry(model, text, path.parent, pin.VISUAL)
+        if joint_types:
+            model = replace_joints(model, joint_types, where or str(path))
+        visual = _geometry(model, text, path.parent, pin.VISUAL)  # found by link (frame) name
         collision = _geometry(model, text, path.parent, pin.COLLISION)
     except (ValueError, RuntimeError) as exc:
         raise InvalidInputError(f"{path}: Pinocchio cannot build the model: {' '.join(str(exc).split())}") from None
-    if joint_types:
-        model = replace_joints(model, joint_types, where or str(path))
     locked = [model.getJointId(n) for n, k in joint_types.items() if k == "FIXED"]
     if locked:
         model, (visual, collision) = pin.buildReducedModel(model, [visual, collision], locked, pin.neutral(model))

@@ -1,0 +1,145 @@
+"""``legkin check PATH``: the rows that check a robot from a file (:func:`check_rows`).
+
+Samples: motor values reachable by construction (:func:`reachable_motors`): from ``q0``, a random motor step
+(uniform in +-0.1 rad for a revolute motor, +-0.01 m for a prismatic one), the passive joints moved by the
+minimum-norm velocity solution, then the loops closed again with every joint free; its motors are the
+sample. ``closed_fk`` must solve it from ``q0`` (the IK contract's "every target the FK makes is solved").
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pinocchio as pin
+
+from ..closing import CLOSED_TOL, close_loops, loop_errors
+from ..errors import LegkinError, LoopClosureError, UnreachableError
+from ..validation import CheckResult, compare
+from .robot import FileRobot
+
+__all__ = ["check_rows", "reachable_motors", "jacobian_fd_error", "mjcf_round_trip_error", "SPREAD"]
+
+#: Motor step of the samples: rad for a revolute motor, m for a prismatic one.
+SPREAD = {"revolute": 0.1, "prismatic": 0.01}
+#: Central-difference step (rad or m) and the Jacobian row's tolerance (truncation ~h^2, round-off ~eps/h).
+FD_STEP, TOL_JACOBIAN = 1e-6, 1e-6
+
+
+def _spread(robot: FileRobot) -> np.ndarray:
+    kinds = [robot.model.joints[robot.joint_id(a)].shortname() for a in robot.actuated]
+    return np.array([SPREAD["prismatic"] if "JointModelP" in k else SPREAD["revolute"] for k in kinds])
+
+
+def reachable_motors(robot: FileRobot, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` motor vectors reachable from ``robot.q0`` and the closed configurations that make them."""
+    iq, iv = robot._motor_index()
+    jc = robot.constraint_jacobian(robot.q0)
+    passive = np.ones(robot.model.nv, dtype=bool)
+    passive[iv] = False
+    pp = np.linalg.pinv(jc[:, passive], rcond=1e-10) @ jc[:, iv]
+    motors, qs = [], []
+    spread = _spread(robot)
+    while len(motors) < n:
+        dm = rng.uniform(-1.0, 1.0, len(iv)) * spread
+        dq = np.zeros(robot.model.nv)
+        dq[iv], dq[passive] = dm, -pp @ dm
+        try:
+            q, _ = close_loops(robot._loopset, pin.integrate(robot.model, robot.q0, dq),
+                               np.ones(robot.model.nv, dtype=bool), homotopy=False, diagnose_failure=False)
+        except LoopClosureError:
+            continue
+        motors.append(q[iq])
+        qs.append(q)
+    return np.array(motors), np.array(qs)
+
+
+def jacobian_fd_error(robot: FileRobot, q: np.ndarray, frame: str) -> float:
+    """Largest entry of ``closed_jacobian(q, frame)`` minus central differences of ``closed_fk`` (m, rad)."""
+    iq, _ = robot._motor_index()
+    jac = robot.closed_jacobian(q, frame)
+    num = np.zeros_like(jac)
+    for i in range(len(iq)):
+        e = np.zeros(len(iq))
+        e[i] = FD_STEP
+        ma = robot.frame_placement(robot.closed_fk(q[iq] + e, q), frame)
+        mb = robot.frame_placement(robot.closed_fk(q[iq] - e, q), frame)
+        num[:3, i] = (ma.translation - mb.translation) / (2 * FD_STEP)
+        num[3:, i] = pin.log3(ma.rotation @ mb.rotation.T) / (2 * FD_STEP)
+    return float(np.max(np.abs(jac - num)))
+
+
+def mjcf_round_trip_error(robot: FileRobot, tmpdir) -> float:
+    """legkin's MJCF export read back by Pinocchio's MJCF parser: the largest loop error (m, rad) of the
+    read-back loops at ``robot.q0``; inf when the loops' count or types differ."""
+    from pathlib import Path
+
+    from ..mjcf import to_mjcf
+    from .robot import load_file
+
+    path = Path(tmpdir) / f"{robot.name}.xml"
+    path.write_text(to_mjcf(robot))
+    back = load_file(path)
+    if [lp.type for lp in back.loops] != [lp.type for lp in robot.loops] or back.actuated != robot.actuated:
+        return float("inf")
+    q = pin.neutral(back.model)
+    for name in robot.joint_names:
+        j = robot.model.joints[robot.joint_id(name)]
+        q[back.idx_q(name): back.idx_q(name) + j.nq] = robot.q0[j.idx_q: j.idx_q + j.nq]
+    return max((e.worst for e in loop_errors(back.model, back.data, back.loops, q)), default=0.0)
+
+
+def _fk_rows(robot: FileRobot, motors: np.ndarray) -> list[CheckResult]:
+    iq, _ = robot._motor_index()
+    held, closed, unsolved = [], [], 0
+    for m in motors:
+        try:
+            q = robot.closed_fk(m)
+        except LoopClosureError:
+            unsolved += 1
+            continue
+        held.append(np.max(np.abs(q[iq] - m)))
+        closed.append(max(e.worst for e in loop_errors(robot.model, robot.data, robot.loops, q)))
+    n = len(motors)
+    return [compare("closed_fk motors held (rad, m)", held, 1e-12),
+            compare("closed_fk loops closed (frames, m, rad)", closed, CLOSED_TOL),
+            CheckResult("closed_fk unsolved fraction", n, unsolved / n, unsolved / n, 0.01, unsolved / n <= 0.01)]
+
+
+def _ik_row(robot: FileRobot, qs: np.ndarray, frame: str) -> CheckResult:
+    errs = []
+    for q in qs:
+        target = robot.frame_placement(q, frame)
+        try:
+            qi = robot.closed_ik(frame, target)
+        except UnreachableError:
+            errs.append(np.nan)
+            continue
+        errs.append(np.linalg.norm(pin.log6(target.actInv(robot.frame_placement(qi, frame))).vector))
+    return compare(f"closed_ik {frame} round trip (m, rad)", errs, CLOSED_TOL)
+
+
+def check_rows(robot: FileRobot, samples: int, rng: np.random.Generator, frame: str | None = None) -> list[CheckResult]:
+    """The rows of ``legkin check PATH``: ``q0`` closed, ``closed_fk`` (motors held, loops, unsolved
+    fraction), ``closed_jacobian`` vs central differences, ``closed_ik`` round trip, MJCF round trip.
+
+    Args:
+        robot: a robot from a file.
+        samples: motor samples of the ``closed_fk`` rows (a tenth of them, at least 3, for the Jacobian and IK).
+        rng: the random generator.
+        frame: the frame of the Jacobian and IK rows (default: the model's last frame).
+    """
+    import tempfile
+
+    if isinstance(robot.closing, LegkinError):
+        return [CheckResult(f"q0 closed from neutral: {robot.closing}", 0, np.nan, np.nan, CLOSED_TOL, False)]
+    frame = frame or robot.model.frames[robot.model.nframes - 1].name
+    rows = [compare("q0 loops closed (frames, m, rad)",
+                    [e.worst for e in loop_errors(robot.model, robot.data, robot.loops, robot.q0)], CLOSED_TOL)]
+    motors, qs = reachable_motors(robot, samples, rng)
+    rows += _fk_rows(robot, motors)
+    few = qs[: max(3, samples // 10)]
+    rows.append(compare(f"closed_jacobian {frame} vs central differences",
+                        [jacobian_fd_error(robot, q, frame) for q in few], TOL_JACOBIAN))
+    rows.append(_ik_row(robot, few, frame))
+    with tempfile.TemporaryDirectory(prefix="legkin-roundtrip-") as tmp:
+        rows.append(compare("MJCF round trip: loops at q0 (m, rad)", [mjcf_round_trip_error(robot, tmp)], CLOSED_TOL))
+    return rows

@@ -4,8 +4,8 @@ The output form follows ``OUT``'s name:
 
 * ``*.yaml`` / ``*.yml``: the sidecar (``closed_loop``, ``type``, ``name_mot``; ``joint_name`` /
   ``joint_type`` carried over from a sidecar input);
-* ``*.urdf``: the input URDF with one ``<loop_closure name type frame1 frame2>`` per loop (and no other
-  change), which ``legkin.load`` reads without a sidecar (joint replacements of a sidecar cannot be
+* ``*.urdf``: the input URDF with one ``<loop_closure name type frame1 frame2>`` per loop and a ROS
+  ``<transmission>`` per motor (no other change), which ``legkin.load`` reads without a sidecar (joint replacements of a sidecar cannot be
   written in a URDF: refused);
 * ``*.xml``: legkin's MJCF export (:func:`legkin.mjcf.to_mjcf`), loops as ``<connect>`` / ``<weld>``
   between sites.
@@ -30,6 +30,13 @@ def _urdf_with_loops(robot: FileRobot) -> str:
         root.remove(el)
     for lp in robot.loops:
         ET.SubElement(root, "loop_closure", name=lp.name, type=lp.type, frame1=lp.frame1, frame2=lp.frame2)
+    declared = {j.get("name") for j in root.iterfind("transmission/joint")}
+    for name in robot.actuated:
+        if name not in declared:  # the motors, as ROS transmissions (read back by legkin.load)
+            tr = ET.SubElement(root, "transmission", name=f"{name}_transmission")
+            ET.SubElement(tr, "type").text = "transmission_interface/SimpleTransmission"
+            ET.SubElement(ET.SubElement(tr, "joint", name=name), "hardwareInterface").text = "PositionJointInterface"
+            ET.SubElement(tr, "actuator", name=f"{name}_motor")
     ET.indent(root)
     return ET.tostring(root, encoding="unicode") + "\n"
 

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import time
+import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import Any, Iterable, Mapping
 
@@ -112,7 +113,8 @@ class FileRobot(Robot):
             specs = parse_loops(io.StringIO(text))  # type: ignore[arg-type]
         except LegkinError as exc:
             raise InvalidInputError(f"{path}: {exc}") from None
-        return built.model, built.visual_model, built.collision_model, specs, [], str(path)
+        motors = [j.get("name", "") for j in ET.fromstring(text).iterfind("transmission/joint")]
+        return built.model, built.visual_model, built.collision_model, specs, motors, str(path)
 
     @property
     def actuated(self) -> tuple[str, ...]:
@@ -160,7 +162,7 @@ def load_file(path: str | Path, *, loops: str | Path | None = None, floating: bo
 
     Args:
         path: a URDF (loops from a ``robot.yaml`` beside it, or ``<name>.yaml``, else its ``<loop_closure>``
-            elements), a xacro (``.xacro``, run without arguments), or an MJCF (``.xml``, loops from its
+            elements and the joints of its ``<transmission>`` elements as the motors), a xacro (``.xacro``, run without arguments), or an MJCF (``.xml``, loops from its
             ``<equality>`` constraints).
         loops: a YAML sidecar to use instead of the one beside the URDF.
         floating: add a free-flyer root joint (URDF only).

@@ -19,7 +19,7 @@ from legkin.loaders.checks import jacobian_fd_error, mjcf_round_trip_error, reac
 DATA = Path(__file__).parent / "data" / "example-parallel-robots"
 CLOSING = ["5bar_linkage", "5bar_linkage_iso3d", "cassie_like", "digit_like", "digit_like_2legs", "disney_like",
            "robot_delta", "talos_like", "wl16_like"]
-#: Measured: mobility (all joints free) and idle mobility (motors held) at the closed q0 (scripts/closed_loop_report.py).
+#: Measured (scripts/closed_loop_report.py): mobility (all joints free) and idle mobility (motors held) at q0.
 MOBILITY = {"5bar_linkage": (3, 1), "5bar_linkage_iso3d": (2, 0), "cassie_like": (7, 2), "digit_like": (9, 3),
             "digit_like_2legs": (12, 0), "disney_like": (9, 3), "robot_delta": (5, 3), "talos_like": (7, 1),
             "wl16_like": (12, 6)}

@@ -366,7 +366,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--png", metavar="PATH", type=output_file, help="also render q0 with MuJoCo (MUJOCO_GL=egl)")
     p.set_defaults(func=_cmd_export)
 
-    p = sub.add_parser("convert", help="convert a robot file's loops: YAML sidecar, URDF <loop_closure>, MJCF equalities")
+    p = sub.add_parser("convert",
+                       help="convert a robot file's loops: YAML sidecar, URDF <loop_closure>, MJCF equalities")
     p.add_argument("input", help="a URDF (+ robot.yaml), xacro or MJCF")
     p.add_argument("output", type=output_file, help="OUT.yaml (sidecar), OUT.urdf (<loop_closure>) or OUT.xml (MJCF)")
     p.add_argument("--loops", metavar="YAML", help="the input URDF's sidecar, if not robot.yaml beside it")

@@ -115,9 +115,7 @@ class ClosedLoopMixin:
         for n in _STEPS:
             qk: np.ndarray | None = q
             for t in np.linspace(0.0, 1.0, n + 1)[1:]:
-                qk = self._fk_once(start + t * (m - start), qk)
-                if qk is None:
-                    break
+                qk = self._fk_once(start + t * (m - start), qk) if qk is not None else None
             if qk is not None:
                 return qk
         errs = loop_errors(self.model, self._loopset.data, self._loopset.loops, self._fk_step(m, q))

@@ -109,7 +109,8 @@ def _attempts(ls: LoopSet, q0: np.ndarray, free: np.ndarray, seed: int, restarts
 
 
 def close_loops(ls: LoopSet, q0: np.ndarray, free: np.ndarray, *, tol: float = CLOSED_TOL, seed: int = 0,
-                restarts: int = RESTARTS, homotopy: bool = True, diagnose_failure: bool = True) -> tuple[np.ndarray, ClosingInfo]:
+                restarts: int = RESTARTS, homotopy: bool = True,
+                diagnose_failure: bool = True) -> tuple[np.ndarray, ClosingInfo]:
     """Close every loop of ``ls`` from ``q0``, moving only the velocity coordinates ``free``.
 
     Args:

@@ -13,8 +13,8 @@ import pinocchio as pin
 from ._batch import as_input
 from ._generate import model_files
 from ._registry import MODELS, get_spec
-from .errors import InvalidInputError, InvalidParameterError
 from .closed import ClosedLoopMixin
+from .errors import InvalidInputError, InvalidParameterError
 from .loops import DEFAULT_DAMPING, LoopSet, LoopSolveInfo, check_count, check_real, parse_loops
 
 __all__ = ["Robot", "load"]

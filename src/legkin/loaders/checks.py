@@ -36,7 +36,8 @@ def reachable_motors(robot: FileRobot, n: int, rng: np.random.Generator) -> tupl
     passive = np.ones(robot.model.nv, dtype=bool)
     passive[iv] = False
     pp = np.linalg.pinv(jc[:, passive], rcond=1e-10) @ jc[:, iv]
-    motors, qs = [], []
+    motors: list[np.ndarray] = []
+    qs: list[np.ndarray] = []
     spread = _spread(robot)
     while len(motors) < n:
         dm = rng.uniform(-1.0, 1.0, len(iv)) * spread
@@ -89,14 +90,16 @@ def mjcf_round_trip_error(robot: FileRobot, tmpdir) -> float:
 
 def _fk_rows(robot: FileRobot, motors: np.ndarray) -> list[CheckResult]:
     iq, _ = robot._motor_index()
-    held, closed, unsolved = [], [], 0
+    held: list[float] = []
+    closed: list[float] = []
+    unsolved = 0
     for m in motors:
         try:
             q = robot.closed_fk(m)
         except LoopClosureError:
             unsolved += 1
             continue
-        held.append(np.max(np.abs(q[iq] - m)))
+        held.append(float(np.max(np.abs(q[iq] - m))))
         closed.append(max(e.worst for e in loop_errors(robot.model, robot.data, robot.loops, q)))
     n = len(motors)
     return [compare("closed_fk motors held (rad, m)", held, 1e-12),
@@ -105,7 +108,7 @@ def _fk_rows(robot: FileRobot, motors: np.ndarray) -> list[CheckResult]:
 
 
 def _ik_row(robot: FileRobot, qs: np.ndarray, frame: str) -> CheckResult:
-    errs = []
+    errs: list[float] = []
     for q in qs:
         target = robot.frame_placement(q, frame)
         try:
@@ -113,7 +116,7 @@ def _ik_row(robot: FileRobot, qs: np.ndarray, frame: str) -> CheckResult:
         except UnreachableError:
             errs.append(np.nan)
             continue
-        errs.append(np.linalg.norm(pin.log6(target.actInv(robot.frame_placement(qi, frame))).vector))
+        errs.append(float(np.linalg.norm(pin.log6(target.actInv(robot.frame_placement(qi, frame))).vector)))
     return compare(f"closed_ik {frame} round trip (m, rad)", errs, CLOSED_TOL)
 
 

@@ -5,8 +5,8 @@ The output form follows ``OUT``'s name:
 * ``*.yaml`` / ``*.yml``: the sidecar (``closed_loop``, ``type``, ``name_mot``; ``joint_name`` /
   ``joint_type`` carried over from a sidecar input);
 * ``*.urdf``: the input URDF with one ``<loop_closure name type frame1 frame2>`` per loop and a ROS
-  ``<transmission>`` per motor (no other change), which ``legkin.load`` reads without a sidecar (joint replacements of a sidecar cannot be
-  written in a URDF: refused);
+  ``<transmission>`` per motor (no other change), which ``legkin.load`` reads without a sidecar (the joint
+  replacements of a sidecar cannot be written in a URDF: refused);
 * ``*.xml``: legkin's MJCF export (:func:`legkin.mjcf.to_mjcf`), loops as ``<connect>`` / ``<weld>``
   between sites.
 """

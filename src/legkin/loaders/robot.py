@@ -129,8 +129,10 @@ class FileRobot(Robot):
     def geometry(self) -> Any:
         raise LegkinError(f"{self.name!r} is a robot from a file: it has no analytic geometry")
 
-    def solve_loops(self, q_init=None, fixed: Mapping[str, float] | Iterable[str] | None = None, *,  # type: ignore[override]
-                    tol: float = CLOSED_TOL, seed: int = 0, return_info: bool = False, **_ignored: Any):
+    def solve_loops(  # type: ignore[override]
+        self, q_init=None, fixed: Mapping[str, float] | Iterable[str] | None = None, *, tol: float = CLOSED_TOL,
+        seed: int = 0, return_info: bool = False, **_ignored: Any,
+    ):
         """Close every loop from ``q_init`` (default neutral): direct, homotopy, then random restarts
         (:func:`legkin.closing.close_loops`), checked on the frames themselves.
 
@@ -162,7 +164,8 @@ def load_file(path: str | Path, *, loops: str | Path | None = None, floating: bo
 
     Args:
         path: a URDF (loops from a ``robot.yaml`` beside it, or ``<name>.yaml``, else its ``<loop_closure>``
-            elements and the joints of its ``<transmission>`` elements as the motors), a xacro (``.xacro``, run without arguments), or an MJCF (``.xml``, loops from its
+            elements and the joints of its ``<transmission>`` elements as the motors), a xacro (``.xacro``,
+            run without arguments), or an MJCF (``.xml``, loops from its
             ``<equality>`` constraints).
         loops: a YAML sidecar to use instead of the one beside the URDF.
         floating: add a free-flyer root joint (URDF only).

@@ -12,7 +12,6 @@ import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
-import numpy as np
 import pinocchio as pin
 
 from ..errors import InvalidInputError
@@ -46,7 +45,7 @@ def urdf_text(path: Path) -> str:
         if path.suffix == ".xacro":
             import xacro
 
-            return str(xacro.process_file(str(path)).toxml())
+            return str(xacro.process_file(str(path)).toxml())  # type: ignore[attr-defined]
         return path.read_text()
     except (OSError, UnicodeDecodeError) as exc:
         raise InvalidInputError(f"{path}: cannot read ({exc})") from None

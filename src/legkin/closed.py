@@ -20,6 +20,7 @@ Every answer is checked on the frames themselves (:func:`legkin.closing.loop_err
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -30,10 +31,64 @@ from .closing import CLOSED_TOL, loop_errors
 from .errors import InvalidInputError, LoopClosureError, UnreachableError
 from .loops import levenberg_marquardt
 
-__all__ = ["ClosedLoopMixin"]
+__all__ = ["ClosedLoopMixin", "Tree", "tree_of"]
 
 _STEPS = (1, 2, 4, 8, 16, 32, 64)
 _MAX_ITER = 50
+_AXES = {"X": (1.0, 0.0, 0.0), "Y": (0.0, 1.0, 0.0), "Z": (0.0, 0.0, 1.0)}
+
+
+@dataclass(frozen=True)
+class Tree:
+    """A Pinocchio model and its loops as the arrays of :mod:`legkin._tree_kernels` (see there)."""
+
+    parent: np.ndarray
+    kind: np.ndarray
+    axis: np.ndarray
+    place_r: np.ndarray
+    place_t: np.ndarray
+    idx_q: np.ndarray
+    idx_v: np.ndarray
+    loop_j: np.ndarray
+    loop_r: np.ndarray
+    loop_t: np.ndarray
+    loop_six: np.ndarray
+
+    def arrays(self) -> tuple[np.ndarray, ...]:
+        return (self.parent, self.kind, self.axis, self.place_r, self.place_t, self.idx_q, self.idx_v, self.loop_j,
+                self.loop_r, self.loop_t, self.loop_six)
+
+
+def _joint_kind(joint) -> tuple[int, tuple[float, ...]] | None:
+    from ._tree_kernels import PRISMATIC, REVOLUTE, SPHERICAL
+
+    name = joint.shortname()[len("JointModel"):]
+    if name == "Spherical":
+        return SPHERICAL, (0.0, 0.0, 0.0)
+    if name in ("RX", "RY", "RZ", "PX", "PY", "PZ"):
+        return (REVOLUTE if name[0] == "R" else PRISMATIC), _AXES[name[1]]
+    if name in ("RevoluteUnaligned", "PrismaticUnaligned"):
+        return (REVOLUTE if name[0] == "R" else PRISMATIC), tuple(joint.extract().axis)
+    return None
+
+
+def tree_of(model: pin.Model, loops) -> Tree | None:
+    """The arrays of ``model`` and ``loops`` for the compiled solver, or None when a joint is of a kind it does not
+    handle (a free flyer, a composite, a continuous joint: the Pinocchio path then solves)."""
+    kinds = [(0, (0.0, 0.0, 0.0))] + [_joint_kind(j) for j in model.joints[1:]]
+    if any(k is None for k in kinds):
+        return None
+    frames = [[model.frames[model.getFrameId(f)] for f in (lp.frame1, lp.frame2)] for lp in loops]
+    return Tree(
+        np.array(model.parents, dtype=np.int64), np.array([k[0] for k in kinds], dtype=np.int64),  # type: ignore
+        np.array([k[1] for k in kinds], dtype=float),  # type: ignore[index]
+        np.array([m.rotation for m in model.jointPlacements]), np.array([m.translation for m in model.jointPlacements]),
+        np.array([j.idx_q for j in model.joints], dtype=np.int64), np.array([j.idx_v for j in model.joints], dtype=np.int64),
+        np.array([[f.parentJoint for f in pair] for pair in frames], dtype=np.int64).reshape(-1, 2),
+        np.array([[f.placement.rotation for f in pair] for pair in frames]).reshape(-1, 2, 3, 3),
+        np.array([[f.placement.translation for f in pair] for pair in frames]).reshape(-1, 2, 3),
+        np.array([lp.type == "frame" for lp in loops], dtype=np.bool_),
+    )
 
 
 class ClosedLoopMixin:
@@ -75,18 +130,33 @@ class ClosedLoopMixin:
         return int(self.mobility(self.q0 if q is None else q, locked=self.actuated_joints, tol=tol))  # type: ignore
 
     # ------------------------------------------------------------------ closed_fk
-    def _fk_step(self, motors: np.ndarray, q: np.ndarray) -> np.ndarray:
-        """Gauss-Newton (minimum-norm steps) on the passive coordinates from ``q`` with the motors set."""
-        iq, iv = self._motor_index()
-        free = np.ones(self.model.nv, dtype=bool)
-        free[iv] = False
+    def _compiled(self) -> tuple[Tree | None, np.ndarray, np.ndarray, np.ndarray]:
+        """The compiled solver's tree (None: the Pinocchio path), motor q/v indices, passive mask (cached)."""
+        cache = self.__dict__.get("_closed_cache")
+        if cache is None:
+            iq, iv = self._motor_index()
+            passive = np.ones(self.model.nv, dtype=np.bool_)
+            passive[iv] = False
+            cache = (tree_of(self.model, self._loopset.loops), iq, iv, passive)
+            self.__dict__["_closed_cache"] = cache
+        return cache
+
+    def _fk_step(self, motors: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, bool]:
+        """Gauss-Newton (minimum-norm steps) on the passive coordinates from ``q`` with the motors set: the
+        compiled solver (:func:`legkin._tree_kernels.solve_passive`, whose test is the frames' own error), or
+        Pinocchio's for joints it does not know. Returns the configuration reached and whether it is closed."""
+        tree, iq, _, passive = self._compiled()
         q = q.copy()
         q[iq] = motors
-        return levenberg_marquardt(self.model, self._loopset.residual_and_jacobian, q, free, 1e-14, _MAX_ITER)[0]
+        if tree is not None:
+            from ._kernels import OK
+            from ._tree_kernels import solve_passive
 
-    def _fk_once(self, motors: np.ndarray, q: np.ndarray) -> np.ndarray | None:
-        q = self._fk_step(motors, q)
-        return q if self._closed(q) else None
+            out = np.empty_like(q)
+            status = solve_passive(q, *tree.arrays(), passive, CLOSED_TOL, _MAX_ITER, out)
+            return out, status == OK
+        q = levenberg_marquardt(self.model, self._loopset.residual_and_jacobian, q, passive, 1e-14, _MAX_ITER)[0]
+        return q, self._closed(q)
 
     def closed_fk(self, motors, q_near=None) -> np.ndarray:
         """The closed configuration with the motors at ``motors``, continuous with ``q_near``.
@@ -105,7 +175,7 @@ class ClosedLoopMixin:
             LoopClosureError: the loops do not close with these motor values (out of the workspace, or across
                 a singularity from ``q_near``).
         """
-        iq, _ = self._motor_index()
+        iq = self._compiled()[1]
         m = as_input(motors, "motors")
         if m.shape != (len(iq),):
             raise InvalidInputError(f"motors must have shape ({len(iq)},) ({', '.join(self.actuated_joints)}), "
@@ -113,12 +183,14 @@ class ClosedLoopMixin:
         q = self._near(q_near)
         start = q[iq].copy()
         for n in _STEPS:
-            qk: np.ndarray | None = q
-            for t in np.linspace(0.0, 1.0, n + 1)[1:]:
-                qk = self._fk_once(start + t * (m - start), qk) if qk is not None else None
-            if qk is not None:
+            qk, ok = q, True
+            for k in range(1, n + 1):
+                qk, ok = self._fk_step(start + (k / n) * (m - start), qk)
+                if not ok:
+                    break
+            if ok:
                 return qk
-        errs = loop_errors(self.model, self._loopset.data, self._loopset.loops, self._fk_step(m, q))
+        errs = loop_errors(self.model, self._loopset.data, self._loopset.loops, self._fk_step(m, q)[0])
         raise LoopClosureError(
             f"closed_fk: the loops do not close with motors {np.array2string(m, precision=4)} from q_near "
             f"(worst loop {max(errs, key=lambda e: e.worst).name}: {max(e.worst for e in errs):.3g} m or rad)",

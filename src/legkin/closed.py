@@ -54,10 +54,6 @@ class Tree:
     loop_t: np.ndarray
     loop_six: np.ndarray
 
-    def arrays(self) -> tuple[np.ndarray, ...]:
-        return (self.parent, self.kind, self.axis, self.place_r, self.place_t, self.idx_q, self.idx_v, self.loop_j,
-                self.loop_r, self.loop_t, self.loop_six)
-
 
 def _joint_kind(joint) -> tuple[int, tuple[float, ...]] | None:
     from ._tree_kernels import PRISMATIC, REVOLUTE, SPHERICAL
@@ -83,7 +79,8 @@ def tree_of(model: pin.Model, loops) -> Tree | None:
         np.array(model.parents, dtype=np.int64), np.array([k[0] for k in kinds], dtype=np.int64),  # type: ignore
         np.array([k[1] for k in kinds], dtype=float),  # type: ignore[index]
         np.array([m.rotation for m in model.jointPlacements]), np.array([m.translation for m in model.jointPlacements]),
-        np.array([j.idx_q for j in model.joints], dtype=np.int64), np.array([j.idx_v for j in model.joints], dtype=np.int64),
+        np.array([j.idx_q for j in model.joints], dtype=np.int64),
+        np.array([j.idx_v for j in model.joints], dtype=np.int64),
         np.array([[f.parentJoint for f in pair] for pair in frames], dtype=np.int64).reshape(-1, 2),
         np.array([[f.placement.rotation for f in pair] for pair in frames]).reshape(-1, 2, 3, 3),
         np.array([[f.placement.translation for f in pair] for pair in frames]).reshape(-1, 2, 3),
@@ -153,7 +150,9 @@ class ClosedLoopMixin:
             from ._tree_kernels import solve_passive
 
             out = np.empty_like(q)
-            status = solve_passive(q, *tree.arrays(), passive, CLOSED_TOL, _MAX_ITER, out)
+            t = tree
+            status = solve_passive(q, t.parent, t.kind, t.axis, t.place_r, t.place_t, t.idx_q, t.idx_v, t.loop_j,
+                                   t.loop_r, t.loop_t, t.loop_six, passive, CLOSED_TOL, _MAX_ITER, out)
             return out, status == OK
         q = levenberg_marquardt(self.model, self._loopset.residual_and_jacobian, q, passive, 1e-14, _MAX_ITER)[0]
         return q, self._closed(q)

@@ -204,8 +204,9 @@ def _step(jac, res, passive, dv):
 
 @kernel(entry=True)
 def solve_passive(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t, loop_six,
-                  passive, tol, max_iter, q_out):
-    """Close the loops from ``q`` moving the ``passive`` velocity coordinates only; ``q_out`` the result.
+                  passive, tol, max_iter, q_out, info):
+    """Close the loops from ``q`` moving the ``passive`` velocity coordinates only; ``q_out`` the result,
+    ``info[0]`` the Gauss-Newton iterations done, ``info[1]`` the frames' worst error (m or rad).
 
     Returns:
         :data:`legkin._kernels.OK` when every loop's frames end within ``tol`` (m and rad), else :data:`OPEN`.
@@ -221,7 +222,8 @@ def solve_passive(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j,
         q_out[i] = q[i]
     worst = residual_jacobian(q_out, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t,
                               loop_six, o_r, o_t, res, jac)
-    for _ in range(max_iter):
+    info[0], info[1] = 0.0, worst
+    for it in range(max_iter):
         if worst <= POLISH:
             break
         _step(jac, res, passive, dv)
@@ -243,4 +245,5 @@ def solve_passive(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j,
         res, res2 = res2, res
         jac, jac2 = jac2, jac
         worst = w2
+        info[0], info[1] = it + 1.0, worst
     return OK if worst <= tol else OPEN

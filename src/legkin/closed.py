@@ -127,33 +127,47 @@ class ClosedLoopMixin:
         return int(self.mobility(self.q0 if q is None else q, locked=self.actuated_joints, tol=tol))  # type: ignore
 
     # ------------------------------------------------------------------ closed_fk
+    def _tree(self) -> Tree | None:
+        """The compiled solver's arrays of the model and loops (None: the Pinocchio path), cached."""
+        if "_tree_cache" not in self.__dict__:
+            self.__dict__["_tree_cache"] = tree_of(self.model, self._loopset.loops)
+        return self.__dict__["_tree_cache"]
+
     def _compiled(self) -> tuple[Tree | None, np.ndarray, np.ndarray, np.ndarray]:
-        """The compiled solver's tree (None: the Pinocchio path), motor q/v indices, passive mask (cached)."""
+        """:meth:`_tree`, the motors' q and v indices and the passive mask (cached)."""
         cache = self.__dict__.get("_closed_cache")
         if cache is None:
             iq, iv = self._motor_index()
             passive = np.ones(self.model.nv, dtype=np.bool_)
             passive[iv] = False
-            cache = (tree_of(self.model, self._loopset.loops), iq, iv, passive)
+            cache = (self._tree(), iq, iv, passive)
             self.__dict__["_closed_cache"] = cache
         return cache
 
+    def _tree_solve(
+        self, q: np.ndarray, passive: np.ndarray, max_iter: int = _MAX_ITER
+    ) -> tuple[np.ndarray, bool, int]:
+        """The compiled solve (:func:`legkin._tree_kernels.solve_passive`: minimum-norm Gauss-Newton, its test the
+        frames' own error) moving the velocity coordinates ``passive``; returns the configuration, whether it
+        closed and the iterations. Needs :meth:`_tree`."""
+        from ._kernels import OK
+        from ._tree_kernels import solve_passive
+
+        t = self._tree()
+        assert t is not None
+        out, info = np.empty_like(q), np.zeros(2)
+        status = solve_passive(q, t.parent, t.kind, t.axis, t.place_r, t.place_t, t.idx_q, t.idx_v, t.loop_j,
+                               t.loop_r, t.loop_t, t.loop_six, passive, CLOSED_TOL, max_iter, out, info)
+        return out, status == OK, int(info[0])
+
     def _fk_step(self, motors: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, bool]:
-        """Gauss-Newton (minimum-norm steps) on the passive coordinates from ``q`` with the motors set: the
-        compiled solver (:func:`legkin._tree_kernels.solve_passive`, whose test is the frames' own error), or
-        Pinocchio's for joints it does not know. Returns the configuration reached and whether it is closed."""
+        """Gauss-Newton (minimum-norm steps) on the passive coordinates from ``q`` with the motors set: compiled, or
+        Pinocchio's for joint kinds the kernel does not know. Returns the configuration and whether it closed."""
         tree, iq, _, passive = self._compiled()
         q = q.copy()
         q[iq] = motors
         if tree is not None:
-            from ._kernels import OK
-            from ._tree_kernels import solve_passive
-
-            out = np.empty_like(q)
-            t = tree
-            status = solve_passive(q, t.parent, t.kind, t.axis, t.place_r, t.place_t, t.idx_q, t.idx_v, t.loop_j,
-                                   t.loop_r, t.loop_t, t.loop_six, passive, CLOSED_TOL, _MAX_ITER, out)
-            return out, status == OK
+            return self._tree_solve(q, passive)[:2]  # type: ignore[return-value]
         q = levenberg_marquardt(self.model, self._loopset.residual_and_jacobian, q, passive, 1e-14, _MAX_ITER)[0]
         return q, self._closed(q)
 

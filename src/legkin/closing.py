@@ -19,6 +19,7 @@ then names each open loop with its residual (m, rad) and this verdict.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 import pinocchio as pin
@@ -52,7 +53,7 @@ class LoopError:
 
 @dataclass(frozen=True)
 class ClosingInfo:
-    """What :func:`close_loops` did: the strategy that closed (``"direct"``, ``"homotopy"``,
+    """What :func:`close_loops` did: the strategy that closed (``"compiled"``, ``"direct"``, ``"homotopy"``,
     ``"restart k"``), Levenberg-Marquardt ``iterations`` in all, the worst frame error reached (m or rad)."""
 
     strategy: str
@@ -88,8 +89,13 @@ def _lm(ls: LoopSet, q: np.ndarray, free: np.ndarray, shift: np.ndarray | None =
 
 
 def _attempts(ls: LoopSet, q0: np.ndarray, free: np.ndarray, seed: int, restarts: int = RESTARTS,
-              homotopy: bool = True):
+              homotopy: bool = True, fast: Callable | None = None, lm: bool = True):
     """The strategies in turn: yields (name, configuration reached, iterations)."""
+    if fast is not None:
+        q, it = fast(q0, free)
+        yield "compiled", q, it
+    if not lm:
+        return
     q, it = _lm(ls, q0, free)
     yield "direct", q, it
     if not homotopy:
@@ -109,7 +115,7 @@ def _attempts(ls: LoopSet, q0: np.ndarray, free: np.ndarray, seed: int, restarts
 
 
 def close_loops(ls: LoopSet, q0: np.ndarray, free: np.ndarray, *, tol: float = CLOSED_TOL, seed: int = 0,
-                restarts: int = RESTARTS, homotopy: bool = True,
+                restarts: int = RESTARTS, homotopy: bool = True, fast: Callable | None = None, lm: bool = True,
                 diagnose_failure: bool = True) -> tuple[np.ndarray, ClosingInfo]:
     """Close every loop of ``ls`` from ``q0``, moving only the velocity coordinates ``free``.
 
@@ -121,6 +127,9 @@ def close_loops(ls: LoopSet, q0: np.ndarray, free: np.ndarray, *, tol: float = C
         seed: seed of the restarts.
         restarts: random starts tried after the direct and homotopy attempts.
         homotopy: try the homotopy (and the restarts) after the direct attempt.
+        fast: ``(q, free) -> (q, iterations)``, a compiled solve tried first (``Robot._tree_solve``: minimum-norm
+            Gauss-Newton).
+        lm: try the Levenberg-Marquardt strategies (direct, homotopy, restarts) after ``fast``.
         diagnose_failure: on failure, try each open loop alone to say why (:func:`diagnose`).
 
     Returns:
@@ -132,7 +141,7 @@ def close_loops(ls: LoopSet, q0: np.ndarray, free: np.ndarray, *, tol: float = C
     """
     data = ls.model.createData()
     best_q, best_err, iterations = q0, np.inf, 0
-    for name, q, it in _attempts(ls, q0, free, seed, restarts, homotopy):
+    for name, q, it in _attempts(ls, q0, free, seed, restarts, homotopy, fast, lm):
         iterations += it
         err = _worst(loop_errors(ls.model, data, ls.loops, q))
         if err <= tol:
@@ -144,14 +153,18 @@ def close_loops(ls: LoopSet, q0: np.ndarray, free: np.ndarray, *, tol: float = C
     parts = [f"{e.name} ({e.distance:.3g} m, {e.angle:.3g} rad{': ' + verdicts[e.name] if e.name in verdicts else ''})"
              for e in errors if e.worst > tol]
     raise LoopClosureError(
-        f"could not close the loops from this start ({_tried(homotopy, restarts)}, {iterations} "
+        f"could not close the loops from this start ({_tried(homotopy, restarts, fast, lm)}, {iterations} "
         f"iterations): {len(parts)} of {len(errors)} stay open: " + "; ".join(parts),
         residual=best_err, iterations=iterations, q=best_q, open_loops=errors,
     )
 
 
-def _tried(homotopy: bool, restarts: int) -> str:
-    return f"direct, homotopy and {restarts} random starts" if homotopy else "direct Levenberg-Marquardt"
+def _tried(homotopy: bool, restarts: int, fast: Callable | None, lm: bool) -> str:
+    parts = ["compiled Gauss-Newton"] if fast is not None else []
+    if lm:
+        parts.append(f"Levenberg-Marquardt direct, homotopy and {restarts} random starts" if homotopy
+                     else "Levenberg-Marquardt")
+    return ", ".join(parts)
 
 
 def _alone(ls: LoopSet, loop: LoopSpec, q0, free, seed) -> list[LoopError]:

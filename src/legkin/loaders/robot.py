@@ -24,6 +24,8 @@ __all__ = ["FileRobot", "load_file", "REFERENCE_POSE"]
 
 #: Name of the closed reference pose of a robot loaded from a file (``robot.poses["closed"]``, ``robot.q0``).
 REFERENCE_POSE = "closed"
+#: Gauss-Newton iterations of the closing of ``q0`` at load (the nine Gepetto robots that close need 3-11).
+_LOAD_ITER = 100
 
 
 def _robot_name(path: Path) -> str:
@@ -56,8 +58,8 @@ class FileRobot(Robot):
         missing_meshes: mesh files the URDF names that are not there (left out of the visual model).
         closing: how ``q0`` was closed (:class:`legkin.closing.ClosingInfo`), or the
             :class:`~legkin.errors.LoopClosureError` raised when it could not be (then ``q0`` is neutral;
-            the load tries a direct Levenberg-Marquardt only: ``solve_loops()`` adds a homotopy and restarts, and
-            says why a loop stays open).
+            the load tries the compiled Gauss-Newton only, or a direct Levenberg-Marquardt for joint kinds it does not
+            handle: ``solve_loops()`` adds a homotopy and restarts, and says why a loop stays open).
         load_seconds: wall time of the model's construction, s (the closing of ``q0`` excluded).
     """
 
@@ -88,9 +90,10 @@ class FileRobot(Robot):
         self.load_seconds = time.perf_counter() - t0
         self.q0 = pin.neutral(model)
         self.closing: ClosingInfo | LoopClosureError
+        fast, lm = self._fast()
         try:
-            self.q0, self.closing = close_loops(self._loopset, self.q0, np.ones(model.nv, dtype=bool),
-                                                homotopy=False, diagnose_failure=False)
+            self.q0, self.closing = close_loops(self._loopset, self.q0, np.ones(model.nv, dtype=bool), fast=fast,
+                                                lm=lm, homotopy=False, diagnose_failure=False)
             self.poses[REFERENCE_POSE] = self.q0.copy()
         except LoopClosureError as exc:
             self.closing = exc
@@ -115,6 +118,18 @@ class FileRobot(Robot):
             raise InvalidInputError(f"{path}: {exc}") from None
         motors = [j.get("name", "") for j in ET.fromstring(text).iterfind("transmission/joint")]
         return built.model, built.visual_model, built.collision_model, specs, motors, str(path)
+
+    def _fast(self) -> tuple[Any, bool]:
+        """The compiled solve for :func:`legkin.closing.close_loops` (None when a joint kind is not supported) and
+        whether the Levenberg-Marquardt strategies must run (only without it)."""
+        if self._tree() is None:
+            return None, True
+
+        def fast(q, free):
+            q, _, iterations = self._tree_solve(q, np.asarray(free, dtype=np.bool_), _LOAD_ITER)
+            return q, iterations
+
+        return fast, False
 
     @property
     def actuated(self) -> tuple[str, ...]:
@@ -155,7 +170,8 @@ class FileRobot(Robot):
             for name, value in fixed.items():
                 sl, x = self._joint_value(f"fixed[{name!r}]", name, value)
                 q[sl] = x
-        q, info = close_loops(self._loopset, q, self._free_mask(fixed), tol=tol, seed=seed)
+        fast = self._fast()[0]
+        q, info = close_loops(self._loopset, q, self._free_mask(fixed), tol=tol, seed=seed, fast=fast)
         return (q, info) if return_info else q
 
 

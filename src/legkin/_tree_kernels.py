@@ -13,9 +13,9 @@ are the norms of its parts, so the solver's stopping test is the frames' own err
 (revolute; each of the 3 axes of a spherical joint's frame) or ``[w; 0]`` (prismatic); the angular rows use
 ``d log3 ~ w1 - w2`` (exact at closure, where the iteration ends).
 
-Gauss-Newton on the passive coordinates, minimum-norm steps ``dv = J^T (J J^T + mu I)^-1 r`` (``mu`` = 1e-12
-times the largest diagonal entry: the redundant rows of planar loops make ``J J^T`` singular), halved while the
-residual grows.
+Gauss-Newton on the passive coordinates, minimum-norm steps ``dv = -J^T y``, ``J J^T y = r`` solved by an
+``LDL^T`` factorisation that skips the zero pivots (the redundant rows of planar loops make ``J J^T`` singular),
+halved while the residual grows. No LAPACK: numba's ``np.linalg`` needs SciPy, which legkin does not require.
 """
 
 from __future__ import annotations
@@ -189,17 +189,62 @@ def _integrate(q, dv, kind, idx_q, idx_v, out):
 
 
 @kernel
+def _solve_psd(a, b, out):
+    """A solution of ``a y = b`` for a positive semi-definite ``a`` (``LDL^T``, pivots below 1e-12 times the largest
+    diagonal entry treated as 0: the redundant rows of planar loops): ``out = y``."""
+    n = a.shape[0]
+    low, d = np.zeros((n, n)), np.zeros(n)
+    eps = 0.0
+    for k in range(n):
+        eps = max(eps, a[k, k])
+    eps *= 1e-12
+    for k in range(n):
+        dk = a[k, k]
+        for j in range(k):
+            dk -= low[k, j] * low[k, j] * d[j]
+        low[k, k] = 1.0
+        if dk <= eps:
+            continue
+        d[k] = dk
+        for i in range(k + 1, n):
+            x = a[i, k]
+            for j in range(k):
+                x -= low[i, j] * low[k, j] * d[j]
+            low[i, k] = x / dk
+    for i in range(n):  # L z = b, then w = z / D (0 where D is), then L^T y = w
+        x = b[i]
+        for j in range(i):
+            x -= low[i, j] * out[j]
+        out[i] = x
+    for i in range(n):
+        out[i] = out[i] / d[i] if d[i] > 0.0 else 0.0
+    for i in range(n - 1, -1, -1):
+        x = out[i]
+        for j in range(i + 1, n):
+            x -= low[j, i] * out[j]
+        out[i] = x
+
+
+@kernel
 def _step(jac, res, passive, dv):
-    """Minimum-norm Gauss-Newton step on the passive columns: ``dv = -J^T (J J^T + mu I)^-1 r``."""
-    jp = jac[:, passive]
-    a = jp @ jp.T
-    mu = 1e-12 * max(1.0, np.max(np.diag(a)))
-    for i in range(a.shape[0]):
-        a[i, i] += mu
-    y = np.linalg.solve(a, res)
-    step = -(jp.T @ y)
-    dv[:] = 0.0
-    dv[passive] = step
+    """Minimum-norm Gauss-Newton step on the passive columns: ``dv = -J^T y`` with ``J J^T y = r``."""
+    rows, nv = jac.shape
+    a, y = np.zeros((rows, rows)), np.empty(rows)
+    for i in range(rows):
+        for k in range(i + 1):
+            x = 0.0
+            for v in range(nv):
+                if passive[v]:
+                    x += jac[i, v] * jac[k, v]
+            a[i, k] = x
+            a[k, i] = x
+    _solve_psd(a, res, y)
+    for v in range(nv):
+        x = 0.0
+        if passive[v]:
+            for i in range(rows):
+                x -= jac[i, v] * y[i]
+        dv[v] = x
 
 
 @kernel(entry=True)

@@ -63,9 +63,9 @@ def _rot_quat(x, y, z, w, out):
 
 
 @kernel
-def _fk(q, parent, kind, axis, place_r, place_t, idx_q, o_r, o_t):
-    """World placements ``(o_r[j], o_t[j])`` of every joint at ``q``."""
-    m, rp, v = np.empty((3, 3)), np.empty((3, 3)), np.empty(3)
+def _fk(q, parent, kind, axis, place_r, place_t, idx_q, o_r, o_t, mats, vecs):
+    """World placements ``(o_r[j], o_t[j])`` of every joint at ``q`` (``mats``, ``vecs``: work arrays)."""
+    m, rp, v = mats[0], mats[1], vecs[0]
     for j in range(1, parent.shape[0]):
         p = parent[j]
         _mm3(o_r[p], place_r[j], rp)
@@ -108,9 +108,9 @@ def _log3(r, out):
 
 
 @kernel
-def _add_columns(jac, row, sign, j, p, parent, kind, axis, idx_v, o_r, o_t, angular):
-    """Add ``sign`` times the columns of the joints on the path root -> ``j`` of a point ``p`` to ``jac``."""
-    w = np.empty(3)
+def _add_columns(jac, row, sign, j, p, parent, kind, axis, idx_v, o_r, o_t, angular, w):
+    """Add ``sign`` times the columns of the joints on the path root -> ``j`` of a point ``p`` to ``jac`` (``w``: a
+    work vector)."""
     while j > 0:
         v = idx_v[j]
         n = 3 if kind[j] == SPHERICAL else 1
@@ -135,14 +135,15 @@ def _add_columns(jac, row, sign, j, p, parent, kind, axis, idx_v, o_r, o_t, angu
 
 @kernel
 def residual_jacobian(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t, loop_six,
-                      o_r, o_t, res, jac):
+                      o_r, o_t, res, jac, mats, vecs):
     """The stacked loop residual ``res`` and its Jacobian ``jac`` (rows x nv) at ``q``; returns the worst loop
-    error, max over loops of the origins' distance (m) and the orientations' angle (rad)."""
-    _fk(q, parent, kind, axis, place_r, place_t, idx_q, o_r, o_t)
+    error, max over loops of the origins' distance (m) and the orientations' angle (rad). ``mats`` (5, 3, 3) and
+    ``vecs`` (4, 3): work arrays."""
+    _fk(q, parent, kind, axis, place_r, place_t, idx_q, o_r, o_t, mats, vecs)
     jac[:, :] = 0.0
     row, worst = 0, 0.0
-    e, p1, p2 = np.empty(3), np.empty(3), np.empty(3)
-    r1, r2, rel = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))
+    e, p1, p2, w = vecs[0], vecs[1], vecs[2], vecs[3]
+    r1, r2, rel = mats[2], mats[3], mats[4]
     for k in range(loop_j.shape[0]):
         j1, j2 = loop_j[k, 0], loop_j[k, 1]
         _mv3(o_r[j1], loop_t[k, 0], p1)
@@ -155,8 +156,8 @@ def residual_jacobian(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loo
             dist += res[row + a] ** 2
         worst = max(worst, np.sqrt(dist))
         six = loop_six[k]
-        _add_columns(jac, row, 1.0, j1, p1, parent, kind, axis, idx_v, o_r, o_t, six)
-        _add_columns(jac, row, -1.0, j2, p2, parent, kind, axis, idx_v, o_r, o_t, six)
+        _add_columns(jac, row, 1.0, j1, p1, parent, kind, axis, idx_v, o_r, o_t, six, w)
+        _add_columns(jac, row, -1.0, j2, p2, parent, kind, axis, idx_v, o_r, o_t, six, w)
         if six:
             _mm3(o_r[j1], loop_r[k, 0], r1)
             _mm3(o_r[j2], loop_r[k, 1], r2)
@@ -226,25 +227,28 @@ def _solve_psd(a, b, out):
 
 
 @kernel
-def _step(jac, res, passive, dv):
-    """Minimum-norm Gauss-Newton step on the passive columns: ``dv = -J^T y`` with ``J J^T y = r``."""
-    rows, nv = jac.shape
-    a, y = np.zeros((rows, rows)), np.empty(rows)
+def _step(jac, res, cols, jp, a, y, dv):
+    """Minimum-norm Gauss-Newton step on the passive columns ``cols``: ``dv = -J^T y`` with ``J J^T y = r``
+    (``jp``, ``a``, ``y``: work arrays of shapes (rows, len(cols)), (rows, rows), (rows,))."""
+    rows, n = jp.shape
+    for i in range(rows):
+        for c in range(n):
+            jp[i, c] = jac[i, cols[c]]
     for i in range(rows):
         for k in range(i + 1):
             x = 0.0
-            for v in range(nv):
-                if passive[v]:
-                    x += jac[i, v] * jac[k, v]
+            for c in range(n):
+                x += jp[i, c] * jp[k, c]
             a[i, k] = x
             a[k, i] = x
     _solve_psd(a, res, y)
-    for v in range(nv):
+    for v in range(dv.shape[0]):
+        dv[v] = 0.0
+    for c in range(n):
         x = 0.0
-        if passive[v]:
-            for i in range(rows):
-                x -= jac[i, v] * y[i]
-        dv[v] = x
+        for i in range(rows):
+            x -= jp[i, c] * y[i]
+        dv[cols[c]] = x
 
 
 @kernel(entry=True)
@@ -263,21 +267,31 @@ def solve_passive(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j,
     o_r[0] = np.eye(3)
     res, jac, dv = np.zeros(rows), np.zeros((rows, nv)), np.zeros(nv)
     res2, jac2, trial = np.zeros(rows), np.zeros((rows, nv)), np.empty_like(q)
+    n_free = 0
+    for v in range(nv):
+        n_free += 1 if passive[v] else 0
+    cols, k = np.empty(n_free, dtype=np.int64), 0
+    for v in range(nv):
+        if passive[v]:
+            cols[k] = v
+            k += 1
+    jp, a, y = np.empty((rows, n_free)), np.empty((rows, rows)), np.empty(rows)
+    mats, vecs = np.empty((5, 3, 3)), np.empty((4, 3))
     for i in range(q.shape[0]):
         q_out[i] = q[i]
     worst = residual_jacobian(q_out, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t,
-                              loop_six, o_r, o_t, res, jac)
+                              loop_six, o_r, o_t, res, jac, mats, vecs)
     info[0], info[1] = 0.0, worst
     for it in range(max_iter):
         if worst <= POLISH:
             break
-        _step(jac, res, passive, dv)
+        _step(jac, res, cols, jp, a, y, dv)
         norm = np.sqrt(np.sum(res * res))
         reduced = False
         for _half in range(12):
             _integrate(q_out, dv, kind, idx_q, idx_v, trial)
             w2 = residual_jacobian(trial, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r,
-                                   loop_t, loop_six, o_r, o_t, res2, jac2)
+                                   loop_t, loop_six, o_r, o_t, res2, jac2, mats, vecs)
             if np.sqrt(np.sum(res2 * res2)) < norm:
                 reduced = True
                 break

@@ -55,6 +55,18 @@ class Tree:
     loop_six: np.ndarray
 
 
+_SOLVER: list[Any] = []
+
+
+def _solver() -> Any:
+    """:func:`legkin._tree_kernels.solve_passive`, imported on first use (``import legkin.robot`` stays numba-free)."""
+    if not _SOLVER:
+        from ._tree_kernels import solve_passive
+
+        _SOLVER.append(solve_passive)
+    return _SOLVER[0]
+
+
 def _joint_kind(joint) -> tuple[int, tuple[float, ...]] | None:
     from ._tree_kernels import PRISMATIC, REVOLUTE, SPHERICAL
 
@@ -150,15 +162,12 @@ class ClosedLoopMixin:
         """The compiled solve (:func:`legkin._tree_kernels.solve_passive`: minimum-norm Gauss-Newton, its test the
         frames' own error) moving the velocity coordinates ``passive``; returns the configuration, whether it
         closed and the iterations. Needs :meth:`_tree`."""
-        from ._kernels import OK
-        from ._tree_kernels import solve_passive
-
         t = self._tree()
         assert t is not None
         out, info = np.empty_like(q), np.zeros(2)
-        status = solve_passive(q, t.parent, t.kind, t.axis, t.place_r, t.place_t, t.idx_q, t.idx_v, t.loop_j,
-                               t.loop_r, t.loop_t, t.loop_six, passive, CLOSED_TOL, max_iter, out, info)
-        return out, status == OK, int(info[0])
+        status = _solver()(q, t.parent, t.kind, t.axis, t.place_r, t.place_t, t.idx_q, t.idx_v, t.loop_j,
+                           t.loop_r, t.loop_t, t.loop_six, passive, CLOSED_TOL, max_iter, out, info)
+        return out, status == 0, int(info[0])  # 0: legkin._kernels.OK
 
     def _fk_step(self, motors: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, bool]:
         """Gauss-Newton (minimum-norm steps) on the passive coordinates from ``q`` with the motors set: compiled, then

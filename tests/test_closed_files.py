@@ -161,3 +161,28 @@ def test_mjcf_body_form_equality(tmp_path):
     robot = legkin.load(xml)
     assert robot.actuated == ("ja",) and [lp.type for lp in robot.loops] == ["point"]
     assert robot.model.nq == 3 and _worst(robot, robot.q0) <= CLOSED_TOL
+
+
+def test_single_and_batch_rule():
+    robot = legkin.load(DATA / "cassie_like" / "robot.urdf")
+    motors, qs = reachable_motors(robot, 3, np.random.default_rng(2))
+    far = robot.q0[robot._motor_index()[0]].copy()
+    far[4] += 2.0  # motor_ankle 2 rad from q0: the loops no longer close (measured: 1.5 rad still does)
+    batch = np.stack([motors[0], far, motors[1]]).reshape(3, 1, -1)
+    q, mask = robot.closed_fk(batch, return_mask=True)
+    assert q.shape == (3, 1, robot.model.nq) and mask.tolist() == [[True], [False], [True]]
+    assert np.all(np.isnan(q[1])) and np.allclose(q[0, 0], robot.closed_fk(motors[0]), atol=1e-12)
+    with pytest.raises(LoopClosureError, match="closed_fk"):
+        robot.closed_fk(far)
+    with pytest.raises(InvalidInputError):
+        robot.closed_fk(motors[0][:-1])
+    jac, ok = robot.closed_jacobian(qs[:2], "closedloop2_B", return_mask=True)
+    assert jac.shape == (2, 6, len(robot.actuated)) and ok.all()
+    assert np.allclose(jac[1], robot.closed_jacobian(qs[1], "closedloop2_B"))
+    targets = np.array([robot.frame_placement(q, "closedloop2_B").translation for q in qs[:2]] + [[9.0, 9.0, 9.0]])
+    qi, ok = robot.closed_ik("closedloop2_B", targets, return_mask=True)
+    assert ok.tolist() == [True, True, False] and np.all(np.isnan(qi[2]))
+    for q, t in zip(qi[:2], targets[:2]):
+        assert np.linalg.norm(robot.frame_placement(q, "closedloop2_B").translation - t) <= CLOSED_TOL
+    with pytest.raises(legkin.UnreachableError):
+        robot.closed_ik("closedloop2_B", targets[2])

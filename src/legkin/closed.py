@@ -21,7 +21,7 @@ Every answer is checked on the frames themselves (:func:`legkin.closing.loop_err
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal, overload
 
 import numpy as np
 import pinocchio as pin
@@ -184,29 +184,8 @@ class ClosedLoopMixin:
         q = levenberg_marquardt(self.model, self._loopset.residual_and_jacobian, q, passive, 1e-14, _MAX_ITER)[0]
         return q, self._closed(q)
 
-    def closed_fk(self, motors, q_near=None) -> np.ndarray:
-        """The closed configuration with the motors at ``motors``, continuous with ``q_near``.
-
-        Args:
-            motors: the actuated joints' values, in ``robot.actuated_joints`` order (rad or m), shape
-                ``(n_motors,)``.
-            q_near: the configuration the answer is continuous with (default ``q0``): the branch a controller is
-                on. Warm-start it with the last answer.
-
-        Returns:
-            ``q`` (``model.nq``): motors exactly as given, every loop closed to 1e-10 m and rad.
-
-        Raises:
-            InvalidInputError: ``motors`` of the wrong shape or not finite, a bad ``q_near``.
-            LoopClosureError: the loops do not close with these motor values (out of the workspace, or across
-                a singularity from ``q_near``).
-        """
-        iq = self._compiled()[1]
-        m = as_input(motors, "motors")
-        if m.shape != (len(iq),):
-            raise InvalidInputError(f"motors must have shape ({len(iq)},) ({', '.join(self.actuated_joints)}), "
-                                    f"got shape {m.shape}")
-        q = self._near(q_near)
+    def _closed_fk_one(self, m: np.ndarray, q: np.ndarray, iq: np.ndarray) -> np.ndarray | None:
+        """One closed_fk solve (continuation in 1, 2, ... 64 motor steps from ``q``), or None."""
         start = q[iq].copy()
         for n in _STEPS:
             qk, ok = q, True
@@ -216,67 +195,111 @@ class ClosedLoopMixin:
                     break
             if ok:
                 return qk
+        return None
+
+    def _fk_error(self, m: np.ndarray, q: np.ndarray) -> LoopClosureError:
         errs = loop_errors(self.model, self._loopset.data, self._loopset.loops, self._fk_step(m, q)[0])
-        raise LoopClosureError(
+        worst = max(errs, key=lambda e: e.worst)
+        return LoopClosureError(
             f"closed_fk: the loops do not close with motors {np.array2string(m, precision=4)} from q_near "
-            f"(worst loop {max(errs, key=lambda e: e.worst).name}: {max(e.worst for e in errs):.3g} m or rad)",
-            residual=max(e.worst for e in errs), open_loops=errs,
+            f"(worst loop {worst.name}: {worst.worst:.3g} m or rad)", residual=worst.worst, open_loops=errs,
         )
 
+    @overload
+    def closed_fk(self, motors, q_near=..., *, return_mask: Literal[False] = ...) -> np.ndarray: ...
+
+    @overload
+    def closed_fk(self, motors, q_near=..., *, return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+
+    def closed_fk(self, motors, q_near=None, *, return_mask: bool = False):
+        """The closed configuration with the motors at ``motors``, continuous with ``q_near``.
+
+        Args:
+            motors: the actuated joints' values, in ``robot.actuated_joints`` order (rad or m), shape
+                ``(..., n_motors)``.
+            q_near: the configuration the answer is continuous with (default ``q0``): the branch a controller is
+                on. Warm-start it with the last answer. Every row of a batch starts from it.
+            return_mask: also return the mask of the rows solved.
+
+        Returns:
+            ``q`` (``(..., model.nq)``): motors exactly as given, every loop closed to 1e-10 m and rad; a batch has
+            NaN rows where the loops do not close (and, with ``return_mask``, ``(q, mask)``).
+
+        Raises:
+            InvalidInputError: ``motors`` of the wrong shape or not finite, a bad ``q_near``.
+            LoopClosureError: (single call) the loops do not close with these motor values (out of the workspace,
+                or across a singularity from ``q_near``).
+        """
+        from ._batch import check_flag, finish
+
+        iq = self._compiled()[1]
+        m = as_input(motors, "motors", (len(iq),))
+        return_mask = check_flag(return_mask, "return_mask")
+        q = self._near(q_near)
+        if m.ndim == 1:
+            out = self._closed_fk_one(m, q, iq)
+            return finish(q if out is None else out, np.asarray(out is not None), True, return_mask,
+                          lambda: self._fk_error(m, q))
+        rows = m.reshape(-1, len(iq))
+        qs = np.full((len(rows), self.model.nq), np.nan)
+        for i, row in enumerate(rows):
+            out = self._closed_fk_one(row, q, iq)
+            if out is not None:
+                qs[i] = out
+        ok = ~np.isnan(qs[:, 0])
+        return finish(qs.reshape(*m.shape[:-1], self.model.nq), ok.reshape(m.shape[:-1]), False, return_mask,
+                      lambda: self._fk_error(m, q))
+
     # ------------------------------------------------------------------ closed_jacobian
-    def closed_jacobian(self, q, frame: str, reference=pin.LOCAL_WORLD_ALIGNED) -> np.ndarray:
+    def _jacobian_one(self, q: np.ndarray, frame: str, reference) -> np.ndarray:
+        iv = self._compiled()[2]
+        jf = self.frame_jacobian(q, frame, reference)  # type: ignore[attr-defined]
+        jc = self._loopset.residual_and_jacobian(q)[1]
+        passive = self._compiled()[3]
+        dvp = -np.linalg.pinv(jc[:, passive], rcond=1e-10) @ jc[:, iv]
+        return np.asarray(jf[:, iv] + jf[:, passive] @ dvp)
+
+    def closed_jacobian(self, q, frame: str, reference=pin.LOCAL_WORLD_ALIGNED, *, return_mask: bool = False):
         """The twist of ``frame`` per motor velocity through the loops, 6 x n_motors.
 
         ``(J_f,m - J_f,p pinv(J_p) J_m)``: the passive velocities are the minimum-norm solution of the loops'
         velocity equation (idle motions set to zero).
 
         Args:
-            q: a closed configuration (``model.nq``).
+            q: a closed configuration, shape ``(..., model.nq)``.
             frame: a frame name.
             reference: as :meth:`legkin.Robot.frame_jacobian` (default ``LOCAL_WORLD_ALIGNED``: linear part the
-                frame origin's velocity in world axes, m per rad; angular part rad/s per rad/s, world axes).
+                frame origin's velocity in world axes, m per rad (or per m); angular part rad/s, world axes).
+            return_mask: also return the mask (every row of finite input is computed).
+
+        Returns:
+            ``(..., 6, n_motors)`` (and, with ``return_mask``, the mask).
 
         Raises:
-            InvalidInputError: a bad ``q`` or frame name.
+            InvalidInputError: a bad ``q`` (shape, NaN/inf) or frame name.
         """
-        q = self.check_q(q)  # type: ignore[attr-defined]
-        _, iv = self._motor_index()
-        jf = self.frame_jacobian(q, frame, reference)  # type: ignore[attr-defined]
-        jc = self._loopset.residual_and_jacobian(q)[1]
-        passive = np.ones(self.model.nv, dtype=bool)
-        passive[iv] = False
-        dvp = -np.linalg.pinv(jc[:, passive], rcond=1e-10) @ jc[:, iv]
-        return np.asarray(jf[:, iv] + jf[:, passive] @ dvp)
+        from ._batch import check_flag, finish
+
+        return_mask = check_flag(return_mask, "return_mask")
+        x = as_input(q, "q", (self.model.nq,))
+        n = len(self._compiled()[1])
+        rows = x.reshape(-1, self.model.nq)
+        out = np.array([self._jacobian_one(self.check_q(r), frame, reference) for r in rows])  # type: ignore
+        out = out.reshape(*x.shape[:-1], 6, n)
+        ok = np.ones(x.shape[:-1], dtype=bool)
+        return finish(out, ok, x.ndim == 1, return_mask, lambda: InvalidInputError("closed_jacobian: not computed"))
 
     # ------------------------------------------------------------------ closed_ik
     def _pose_target(self, pose) -> tuple[pin.SE3 | None, np.ndarray]:
         if isinstance(pose, pin.SE3):
             return pose, pose.translation
-        x = as_input(pose, "pose")
+        x = np.asarray(pose, dtype=float)
         if x.shape == (3,):
             return None, x
-        if x.shape == (4, 4):
-            return pin.SE3(x), x[:3, 3]
-        raise InvalidInputError(f"pose must be a pinocchio.SE3, a 4 x 4 matrix or a position (3,), got shape {x.shape}")
+        return pin.SE3(x), x[:3, 3]
 
-    def closed_ik(self, frame: str, pose, q_near=None) -> np.ndarray:
-        """A closed configuration placing ``frame`` at ``pose``, continuous with ``q_near``.
-
-        Args:
-            frame: a frame name.
-            pose: the target: a ``pinocchio.SE3`` or 4 x 4 matrix (placement), or a 3-vector (position only, m).
-            q_near: the start (default ``q0``); the answer is the one Gauss-Newton reaches from it.
-
-        Returns:
-            ``q`` (``model.nq``) with every loop closed to 1e-10 and the frame on the target to 1e-10 m / rad;
-            the motors are ``q`` at ``robot.actuated_joints``.
-
-        Raises:
-            InvalidInputError: a bad frame, pose or ``q_near``.
-            UnreachableError: no closed configuration reached from ``q_near`` places the frame there (``closest``:
-                the configuration reached, ``distance``: its position error, m).
-        """
-        fid = self.frame_id(frame)  # type: ignore[attr-defined]
+    def _ik_one(self, fid: int, pose, q0: np.ndarray) -> tuple[np.ndarray, float, float]:
+        """Gauss-Newton from ``q0`` on the loops and the frame's error; returns q, distance (m), angle (rad)."""
         target, position = self._pose_target(pose)
         model, data = self.model, self._loopset.data
         free = np.ones(model.nv, dtype=bool)
@@ -291,14 +314,63 @@ class ClosedLoopMixin:
             err = pin.log6(target.actInv(om)).vector
             return np.concatenate([r, err]), np.vstack([jc, pin.Jlog6(target.actInv(om)) @ jf])
 
-        q, _, _, _, _ = levenberg_marquardt(model, fun, self._near(q_near), free, 1e-14, 4 * _MAX_ITER)
+        q, _, _, _, _ = levenberg_marquardt(model, fun, q0, free, 1e-14, 4 * _MAX_ITER)
         pin.framesForwardKinematics(model, data, q)
         om = data.oMf[fid]
         dist = float(np.linalg.norm(om.translation - position))
         angle = 0.0 if target is None else float(np.linalg.norm(pin.log3(target.rotation.T @ om.rotation)))
-        if self._closed(q) and max(dist, angle) <= CLOSED_TOL:
-            return q
-        raise UnreachableError(
-            f"closed_ik: frame {frame!r} does not reach the target from q_near: {dist:.3g} m and {angle:.3g} rad "
-            "off at the closest closed configuration found", target=pose, closest=q, distance=dist,
-        )
+        return q, dist, angle
+
+    def closed_ik(self, frame: str, pose, q_near=None, *, return_mask: bool = False):
+        """A closed configuration placing ``frame`` at ``pose``, continuous with ``q_near``.
+
+        Args:
+            frame: a frame name.
+            pose: the target: a ``pinocchio.SE3``, a 4 x 4 matrix (placement) or a position (3,) (m); a batch of
+                matrices ``(..., 4, 4)`` or of positions ``(..., 3)``.
+            q_near: the start (default ``q0``); the answer is the one Gauss-Newton reaches from it.
+            return_mask: also return the mask of the targets solved.
+
+        Returns:
+            ``q`` (``(..., model.nq)``) with every loop closed to 1e-10 and the frame on the target to 1e-10 m / rad
+            (NaN rows of a batch where not); the motors are ``q`` at ``robot.actuated_joints``.
+
+        Raises:
+            InvalidInputError: a bad frame, pose or ``q_near``.
+            UnreachableError: (single call) no closed configuration reached from ``q_near`` places the frame there
+                (``closest``: the configuration reached, ``distance``: its position error, m).
+        """
+        from ._batch import check_flag, finish
+
+        return_mask = check_flag(return_mask, "return_mask")
+        fid = self.frame_id(frame)  # type: ignore[attr-defined]
+        q0 = self._near(q_near)
+        core: tuple[int, ...] = ()
+        shape: tuple[int, ...] = ()
+        if isinstance(pose, pin.SE3):
+            items: list[Any] = [pose]
+        else:
+            x = as_input(pose, "pose")
+            core = (4, 4) if x.shape[-2:] == (4, 4) else (3,)
+            if x.shape[x.ndim - len(core):] != core:
+                raise InvalidInputError(
+                    f"pose must be a pinocchio.SE3, a (..., 4, 4) matrix or a (..., 3) position, got shape {x.shape}"
+                )
+            shape = x.shape[: x.ndim - len(core)]
+            items = list(x.reshape(-1, *core))
+        qs = np.full((len(items), self.model.nq), np.nan)
+        last = (q0, np.inf, np.inf)
+        for i, item in enumerate(items):
+            last = self._ik_one(fid, item, q0)
+            if self._closed(last[0]) and max(last[1], last[2]) <= CLOSED_TOL:
+                qs[i] = last[0]
+        ok = ~np.isnan(qs[:, 0])
+
+        def error() -> UnreachableError:
+            return UnreachableError(
+                f"closed_ik: frame {frame!r} does not reach the target from q_near: {last[1]:.3g} m and "
+                f"{last[2]:.3g} rad off at the closest closed configuration found", target=pose, closest=last[0],
+                distance=last[1],
+            )
+
+        return finish(qs.reshape(*shape, self.model.nq), ok.reshape(shape), shape == (), return_mask, error)

@@ -121,9 +121,9 @@ class ClosedLoopMixin:
             iv.append(j.idx_v)
         return np.array(iq, dtype=int), np.array(iv, dtype=int)
 
-    def _closed(self, q: np.ndarray) -> bool:
+    def _closed(self, q: np.ndarray, tol: float = CLOSED_TOL) -> bool:
         errs = loop_errors(self.model, self._loopset.data, self._loopset.loops, q)
-        return max((e.worst for e in errs), default=0.0) <= CLOSED_TOL
+        return max((e.worst for e in errs), default=0.0) <= tol
 
     def _near(self, q_near) -> np.ndarray:
         return self.check_q(self.q0 if q_near is None else q_near, "q_near").copy()  # type: ignore[attr-defined]
@@ -177,10 +177,13 @@ class ClosedLoopMixin:
         q = q.copy()
         q[iq] = motors
         if tree is not None:
-            q, ok, _ = self._tree_solve(q, passive)
+            qt, ok, _ = self._tree_solve(q, passive)
             if ok:
-                return q, True
-            # stalled (measured: robot_delta, 2 of 200 samples, ~3e-10): Pinocchio's damped LM finishes from there
+                return qt, True
+            # stalled near closure (measured: robot_delta, 2 of 200 samples, ~3e-10): Pinocchio's damped LM finishes
+            # from there; stalled far (a poor start): the damped LM starts again from q, as without the kernel
+            if self._closed(qt, 1e-6):
+                q = qt
         q = levenberg_marquardt(self.model, self._loopset.residual_and_jacobian, q, passive, 1e-14, _MAX_ITER)[0]
         return q, self._closed(q)
 

@@ -186,3 +186,21 @@ def test_single_and_batch_rule():
         assert np.linalg.norm(robot.frame_placement(q, "closedloop2_B").translation - t) <= CLOSED_TOL
     with pytest.raises(legkin.UnreachableError):
         robot.closed_ik("closedloop2_B", targets[2])
+
+
+def test_cli_check_convert_export(tmp_path, capsys):
+    from legkin.__main__ import main
+
+    urdf = str(DATA / "talos_like" / "robot.urdf")
+    assert main(["check", urdf, "--samples", "5"]) == 0
+    out = capsys.readouterr().out
+    assert "MJCF round trip" in out and "closed_fk unsolved fraction" in out and "all checks passed" in out
+    assert main(["convert", urdf, str(tmp_path / "talos.urdf")]) == 0
+    assert main(["convert", str(tmp_path / "talos.urdf"), str(tmp_path / "talos.yaml")]) == 0
+    assert "closedloop1_B" in (tmp_path / "talos.yaml").read_text()
+    assert main(["export", urdf, "--mjcf", str(tmp_path / "talos.xml")]) == 0
+    assert main(["convert", str(tmp_path / "talos.xml"), str(tmp_path / "back.yaml")]) == 0
+    assert main(["convert", urdf, str(tmp_path / "talos.txt")]) == 2
+    assert "unknown output form '.txt'" in capsys.readouterr().err
+    assert main(["convert", str(DATA / "digit_like_2legs" / "robot.urdf"), str(tmp_path / "d.urdf")]) == 2
+    assert "replaces joints" in capsys.readouterr().err

@@ -204,3 +204,15 @@ def test_cli_check_convert_export(tmp_path, capsys):
     assert "unknown output form '.txt'" in capsys.readouterr().err
     assert main(["convert", str(DATA / "digit_like_2legs" / "robot.urdf"), str(tmp_path / "d.urdf")]) == 2
     assert "replaces joints" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("reference", ["LOCAL_WORLD_ALIGNED", "LOCAL", "WORLD"])
+def test_closed_jacobian_kernel_matches_pinocchio(robot, reference):
+    """The compiled closed_jacobian against the same formula on Pinocchio's frame and constraint Jacobians
+    (measured: <= 2.3e-13 on these robots; tolerance 1e-11)."""
+    _, qs = reachable_motors(robot, 1, np.random.default_rng(3))
+    frame = robot.model.frames[robot.model.nframes - 1].name
+    _, _, iv, passive = robot._compiled()
+    jf, jc = robot.frame_jacobian(qs[0], frame, reference), robot.constraint_jacobian(qs[0])
+    expected = jf[:, iv] - jf[:, passive] @ np.linalg.pinv(jc[:, passive], rcond=1e-10) @ jc[:, iv]
+    assert np.max(np.abs(robot.closed_jacobian(qs[0], frame, reference) - expected)) <= 1e-11

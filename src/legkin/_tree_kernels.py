@@ -306,3 +306,51 @@ def solve_passive(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j,
         worst = w2
         info[0], info[1] = it + 1.0, worst
     return OK if worst <= tol else OPEN
+
+
+@kernel(entry=True)
+def closed_jacobian_k(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t, loop_six,
+                      passive, motor_v, frame_j, frame_r, frame_t, out, placement):
+    """The twist of a frame (joint ``frame_j``, placement ``frame_r``, ``frame_t``) per motor velocity through the
+    loops, ``LOCAL_WORLD_ALIGNED`` (linear: the frame origin's velocity, world axes; angular: world axes), into
+    ``out`` (6 x n_motors): ``J_f,m - J_f,p J_p^T (J_p J_p^T)^+ J_m`` (passive velocities of minimum norm);
+    ``placement`` (4 x 4) receives the frame's world placement."""
+    nj, nv, rows = parent.shape[0], passive.shape[0], 0
+    for k in range(loop_six.shape[0]):
+        rows += 6 if loop_six[k] else 3
+    o_r, o_t = np.zeros((nj, 3, 3)), np.zeros((nj, 3))
+    o_r[0] = np.eye(3)
+    res, jac, jf = np.zeros(rows), np.zeros((rows, nv)), np.zeros((6, nv))
+    mats, vecs = np.empty((5, 3, 3)), np.empty((4, 3))
+    residual_jacobian(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t, loop_six,
+                      o_r, o_t, res, jac, mats, vecs)
+    p, w = np.empty(3), np.empty(3)
+    _mv3(o_r[frame_j], frame_t, p)
+    for a in range(3):
+        p[a] += o_t[frame_j, a]
+    _add_columns(jf, 0, 1.0, frame_j, p, parent, kind, axis, idx_v, o_r, o_t, True, w)
+    _mm3(o_r[frame_j], frame_r, mats[0])
+    for a in range(3):
+        for b in range(3):
+            placement[a, b] = mats[0][a, b]
+        placement[a, 3] = p[a]
+        placement[3, a] = 0.0
+    placement[3, 3] = 1.0
+    n_free = 0
+    for v in range(nv):
+        n_free += 1 if passive[v] else 0
+    cols, k = np.empty(n_free, dtype=np.int64), 0
+    for v in range(nv):
+        if passive[v]:
+            cols[k] = v
+            k += 1
+    jp, a2, y, dv = np.empty((rows, n_free)), np.empty((rows, rows)), np.empty(rows), np.empty(nv)
+    for m in range(motor_v.shape[0]):
+        for i in range(rows):
+            res[i] = jac[i, motor_v[m]]
+        _step(jac, res, cols, jp, a2, y, dv)  # J_p dv_p = -J_m e_m: dv_p = -J_p^T y with J_p J_p^T y = J_m e_m
+        for r in range(6):
+            x = jf[r, motor_v[m]]
+            for c in range(n_free):
+                x += jf[r, cols[c]] * dv[cols[c]]
+            out[r, m] = x

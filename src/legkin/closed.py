@@ -55,6 +55,18 @@ class Tree:
     loop_six: np.ndarray
 
 
+def _from_lwa(jac: np.ndarray, placement: np.ndarray, reference) -> np.ndarray:
+    """A ``LOCAL_WORLD_ALIGNED`` twist Jacobian (6 x n) of a frame at ``placement`` (4 x 4) in ``reference``."""
+    if isinstance(reference, str):
+        reference = dict(pin.ReferenceFrame.names)[reference]
+    if reference == pin.LOCAL_WORLD_ALIGNED:
+        return jac
+    rot, p = placement[:3, :3], placement[:3, 3]
+    if reference == pin.LOCAL:
+        return np.vstack([rot.T @ jac[:3], rot.T @ jac[3:]])
+    return np.vstack([jac[:3] - np.cross(jac[3:].T, p).T, jac[3:]])  # WORLD: v_O = v_p - w x p
+
+
 _SOLVER: list[Any] = []
 
 
@@ -255,12 +267,22 @@ class ClosedLoopMixin:
 
     # ------------------------------------------------------------------ closed_jacobian
     def _jacobian_one(self, q: np.ndarray, frame: str, reference) -> np.ndarray:
-        iv = self._compiled()[2]
-        jf = self.frame_jacobian(q, frame, reference)  # type: ignore[attr-defined]
-        jc = self._loopset.residual_and_jacobian(q)[1]
-        passive = self._compiled()[3]
-        dvp = -np.linalg.pinv(jc[:, passive], rcond=1e-10) @ jc[:, iv]
-        return np.asarray(jf[:, iv] + jf[:, passive] @ dvp)
+        tree, _, iv, passive = self._compiled()
+        if tree is None:  # joint kinds the kernel does not handle: Pinocchio's Jacobians
+            jf = self.frame_jacobian(q, frame, reference)  # type: ignore[attr-defined]
+            jc = self._loopset.residual_and_jacobian(q)[1]
+            dvp = -np.linalg.pinv(jc[:, passive], rcond=1e-10) @ jc[:, iv]
+            return np.asarray(jf[:, iv] + jf[:, passive] @ dvp)
+        from ._tree_kernels import closed_jacobian_k
+
+        self.frame_jacobian(q, frame, reference)  # type: ignore[attr-defined]  # checks frame and reference
+        f = self.model.frames[self.frame_id(frame)]  # type: ignore[attr-defined]
+        t = tree
+        out, m = np.empty((6, len(iv))), np.empty((4, 4))
+        closed_jacobian_k(q, t.parent, t.kind, t.axis, t.place_r, t.place_t, t.idx_q, t.idx_v, t.loop_j, t.loop_r,
+                          t.loop_t, t.loop_six, passive, iv, f.parentJoint, f.placement.rotation.copy(),
+                          f.placement.translation.copy(), out, m)
+        return _from_lwa(out, m, reference)
 
     def closed_jacobian(self, q, frame: str, reference=pin.LOCAL_WORLD_ALIGNED, *, return_mask: bool = False):
         """The twist of ``frame`` per motor velocity through the loops, 6 x n_motors.

@@ -26,7 +26,7 @@ from typing import Any, Literal, overload
 import numpy as np
 import pinocchio as pin
 
-from ._batch import as_input
+from ._batch import as_input, check_flag, finish
 from .closing import CLOSED_TOL, loop_errors
 from .errors import InvalidInputError, LoopClosureError, UnreachableError
 from .loops import levenberg_marquardt
@@ -200,9 +200,12 @@ class ClosedLoopMixin:
         return q, self._closed(q)
 
     def _closed_fk_one(self, m: np.ndarray, q: np.ndarray, iq: np.ndarray) -> np.ndarray | None:
-        """One closed_fk solve (continuation in 1, 2, ... 64 motor steps from ``q``), or None."""
+        """One closed_fk solve (directly, then by continuation in 2, 4, ... 64 motor steps from ``q``), or None."""
+        qk, ok = self._fk_step(m, q)
+        if ok:
+            return qk
         start = q[iq].copy()
-        for n in _STEPS:
+        for n in _STEPS[1:]:
             qk, ok = q, True
             for k in range(1, n + 1):
                 qk, ok = self._fk_step(start + (k / n) * (m - start), qk)
@@ -245,8 +248,6 @@ class ClosedLoopMixin:
             LoopClosureError: (single call) the loops do not close with these motor values (out of the workspace,
                 or across a singularity from ``q_near``).
         """
-        from ._batch import check_flag, finish
-
         iq = self._compiled()[1]
         m = as_input(motors, "motors", (len(iq),))
         return_mask = check_flag(return_mask, "return_mask")
@@ -303,8 +304,6 @@ class ClosedLoopMixin:
         Raises:
             InvalidInputError: a bad ``q`` (shape, NaN/inf) or frame name.
         """
-        from ._batch import check_flag, finish
-
         return_mask = check_flag(return_mask, "return_mask")
         x = as_input(q, "q", (self.model.nq,))
         n = len(self._compiled()[1])
@@ -365,8 +364,6 @@ class ClosedLoopMixin:
             UnreachableError: (single call) no closed configuration reached from ``q_near`` places the frame there
                 (``closest``: the configuration reached, ``distance``: its position error, m).
         """
-        from ._batch import check_flag, finish
-
         return_mask = check_flag(return_mask, "return_mask")
         fid = self.frame_id(frame)  # type: ignore[attr-defined]
         q0 = self._near(q_near)

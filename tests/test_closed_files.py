@@ -216,3 +216,26 @@ def test_closed_jacobian_kernel_matches_pinocchio(robot, reference):
     jf, jc = robot.frame_jacobian(qs[0], frame, reference), robot.constraint_jacobian(qs[0])
     expected = jf[:, iv] - jf[:, passive] @ np.linalg.pinv(jc[:, passive], rcond=1e-10) @ jc[:, iv]
     assert np.max(np.abs(robot.closed_jacobian(qs[0], frame, reference) - expected)) <= 1e-11
+
+
+@pytest.mark.parametrize("kind, flip", [("point", "0 0 0"), ("frame", "0 0 0"), ("frame", "3.141592653589793 0 0")])
+def test_six_d_frames_that_cannot_coincide_are_misaligned(tmp_path, monkeypatch, kind, flip):
+    """legkin's planar four-bar, cut at D: as a point loop it closes; as a 6d loop it cannot (three parallel
+    revolute joints cannot bring both the origins and the orientations together: 0.1 m stays), and with one cut
+    frame flipped by 180 degrees about x (its z axis against the other's) the angle left is pi: both are told
+    "misaligned", not a hard start."""
+    import legkin.closing as closing
+
+    monkeypatch.setattr(closing, "RESTARTS", 2)
+    text = (Path(__file__).parent / "data" / "fourbar.urdf").read_text()
+    text = text.replace('type="point"', f'type="{kind}"').replace(
+        '<origin xyz="0.2 0 0"/>', f'<origin xyz="0.2 0 0" rpy="{flip}"/>')
+    (tmp_path / "fourbar.urdf").write_text(text)
+    robot = legkin.load(tmp_path / "fourbar.urdf")
+    if kind == "point":
+        assert _worst(robot, robot.solve_loops()) <= CLOSED_TOL
+        return
+    with pytest.raises(LoopClosureError, match=r"D \(.* m, .* rad: misaligned") as info:
+        robot.solve_loops()
+    assert "2 random starts" in str(info.value)
+    assert info.value.open_loops[0].angle == pytest.approx(np.pi if flip != "0 0 0" else 0.0, abs=1e-6)

@@ -88,7 +88,7 @@ def _lm(ls: LoopSet, q: np.ndarray, free: np.ndarray, shift: np.ndarray | None =
     return q, it
 
 
-def _attempts(ls: LoopSet, q0: np.ndarray, free: np.ndarray, seed: int, restarts: int = RESTARTS,
+def _attempts(ls: LoopSet, q0: np.ndarray, free: np.ndarray, seed: int, restarts: int | None = None,
               homotopy: bool = True, fast: Callable | None = None, lm: bool = True):
     """The strategies in turn: yields (name, configuration reached, iterations)."""
     if fast is not None:
@@ -107,7 +107,7 @@ def _attempts(ls: LoopSet, q0: np.ndarray, free: np.ndarray, seed: int, restarts
         total += it
     yield "homotopy", q, total
     rng = np.random.default_rng(seed)
-    for k in range(restarts):
+    for k in range(RESTARTS if restarts is None else restarts):
         dq = np.zeros(ls.model.nv)
         dq[free] = rng.uniform(-RESTART_SPREAD, RESTART_SPREAD, int(free.sum()))
         q, it = _lm(ls, pin.integrate(ls.model, q0, dq), free)
@@ -115,7 +115,7 @@ def _attempts(ls: LoopSet, q0: np.ndarray, free: np.ndarray, seed: int, restarts
 
 
 def close_loops(ls: LoopSet, q0: np.ndarray, free: np.ndarray, *, tol: float = CLOSED_TOL, seed: int = 0,
-                restarts: int = RESTARTS, homotopy: bool = True, fast: Callable | None = None, lm: bool = True,
+                restarts: int | None = None, homotopy: bool = True, fast: Callable | None = None, lm: bool = True,
                 diagnose_failure: bool = True) -> tuple[np.ndarray, ClosingInfo]:
     """Close every loop of ``ls`` from ``q0``, moving only the velocity coordinates ``free``.
 
@@ -125,7 +125,7 @@ def close_loops(ls: LoopSet, q0: np.ndarray, free: np.ndarray, *, tol: float = C
         free: boolean mask over the velocity coordinates that may move.
         tol: the largest frame error accepted (m and rad).
         seed: seed of the restarts.
-        restarts: random starts tried after the direct and homotopy attempts.
+        restarts: random starts tried after the direct and homotopy attempts (default :data:`RESTARTS`).
         homotopy: try the homotopy (and the restarts) after the direct attempt.
         fast: ``(q, free) -> (q, iterations)``, a compiled solve tried first (``Robot._tree_solve``: minimum-norm
             Gauss-Newton).
@@ -159,7 +159,8 @@ def close_loops(ls: LoopSet, q0: np.ndarray, free: np.ndarray, *, tol: float = C
     )
 
 
-def _tried(homotopy: bool, restarts: int, fast: Callable | None, lm: bool) -> str:
+def _tried(homotopy: bool, restarts: int | None, fast: Callable | None, lm: bool) -> str:
+    restarts = RESTARTS if restarts is None else restarts
     parts = ["compiled Gauss-Newton"] if fast is not None else []
     if lm:
         parts.append(f"Levenberg-Marquardt direct, homotopy and {restarts} random starts" if homotopy
@@ -183,8 +184,8 @@ def diagnose(ls: LoopSet, q0: np.ndarray, free: np.ndarray, names: list[str], se
     """Why each loop of ``names`` stays open: a verdict per loop name.
 
     ``"closes alone: ..."`` (a hard start, or loops that contradict each other), ``"misaligned: ..."`` (a 6d
-    loop whose origins meet when it is a point loop, but whose orientations stay apart from every start: the
-    angles left are given), or ``"cannot close even alone ..."``.
+    loop whose origins meet when it is a point loop, but which stays open as a 6d loop from every start: the
+    distances and angles left are given), or ``"cannot close even alone ..."``.
     """
     out = {}
     for lp in ls.loops:
@@ -196,9 +197,10 @@ def diagnose(ls: LoopSet, q0: np.ndarray, free: np.ndarray, names: list[str], se
             continue
         point = _alone(ls, LoopSpec(lp.name, "point", lp.frame1, lp.frame2), q0, free, seed)
         if lp.type == "frame" and point[-1].worst <= CLOSED_TOL:
-            angles = [e.angle for e in alone]
-            out[lp.name] = (f"misaligned: its origins meet, but from {len(alone)} starts its orientations stay "
-                            f"{min(angles):.3g} to {max(angles):.3g} rad apart (frames that cannot coincide)")
+            dist, angle = [e.distance for e in alone], [e.angle for e in alone]
+            out[lp.name] = (f"misaligned: its origins meet as a point loop, but as a 6d loop it stays {min(dist):.3g} "
+                            f"to {max(dist):.3g} m and {min(angle):.3g} to {max(angle):.3g} rad open from {len(alone)} "
+                            "starts (frames that cannot coincide)")
         else:
             out[lp.name] = f"cannot close even alone (origins {min(e.distance for e in point):.3g} m apart at best)"
     return out

@@ -191,14 +191,14 @@ def _integrate(q, dv, kind, idx_q, idx_v, out):
 
 @kernel
 def _solve_psd(a, b, out):
-    """A solution of ``a y = b`` for a positive semi-definite ``a`` (``LDL^T``, pivots below 1e-12 times the largest
+    """A solution of ``a y = b`` for a positive semi-definite ``a`` (``LDL^T``, pivots below 1e-15 times the largest
     diagonal entry treated as 0: the redundant rows of planar loops): ``out = y``."""
     n = a.shape[0]
     low, d = np.zeros((n, n)), np.zeros(n)
     eps = 0.0
     for k in range(n):
         eps = max(eps, a[k, k])
-    eps *= 1e-12
+    eps *= 1e-15
     for k in range(n):
         dk = a[k, k]
         for j in range(k):
@@ -344,11 +344,20 @@ def closed_jacobian_k(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loo
         if passive[v]:
             cols[k] = v
             k += 1
-    jp, a2, y, dv = np.empty((rows, n_free)), np.empty((rows, rows)), np.empty(rows), np.empty(nv)
+    jp, a2, y = np.empty((rows, n_free)), np.empty((rows, rows)), np.empty(rows)
+    dv, ddv = np.zeros(nv), np.empty(nv)
     for m in range(motor_v.shape[0]):
-        for i in range(rows):
-            res[i] = jac[i, motor_v[m]]
-        _step(jac, res, cols, jp, a2, y, dv)  # J_p dv_p = -J_m e_m: dv_p = -J_p^T y with J_p J_p^T y = J_m e_m
+        for v in range(nv):
+            dv[v] = 0.0
+        for _refine in range(3):  # J_p dv_p = -J_m e_m, minimum norm; refined twice (J_p J_p^T squares the
+            for i in range(rows):  # condition number: near a singularity one solve loses digits)
+                x = jac[i, motor_v[m]]
+                for c in range(n_free):
+                    x += jac[i, cols[c]] * dv[cols[c]]
+                res[i] = x
+            _step(jac, res, cols, jp, a2, y, ddv)
+            for v in range(nv):
+                dv[v] += ddv[v]
         for r in range(6):
             x = jf[r, motor_v[m]]
             for c in range(n_free):

@@ -170,16 +170,16 @@ class ClosedLoopMixin:
 
     def _tree_solve(
         self, q: np.ndarray, passive: np.ndarray, max_iter: int = _MAX_ITER
-    ) -> tuple[np.ndarray, bool, int]:
+    ) -> tuple[np.ndarray, bool, int, float]:
         """The compiled solve (:func:`legkin._tree_kernels.solve_passive`: minimum-norm Gauss-Newton, its test the
         frames' own error) moving the velocity coordinates ``passive``; returns the configuration, whether it
-        closed and the iterations. Needs :meth:`_tree`."""
+        closed, the iterations and the worst frame error (m or rad). Needs :meth:`_tree`."""
         t = self._tree()
         assert t is not None
         out, info = np.empty_like(q), np.zeros(2)
         status = _solver()(q, t.parent, t.kind, t.axis, t.place_r, t.place_t, t.idx_q, t.idx_v, t.loop_j,
                            t.loop_r, t.loop_t, t.loop_six, passive, CLOSED_TOL, max_iter, out, info)
-        return out, status == 0, int(info[0])  # 0: legkin._kernels.OK
+        return out, status == 0, int(info[0]), float(info[1])  # 0: legkin._kernels.OK
 
     def _fk_step(self, motors: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, bool]:
         """Gauss-Newton (minimum-norm steps) on the passive coordinates from ``q`` with the motors set: compiled, then
@@ -189,12 +189,13 @@ class ClosedLoopMixin:
         q = q.copy()
         q[iq] = motors
         if tree is not None:
-            qt, ok, _ = self._tree_solve(q, passive)
+            qt, ok, _, worst = self._tree_solve(q, passive)
             if ok:
                 return qt, True
-            # stalled near closure (measured: robot_delta, 2 of 200 samples, ~3e-10): Pinocchio's damped LM finishes
-            # from there; stalled far (a poor start): the damped LM starts again from q, as without the kernel
-            if self._closed(qt, 1e-6):
+            # stalled near closure (measured: robot_delta, 2 of 200 samples at ~3e-10): Pinocchio's damped LM
+            # finishes from there; stalled far (a poor start): the damped LM starts again from q, as without the
+            # kernel. (Not used to polish answers the kernel closed: LM's damped steps move the idle joints.)
+            if worst <= 1e-6:
                 q = qt
         q = levenberg_marquardt(self.model, self._loopset.residual_and_jacobian, q, passive, 1e-14, _MAX_ITER)[0]
         return q, self._closed(q)

@@ -126,7 +126,7 @@ class FileRobot(Robot):
             return None, True
 
         def fast(q, free):
-            q, _, iterations = self._tree_solve(q, np.asarray(free, dtype=np.bool_), _LOAD_ITER)
+            q, _, iterations, _ = self._tree_solve(q, np.asarray(free, dtype=np.bool_), _LOAD_ITER)
             return q, iterations
 
         return fast, False

@@ -22,7 +22,7 @@ import pinocchio as pin
 import legkin
 from legkin.closing import loop_errors
 from legkin.errors import LoopClosureError
-from legkin.loaders.checks import _spread, jacobian_fd_error, reachable_motors
+from legkin.loaders.checks import _spread, determined_frames, jacobian_fd_error, reachable_motors
 
 
 def _closing(robot) -> tuple[str, str, str]:
@@ -84,7 +84,7 @@ def report(path: Path, samples: int) -> None:
     iq, _ = robot._motor_index()
     box = robot.q0[iq] + rng.uniform(-1, 1, (samples, len(iq))) * _spread(robot)
     ok_box = _fk_stats(robot, box)[0]
-    frame = robot.model.frames[robot.model.nframes - 1].name
+    frame = determined_frames(robot, robot.q0)[-1]
     jac = max(jacobian_fd_error(robot, q, frame) for q in qs[:10])
     fk, cjj = _speed(robot, qs[0])
     print(f"{name:<19} {len(robot.loops):>5} {len(robot.actuated):>6} {robot.mobility(robot.q0):>4} "

@@ -13,6 +13,7 @@ import pinocchio as pin
 
 from ..closing import CLOSED_TOL, close_loops, loop_errors
 from ..errors import LegkinError, LoopClosureError, UnreachableError
+from ..robot import Robot
 from ..validation import CheckResult, compare
 from .robot import FileRobot
 
@@ -94,9 +95,10 @@ def jacobian_fd_error(robot: FileRobot, q: np.ndarray, frame: str) -> float:
     return float(np.max(np.abs(robot.closed_jacobian(q, frame) - num)))
 
 
-def mjcf_round_trip_error(robot: FileRobot, tmpdir) -> float:
-    """legkin's MJCF export read back by Pinocchio's MJCF parser: the largest loop error (m, rad) of the
-    read-back loops at ``robot.q0``; inf when the loops' count or types differ."""
+def mjcf_round_trip_error(robot: Robot, tmpdir, qs: np.ndarray | None = None) -> float:
+    """legkin's MJCF export of ``robot`` read back by Pinocchio's MJCF parser (:func:`legkin.loaders.load_file`):
+    the largest loop error (m, rad) of the read-back loops at ``robot.q0`` and the closed configurations ``qs``
+    (joints matched by name); inf when the loops' count or types, or the motors, differ."""
     from pathlib import Path
 
     from ..mjcf import to_mjcf
@@ -105,13 +107,17 @@ def mjcf_round_trip_error(robot: FileRobot, tmpdir) -> float:
     path = Path(tmpdir) / f"{robot.name}.xml"
     path.write_text(to_mjcf(robot))
     back = load_file(path)
-    if [lp.type for lp in back.loops] != [lp.type for lp in robot.loops] or back.actuated != robot.actuated:
+    if [lp.type for lp in back.loops] != [lp.type for lp in robot.loops] or back.actuated != tuple(
+            robot.actuated_joints):
         return float("inf")
-    q = pin.neutral(back.model)
-    for name in robot.joint_names:
-        j = robot.model.joints[robot.joint_id(name)]
-        q[back.idx_q(name): back.idx_q(name) + j.nq] = robot.q0[j.idx_q: j.idx_q + j.nq]
-    return max((e.worst for e in loop_errors(back.model, back.data, back.loops, q)), default=0.0)
+    worst = 0.0
+    for q_robot in [robot.q0, *([] if qs is None else qs)]:
+        q = pin.neutral(back.model)
+        for name in robot.joint_names:
+            j = robot.model.joints[robot.joint_id(name)]
+            q[back.idx_q(name): back.idx_q(name) + j.nq] = q_robot[j.idx_q: j.idx_q + j.nq]
+        worst = max([worst] + [e.worst for e in loop_errors(back.model, back.data, back.loops, q)])
+    return worst
 
 
 def _fk_rows(robot: FileRobot, motors: np.ndarray) -> list[CheckResult]:

@@ -223,8 +223,8 @@ def _round_trip_row(robot, qs) -> "CheckResult":
 
     with tempfile.TemporaryDirectory(prefix="legkin-roundtrip-") as tmp:
         error = mjcf_round_trip_error(robot, tmp, qs)
-    return compare(f"MJCF round trip (Pinocchio's parser): {len(robot.loops)} loops at {len(qs)} configurations (m/rad)",
-                   [error], CLOSED_TOL)
+    name = f"MJCF round trip (Pinocchio's parser): {len(robot.loops)} loops at {len(qs)} configurations (m/rad)"
+    return compare(name, [error], CLOSED_TOL)
 
 
 def check_rows(

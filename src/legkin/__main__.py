@@ -1,4 +1,4 @@
-"""The ``legkin`` command line: list, generate, check, view, bench, study.
+"""The ``legkin`` command line: list, generate, check, view, bench, study, sim, export, convert.
 
 Every error ends the command with one line on stderr (``legkin: error: ...``) and a non-zero exit status:
 1 when checks fail or files are stale, 2 for a bad command line or a legkin error, 3 for an unexpected
@@ -98,8 +98,11 @@ def output_dir(text: str) -> str:
 def _check_models(names) -> list[str] | None:
     """The model names of the command line, every one checked before any work starts."""
     from ._registry import get_spec
+    from .robot import _is_path
 
     for name in names:
+        if _is_path(name):
+            continue  # a robot file: read by legkin.load
         get_spec(name)  # UnknownModelError lists the known names
     return list(names) or None
 
@@ -142,6 +145,11 @@ def _cmd_check(args) -> int:
     from .validation import all_passed, format_table, run_checks, write_json
 
     models = _check_models(args.models)
+    files = [m for m in models or [] if _is_file(m)]
+    if files:
+        if len(files) != len(models or []):
+            raise UsageError("legkin check: error: give either model names or robot files, not both")
+        return _check_files(files, args)
     if args.jobs is None:
         args.jobs = min(4, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
     if args.plots and importlib.util.find_spec("matplotlib") is None:
@@ -176,6 +184,35 @@ def _cmd_check(args) -> int:
     return 0 if ok else 1
 
 
+def _is_file(name: str) -> bool:
+    from .robot import _is_path
+
+    return _is_path(name)
+
+
+def _check_files(paths: list[str], args) -> int:
+    """``legkin check PATH...``: the rows of :func:`legkin.loaders.checks.check_rows` per robot file."""
+    import time
+
+    import numpy as np
+
+    from .loaders import load_file
+    from .loaders.checks import check_rows
+    from .validation import all_passed, format_table, write_json
+
+    results = {}
+    for path in paths:
+        t0 = time.perf_counter()
+        robot = load_file(path)
+        results[path] = (check_rows(robot, args.samples, np.random.default_rng(args.seed)), time.perf_counter() - t0)
+    print(format_table(results))
+    if args.json:
+        write_json(results, args.json)
+    ok = all_passed(results)
+    print("all checks passed" if ok else "SOME CHECKS FAILED")
+    return 0 if ok else 1
+
+
 def _first_run_note(models: list[str] | None) -> str | None:
     """The note of a first run after an install (most of the models' kernels, default all, not in numba's cache
     yet), or None."""
@@ -202,6 +239,10 @@ def _cmd_view(args) -> int:
     if args.animate and (args.q is not None or args.pose is not None):
         raise UsageError("legkin view: error: --animate plays a clip: it takes no --pose or --q")
     robot = load(args.model, floating=args.floating)
+    missing = getattr(robot, "missing_meshes", [])
+    if missing:
+        print(f"legkin view: {len(missing)} mesh file(s) not found, left out of the view: {', '.join(missing)}",
+              file=sys.stderr)
     if args.q is not None:
         if len(args.q) != robot.model.nq:
             raise errors.InvalidInputError(
@@ -239,6 +280,13 @@ def _cmd_export(args) -> int:
 
     args.output = str(args.mjcf)
     return run_export(args)
+
+
+def _cmd_convert(args) -> int:
+    from .loaders.convert import convert
+
+    print(f"wrote {convert(args.input, args.output, loops=args.loops)}")
+    return 0
 
 
 def _cmd_bench(args) -> int:
@@ -321,6 +369,13 @@ def build_parser() -> argparse.ArgumentParser:
                    help="simulation step, s (default 0.0002; 0.001 with --floating)")
     p.add_argument("--png", metavar="PATH", type=output_file, help="also render q0 with MuJoCo (MUJOCO_GL=egl)")
     p.set_defaults(func=_cmd_export)
+
+    p = sub.add_parser("convert",
+                       help="convert a robot file's loops: YAML sidecar, URDF <loop_closure>, MJCF equalities")
+    p.add_argument("input", help="a URDF (+ robot.yaml), xacro or MJCF")
+    p.add_argument("output", type=output_file, help="OUT.yaml (sidecar), OUT.urdf (<loop_closure>) or OUT.xml (MJCF)")
+    p.add_argument("--loops", metavar="YAML", help="the input URDF's sidecar, if not robot.yaml beside it")
+    p.set_defaults(func=_cmd_convert)
     return parser
 
 

@@ -141,13 +141,24 @@ class LoopClosureError(LegkinError):
     Attributes:
         residual: norm of the stacked constraint residual reached.
         iterations: iterations performed.
+        q: the configuration reached (the closest found), when known.
+        open_loops: per loop, how far it stays open (``legkin.closing.LoopError``: name, distance m,
+            angle rad), when known (else empty).
     """
 
-    def __init__(self, message: str, residual: float = float("nan"), iterations: int = 0, q: Any = None) -> None:
+    def __init__(
+        self,
+        message: str,
+        residual: float = float("nan"),
+        iterations: int = 0,
+        q: Any = None,
+        open_loops: Sequence[Any] = (),
+    ) -> None:
         super().__init__(message)
         self.residual = residual
         self.iterations = iterations
         self.q = q
+        self.open_loops = list(open_loops)
 
 
 class ConvergenceError(LegkinError):

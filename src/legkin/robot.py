@@ -13,6 +13,7 @@ import pinocchio as pin
 from ._batch import as_input, check_flag, check_integer, check_number
 from ._generate import model_files
 from ._registry import MODELS, ModelSpec, get_spec
+from .closed import ClosedLoopMixin
 from .errors import InvalidInputError, InvalidParameterError
 from .loops import DEFAULT_DAMPING, LoopSet, LoopSolveInfo, parse_loops
 
@@ -37,7 +38,7 @@ def _names(name: str, value) -> list[str]:
     return names
 
 
-class Robot:
+class Robot(ClosedLoopMixin):
     """A mechanism loaded in Pinocchio.
 
     Attributes:
@@ -403,11 +404,22 @@ class Robot:
         return (q, info) if return_info else q
 
 
-def load(name: str, *, floating: bool = False, **params) -> Robot:
-    """Load a registered mechanism in Pinocchio.
+def _is_path(name: object) -> bool:
+    """A file name rather than a registry name: it has a path separator or a model file's suffix."""
+    import os
+
+    return isinstance(name, (str, os.PathLike)) and (
+        not isinstance(name, str) or "/" in name or os.sep in name or name.lower().endswith((".urdf", ".xacro", ".xml"))
+    )
+
+
+def load(name, *, floating: bool = False, **params) -> Robot:
+    """Load a registered mechanism, or a robot from its own files, in Pinocchio.
 
     Args:
-        name: a name from :func:`legkin.list_models`.
+        name: a name from :func:`legkin.list_models`, or a path (``str`` with a ``/`` or a ``.urdf``, ``.xacro``
+            or ``.xml`` suffix, or a ``pathlib.Path``): a robot from its own files, read by
+            :func:`legkin.loaders.load_file` (its keyword ``loops=``: a YAML sidecar path).
         floating: add a free-flyer root joint (only for models where that makes sense).
         **params: xacro arguments; validated before any file is written.
 
@@ -416,9 +428,17 @@ def load(name: str, *, floating: bool = False, **params) -> Robot:
         InvalidParameterError: an unknown argument, a value out of range or of the wrong kind (a string
             argument given a non-string, a number given a bool, an array or a complex), ``floating`` not a bool.
     """
-    spec = get_spec(name)
     if not isinstance(floating, (bool, np.bool_)):
         raise InvalidParameterError(f"floating must be True or False, got {floating!r}")
+    if _is_path(name):
+        import importlib  # the file loader sits above this module (it subclasses Robot): found by name, at run time
+
+        load_file = importlib.import_module("legkin.loaders").load_file
+        unknown = sorted(set(params) - {"loops"})
+        if unknown:
+            raise InvalidParameterError(f"unknown argument(s) {', '.join(unknown)} for a robot file; known: loops")
+        return load_file(name, floating=bool(floating), **params)
+    spec = get_spec(name)
     floating = bool(floating)
     args = spec.resolve_params(params)
     if floating and not spec.floating:

@@ -213,6 +213,17 @@ def _clip_frames(robot: "Robot") -> tuple[str | None, list[np.ndarray]]:
     return name, [np.asarray(q, dtype=float) for q in frames(robot, name)]
 
 
+def _round_trip_row(robot, qs) -> "CheckResult":
+    """legkin's MJCF export read back by Pinocchio's MJCF parser: its loops at ``q0`` and ``qs`` (m/rad)."""
+    from .._checkkit import compare
+    from ..closing import CLOSED_TOL
+    from .roundtrip import mjcf_round_trip_error
+
+    error = mjcf_round_trip_error(robot, qs)
+    name = f"MJCF round trip (Pinocchio's parser): {len(robot.loops)} loops at {len(qs)} configurations (m/rad)"
+    return compare(name, [error], CLOSED_TOL)
+
+
 def check_rows(
     name: str,
     samples: int = 10,
@@ -227,6 +238,8 @@ def check_rows(
     1. at ``q0`` and ``samples`` random closed configurations (:func:`closed_configurations`), MuJoCo's body
        and site positions (``mj_kinematics``) equal Pinocchio's joint and frame placements (1e-12 m);
     2. MuJoCo's equality residuals there (``efc_pos`` after ``mj_forward``) are 0 (1e-12; models with loops);
+       and the MJCF round trip: Pinocchio's MJCF parser reads the export back with the same loops, closed at
+       those configurations (1e-10 m and rad; :func:`legkin.mjcf.roundtrip.mjcf_round_trip_error`);
     3. 2 s under gravity from ``q0`` with the actuators holding it: a finite state, every loop residual
        under 1e-4 (m, rad); for a model without loops, the state stays finite (its actuated joints' largest
        drift from ``q0`` is the row's error, tolerance 0.05 rad);
@@ -264,6 +277,8 @@ def check_rows(
             f"MuJoCo equality residuals efc_pos at closed configurations ({len(robot.loops)} loops, m/rad)",
             equality_errors(mech, qs), TOL_EQUALITY,
         ))
+    if robot.loops:
+        rows.append(_round_trip_row(robot, qs))
     hold = hold_under_gravity(mech, seconds)
     if robot.loops:
         rows.append(compare(

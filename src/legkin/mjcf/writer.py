@@ -264,15 +264,18 @@ def _bodies(model: pin.Model, joints: Sequence[Any], world: ET.Element,
     return bodies, notes
 
 
-def _sites_and_visuals(robot: "Robot", bodies: Mapping[int, ET.Element], asset: ET.Element) -> set[str]:
-    """Sites at the body and operational frames, then the visuals; returns the names of the sites."""
+def _sites_and_visuals(robot: "Robot", bodies: Mapping[int, ET.Element], asset: ET.Element) -> dict[str, str]:
+    """Sites at the body and operational frames (and at the joint frames a loop names, as ``<joint>_site``: a
+    robot from a file may close a loop on a joint's origin), then the visuals; returns frame name -> site name."""
     model = robot.model
-    seen = set()
+    seen: dict[str, str] = {}
+    loop_frames = {name for lp in robot.loops for name in (lp.frame1, lp.frame2)}
     for f in model.frames:
-        if f.type not in (pin.FrameType.BODY, pin.FrameType.OP_FRAME) or f.name in seen:
+        at_joint = f.type == pin.FrameType.JOINT and f.name in loop_frames
+        if (f.type not in (pin.FrameType.BODY, pin.FrameType.OP_FRAME) and not at_joint) or f.name in seen:
             continue
-        seen.add(f.name)
-        site = ET.SubElement(bodies[f.parentJoint], "site", name=f.name)
+        seen[f.name] = f"{f.name}_site" if at_joint else f.name
+        site = ET.SubElement(bodies[f.parentJoint], "site", name=seen[f.name])
         site.set("class", "frame")
         _set_pose(site, f.placement)
     mesh_assets: dict = {}
@@ -293,7 +296,7 @@ def _floor(robot: "Robot", asset: ET.Element, world: ET.Element) -> None:
                   diffuse="0.5 0.5 0.5", castshadow="true")
 
 
-def _equalities(root: ET.Element, robot: "Robot", seen: set[str], o: Mapping[str, Any]) -> None:
+def _equalities(root: ET.Element, robot: "Robot", seen: Mapping[str, str], o: Mapping[str, Any]) -> None:
     """The loop closures as ``<connect>`` (point) or ``<weld>`` equalities between sites."""
     if not robot.loops:
         return
@@ -303,7 +306,7 @@ def _equalities(root: ET.Element, robot: "Robot", seen: set[str], o: Mapping[str
             if fname not in seen:
                 raise LegkinError(f"loop {lp.name!r}: frame {fname!r} is not a body or operational frame")
         ET.SubElement(
-            eq, "connect" if lp.type == "point" else "weld", name=lp.name, site1=lp.frame1, site2=lp.frame2,
+            eq, "connect" if lp.type == "point" else "weld", name=lp.name, site1=seen[lp.frame1], site2=seen[lp.frame2],
             solref=_vec(o["eq_solref"]), solimp=_vec(o["eq_solimp"]),
         )
 

@@ -194,6 +194,44 @@ def _executor(workers: int) -> ThreadPoolExecutor:
         return _pool
 
 
+#: numba's threading layers that run ``parfor`` loops from several Python threads at once (numba's documentation,
+#: "Selecting a threading layer"): ``workqueue`` aborts the process ("Concurrent access has been detected").
+_THREADSAFE_LAYERS = ("tbb", "omp")
+#: The layers that survive a fork: GNU OpenMP kills a forked child at its first parallel region ("fork() called
+#: from a process already using GNU OpenMP"); numba's ``workqueue`` threads do not exist in the child.
+_FORKSAFE_LAYERS = ("tbb",)
+#: Serializes the ``parfor`` batches of a threading layer that is not thread-safe (:data:`_THREADSAFE_LAYERS`).
+_parfor_lock = threading.Lock()
+#: True in a process forked after numba's threads were started on a layer that does not survive a fork
+#: (:data:`_FORKSAFE_LAYERS`): its ``parfor`` batches run their serial compilation.
+_forked_serial = False
+
+
+def threading_layer() -> str | None:
+    """numba's threading layer of this process (``"tbb"``, ``"omp"``, ``"workqueue"``), or None before the first
+    ``parfor`` batch starts it. numba picks the first available of TBB, OpenMP, workqueue, unless
+    ``NUMBA_THREADING_LAYER`` (or ``numba.config.THREADING_LAYER``, set before the first parallel batch) names
+    one; see docs/robustness.md, "Threads, processes and fork"."""
+    try:
+        return str(numba.threading_layer())
+    except ValueError:  # numba: "Threading layer is not initialized."
+        return None
+
+
+def _after_fork_in_child() -> None:
+    """``os.register_at_fork`` hook: the child of a fork has none of the parent's threads. Its chunk pool starts
+    afresh (the parent's pool threads, and any lock they held, do not exist), and its ``parfor`` batches run
+    serially when the parent's numba threading layer does not survive a fork."""
+    global _pool, _pool_size, _pool_lock, _parfor_lock, _forked_serial
+    _pool, _pool_size = None, 0
+    _pool_lock, _parfor_lock = threading.Lock(), threading.Lock()
+    layer = threading_layer()
+    _forked_serial = _forked_serial or (layer is not None and layer not in _FORKSAFE_LAYERS)
+
+
+os.register_at_fork(after_in_child=_after_fork_in_child)
+
+
 #: True: a ``parfor`` batch loop runs its serial compilation and never compiles its parallel twin (numba's parallel
 #: compiler, 0.4-0.9 s a loop on the first run). Set in ``legkin check``'s worker processes, which run on one
 #: thread and need the rows, not the speed (the rows are the same bit for bit).
@@ -230,8 +268,8 @@ class BatchLoop:
         n = args[self.rows[0]].shape[0]
         if n < self.min_parallel:
             return self.kernel(*args)
-        if self.parfor is not None and not serial_parfor_loops:
-            return self.parfor(*args)
+        if self.parfor is not None and not (serial_parfor_loops or _forked_serial):
+            return self._run_parfor(args)
         k = min(threads(), n)
         if k <= 1:
             return self.kernel(*args)
@@ -248,6 +286,15 @@ class BatchLoop:
         first = self.kernel(*chunks[0])
         rest = [f.result() for f in futures]
         return first if first is None else first + sum(rest)
+
+    def _run_parfor(self, args: tuple[Any, ...]) -> Any:
+        """The ``parfor`` twin on numba's threading layer, one batch at a time where the layer is not thread-safe
+        (or not yet started: numba picks it on the first parallel batch)."""
+        parfor: Callable[..., Any] = self.parfor  # type: ignore[assignment] # set: BatchLoop.__call__ checked it
+        if threading_layer() in _THREADSAFE_LAYERS:
+            return parfor(*args)
+        with _parfor_lock:
+            return parfor(*args)
 
 
 def _renamed(fn: Callable[..., Any], suffix: str) -> Callable[..., Any]:

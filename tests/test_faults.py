@@ -94,3 +94,142 @@ def test_concurrent_batches_on_every_threading_layer(layer):
     """, env={"NUMBA_THREADING_LAYER": layer})
     assert proc.returncode == 0, proc.stderr[-2000:]
     assert proc.stdout.split() == [layer, "True", "100"]
+
+
+# --- numba's cache ----------------------------------------------------------------------------------------------
+
+KERNELS = """
+from legkin._kernels import kernel
+
+
+@kernel(entry=True)
+def twice(x):
+    return 2.0 * x
+
+
+@kernel(entry=True)
+def thrice(x):
+    return 3.0 * x
+"""
+
+CALL_KERNELS = """
+    import sys, warnings
+    sys.path.insert(0, {where!r})
+    warnings.simplefilter("always")
+    import kmod
+    print(kmod.twice(1.5), kmod.thrice(1.5))
+    print("compiled", sum(len(k.stats.cache_misses) for k in (kmod.twice, kmod.thrice)))
+"""
+
+
+def _damage(files: dict[str, Path], how: str) -> Path:
+    """Damage the cache of ``kmod.twice`` as ``how`` says; the file damaged."""
+    nbi, nbc = files["twice.nbi"], files["twice.nbc"]
+    if how == "truncated index":
+        nbi.write_bytes(nbi.read_bytes()[:20])
+        return nbi
+    if how == "garbage index":
+        nbi.write_bytes(os.urandom(300))
+        return nbi
+    if how == "truncated data":
+        nbc.write_bytes(nbc.read_bytes()[: nbc.stat().st_size // 2])
+        return nbc
+    if how == "flipped bytes":
+        raw = bytearray(nbc.read_bytes())
+        for i in range(len(raw) // 2, len(raw) // 2 + 64):
+            raw[i] ^= 0xFF
+        nbc.write_bytes(bytes(raw))
+        return nbc
+    if how == "swapped data":  # thrice's machine code under twice's name
+        nbc.write_bytes(files["thrice.nbc"].read_bytes())
+        return nbc
+    assert how == "swapped index"
+    nbi.write_bytes(files["thrice.nbi"].read_bytes())
+    return nbi
+
+
+@pytest.mark.parametrize("how", ["truncated index", "garbage index", "truncated data", "flipped bytes",
+                                 "swapped data", "swapped index"])
+def test_damaged_cache_file_is_discarded_and_rebuilt(tmp_path, how):
+    """A damaged cache file (the issue: a truncated index gave EOFError in every later process, garbage
+    UnpicklingError, flipped bytes SIGABRT, a swapped file SIGSEGV or another kernel's answer): the next process
+    warns naming the file, compiles the kernel again and gets the right answer; the process after it loads the
+    rebuilt entry without a warning."""
+    (tmp_path / "kmod.py").write_text(KERNELS)
+    env = {"NUMBA_CACHE_DIR": str(tmp_path / "cache")}
+    call = CALL_KERNELS.format(where=str(tmp_path))
+    warm = run_py(call, env=env)
+    assert warm.returncode == 0 and warm.stdout.split() == ["3.0", "4.5", "compiled", "2"], warm.stderr
+    found = (tmp_path / "cache").rglob("kmod.*.nb?")
+    files = {f"{p.name.split('.')[1].split('-')[0]}.{p.suffix[1:]}": p for p in found}
+    assert sorted(files) == ["thrice.nbc", "thrice.nbi", "twice.nbc", "twice.nbi"], files
+    damaged = _damage(files, how)
+    hit = run_py(call, env=env)
+    assert hit.returncode == 0, hit.stderr[-3000:]
+    assert hit.stdout.split() == ["3.0", "4.5", "compiled", "1"], (hit.stdout, hit.stderr)
+    assert "CacheWarning" in hit.stderr and str(damaged) in hit.stderr, hit.stderr
+    again = run_py(call, env=env)
+    assert again.stdout.split() == ["3.0", "4.5", "compiled", "0"] and "Warning" not in again.stderr, again.stderr
+
+
+READ_ONLY = ("mount --bind {src} {src} && mount -o remount,bind,ro {src} && "
+             "HOME=/proc/legkin XDG_CACHE_HOME=/proc/legkin NUMBA_CACHE_DIR=/proc/legkin {python} -c {code}")
+
+
+def _read_only_run(src: str, code: str) -> subprocess.CompletedProcess:
+    """Run ``code`` with ``src`` mounted read-only and every numba cache location unwritable (a private mount
+    namespace); skips where there is none."""
+    import shlex
+
+    probe = subprocess.run(["unshare", "--mount", "true"], capture_output=True)
+    if probe.returncode != 0:
+        pytest.skip("no private mount namespace here (unshare --mount)")
+    script = READ_ONLY.format(src=shlex.quote(src), python=shlex.quote(sys.executable),
+                              code=shlex.quote(textwrap.dedent(code)))
+    return subprocess.run(["unshare", "--mount", "bash", "-c", script], capture_output=True, text=True,
+                          env={**os.environ, "PYTHONPATH": SRC}, timeout=300)
+
+
+def test_no_writable_cache_location_loads_the_readable_cache():
+    """The issue's case: site-packages, $HOME and NUMBA_CACHE_DIR read-only, a complete cache in the package's
+    ``__pycache__``. Every call raised ``RuntimeError: no locator available``; now the kernels load from that cache
+    (none compiled) with one CacheWarning."""
+    code = """
+        import warnings, numpy as np
+        warnings.simplefilter("always")
+        from legkin import tripod, _kernels
+        m = tripod.ik(np.array([0.2, -0.1]))
+        print(np.round(tripod.fk(m), 12).tolist())
+        print("compiled", sum(len(r().stats.cache_misses) for r in _kernels._cached_kernels if r() is not None))
+    """
+    warm = run_py(code, env={"NUMBA_CACHE_DIR": ""})
+    assert warm.returncode == 0, warm.stderr[-2000:]
+    proc = _read_only_run(SRC, code)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.splitlines() == [warm.stdout.splitlines()[0], "compiled 0"], proc.stdout
+    assert proc.stderr.count("CacheWarning") == 1, proc.stderr
+
+
+def test_no_cache_at_all_compiles_in_memory(tmp_path):
+    """No writable location and nothing cached: the kernels compile in memory, one warning."""
+    (tmp_path / "kmod.py").write_text(KERNELS)
+    proc = _read_only_run(str(tmp_path), CALL_KERNELS.format(where=str(tmp_path)))
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.split() == ["3.0", "4.5", "compiled", "2"], proc.stdout
+    assert proc.stderr.count("CacheWarning") == 1, proc.stderr
+    assert not list(tmp_path.rglob("*.nb?"))
+
+
+def test_numba_cache_internals_are_the_checked_ones():
+    """legkin._cache subclasses numba's cache classes (not an extension API): it was read and tested against the numba
+    versions of ``CHECKED_NUMBA``. A numba outside them fails here, so that it is checked before it is declared."""
+    import numba
+
+    from legkin import _cache
+
+    assert _cache.numba_checked(), f"numba {numba.__version__}: check legkin/_cache.py against its numba.core.caching"
+    from numba.core import caching
+
+    for name in ("_load_index", "_save_index", "_load_data", "_save_data", "_open_for_write", "_dump"):
+        assert callable(getattr(caching.IndexDataCacheFile, name))
+    assert caching.FunctionCache._impl_class._locator_classes[0].__name__.lstrip("_") == "UserProvidedCacheLocator"

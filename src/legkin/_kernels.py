@@ -49,6 +49,8 @@ from numba.core import config, types
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.registry import CPUDispatcher
 
+from . import _cache
+
 __all__ = ["kernel", "batch_kernel", "BatchLoop", "OK", "as_items", "as_rows", "prange", "threads"]
 
 F = TypeVar("F", bound=Callable[..., Any])
@@ -86,6 +88,11 @@ class KernelDispatcher(CPUDispatcher):
         if self._cache_enabled and not self._cache_ready:
             self._cache_ready = True
             self.enable_caching()
+
+    def enable_caching(self) -> None:
+        """numba's on-disk cache, checked and degrading (:mod:`legkin._cache`): a damaged file is discarded and
+        rebuilt, and with no writable directory the kernel loads from a readable cache or compiles in memory."""
+        self._cache = _cache.function_cache(self.py_func)
 
 
 class InternalKernel(KernelDispatcher):

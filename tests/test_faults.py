@@ -233,3 +233,141 @@ def test_numba_cache_internals_are_the_checked_ones():
     for name in ("_load_index", "_save_index", "_load_data", "_save_data", "_open_for_write", "_dump"):
         assert callable(getattr(caching.IndexDataCacheFile, name))
     assert caching.FunctionCache._impl_class._locator_classes[0].__name__.lstrip("_") == "UserProvidedCacheLocator"
+
+
+# --- signals, the viewer's address, a broken pipe ---------------------------------------------------------------
+
+def _descendants(pid: int) -> list[int]:
+    """The process ids below ``pid`` (from /proc)."""
+    children: dict[int, list[int]] = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        children.setdefault(int(fields[1]), []).append(int(stat.parent.name))
+    out, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            out.append(child)
+            todo.append(child)
+    return out
+
+
+def _alive(pid: int) -> bool:
+    """True if ``pid`` runs (a zombie, dead but not reaped, does not count)."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.parametrize("signum, status", [(2, 130), (15, 143)], ids=["SIGINT", "SIGTERM"])
+def test_signal_stops_check_and_its_workers(signum, status):
+    """Ctrl-C (SIGINT) or SIGTERM to ``legkin check --jobs 2`` while its workers run: the command exits within 2 s
+    with 128 + the signal's number and leaves no process behind (the issue: Ctrl-C waited up to 115 s for the
+    workers; SIGTERM killed the parent and left 2 workers and the resource tracker running)."""
+    import signal
+    import time
+
+    proc = subprocess.Popen([sys.executable, "-m", "legkin", "check", "tripod", "hybrid_leg", "--jobs", "2",
+                             "--samples", "100000", "--quiet"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            env={**os.environ, "PYTHONPATH": SRC}, text=True)
+    try:
+        deadline = time.monotonic() + 60
+        while len(_descendants(proc.pid)) < 3 and time.monotonic() < deadline:  # 2 workers and a resource tracker
+            time.sleep(0.2)
+        time.sleep(2.0)  # the workers are busy
+        below = _descendants(proc.pid)
+        assert len(below) >= 2, "the workers did not start"
+        t0 = time.monotonic()
+        os.kill(proc.pid, signal.Signals(signum))
+        code = proc.wait(timeout=30)
+        seconds = time.monotonic() - t0
+        while any(_alive(p) for p in below) and time.monotonic() - t0 < 5:
+            time.sleep(0.05)
+        left = [p for p in below if _alive(p)]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert code == status, proc.stderr.read()
+    assert seconds < 2.0, f"exited {seconds:.1f} s after the signal"
+    assert not left, f"processes left behind: {left}"
+
+
+def test_sighup_stops_the_viewer_server():
+    """SIGHUP (the terminal closed) to ``legkin view``: its meshcat server stops too (it runs in a session of its
+    own, so the terminal's SIGHUP never reaches it; the issue: it kept running)."""
+    import signal
+
+    proc = subprocess.Popen([sys.executable, "-m", "legkin", "view", "tripod"], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": SRC})
+    try:
+        assert "meshcat viewer" in proc.stdout.readline()
+        below = _descendants(proc.pid)
+        assert below, "no server process"
+        proc.send_signal(signal.SIGHUP)
+        proc.wait(timeout=15)
+        import time
+
+        t0 = time.monotonic()
+        while any(_alive(p) for p in below) and time.monotonic() - t0 < 10:
+            time.sleep(0.05)
+        left = [p for p in below if _alive(p)]
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+        for p in _descendants(proc.pid):
+            os.kill(p, signal.SIGKILL)
+    assert not left, "the meshcat server outlived legkin view"
+
+
+def _listening(pid: int) -> list[str]:
+    """The local addresses ``pid``'s TCP sockets listen on (from /proc/net/tcp, tcp6)."""
+    inodes = set()
+    for fd in Path(f"/proc/{pid}/fd").iterdir():
+        try:
+            target = os.readlink(fd)
+        except OSError:
+            continue
+        if target.startswith("socket:["):
+            inodes.add(target[8:-1])
+    out = []
+    for table in ("tcp", "tcp6"):
+        for line in Path(f"/proc/net/{table}").read_text().splitlines()[1:]:
+            f = line.split()
+            if f[3] == "0A" and f[9] in inodes:  # 0A: LISTEN
+                addr, port = f[1].split(":")
+                out.append(f"{'.'.join(str(int(addr[i:i + 2], 16)) for i in (6, 4, 2, 0)) if len(addr) == 8 else addr}"
+                           f":{int(port, 16)}")
+    return out
+
+
+@pytest.mark.parametrize("host, expect", [(None, "127.0.0.1"), ("0.0.0.0", "0.0.0.0")], ids=["default", "open"])
+def test_viewer_binds_localhost_unless_asked(host, expect):
+    """``legkin view`` serves on 127.0.0.1 only (the issue: on every interface); ``--host 0.0.0.0`` opens it."""
+    import signal
+
+    extra = [] if host is None else ["--host", host]
+    proc = subprocess.Popen([sys.executable, "-m", "legkin", "view", "tripod", *extra], stdout=subprocess.PIPE,
+                            stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": SRC})
+    try:
+        assert "meshcat viewer" in proc.stdout.readline()
+        addresses = [a for p in _descendants(proc.pid) for a in _listening(p)]
+    finally:
+        proc.send_signal(signal.SIGINT)
+        proc.wait(timeout=15)
+    assert addresses, "no listening socket found"
+    web = [a for a in addresses if not a.endswith(":6000") and not a.split(":")[-1].startswith("60")]
+    assert web and all(a.startswith(expect + ":") for a in web), addresses
+    assert all(a.startswith(("127.0.0.1:", expect + ":")) for a in addresses), addresses
+
+
+def test_broken_pipe_exits_quietly_with_its_own_code():
+    """``legkin list | head -0``: the reader went away. Exit 141 (128 + SIGPIPE), nothing on stderr; it was 1, the
+    status that means "checks failed"."""
+    proc = subprocess.run(f"{sys.executable} -m legkin check tripod --samples 200 --quiet | head -c 0; "
+                          "exit ${PIPESTATUS[0]}", shell=True, executable="/bin/bash", capture_output=True,
+                          text=True, env={**os.environ, "PYTHONPATH": SRC}, timeout=300)
+    assert proc.returncode == 141, (proc.returncode, proc.stderr)
+    assert proc.stderr == ""

@@ -371,3 +371,84 @@ def test_broken_pipe_exits_quietly_with_its_own_code():
                           text=True, env={**os.environ, "PYTHONPATH": SRC}, timeout=300)
     assert proc.returncode == 141, (proc.returncode, proc.stderr)
     assert proc.stderr == ""
+
+
+# --- small gaps of the error contract ---------------------------------------------------------------------------
+
+def test_leg_check_does_not_depend_on_history():
+    """wheel_leg accepted ``leg=True`` or ``1.0`` after one call with ``leg=1`` (an ``lru_cache`` keyed on the leg
+    value: ``True == 1 == 1.0``) but refused them in a fresh process. Now refused after it too."""
+    proc = run_py("""
+        import numpy as np
+        from legkin import wheel_leg
+        from legkin.errors import InvalidParameterError
+        q = np.array([1.2, 0.3, 0.1])
+        wheel_leg.fk(q, 1); wheel_leg.module_origin(1)
+        for leg in (True, 1.0):
+            for call in (lambda: wheel_leg.fk(q, leg), lambda: wheel_leg.module_origin(leg)):
+                try:
+                    call()
+                    print("accepted", leg)
+                except InvalidParameterError:
+                    print("refused", leg)
+    """)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["refused", "True"] * 2 + ["refused", "1.0"] * 2
+
+
+@pytest.mark.parametrize("call", [
+    "wheel_leg.linkage_points(10**400, 0.2)",
+    "wheel_leg.passive_angles(10**400, 0.2)",
+    "wheel_leg.linkage_points(1.0, 10**400)",
+    "hybrid_leg.extension_motor_angle(1e308)",
+    "hybrid_leg.extension_motor_angle([0.1, -1e308])",
+    "hybrid_leg.extension_motor_angle(10**400)",
+])
+def test_huge_numbers_get_legkin_errors(call):
+    """An int beyond the largest float raised ``OverflowError``; ``extension_motor_angle(1e308)`` returned -inf (its
+    inverse overflows). Now an InvalidInputError that says so."""
+    proc = run_py(f"""
+        from legkin import hybrid_leg, wheel_leg
+        from legkin.errors import InvalidInputError
+        try:
+            print({call})
+        except InvalidInputError as exc:
+            print("InvalidInputError:", exc)
+    """)
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.startswith("InvalidInputError:"), proc.stdout
+    assert "digits" in proc.stdout or "overflows" in proc.stdout or "out of range" in proc.stdout, proc.stdout
+
+
+def test_batch_error_names_the_first_bad_row():
+    """An inf in one row refused the whole batch without saying which row."""
+    proc = run_py("""
+        import numpy as np
+        from legkin import tripod
+        t = np.tile([0.2, -0.1], (6, 1)); t[3, 1] = np.inf; t[5, 0] = np.nan
+        try:
+            tripod.ik(t)
+        except Exception as exc:
+            print(type(exc).__name__, exc)
+    """)
+    assert proc.stdout.strip() == "InvalidInputError target must be finite: row 3 has inf (target[3, 1])", proc
+
+
+def test_uncompiled_path_raises_the_same_errors():
+    """Under ``NUMBA_DISABLE_JIT=1 -W error``, ``tripod.ik`` of an unreachable target raised numpy's RuntimeWarning
+    where the compiled path raises UnreachableError; a batch warned where it gives NaN rows."""
+    code = """
+        import warnings, numpy as np
+        warnings.simplefilter("error")
+        from legkin import tripod
+        try:
+            tripod.ik(np.array([3.0, 0.0]))
+        except Exception as exc:
+            print(type(exc).__name__)
+        q, ok = tripod.ik(np.array([[3.0, 0.0], [0.2, -0.1]]), return_mask=True)
+        print(ok.tolist(), bool(np.isnan(q[0]).all()))
+    """
+    compiled = run_py(code)
+    uncompiled = run_py(code, env={"NUMBA_DISABLE_JIT": "1"})
+    assert compiled.stdout.split() == ["UnreachableError", "[False,", "True]", "True"], compiled.stderr
+    assert uncompiled.stdout == compiled.stdout, uncompiled.stderr[-2000:]

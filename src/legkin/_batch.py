@@ -40,6 +40,12 @@ def as_input(x, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = Fals
         raise InvalidInputError(f"{name} must be a numeric array, got {x!r}") from exc
     if raw.dtype.kind == "c":
         raise InvalidInputError(f"{name} must be real, got a complex array ({raw.dtype})")
+    if raw.dtype.kind == "O" and raw.size and all(type(v) is int for v in raw.ravel()):  # ints beyond int64
+        big = [v for v in raw.ravel() if abs(v) > int(np.finfo(float).max)]
+        if big:
+            raise InvalidInputError(f"{name} must be finite, got an integer of {len(str(abs(big[0])))} digits, "
+                                    "beyond the largest float (1.8e308)")
+        raw = raw.astype(float)
     if raw.dtype.kind not in "biuf":
         raise InvalidInputError(f"{name} must be numeric, got {x!r}")
     arr = raw if raw.dtype == np.float64 else raw.astype(float)
@@ -48,9 +54,20 @@ def as_input(x, name: str, core: tuple[int, ...] = (), *, allow_nan: bool = Fals
             f"{name} must have shape (..., {', '.join(map(str, core))}), got shape {arr.shape}"
         )
     if not allow_nan and not np.isfinite(arr).all():
-        bad = arr[~np.isfinite(arr)].ravel()[0]
-        raise InvalidInputError(f"{name} must be finite, got a {bad} entry")
+        raise InvalidInputError(_not_finite(arr, name, len(core)))
     return arr
+
+
+def _not_finite(arr: np.ndarray, name: str, core: int) -> str:
+    """The message for an array with a NaN or inf entry: the first such entry, and in a batch its row (the index
+    over the leading dimensions), e.g. ``target must be finite: row 3 has inf (target[3, 0])``."""
+    where = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
+    value = arr[where]
+    if arr.ndim <= core:
+        return f"{name} must be finite, got a {value} entry"
+    lead = where[: arr.ndim - core]
+    row = lead[0] if len(lead) == 1 else lead
+    return f"{name} must be finite: row {row} has {value} ({name}[{', '.join(map(str, where))}])"
 
 
 def as_angles(*xs, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:

@@ -35,6 +35,7 @@ install writes every file anew, so users never see a stale kernel).
 
 from __future__ import annotations
 
+import functools
 import inspect
 import os
 import threading
@@ -124,7 +125,7 @@ def _njit(fn: Callable[..., Any], *, cache: bool = True, entry: bool = True, **o
     """``numba.njit(cache=cache, error_model="numpy", **options)(fn)`` on a :class:`KernelDispatcher`
     (``entry=False``: an :class:`InternalKernel`, without the CPython wrapper)."""
     if config.DISABLE_JIT:  # type: ignore[attr-defined]
-        return fn
+        return _uncompiled(fn)
     # no_cfunc_wrapper: the C-callable wrapper serves numba's first-class functions, which legkin does not use
     targetoptions = {"nopython": True, "boundscheck": None, "error_model": "numpy", "no_cfunc_wrapper": True}
     if not entry:
@@ -135,6 +136,17 @@ def _njit(fn: Callable[..., Any], *, cache: bool = True, entry: bool = True, **o
     if cache and not options.get("parallel"):  # a parfor twin compiles only on a large batch: not counted
         _cached_kernels.append(weakref.ref(disp))
     return disp
+
+
+def _uncompiled(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """``fn`` run as Python (``NUMBA_DISABLE_JIT=1``) with numba's ``error_model="numpy"`` semantics: numpy's
+    floating-point warnings off, so that NaN and inf propagate to the kernel's status code and the wrapper raises
+    the same legkin error as the compiled kernel (not a ``RuntimeWarning``, an exception under ``-W error``)."""
+    @functools.wraps(fn)
+    def run(*args: Any, **kws: Any) -> Any:
+        with np.errstate(all="ignore"):
+            return fn(*args, **kws)
+    return run
 
 
 #: The cached kernels created in this process (weak references), for :func:`cache_status`.

@@ -89,7 +89,7 @@ def _options(options: object) -> IKOptions:
 
 
 # ---------------------------------------------------------------- single-target fast paths
-@lru_cache(maxsize=64)
+@lru_cache(maxsize=64, typed=True)  # typed: leg=1 must not admit leg=True or 1.0 (issue 25)
 def _single_ctx(leg, rim, radius, geo: Geometry, method: str):
     """The contact kernels' constants and the method's tables for one keyword set (validated)."""
     kc = _kctx_cached(leg, rim, radius, geo)

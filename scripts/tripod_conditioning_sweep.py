@@ -1,0 +1,74 @@
+"""The tripod's "A_u vs Pinocchio" check rows over many seeds and sample counts (issue 25): the measurement behind
+``legkin.tripod.checks.AMP_CONSTANT`` (too slow for CI: ~0.5 ms a sample, Pinocchio's SVD in Python).
+
+For each seed and sample count it draws the orientations as ``legkin check`` does (``sample_workspace``, and the
+near-flip samples where the workspace reaches the flip), and prints the largest error of the row held to 1e-12
+(amplification <= AMP_WELL, far from the flip) and the largest error / (eps x amplification) of the others, with
+whether both rows pass.
+
+    python scripts/tripod_conditioning_sweep.py --alpha pi/2 --seeds 20 --sizes 1000 10000 100000
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+
+import numpy as np
+
+from legkin import load
+from legkin import tripod as at
+from legkin.tripod import checks
+from legkin.tripod.configuration import sample_workspace
+
+ALPHAS = {"pi/3": math.pi / 3, "pi/4": math.pi / 4, "pi/2": math.pi / 2}
+
+
+def sweep_one(robot, geo: at.Geometry, alpha: float, seed: int, n: int) -> tuple[float, float, float, int]:
+    """(max error of the TOL row, max error / (eps x amplification) overall, of the other row, samples)."""
+    rng = np.random.default_rng(seed)
+    ay, az = sample_workspace(n, rng, geo)
+    fy, fz = checks.sample_near_flip(max(n // 10, 50), rng, alpha)
+    if len(fy):
+        ay, az = np.concatenate([ay, fy]), np.concatenate([az, fz])
+    far = 1 + np.cos(ay) * np.cos(az) > checks.NEAR_FLIP
+    q = at.ik_joints(np.stack([ay, az], axis=-1), geometry=geo)
+    err, amp = checks.actuation_jacobian_errors(robot, geo, q, ay, az)
+    ratio = err / (float(np.finfo(float).eps) * amp)
+    well = (amp <= checks.AMP_WELL) & far
+    top = lambda x: float(x.max()) if x.size else 0.0  # noqa: E731
+    return top(err[well]), top(ratio), top(ratio[~well]), len(q)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Print one line per (seed, sample count) and the overall maxima; exit 1 if a row would fail."""
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--alpha", choices=sorted(ALPHAS), default="pi/2")
+    p.add_argument("--seeds", type=int, default=20)
+    p.add_argument("--sizes", type=int, nargs="+", default=[1000, 10000, 100000])
+    args = p.parse_args(argv)
+    alpha = ALPHAS[args.alpha]
+    geo = at.Geometry(alpha=alpha)
+    robot = load("tripod") if args.alpha == "pi/3" else load("tripod", alpha=alpha)
+    worst_err = worst_ratio = 0.0
+    failed = False
+    print(f"alpha={args.alpha}: TOL={checks.TOL:g} (amplification <= {checks.AMP_WELL:.0f}), "
+          f"AMP_CONSTANT={checks.AMP_CONSTANT:g}")
+    for n in args.sizes:
+        for seed in range(args.seeds):
+            t0 = time.perf_counter()
+            err, ratio, ratio_ill, m = sweep_one(robot, geo, alpha, seed, n)
+            ok = err <= checks.TOL and ratio_ill <= checks.AMP_CONSTANT
+            failed |= not ok
+            worst_err, worst_ratio = max(worst_err, err), max(worst_ratio, ratio)
+            print(f"n={n:>6} seed={seed:>2} samples={m:>6}  max err (TOL row) {err:.3e}  max err/(eps amp) "
+                  f"{ratio:6.3f}  {'pass' if ok else 'FAIL'}  ({time.perf_counter() - t0:.0f} s)", flush=True)
+    print(f"overall: max err of the TOL row {worst_err:.3e} (TOL {checks.TOL:g}), max err/(eps amp) "
+          f"{worst_ratio:.3f} (AMP_CONSTANT {checks.AMP_CONSTANT:g}); {'FAIL' if failed else 'every row passes'}")
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -365,6 +365,20 @@ def _signals_raise() -> Iterator[None]:
             signal.signal(sig, handler)
 
 
+def _stop(argv: list[str] | None, status: int) -> int:
+    """After a signal, the command line (``argv`` None: ``sys.argv``) exits at once with ``status``: the clean-up
+    that matters has run (``legkin check``'s workers killed, ``legkin view``'s server stopped), and the interpreter's
+    teardown took 0.4 s idle, 4 s on a loaded machine. A call of :func:`main` with ``argv`` returns ``status``."""
+    if argv is not None:
+        return status
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(status)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (never raises, except SystemExit from --help)."""
     parser = build_parser()
@@ -373,13 +387,13 @@ def main(argv: list[str] | None = None) -> int:
             args = parser.parse_args(argv)
             return args.func(args)
     except Terminated as exc:
-        return _fail("legkin: terminated", 128 + exc.signum)
+        return _stop(argv, _fail("legkin: terminated", 128 + exc.signum))
     except UsageError as exc:
         return _fail(str(exc), 2)
     except errors.LegkinError as exc:
         return _fail(f"legkin: error: {exc}", 2)
     except KeyboardInterrupt:
-        return _fail("legkin: interrupted", 130)
+        return _stop(argv, _fail("legkin: interrupted", 130))
     except BrokenPipeError:  # e.g. `legkin list | head -1`: stop quietly
         try:
             sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - Python flushes stdout at exit

@@ -145,6 +145,7 @@ class MethodResult:
     iterations_median: float | None = None
     fk_evals_mean: float | None = None
     reached: float | None = None  # percent
+    bytes_per_target: float | None = None  # legkin's batch methods: peak memory a call allocates, per target
     note: str = ""
 
     def as_dict(self) -> dict:
@@ -161,7 +162,7 @@ class MethodResult:
             "repeats": self.repeats,
             "ratio_to_fastest": self.ratio,
         }
-        for key in ("reached", "iterations_median", "fk_evals_mean"):
+        for key in ("reached", "iterations_median", "fk_evals_mean", "bytes_per_target"):
             if getattr(self, key) is not None:
                 d[key] = getattr(self, key)
         if self.median_orientation_error is not None:
@@ -233,6 +234,20 @@ def _time_method(m: Method, inputs, progress: _Progress) -> tuple[float, Any]:
     return float(np.median(times)), out
 
 
+def _peak_bytes(m: Method, inputs) -> float:
+    """The peak memory (bytes) one more run of ``m`` allocates, answer included (``tracemalloc``: numpy's arrays
+    are traced; numba's compiled loops allocate none of their own)."""
+    import tracemalloc
+
+    assert m.run is not None
+    tracemalloc.start()
+    try:
+        m.run(inputs)
+        return float(tracemalloc.get_traced_memory()[1])
+    finally:
+        tracemalloc.stop()
+
+
 def _subset(inputs, k: int | None):
     if k is None:
         return inputs
@@ -292,6 +307,8 @@ def _run_methods(bench: ModelBench, runnable: list[Method], progress: _Progress)
         )
         if s.reached is not None:
             r.reached = 100.0 * float(np.sum(s.reached)) / k
+        if m.name.startswith("legkin") and "batch" in m.name:  # the memory of legkin's batch calls (issue 25)
+            r.bytes_per_target = _peak_bytes(m, inputs) / k
         if s.orientation is not None:
             omed, oworst = _stats(s.orientation)
             if not np.all(np.isfinite(np.asarray(s.orientation, dtype=float))):
@@ -397,6 +414,9 @@ def format_table(name: str, bench: ModelBench, results: list[MethodResult]) -> s
         head += f"  {'iters':>5}"
     if has_fk:
         head += f"  {'FK/solve':>8}"
+    has_mem = any(r.bytes_per_target is not None for r in results)
+    if has_mem:
+        head += f"  {'B/target':>8}"
     head += f"  {'time/target':>11}  {'ratio':>8}"
     groups = list(dict.fromkeys(m.group for m in bench.methods))
     for g in groups:
@@ -415,6 +435,8 @@ def format_table(name: str, bench: ModelBench, results: list[MethodResult]) -> s
                 line += f"  {'-' if r.iterations_median is None else f'{r.iterations_median:g}':>5}"
             if has_fk:
                 line += f"  {'-' if r.fk_evals_mean is None else f'{r.fk_evals_mean:.3g}':>8}"
+            if has_mem:
+                line += f"  {'-' if r.bytes_per_target is None else f'{r.bytes_per_target:.0f}':>8}"
             line += f"  {_fmt_time(r.time_per_target_s):>11}  {r.ratio:>7.1f}x"
             lines.append(line)
         for m in bench.methods:

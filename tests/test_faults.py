@@ -283,9 +283,7 @@ def test_signal_stops_check_and_its_workers(signum, status):
     import signal
     import time
 
-    proc = subprocess.Popen([sys.executable, "-m", "legkin", "check", "tripod", "hybrid_leg", "--jobs", "2",
-                             "--samples", "100000", "--quiet"], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            env={**os.environ, "PYTHONPATH": SRC}, text=True)
+    proc = _legkin("check", "tripod", "hybrid_leg", "--jobs", "2", "--samples", "100000", "--quiet")
     below: list[int] = []
     try:
         deadline = time.monotonic() + 60
@@ -298,46 +296,57 @@ def test_signal_stops_check_and_its_workers(signum, status):
         os.kill(proc.pid, signal.Signals(signum))
         code = proc.wait(timeout=30)
         seconds = time.monotonic() - t0
-        while any(_alive(p) for p in below) and time.monotonic() - t0 < 5:
-            time.sleep(0.05)
-        left = [p for p in below if _alive(p)]
+        left = _left_behind(below, t0 + 5)
     finally:
-        if proc.poll() is None:
-            proc.kill()
-        for p in _descendants(proc.pid) + below:  # workers left behind (the fault) are stopped by the test
-            if _alive(p):
-                os.kill(p, signal.SIGKILL)
+        _reap(proc, below)
     assert code == status, proc.stderr.read()
     assert seconds < 2.0, f"exited {seconds:.1f} s after the signal"
     assert not left, f"processes left behind: {left}"
+
+
+def _legkin(*argv: str) -> subprocess.Popen:
+    """``python -m legkin ARGV`` started (stdout and stderr piped, text)."""
+    return subprocess.Popen([sys.executable, "-m", "legkin", *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, env={**os.environ, "PYTHONPATH": SRC})
+
+
+def _left_behind(pids: list[int], until: float) -> list[int]:
+    """The processes of ``pids`` still running at the monotonic time ``until`` (or as soon as none runs)."""
+    import time
+
+    while any(_alive(p) for p in pids) and time.monotonic() < until:
+        time.sleep(0.05)
+    return [p for p in pids if _alive(p)]
+
+
+def _reap(proc: subprocess.Popen, below: list[int]) -> None:
+    """Kill ``proc`` if it runs, and the processes of ``below`` (those left behind: the faults) that still do."""
+    import signal
+
+    if proc.poll() is None:
+        proc.kill()
+    for p in below:
+        if _alive(p):
+            os.kill(p, signal.SIGKILL)
 
 
 def test_sighup_stops_the_viewer_server():
     """SIGHUP (the terminal closed) to ``legkin view``: its meshcat server stops too (it runs in a session of its
     own, so the terminal's SIGHUP never reaches it; the issue: it kept running)."""
     import signal
+    import time
 
-    proc = subprocess.Popen([sys.executable, "-m", "legkin", "view", "tripod"], stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": SRC})
+    proc = _legkin("view", "tripod")
     below: list[int] = []
     try:
-        assert "meshcat viewer" in proc.stdout.readline()
+        assert proc.stdout is not None and "meshcat viewer" in proc.stdout.readline()
         below = _descendants(proc.pid)
         assert below, "no server process"
         proc.send_signal(signal.SIGHUP)
         proc.wait(timeout=15)
-        import time
-
-        t0 = time.monotonic()
-        while any(_alive(p) for p in below) and time.monotonic() - t0 < 10:
-            time.sleep(0.05)
-        left = [p for p in below if _alive(p)]
+        left = _left_behind(below, time.monotonic() + 10)
     finally:
-        if proc.poll() is None:
-            proc.kill()
-        for p in below:  # a server left behind (the fault) is stopped by the test
-            if _alive(p):
-                os.kill(p, signal.SIGKILL)
+        _reap(proc, below)
     assert not left, "the meshcat server outlived legkin view"
 
 

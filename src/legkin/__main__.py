@@ -11,16 +11,13 @@ worker processes are killed first), and 141 when the reader of its output went a
 from __future__ import annotations
 
 import argparse
-import contextlib
 import math
 import os
-import signal
 import sys
-import threading
 from pathlib import Path
-from typing import Iterator
 
 from . import errors
+from ._signals import signals_raise
 
 #: Unsolved IK targets ``legkin check`` classifies per model unless ``--classify-all``.
 CLASSIFY_DEFAULT = 2000
@@ -347,24 +344,6 @@ class Terminated(BaseException):
         self.signum = signum
 
 
-@contextlib.contextmanager
-def _signals_raise() -> Iterator[None]:
-    """Inside the block, SIGTERM and SIGHUP raise :class:`Terminated` (main thread only; handlers restored)."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def terminated(signum, frame):
-        raise Terminated(signum)
-
-    previous = {sig: signal.signal(sig, terminated) for sig in (signal.SIGTERM, signal.SIGHUP)}
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
-
-
 def _stop(argv: list[str] | None, status: int) -> int:
     """After a signal, the command line (``argv`` None: ``sys.argv``) exits at once with ``status``: the clean-up
     that matters has run (``legkin check``'s workers killed, ``legkin view``'s server stopped), and the interpreter's
@@ -383,7 +362,7 @@ def main(argv: list[str] | None = None) -> int:
     """Run the command line; returns the exit status (never raises, except SystemExit from --help)."""
     parser = build_parser()
     try:
-        with _signals_raise():
+        with signals_raise(Terminated):
             args = parser.parse_args(argv)
             return args.func(args)
     except Terminated as exc:

@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import contextlib
 import io
-import signal
 import subprocess
-import threading
 from pathlib import Path
 from typing import Any, Iterator, Sequence
 
 import numpy as np
 
+from ._signals import signals_raise
 from .robot import Robot
 
 __all__ = ["open_viewer", "show", "write_html", "write_animation_html"]
@@ -20,26 +19,10 @@ __all__ = ["open_viewer", "show", "write_html", "write_animation_html"]
 DEFAULT_CAMERA = (1.2, 0.7, 1.2)
 
 
-@contextlib.contextmanager
-def _sigterm_interrupts() -> Iterator[None]:
+def _sigterm_interrupts() -> contextlib.AbstractContextManager[None]:
     """Inside the block, SIGTERM and SIGHUP (a closed terminal) raise KeyboardInterrupt (as Ctrl-C does), so that
-    ``finally`` clauses run: the meshcat server, in a session of its own, would not get the terminal's SIGHUP.
-
-    Only in the main thread (Python delivers signals there); the previous handler is restored on exit.
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def interrupt(signum, frame):
-        raise KeyboardInterrupt(f"signal {signum}")
-
-    previous = {sig: signal.signal(sig, interrupt) for sig in (signal.SIGTERM, signal.SIGHUP)}
-    try:
-        yield
-    finally:
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+    ``finally`` clauses run: the meshcat server, in a session of its own, would not get the terminal's SIGHUP."""
+    return signals_raise(lambda signum: KeyboardInterrupt(f"signal {signum}"))
 
 
 @contextlib.contextmanager

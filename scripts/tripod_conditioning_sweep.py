@@ -2,9 +2,8 @@
 ``legkin.tripod.checks.AMP_CONSTANT`` (too slow for CI: ~0.5 ms a sample, Pinocchio's SVD in Python).
 
 For each seed and sample count it draws the orientations as ``legkin check`` does (``sample_workspace``, and the
-near-flip samples where the workspace reaches the flip), and prints the largest error of the row held to 1e-12
-(amplification <= AMP_WELL, far from the flip) and the largest error / (eps x amplification) of the others, with
-whether both rows pass.
+near-flip samples where the workspace reaches the flip), and prints the largest error and the largest
+error / (eps x amplification), the row's value, with whether the row passes (<= AMP_CONSTANT).
 
     python scripts/tripod_conditioning_sweep.py --alpha pi/2 --seeds 20 --sizes 1000 10000 100000
 """
@@ -26,20 +25,16 @@ from legkin.tripod.configuration import sample_workspace
 ALPHAS = {"pi/3": math.pi / 3, "pi/4": math.pi / 4, "pi/2": math.pi / 2}
 
 
-def sweep_one(robot, geo: at.Geometry, alpha: float, seed: int, n: int) -> tuple[float, float, float, int]:
-    """(max error of the TOL row, max error / (eps x amplification) overall, of the other row, samples)."""
+def sweep_one(robot, geo: at.Geometry, alpha: float, seed: int, n: int) -> tuple[float, float, int]:
+    """(largest error, largest error / (eps x amplification): the row's value, samples) of one check run's draw."""
     rng = np.random.default_rng(seed)
     ay, az = sample_workspace(n, rng, geo)
     fy, fz = checks.sample_near_flip(max(n // 10, 50), rng, alpha)
     if len(fy):
         ay, az = np.concatenate([ay, fy]), np.concatenate([az, fz])
-    far = 1 + np.cos(ay) * np.cos(az) > checks.NEAR_FLIP
     q = at.ik_joints(np.stack([ay, az], axis=-1), geometry=geo)
     err, amp = checks.actuation_jacobian_errors(robot, geo, q, ay, az)
-    ratio = err / (float(np.finfo(float).eps) * amp)
-    well = (amp <= checks.AMP_WELL) & far
-    top = lambda x: float(x.max()) if x.size else 0.0  # noqa: E731
-    return top(err[well]), top(ratio), top(ratio[~well]), len(q)
+    return float(err.max()), float((err / (float(np.finfo(float).eps) * amp)).max()), len(q)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -53,20 +48,18 @@ def main(argv: list[str] | None = None) -> int:
     geo = at.Geometry(alpha=alpha)
     robot = load("tripod") if args.alpha == "pi/3" else load("tripod", alpha=alpha)
     worst_err = worst_ratio = 0.0
-    failed = False
-    print(f"alpha={args.alpha}: TOL={checks.TOL:g} (amplification <= {checks.AMP_WELL:.0f}), "
-          f"AMP_CONSTANT={checks.AMP_CONSTANT:g}")
+    print(f"alpha={args.alpha}: the row's tolerance AMP_CONSTANT={checks.AMP_CONSTANT:g}")
     for n in args.sizes:
         for seed in range(args.seeds):
             t0 = time.perf_counter()
-            err, ratio, ratio_ill, m = sweep_one(robot, geo, alpha, seed, n)
-            ok = err <= checks.TOL and ratio_ill <= checks.AMP_CONSTANT
-            failed |= not ok
+            err, ratio, m = sweep_one(robot, geo, alpha, seed, n)
             worst_err, worst_ratio = max(worst_err, err), max(worst_ratio, ratio)
-            print(f"n={n:>6} seed={seed:>2} samples={m:>6}  max err (TOL row) {err:.3e}  max err/(eps amp) "
-                  f"{ratio:6.3f}  {'pass' if ok else 'FAIL'}  ({time.perf_counter() - t0:.0f} s)", flush=True)
-    print(f"overall: max err of the TOL row {worst_err:.3e} (TOL {checks.TOL:g}), max err/(eps amp) "
-          f"{worst_ratio:.3f} (AMP_CONSTANT {checks.AMP_CONSTANT:g}); {'FAIL' if failed else 'every row passes'}")
+            print(f"n={n:>6} seed={seed:>2} samples={m:>6}  max error {err:.3e}  max error/(eps amp) {ratio:6.3f}  "
+                  f"{'pass' if ratio <= checks.AMP_CONSTANT else 'FAIL'}  ({time.perf_counter() - t0:.0f} s)",
+                  flush=True)
+    failed = worst_ratio > checks.AMP_CONSTANT
+    print(f"overall: max error {worst_err:.3e}, max error/(eps amp) {worst_ratio:.3f} (AMP_CONSTANT "
+          f"{checks.AMP_CONSTANT:g}); {'FAIL' if failed else 'the row passes at every seed and size'}")
     return 1 if failed else 0
 
 

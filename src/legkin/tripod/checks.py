@@ -25,12 +25,12 @@ ALPHAS = (("pi/3", math.pi / 3), ("pi/4", math.pi / 4), ("pi/2", math.pi / 2))
 #: cond(G) (the inverse's) + 1 / cos^2 alpha_y (G's rows divide by cos alpha_y and cos^2 alpha_y: the
 #: parametrization's singularity at alpha_y = +-pi/2) + 1 / (1 + c_y c_z) (the flip, where |A_u| grows like it),
 #: times a constant of the floating-point operations: the row reports error / (eps x amplification) against
-#: AMP_CONSTANT. scripts/tripod_conditioning_sweep.py measured it over 20 seeds x 10^3, 10^4, 10^5 samples: median
-#: ~0.15, largest 24.8 at alpha = pi/2 and 37.8 at alpha = pi/4 (near the flip, seed 7 of 10^5; see the script's
-#: output for the last figures). AMP_CONSTANT keeps a margin of ~2.6. Every sample's amplification exceeds ~86
-#: (the SVD's gap), so no sample has a bound below 1e-12: a fixed tolerance of 1e-12 on any subset fails by
-#: chance (it did: 3.3e-12 at 20,000 samples, alpha = pi/2, |A_u| = 1563; 1.6e-12 at alpha = pi/4 where the
-#: amplification is below 225).
+#: AMP_CONSTANT. scripts/tripod_conditioning_sweep.py measured it over 20 seeds x 10^3, 10^4, 10^5 samples at each
+#: alpha: median ~0.15, largest 24.8 at alpha = pi/2, 37.8 at pi/4 and 41.7 at pi/3 (near the flip, where the
+#: errors reach 2.4e-9 with |A_u| ~ 1 / (1 + c_y c_z)). AMP_CONSTANT keeps a margin of 2.4. Every sample's
+#: amplification exceeds ~86 (the SVD's gap), so no sample has a bound below 1e-12: a fixed tolerance of 1e-12
+#: on any subset fails by chance (it did: 3.3e-12 at 20,000 samples, alpha = pi/2, |A_u| = 1563; 1.6e-12 at
+#: alpha = pi/4 where the amplification is below 225).
 AMP_CONSTANT = 100.0
 #: Central differences of ik (4th order at H and H/2, Richardson-combined to 6th order): truncation
 #: ~ H^6 |q^(7)|, roundoff ~ 1e-16 / H;

@@ -46,7 +46,7 @@ traceback.
   contents: a damaged file (truncated, garbage, altered, another kernel's) is discarded with a
   `legkin.errors.CacheWarning` naming it and the kernel compiled again. With no writable location, kernels load
   from a readable cache or compile in memory in each process, with one `CacheWarning`.
-* **Signals.** Ctrl-C or SIGTERM stops `legkin check` and its worker processes at once (measured 0.1-0.3 s;
+* **Signals.** Ctrl-C or SIGTERM stops `legkin check` and its worker processes at once (measured 0.03-0.1 s idle;
   the workers also die with their parent if it is killed). SIGHUP or SIGTERM to `legkin view` stops its meshcat
   server.
 * **The viewer's address.** `legkin view` serves the scene on 127.0.0.1 (this machine only); `--host 0.0.0.0`

@@ -21,8 +21,38 @@ Every legkin function checks what comes in. NaN/inf, complex input and wrong sha
 (both are `ValueError` subclasses of `LegkinError`); a target that cannot be solved raises
 `UnreachableError`, `JointLimitError` (reachable only outside the URDF limits) or `AssemblyModeError`
 (reachable only in another assembly mode) from a single call, and is NaN with mask False in a batch. No
-numpy, scipy or Pinocchio exception escapes. The CLI prints one line on stderr and exits non-zero
-(usage 2, legkin and OS errors 2, internal 3, interrupt 130), never a traceback.
+numpy, scipy or Pinocchio exception escapes (an integer beyond the largest float, 1.8e308, is an
+`InvalidInputError` too; a batch's error names its first bad row: `target must be finite: row 3 has inf
+(target[3, 1])`). The uncompiled path (`NUMBA_DISABLE_JIT=1`) raises the same errors. The CLI prints one line on
+stderr and exits non-zero (checks failed 1, usage 2, legkin and OS errors 2, internal 3, Ctrl-C 130, SIGHUP 129,
+SIGTERM 143, and 141 quietly when the reader of its output went away, as in `legkin check | head -1`), never a
+traceback.
+
+## Faults a program meets (issue 25; `tests/test_faults.py` reproduces each in a fresh process)
+
+* **Threads.** Every function may be called from several Python threads at once. Large batches of the
+  quadruped and the legs of `legkin.legs` run on numba's threading layer, chosen by numba on the first parallel
+  batch: TBB if installed (`pip install tbb`), else OpenMP, else `workqueue`; `NUMBA_THREADING_LAYER=omp|tbb|
+  workqueue` (before the first batch) chooses it, `legkin._kernels.threading_layer()` says which one runs.
+  `workqueue` is not thread-safe (two threads in it abort the process): under it legkin runs one such batch at a
+  time. The other mechanisms split large batches among a thread pool of their own. `numba.set_num_threads(k)` or
+  `NUMBA_NUM_THREADS` sets the thread count.
+* **fork.** A process forked after a large batch (`multiprocessing`'s default start method on Linux before
+  Python 3.14) runs its batches too: legkin's pool starts afresh in the child (`os.register_at_fork`), and where
+  the parent's threading layer does not survive a fork (GNU OpenMP, `workqueue`) the child's batches run serially.
+  TBB, or the `spawn` / `forkserver` start methods, keep them parallel.
+* **The kernel cache.** numba caches the compiled kernels on disk (the package's `__pycache__`, else the user
+  cache directory; `NUMBA_CACHE_DIR` overrides both). Each file legkin writes carries a SHA-256 of its name and
+  contents: a damaged file (truncated, garbage, altered, another kernel's) is discarded with a
+  `legkin.errors.CacheWarning` naming it and the kernel compiled again. With no writable location, kernels load
+  from a readable cache or compile in memory in each process, with one `CacheWarning`.
+* **Signals.** Ctrl-C or SIGTERM stops `legkin check` and its worker processes at once (measured 0.03-0.1 s idle;
+  the workers also die with their parent if it is killed). SIGHUP or SIGTERM to `legkin view` stops its meshcat
+  server.
+* **The viewer's address.** `legkin view` serves the scene on 127.0.0.1 (this machine only); `--host 0.0.0.0`
+  opens it to the network on purpose (anyone who reaches the machine's port 7000 then sees it).
+* **Memory.** `wheel_leg.ik` solves a batch of more than 65,536 targets by chunks: its memory beyond the answer
+  stays ~20 MB (it was ~310 bytes a target, 13x the answer).
 
 ## The IK contract
 

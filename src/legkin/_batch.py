@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import math
 import numbers
-from typing import Any, Callable, Iterable
+from typing import Any, Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -53,6 +53,12 @@ def as_input(x: object, name: str, core: tuple[int, ...] = (), *, allow_nan: boo
         raise InvalidInputError(f"{name} must be a numeric array, got {x!r}") from exc
     if raw.dtype.kind == "c":
         raise InvalidInputError(f"{name} must be real, got a complex array ({raw.dtype})")
+    if raw.dtype.kind == "O" and raw.size and all(type(v) is int for v in raw.ravel()):  # ints beyond int64
+        big = [v for v in raw.ravel() if abs(v) > int(np.finfo(float).max)]
+        if big:
+            raise InvalidInputError(f"{name} must be finite, got an integer of {len(str(abs(big[0])))} digits, "
+                                    "beyond the largest float (1.8e308)")
+        raw = raw.astype(float)
     if raw.dtype.kind not in "biuf":
         raise InvalidInputError(f"{name} must be numeric, got {x!r}")
     arr = raw if raw.dtype == np.float64 else raw.astype(float)
@@ -61,9 +67,48 @@ def as_input(x: object, name: str, core: tuple[int, ...] = (), *, allow_nan: boo
             f"{name} must have shape (..., {', '.join(map(str, core))}), got shape {arr.shape}"
         )
     if not allow_nan and not np.isfinite(arr).all():
-        bad = arr[~np.isfinite(arr)].ravel()[0]
-        raise InvalidInputError(f"{name} must be finite, got a {bad} entry")
+        raise InvalidInputError(_not_finite(arr, name, len(core)))
     return arr
+
+
+def _not_finite(arr: np.ndarray, name: str, core: int) -> str:
+    """The message for an array with a NaN or inf entry: the first such entry, and in a batch its row (the index
+    over the leading dimensions), e.g. ``target must be finite: row 3 has inf (target[3, 0])``."""
+    where = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
+    value = arr[where]
+    if arr.ndim <= core:
+        return f"{name} must be finite, got a {value} entry"
+    lead = where[: arr.ndim - core]
+    row = lead[0] if len(lead) == 1 else lead
+    return f"{name} must be finite: row {row} has {value} ({name}[{', '.join(map(str, where))}])"
+
+
+#: Items per chunk of a batch that a function splits to bound its working memory (:func:`in_chunks`): 65,536 items
+#: keep a wheel_leg.ik chunk's temporaries (~310 B an item) near 20 MB.
+CHUNK = 1 << 16
+
+
+def in_chunks(solve: Callable[..., tuple[np.ndarray, np.ndarray]], rows: Sequence[np.ndarray | None],
+              out_core: int, chunk: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Run a batch ``chunk`` items at a time, so that its temporaries take ``chunk`` items' worth of memory, not n's.
+
+    Args:
+        solve: ``solve(*rows_slice) -> (values (m, out_core), mask (m,))`` on consecutive slices of the rows.
+        rows: the per-item inputs, each (n, ...) (sliced) or None (passed as None); the first is not None.
+        out_core: the width of one item's values.
+        chunk: items per call (default :data:`CHUNK`).
+
+    Returns:
+        ``(values (n, out_core), mask (n,))``, filled chunk by chunk (the only arrays of n items allocated here).
+    """
+    n = next(x for x in rows if x is not None).shape[0]
+    chunk = CHUNK if chunk is None else chunk
+    values, mask = np.empty((n, out_core)), np.empty(n, dtype=bool)
+    for lo in range(0, n, chunk):
+        hi = min(n, lo + chunk)
+        v, m = solve(*(None if x is None else x[lo:hi] for x in rows))
+        values[lo:hi], mask[lo:hi] = v, m
+    return values, mask
 
 
 def as_angles(*xs: object, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:

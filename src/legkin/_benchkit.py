@@ -188,6 +188,7 @@ class MethodResult:
     iterations_median: float | None = None
     fk_evals_mean: float | None = None
     reached: float | None = None  # percent
+    bytes_per_target: float | None = None  # legkin's batch methods: peak memory a call allocates, per target
     note: str = ""
 
     def as_dict(self) -> dict:
@@ -204,7 +205,7 @@ class MethodResult:
             "repeats": self.repeats,
             "ratio_to_fastest": self.ratio,
         }
-        for key in ("reached", "iterations_median", "fk_evals_mean"):
+        for key in ("reached", "iterations_median", "fk_evals_mean", "bytes_per_target"):
             if getattr(self, key) is not None:
                 d[key] = getattr(self, key)
         if self.median_orientation_error is not None:

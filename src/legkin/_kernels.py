@@ -35,6 +35,7 @@ install writes every file anew, so users never see a stale kernel).
 
 from __future__ import annotations
 
+import functools
 import inspect
 import os
 import threading
@@ -48,6 +49,8 @@ import numpy as np
 from numba.core import config, types
 from numba.core.compiler_lock import global_compiler_lock
 from numba.core.registry import CPUDispatcher
+
+from . import _cache
 
 __all__ = ["kernel", "batch_kernel", "BatchLoop", "OK", "as_items", "as_rows", "prange", "threads"]
 
@@ -87,6 +90,11 @@ class KernelDispatcher(CPUDispatcher):
             self._cache_ready = True
             self.enable_caching()
 
+    def enable_caching(self) -> None:
+        """numba's on-disk cache, checked and degrading (:mod:`legkin._cache`): a damaged file is discarded and
+        rebuilt, and with no writable directory the kernel loads from a readable cache or compiles in memory."""
+        self._cache = _cache.function_cache(self.py_func)
+
 
 class InternalKernel(KernelDispatcher):
     """A kernel that only other kernels call (:func:`kernel`'s default): compiled without numba's CPython wrapper.
@@ -117,7 +125,7 @@ def _njit(fn: Callable[..., Any], *, cache: bool = True, entry: bool = True, **o
     """``numba.njit(cache=cache, error_model="numpy", **options)(fn)`` on a :class:`KernelDispatcher`
     (``entry=False``: an :class:`InternalKernel`, without the CPython wrapper)."""
     if config.DISABLE_JIT:  # type: ignore[attr-defined]
-        return fn
+        return _uncompiled(fn)
     # no_cfunc_wrapper: the C-callable wrapper serves numba's first-class functions, which legkin does not use
     targetoptions = {"nopython": True, "boundscheck": None, "error_model": "numpy", "no_cfunc_wrapper": True}
     if not entry:
@@ -128,6 +136,17 @@ def _njit(fn: Callable[..., Any], *, cache: bool = True, entry: bool = True, **o
     if cache and not options.get("parallel"):  # a parfor twin compiles only on a large batch: not counted
         _cached_kernels.append(weakref.ref(disp))
     return disp
+
+
+def _uncompiled(fn: Callable[..., Any]) -> Callable[..., Any]:
+    """``fn`` run as Python (``NUMBA_DISABLE_JIT=1``) with numba's ``error_model="numpy"`` semantics: numpy's
+    floating-point warnings off, so that NaN and inf propagate to the kernel's status code and the wrapper raises
+    the same legkin error as the compiled kernel (not a ``RuntimeWarning``, an exception under ``-W error``)."""
+    @functools.wraps(fn)
+    def run(*args: Any, **kws: Any) -> Any:
+        with np.errstate(all="ignore"):
+            return fn(*args, **kws)
+    return run
 
 
 #: The cached kernels created in this process (weak references), for :func:`cache_status`.
@@ -194,6 +213,44 @@ def _executor(workers: int) -> ThreadPoolExecutor:
         return _pool
 
 
+#: numba's threading layers that run ``parfor`` loops from several Python threads at once (numba's documentation,
+#: "Selecting a threading layer"): ``workqueue`` aborts the process ("Concurrent access has been detected").
+_THREADSAFE_LAYERS = ("tbb", "omp")
+#: The layers that survive a fork: GNU OpenMP kills a forked child at its first parallel region ("fork() called
+#: from a process already using GNU OpenMP"); numba's ``workqueue`` threads do not exist in the child.
+_FORKSAFE_LAYERS = ("tbb",)
+#: Serializes the ``parfor`` batches of a threading layer that is not thread-safe (:data:`_THREADSAFE_LAYERS`).
+_parfor_lock = threading.Lock()
+#: True in a process forked after numba's threads were started on a layer that does not survive a fork
+#: (:data:`_FORKSAFE_LAYERS`): its ``parfor`` batches run their serial compilation.
+_forked_serial = False
+
+
+def threading_layer() -> str | None:
+    """numba's threading layer of this process (``"tbb"``, ``"omp"``, ``"workqueue"``), or None before the first
+    ``parfor`` batch starts it. numba picks the first available of TBB, OpenMP, workqueue, unless
+    ``NUMBA_THREADING_LAYER`` (or ``numba.config.THREADING_LAYER``, set before the first parallel batch) names
+    one; see docs/robustness.md, "Threads, processes and fork"."""
+    try:
+        return str(numba.threading_layer())
+    except ValueError:  # numba: "Threading layer is not initialized."
+        return None
+
+
+def _after_fork_in_child() -> None:
+    """``os.register_at_fork`` hook: the child of a fork has none of the parent's threads. Its chunk pool starts
+    afresh (the parent's pool threads, and any lock they held, do not exist), and its ``parfor`` batches run
+    serially when the parent's numba threading layer does not survive a fork."""
+    global _pool, _pool_size, _pool_lock, _parfor_lock, _forked_serial
+    _pool, _pool_size = None, 0
+    _pool_lock, _parfor_lock = threading.Lock(), threading.Lock()
+    layer = threading_layer()
+    _forked_serial = _forked_serial or (layer is not None and layer not in _FORKSAFE_LAYERS)
+
+
+os.register_at_fork(after_in_child=_after_fork_in_child)
+
+
 #: True: a ``parfor`` batch loop runs its serial compilation and never compiles its parallel twin (numba's parallel
 #: compiler, 0.4-0.9 s a loop on the first run). Set in ``legkin check``'s worker processes, which run on one
 #: thread and need the rows, not the speed (the rows are the same bit for bit).
@@ -230,8 +287,8 @@ class BatchLoop:
         n = args[self.rows[0]].shape[0]
         if n < self.min_parallel:
             return self.kernel(*args)
-        if self.parfor is not None and not serial_parfor_loops:
-            return self.parfor(*args)
+        if self.parfor is not None and not (serial_parfor_loops or _forked_serial):
+            return self._run_parfor(args)
         k = min(threads(), n)
         if k <= 1:
             return self.kernel(*args)
@@ -248,6 +305,15 @@ class BatchLoop:
         first = self.kernel(*chunks[0])
         rest = [f.result() for f in futures]
         return first if first is None else first + sum(rest)
+
+    def _run_parfor(self, args: tuple[Any, ...]) -> Any:
+        """The ``parfor`` twin on numba's threading layer, one batch at a time where the layer is not thread-safe
+        (or not yet started: numba picks it on the first parallel batch)."""
+        parfor: Callable[..., Any] = self.parfor  # type: ignore[assignment] # set: BatchLoop.__call__ checked it
+        if threading_layer() in _THREADSAFE_LAYERS:
+            return parfor(*args)
+        with _parfor_lock:
+            return parfor(*args)
 
 
 def _renamed(fn: Callable[..., Any], suffix: str) -> Callable[..., Any]:

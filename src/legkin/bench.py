@@ -113,6 +113,20 @@ def _time_method(m: Method, inputs, progress: _Progress) -> tuple[float, Any]:
     return float(np.median(times)), out
 
 
+def _peak_bytes(m: Method, inputs) -> float:
+    """The peak memory (bytes) one more run of ``m`` allocates, answer included (``tracemalloc``: numpy's arrays
+    are traced; numba's compiled loops allocate none of their own)."""
+    import tracemalloc
+
+    assert m.run is not None
+    tracemalloc.start()
+    try:
+        m.run(inputs)
+        return float(tracemalloc.get_traced_memory()[1])
+    finally:
+        tracemalloc.stop()
+
+
 def _subset(inputs, k: int | None):
     if k is None:
         return inputs
@@ -172,6 +186,8 @@ def _run_methods(bench: ModelBench, runnable: list[Method], progress: _Progress)
         )
         if s.reached is not None:
             r.reached = 100.0 * float(np.sum(s.reached)) / k
+        if m.name.startswith("legkin") and "batch" in m.name:  # the memory of legkin's batch calls (issue 25)
+            r.bytes_per_target = _peak_bytes(m, inputs) / k
         if s.orientation is not None:
             omed, oworst = _stats(s.orientation)
             if not np.all(np.isfinite(np.asarray(s.orientation, dtype=float))):
@@ -277,6 +293,8 @@ def _columns(bench: ModelBench, results: list[MethodResult]) -> list[tuple[str, 
             ("iters", 5, lambda r: _optional(r.iterations_median, "g"))]),
         (any(r.fk_evals_mean is not None for r in results), [
             ("FK/solve", 8, lambda r: _optional(r.fk_evals_mean, ".3g"))]),
+        (any(r.bytes_per_target is not None for r in results), [
+            ("B/target", 8, lambda r: _optional(r.bytes_per_target, ".0f"))]),
         (True, [("time/target", 11, lambda r: _fmt_time(r.time_per_target_s))]),
     ]
     return [col for present, cols in candidates if present for col in cols]

@@ -17,6 +17,7 @@ __all__ = [
     "SingularityError",
     "LoopClosureError",
     "ConvergenceError",
+    "CacheWarning",
 ]
 
 
@@ -163,3 +164,9 @@ class LoopClosureError(LegkinError):
 
 class ConvergenceError(LegkinError):
     """An iterative analytic solver (forward kinematics of a parallel mechanism) did not converge."""
+
+
+class CacheWarning(UserWarning):
+    """numba's on-disk cache of legkin's kernels could not be used as is: a damaged cache file (discarded; the
+    kernel is compiled again), or no writable cache directory (kernels load from a readable cache or compile in
+    memory). Results are unaffected; only the first-call time is. See docs/robustness.md, "The kernel cache"."""

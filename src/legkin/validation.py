@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 import importlib
 import json
+import sys
 import time
 import types
 from pathlib import Path
@@ -74,25 +75,62 @@ def run_checks(
 
             bar.set_postfix_str(f"{len(names)} models in {min(jobs, len(groups))} processes")
             context = multiprocessing.get_context("spawn")  # no fork of a process with threads (numba, tqdm)
-            with ProcessPoolExecutor(max_workers=min(jobs, len(groups)), mp_context=context,
-                                     initializer=_one_thread) as pool:
+            pool = ProcessPoolExecutor(max_workers=min(jobs, len(groups)), mp_context=context,
+                                       initializer=_one_thread)
+            try:
                 futures = {pool.submit(_run_models, group, **options): group for group in groups}
                 for future in as_completed(futures):
                     out.update(future.result())
                     bar.update(sum(steps[name] for name in futures[future]))
+            except BaseException:  # Ctrl-C, SIGTERM (legkin.__main__), a failed worker: stop the others now
+                _kill_workers(pool)
+                raise
+            finally:
+                pool.shutdown(wait=True, cancel_futures=True)
     return {name: out[name] for name in names}
+
+
+def _kill_workers(pool: Any) -> None:
+    """Kill the worker processes of ``pool`` (a ``ProcessPoolExecutor``) and reap them: ``shutdown`` alone waits
+    for the running checks (minutes)."""
+    workers = list((getattr(pool, "_processes", None) or {}).values())
+    for proc in workers:
+        proc.kill()
+    for proc in workers:
+        proc.join(timeout=5)
 
 
 def _one_thread() -> None:
     """A worker process runs its batches on one thread: the worker processes are the parallelism (numba's threads
     in each would oversubscribe the CPUs; the rows do not depend on the thread count), and its ``parfor`` loops on
-    their serial compilation (no parallel twin to compile: ~4 s of CPU on a first run)."""
+    their serial compilation (no parallel twin to compile: ~4 s of CPU on a first run). It leaves Ctrl-C to the
+    parent (which kills the workers at once) and dies with the parent (Linux's parent-death signal), so that no
+    worker outlives a killed ``legkin check``."""
+    import signal
+
     import numba
 
     from . import _kernels
 
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    _die_with_parent()
     numba.set_num_threads(1)
     _kernels.serial_parfor_loops = True
+
+
+def _die_with_parent() -> None:
+    """Linux: this process gets SIGKILL when its parent dies (``prctl(PR_SET_PDEATHSIG)``); elsewhere nothing."""
+    import ctypes
+    import ctypes.util
+    import signal
+
+    if not sys.platform.startswith("linux"):
+        return
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6", use_errno=True)
+        libc.prctl(1, int(signal.SIGKILL), 0, 0, 0)  # 1 = PR_SET_PDEATHSIG
+    except (OSError, AttributeError):
+        pass
 
 
 #: The order in which the worker processes take the groups: dearest first by the first-run time of their checks

@@ -4,14 +4,13 @@ from __future__ import annotations
 
 import contextlib
 import io
-import signal
 import subprocess
-import threading
 from pathlib import Path
 from typing import Any, Iterator, Sequence
 
 import numpy as np
 
+from ._signals import signals_raise
 from .robot import Robot
 
 __all__ = ["open_viewer", "show", "write_html", "write_animation_html"]
@@ -20,40 +19,43 @@ __all__ = ["open_viewer", "show", "write_html", "write_animation_html"]
 DEFAULT_CAMERA = (1.2, 0.7, 1.2)
 
 
-@contextlib.contextmanager
-def _sigterm_interrupts() -> Iterator[None]:
-    """Inside the block, SIGTERM raises KeyboardInterrupt (as Ctrl-C does), so that ``finally`` clauses run.
-
-    Only in the main thread (Python delivers signals there); the previous handler is restored on exit.
-    """
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def interrupt(signum, frame):
-        raise KeyboardInterrupt(f"signal {signum}")
-
-    previous = signal.signal(signal.SIGTERM, interrupt)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+def _sigterm_interrupts() -> contextlib.AbstractContextManager[None]:
+    """Inside the block, SIGTERM and SIGHUP (a closed terminal) raise KeyboardInterrupt (as Ctrl-C does), so that
+    ``finally`` clauses run: the meshcat server, in a session of its own, would not get the terminal's SIGHUP."""
+    return signals_raise(lambda signum: KeyboardInterrupt(f"signal {signum}"))
 
 
 @contextlib.contextmanager
-def open_viewer(robot: Robot, camera: Sequence[float] | None = None, ground: bool = True) -> Iterator[Any]:
-    """A ``pinocchio.visualize.MeshcatVisualizer`` with ``robot`` loaded; its zmq server is always stopped.
+def open_viewer(robot: Robot, camera: Sequence[float] | None = None, ground: bool = True,
+                host: str = "127.0.0.1") -> Iterator[Any]:
+    """A ``pinocchio.visualize.MeshcatVisualizer`` with ``robot`` loaded; its server is always stopped.
 
-    meshcat 0.3.2 starts the server as a child process and has no working ``close``: the context
-    manager terminates it on exit, whatever happens inside, SIGTERM included (it raises KeyboardInterrupt
-    inside the block, as Ctrl-C does).
+    Args:
+        robot: the model to show.
+        camera: the camera position (m), looking at the origin; None fits it to the model.
+        ground: a ground plane under a walking robot.
+        host: the address the web page is served on: 127.0.0.1 (this machine only) unless given; ``"0.0.0.0"``
+            opens it to every network interface (anyone who can reach the machine sees the scene).
+
+    Returns:
+        The visualizer, inside the ``with`` block.
+
+    The server (meshcat's, bound to ``host``: :mod:`legkin._meshcat_server`) is a child process, and meshcat 0.3
+    has no working ``close``: the context manager terminates it on exit, whatever happens inside, SIGTERM and
+    SIGHUP included (they raise KeyboardInterrupt inside the block, as Ctrl-C does).
     """
     import meshcat
     from pinocchio.visualize import MeshcatVisualizer
 
     with _sigterm_interrupts():
-        with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; callers decide what to show
-            viewer = meshcat.Visualizer()
+        proc, zmq_url = _start_server(host)
+        try:
+            with contextlib.redirect_stdout(io.StringIO()):  # meshcat prints its URL; callers decide what to show
+                viewer = meshcat.Visualizer(zmq_url=zmq_url)
+        except BaseException:
+            _stop_process(proc)
+            raise
+        viewer.window.server_proc = proc
         try:
             viz = MeshcatVisualizer(robot.model, robot.collision_model, robot.visual_model)
             viz.initViewer(viewer=viewer, open=False)
@@ -67,9 +69,28 @@ def open_viewer(robot: Robot, camera: Sequence[float] | None = None, ground: boo
             _stop_server(viewer)
 
 
+def _start_server(host: str) -> tuple[subprocess.Popen, str]:
+    """Start meshcat's server with its web page on ``host`` (:mod:`legkin._meshcat_server`); ``(process, zmq_url)``.
+    """
+    import sys
+
+    cmd = [sys.executable, "-u", "-m", "legkin._meshcat_server", "--host", host]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+    line = proc.stdout.readline().decode() if proc.stdout else ""
+    if not line.startswith("zmq_url="):
+        err = proc.communicate(timeout=10)[1].decode().strip().splitlines()
+        raise OSError(f"meshcat's server did not start on {host!r}: {err[-1] if err else 'no output'}")
+    proc.stdout.readline()  # type: ignore[union-attr] # web_url=...: the viewer asks the server for it
+    return proc, line.strip().split("=", 1)[1]
+
+
 def _stop_server(viewer) -> None:
     """Terminate meshcat's server process (kill it if it does not stop within 10 s)."""
-    proc = getattr(viewer.window, "server_proc", None)
+    _stop_process(getattr(viewer.window, "server_proc", None))
+
+
+def _stop_process(proc: subprocess.Popen | None) -> None:
+    """Terminate ``proc`` (kill it if it does not stop within 10 s); None: nothing."""
     if proc is None:
         return
     proc.terminate()
@@ -179,12 +200,15 @@ def write_animation_html(
     return path
 
 
-def show(robot: Robot, q: np.ndarray, animation: Sequence[np.ndarray] | None = None, ground: bool = True) -> None:
-    """Serve a live meshcat view of ``robot`` at ``q`` (playing ``animation`` if given) until Ctrl-C."""
+def show(robot: Robot, q: np.ndarray, animation: Sequence[np.ndarray] | None = None, ground: bool = True,
+         host: str = "127.0.0.1") -> None:
+    """Serve a live meshcat view of ``robot`` at ``q`` (playing ``animation`` if given) until Ctrl-C, SIGTERM or
+    SIGHUP; on ``host`` (127.0.0.1: this machine only; ``"0.0.0.0"``: every network interface, see
+    :func:`open_viewer`)."""
     import time
 
     q = robot.check_q(q)
-    with open_viewer(robot, ground=ground) as viz:
+    with open_viewer(robot, ground=ground, host=host) as viz:
         viz.display(q)
         if animation is not None:
             viz.viewer.set_animation(_animation(robot, viz, animation, 30), play=True, repetitions=float("inf"))

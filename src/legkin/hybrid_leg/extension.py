@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Callable
 
 import numpy as np
@@ -9,6 +10,7 @@ from numpy.typing import ArrayLike
 
 from .._batch import as_input
 from .._kernels import batch_kernel, kernel
+from ..errors import InvalidInputError
 from ._options import SCALARS, fast_geometry, flat, resolve
 from .geometry import RATIO, Geometry
 
@@ -82,6 +84,13 @@ def extension_motor_angle(theta_ll: ArrayLike, *, geometry: Geometry | None = No
     """
     g = fast_geometry(geometry)
     if type(theta_ll) in SCALARS and g is not None:
-        return np.float64(theta0_k(theta_ll, g.starting_value))
+        theta0 = theta0_k(theta_ll, g.starting_value)
+        if math.isfinite(theta0):
+            return np.float64(theta0)
     g = resolve(geometry)
-    return _apply(theta_ll, "theta_ll", g.starting_value, _theta0_b)
+    out = _apply(theta_ll, "theta_ll", g.starting_value, _theta0_b)
+    if not np.isfinite(out).all():  # finite inputs (as_input): theta0 overflowed
+        bad = float(np.asarray(theta_ll, dtype=float).ravel()[np.argmax(~np.isfinite(np.ravel(out)))])
+        raise InvalidInputError(f"theta_ll={bad!r} rad is out of range: theta0 = (starting_value - theta_ll) / "
+                                f"{RATIO:.6g} overflows beyond |theta_ll| ~ {RATIO * np.finfo(float).max:.3g} rad")
+    return out

@@ -158,6 +158,24 @@ class _Setup:
 
         return run, score
 
+    def answer_only(self):
+        """(run, score) of a batch ``wl.ik`` (radial) without ``return_info``: the answer alone, which a batch of
+        more than ``legkin._batch.CHUNK`` targets computes by chunks (its bytes per target: issue 25)."""
+        geo = self.geo
+
+        def run(inp):
+            t, a, ww = inp
+            return wl.ik(t, LEG, alpha=a, w=ww, options=OPTIONS, geometry=geo)
+
+        def score(inp, q) -> Score:
+            finite = np.all(np.isfinite(q), axis=-1)
+            qs = np.full((len(q), self.model.nq), np.nan)
+            if finite.any():
+                qs[finite] = self.full_config(q[finite])
+            return self.score_configs(inp, qs, q[:, 0], None, None)
+
+        return run, score
+
     # ---------------------------------------------------------------- Pinocchio closed-loop IK
     def pin_ik(self, inp):
         """The Levenberg-Marquardt of Robot.solve_loops on [16 loop residuals; contact point - target], the 11
@@ -258,6 +276,7 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
     run_d, score_d = setup.analytic("damped")
     run_s, score_s = setup.analytic("gauss_newton_fd")
     run_r, score_r = setup.analytic("radial")
+    run_a, score_a = setup.answer_only()
     run_d1, score_d1 = setup.analytic("damped", scalar=True)
     run_s1, score_s1 = setup.analytic("gauss_newton_fd", scalar=True)
     run_r1, score_r1 = setup.analytic("radial", scalar=True)
@@ -265,6 +284,8 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         Method(f"legkin batch ik, analytic Jacobian (method='damped'; {n_batch} at once)", inputs, run_d, score_d,
                repeats=5),
         Method(f"legkin batch ik, radial (method='radial'; {n_batch} at once)", inputs, run_r, score_r, repeats=5),
+        Method(f"legkin batch ik, radial, answer only (no return_info; {n_batch} at once)", inputs, run_a, score_a,
+               repeats=5),
         Method("seed Gauss-Newton, forward differences (method='gauss_newton_fd'; batch)", inputs, run_s, score_s,
                repeats=5),
         Method("legkin scalar ik (damped), Python loop", inputs, run_d1, score_d1, max_targets=n_scalar, repeats=3),

@@ -46,7 +46,7 @@ def module_origin(leg: Leg, *, geometry: Geometry | None = None) -> np.ndarray:
         raise
 
 
-@lru_cache(maxsize=64)
+@lru_cache(maxsize=64, typed=True)  # typed: leg=1 must not admit leg=True or 1.0 (issue 25)
 def _origin(leg, geo: Geometry) -> np.ndarray:
     _, side, sx = _leg(leg)
     sy = 1.0 if side == "L" else -1.0
@@ -199,7 +199,7 @@ def _q_inputs(q, alpha, w, geo):
     return q, alpha, w
 
 
-@lru_cache(maxsize=64)
+@lru_cache(maxsize=64, typed=True)  # typed: leg=1 must not admit leg=True or 1.0 (issue 25)
 def _kctx_cached(leg, rim, radius, geo: Geometry):
     ctx = _context(np.zeros(()), 0.0, leg, rim, geo, radius)
     if radius is None:

@@ -180,7 +180,7 @@ def _leg_consts(leg, geo: Geometry):
     return (1.0 if side == "L" else -1.0), o, _R_LM[side], _R_0[side]
 
 
-@lru_cache(maxsize=64)
+@lru_cache(maxsize=64, typed=True)  # typed: leg=1 must not admit leg=True or 1.0 (issue 25)
 def _kernel_args(leg, r, geometry) -> tuple[Any, ...]:
     """The ground kernel's per-call constants for (leg, r, geometry), validated (the single-call fast path)."""
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)

@@ -19,7 +19,8 @@ from typing import Any, Literal, NamedTuple, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input, check_choice, check_flag, check_integer, check_number, finish
+from .. import _batch
+from .._batch import as_input, check_choice, check_flag, check_integer, check_number, finish, in_chunks
 from ..errors import InvalidInputError, InvalidParameterError, UnreachableError
 from . import ik_iterative
 from ._common import _LIMITS, _SCALARS, _SOLVED, Leg, Rim, _check_alpha, _check_theta, _check_w, rim_name
@@ -97,7 +98,7 @@ def _options(options: object) -> IKOptions:
 
 
 # ---------------------------------------------------------------- single-target fast paths
-@lru_cache(maxsize=64)
+@lru_cache(maxsize=64, typed=True)  # typed: leg=1 must not admit leg=True or 1.0 (issue 25)
 def _single_ctx(leg, rim, radius, geo: Geometry, method: str):
     """The contact kernels' constants and the method's tables for one keyword set (validated)."""
     kc = _kctx_cached(leg, rim, radius, geo)
@@ -325,12 +326,47 @@ def ik(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.
                 return out
     return_mask = check_flag(return_mask, "return_mask")
     return_info = check_flag(return_info, "return_info")
+    if not return_info and _large_batch(target, alpha, w, q_near, q_start):
+        return _ik_in_chunks(np.asarray(target), leg, alpha, w, q_near, q_start, return_mask, method=method, rim=rim_,
+                             radius=radius, limits=limits, options=opts, geometry=geo)
     run, q_raw = _run(target, alpha, w, leg, q_near, q_start, method, rim_, radius, limits, opts, geo)
     out = finish(run.q, run.ok, run.ok.shape == (), return_mask,
                  lambda: _error(run, q_raw, leg, alpha, w, method, opts.tol))
     if return_info:
         return (*out, run.info) if isinstance(out, tuple) else (out, run.info)
     return out
+
+
+def _large_batch(target, alpha, w, q_near, q_start) -> bool:
+    """True for a batch of more than ``CHUNK`` float64 targets with alpha and w numbers or one per target, and
+    q_near / q_start None or one row per target: :func:`ik` then solves it by chunks (the radial method's
+    temporaries take ~310 B a target, 13x the answer)."""
+    if not (type(target) is np.ndarray and target.dtype == np.float64 and target.ndim >= 2
+            and target.shape[-1] == 3 and target.size > 3 * _batch.CHUNK):
+        return False
+    rows_ok = all(x is None or (type(x) is np.ndarray and x.shape == target.shape) for x in (q_near, q_start))
+    items_ok = all(type(x) in _SCALARS or (type(x) is np.ndarray and x.shape == target.shape[:-1]) for x in (alpha, w))
+    return rows_ok and items_ok
+
+
+def _ik_in_chunks(target: np.ndarray, leg: Leg, alpha, w, q_near, q_start, return_mask: bool, **keywords):
+    """:func:`ik` of a large batch (:func:`_large_batch`), ``CHUNK`` targets at a time (``legkin._batch.in_chunks``):
+    its working memory beyond the answer stays ~20 MB. The inputs are checked whole first, so that an error names
+    the row in the whole batch."""
+    shape = target.shape[:-1]
+    rows: list[np.ndarray | None] = [
+        as_input(x, name, (3,)).reshape(-1, 3) if x is not None else None
+        for x, name in ((target, "target"), (q_near, "q_near"), (q_start, "q_start"))]
+    rows += [as_input(x, name).reshape(-1) if type(x) is np.ndarray else None
+             for x, name in ((alpha, "alpha"), (w, "w"))]
+
+    def solve(t, qn, qs, a, ww):
+        a = float(alpha) if a is None else a
+        ww = float(w) if ww is None else ww
+        return ik(t, leg, alpha=a, w=ww, q_near=qn, q_start=qs, return_mask=True, **keywords)
+
+    q, ok = in_chunks(solve, rows, 3)
+    return finish(q.reshape(shape + (3,)), ok.reshape(shape), False, return_mask, lambda: AssertionError())
 
 
 def _in_limits(sols: np.ndarray) -> np.ndarray:

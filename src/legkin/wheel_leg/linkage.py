@@ -314,9 +314,12 @@ def _angle_pair(theta, beta):
     """(theta, beta) checked, broadcast and flattened; the fast path for two numbers. Returns
     (theta (n,), beta (n,), shape)."""
     if type(theta) in _SCALARS and type(beta) in _SCALARS:
-        t = float(theta)
-        if THETA_MIN - 1e-12 <= t <= THETA_MAX + 1e-12 and math.isfinite(beta):
-            return np.array([t]), np.array([float(beta)]), ()
+        try:
+            t, b = float(theta), float(beta)
+        except OverflowError:  # an int beyond 1.8e308: as_angles names it
+            t = b = math.nan
+        if THETA_MIN - 1e-12 <= t <= THETA_MAX + 1e-12 and math.isfinite(b):
+            return np.array([t]), np.array([b]), ()
     theta, beta = as_angles(theta, beta, names=("theta", "beta"))
     _check_theta(theta)
     return as_rows(theta, 1)[:, 0], as_rows(beta, 1)[:, 0], theta.shape

@@ -361,7 +361,7 @@ def _k_stance_batch(t, n, TH, TAB, RUNS, NRUN, K, KC, gargs, limits, near, has_n
         status[i] = _k_stance(t[i], n[i], TH, TAB, RUNS, NRUN, K, KC, gargs, limits, near[i], has_near, q[i])
 
 
-@lru_cache(maxsize=64)
+@lru_cache(maxsize=64, typed=True)  # typed: leg=1 must not admit leg=True or 1.0 (issue 25)
 def _args(leg, r, geometry) -> tuple[Any, ...]:
     """(TH, TAB, RUNS, NRUN, K, KC, ground-kernel args) of (leg, r, geometry), validated; cached."""
     geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)

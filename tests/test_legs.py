@@ -124,7 +124,7 @@ def test_ik_round_trip_10k_per_robot(erd, name):
         assert ok.all(), f"{name} {leg.name}: {int((~ok).sum())} targets unsolved"
         assert np.all((q >= leg.lower) & (q <= leg.upper))
         answers[:, k] = q
-        q_all, mask = leg.ik_all(feet[:300, k])
+        q_all, mask = leg.ik_all(feet[:300, k], return_mask=True)
         assert mask.any(axis=-1).all()
         for b in range(4):
             rows = mask[:, b]
@@ -293,7 +293,7 @@ def test_general_leg_matches_pinocchio(rpy, t, foot, a1, perp, s3, floating, til
     assert ok.all()
     back = pin_feet(model, found, sol[:, None])[:, 0]
     assert np.linalg.norm(back - feet, axis=-1).max() <= TOL
-    q_all, mask = leg.ik_all(feet)
+    q_all, mask = leg.ik_all(feet, return_mask=True)
     # the sampled q is one of the branches (mod 2 pi), unless a singularity merges them
     d = np.abs(np.angle(np.exp(1j * (q_all - q[:, None, :])))).max(axis=-1)
     assert (np.nanmin(d, axis=-1) < 1e-6).mean() > 0.9
@@ -350,7 +350,7 @@ def test_single_call_equals_batch_row(erd, rows, i, name):
     np.testing.assert_array_equal(leg.fk(q[i]), leg.fk(q)[i])
     np.testing.assert_array_equal(leg.jacobian(q[i]), leg.jacobian(q)[i])
     sol, ok = leg.ik(p, return_mask=True)
-    all_b, mask = leg.ik_all(p)
+    all_b, mask = leg.ik_all(p, return_mask=True)
     if ok[i]:
         np.testing.assert_array_equal(leg.ik(p[i]), sol[i])
         np.testing.assert_array_equal(leg.ik(p[i], q_near=q[i]), leg.ik(p, q_near=q)[i])
@@ -359,7 +359,7 @@ def test_single_call_equals_batch_row(erd, rows, i, name):
         with pytest.raises(UnreachableError):
             leg.ik(p[i])
     if mask[i].any():
-        one, one_mask = leg.ik_all(p[i])
+        one, one_mask = leg.ik_all(p[i], return_mask=True)
         np.testing.assert_array_equal(one, all_b[i])
         np.testing.assert_array_equal(one_mask, mask[i])
 
@@ -379,7 +379,7 @@ def test_big_batch_equals_single_calls_and_shapes(fl):
     assert fl.jacobian(q[:1000].reshape(10, 100, 3)).shape == (10, 100, 3, 3)
     s, ok = fl.ik(p[:1000].reshape(10, 100, 3), return_mask=True)
     assert s.shape == (10, 100, 3) and ok.shape == (10, 100)
-    a, m = fl.ik_all(p[:1000].reshape(10, 100, 3))
+    a, m = fl.ik_all(p[:1000].reshape(10, 100, 3), return_mask=True)
     assert a.shape == (10, 100, 4, 3) and m.shape == (10, 100, 4)
     assert fl.ik(np.empty((0, 3))).shape == (0, 3)
     one, ok1 = fl.ik(p[0], return_mask=True)
@@ -396,7 +396,7 @@ def test_unreachable_nan_mask_and_error(fl):
     q, ok = fl.ik(p, return_mask=True)
     assert ok.tolist() == [True, False, False]
     assert np.isfinite(q[0]).all() and np.isnan(q[1:]).all()
-    q_all, mask = fl.ik_all(p)
+    q_all, mask = fl.ik_all(p, return_mask=True)
     assert mask[0].any() and not mask[1:].any() and np.isnan(q_all[1:]).all()
     with pytest.raises(UnreachableError, match=r"out of reach of leg FL by 0\.5.* m: .*beyond the leg's full stretch"):
         fl.ik(far)
@@ -416,7 +416,7 @@ def test_joint_limit_error(fl):
     q = rng.uniform(-math.pi, math.pi, (2000, 3))
     p = fl.fk(q)
     _, ok = fl.ik(p, return_mask=True)
-    q_all, mask = fl.ik_all(p)
+    q_all, mask = fl.ik_all(p, return_mask=True)
     only_outside = ~ok & mask.any(axis=-1)
     assert only_outside.sum() > 10
     for i in np.flatnonzero(only_outside)[:5]:
@@ -431,7 +431,7 @@ def test_joint_limit_error(fl):
 def test_q_near_picks_the_branch(erd):
     leg = erd["solo12"][1]["FL"]  # limits +-10 rad: every branch is inside
     p = leg.fk(np.array([0.2, 0.7, -1.4]))
-    q_all, mask = leg.ik_all(p)
+    q_all, mask = leg.ik_all(p, return_mask=True)
     assert mask.all()
     for b in range(4):
         near = q_all[b] + 0.01

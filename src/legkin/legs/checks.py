@@ -108,7 +108,7 @@ def run(robot_name: str, samples: int, rng: np.random.Generator) -> list[CheckRe
     q_all = np.empty((samples, nl, 4, 3))
     mask = np.empty((samples, nl, 4), dtype=bool)
     for k, leg in enumerate(legs.values()):
-        q_all[:, k], mask[:, k] = leg.ik_all(pos[:, k])
+        q_all[:, k], mask[:, k] = leg.ik_all(pos[:, k], return_mask=True)
     errs = []
     for b in range(4):
         qb = np.where(mask[:, :, b, None], q_all[:, :, b], 0.0)

@@ -189,7 +189,7 @@ def _build(model, root: int, chain: tuple[int, int, int], foot: str, name: str) 
             f"leg {name}: the HAA-HFE-KFE closed form misses Pinocchio's {foot} by {worst:.3g} m at joint values "
             f"{where.tolist()} (tolerance {VERIFY_TOL:g} m)"
         )
-    q_all, mask = leg.ik_all(f)
+    q_all, mask = leg.ik_all(f, return_mask=True)
     if mask.any():
         miss = float(np.min(np.linalg.norm(leg.fk(q_all[mask]) - f, axis=-1)))
     else:  # pragma: no cover - ik_all raises instead

@@ -432,18 +432,34 @@ class Leg:
             else:
                 text = f"it lies {miss:.6g} m inside the knee's inner reach (| |k| - |l| | = {lo:.6g} m)"
             return UnreachableError(f"target {tgt} is out of reach of leg {self.name} by {miss:.6g} m: {text}",
-                                    target=p)
+                                    target=p, distance=miss)
         if status == _JOINT_LIMIT:
-            branches = self.ik_all(p)[0]
+            branches = self.ik_all(p)
+            j, value, closest = self._least_violation(branches)
             return JointLimitError(
                 f"target {tgt} of leg {self.name} is reachable only outside the joint limits "
-                f"[{self.lower.tolist()}, {self.upper.tolist()}] (by {float(info[0]):.6g} rad at least); "
+                f"[{self.lower.tolist()}, {self.upper.tolist()}] (by {float(info[0]):.6g} rad at least: joint "
+                f"{self.joint_names[j]} = {value:.6g} rad in the closest branch); "
                 f"branches {np.round(branches, 6).tolist()}",
-                target=p,
+                target=p, closest=closest, distance=float(info[0]), joint=self.joint_names[j], value=value,
+                lower=float(self.lower[j]), upper=float(self.upper[j]),
             )
         return InvalidInputError(f"p must be finite, got {tgt}")  # pragma: no cover - as_input caught it
 
-    def ik_all(self, p, *, q_near=None) -> tuple[np.ndarray, np.ndarray]:
+    def _least_violation(self, branches: np.ndarray) -> tuple[int, float, np.ndarray]:
+        """The branch least outside the limits (each angle's 2 pi representative nearest them): the index of its
+        joint farthest outside, that joint's value (rad) and the branch (error path only)."""
+        best: tuple[float, int, float, np.ndarray] = (math.inf, 0, math.nan, branches[0])
+        mid = 0.5 * (np.clip(self.lower, -1e9, 1e9) + np.clip(self.upper, -1e9, 1e9))
+        for q in branches[np.isfinite(branches[:, 0])]:
+            x = q + 2.0 * math.pi * np.round((mid - q) / (2.0 * math.pi))
+            out_by = np.maximum(np.maximum(self.lower - x, x - self.upper), 0.0)
+            j = int(np.argmax(out_by))
+            if out_by[j] < best[0]:
+                best = (float(out_by[j]), j, float(x[j]), x)
+        return best[1], best[2], best[3]
+
+    def ik_all(self, p, *, q_near=None, return_mask: bool = False):
         """Every IK branch of the target(s) ``p`` (m, root frame), joint limits ignored.
 
         Branches in :data:`BRANCHES` order ``(s_a, s_k)``: ``u3 = s_a sqrt(y^2 + z^2 - d^2)`` (abduction) and
@@ -454,15 +470,19 @@ class Leg:
         Args:
             p: targets (3,) or (..., 3).
             q_near: reference joint values (3,) or broadcastable with ``p``.
+            return_mask: also return the mask of the branches that exist.
 
         Returns:
-            ``(q_all, mask)``: (4, 3) or (..., 4, 3) with NaN rows for absent branches, and the (4,) or (..., 4)
-            boolean mask of the branches that exist.
+            ``q_all`` (4, 3) or (..., 4, 3) (rad) with NaN rows for absent branches; with ``return_mask=True``
+            ``(q_all, mask)``, the (4,) or (..., 4) boolean mask of the branches that exist.
 
         Raises:
             UnreachableError: a single target with no branch (the message says by how much it misses).
             InvalidInputError: ``p`` or ``q_near`` not finite real arrays (..., 3), or not broadcastable.
+            InvalidParameterError: ``return_mask`` not a bool.
         """
+        if return_mask is not False and return_mask is not True:
+            return_mask = check_flag(return_mask, "return_mask")
         rows, ref, batch, single = self._prepare(p, q_near)
         n = rows.shape[0]
         out = np.empty((n, 4, 3))
@@ -471,8 +491,9 @@ class Leg:
         _ik_all_batch(rows, self.params, ref, out, status, info)
         if single and status[0] != OK:
             raise self._error(int(status[0]), info[0], rows[0])
-        mask = np.isfinite(out[..., 0])
-        return out.reshape(batch + (4, 3)), mask.reshape(batch + (4,))
+        if not return_mask:
+            return out.reshape(batch + (4, 3))
+        return out.reshape(batch + (4, 3)), np.isfinite(out[..., 0]).reshape(batch + (4,))
 
     def ik(self, p, *, q_near=None, return_mask: bool = False):
         """Joint values placing the foot at ``p``: the branch inside the URDF limits nearest ``q_near``.

@@ -13,9 +13,7 @@ import numpy as np
 from .._contract import Case, Contract
 from .configuration import sample_joints
 from .constants import L1, LEGS, X34, Y12
-from .forward import fk, hip_position, jacobian
-from .inverse import ik
-from .limits import within_limits
+from .kinematics import fk, hip_position, ik, jacobian, within_limits
 
 __all__ = ["contract"]
 
@@ -35,15 +33,11 @@ def _unreachable(leg: str) -> np.ndarray:
 
 
 def _case(leg: str) -> Case:
-    def fk_(q, return_mask=False):
-        x = fk(q, leg)
-        return (x, np.ones(x.shape[:-1], dtype=bool)) if return_mask else x
-
     return Case(
         name=leg,
         nq=3,
         nx=3,
-        fk=fk_,
+        fk=lambda q, return_mask=False: fk(q, leg, return_mask=return_mask),
         ik=lambda x, return_mask=False: ik(x, leg, return_mask=return_mask),
         jacobian=lambda q: jacobian(q, leg),
         of=lambda q: fk(q, leg),

@@ -35,6 +35,7 @@ from ._layout import (
     _TOO_NEAR,
     _TWO_PI,
     _UNREACHABLE,
+    LIMIT_SLACK,
     LIMIT_TOL,
     POLISH_DAMPING,
     POLISH_STEPS,
@@ -43,7 +44,7 @@ from ._layout import (
 
 
 @kernel
-def _polish_k(p, g, q, jac) -> float:
+def _polish_k(p, g, q, jac, fixed) -> float:
     """At most :data:`POLISH_STEPS` damped Newton steps on the exact forward map while the foot error exceeds
     :data:`POLISH_BELOW`, each kept only if it reduces the error: ``e = p - fk(q)``,
     ``dq = J^T (J J^T + lambda^2 I)^-1 e`` (``lambda`` = :data:`POLISH_DAMPING`).
@@ -51,6 +52,7 @@ def _polish_k(p, g, q, jac) -> float:
     The closed form is exact for the ideal structure (a1 perpendicular to a2 = +-a3); URDF angles written
     with 11 digits (``rpy="0 1.57079632679 0"``) leave axes ~5e-12 off, i.e. ~1e-12 m at the foot, and near the
     fold of the knee (|w| -> 0 when |k| = |l|) the law of cosines loses digits: the steps remove both.
+    ``fixed`` (bits 1, 2, 4 for q1, q2, q3): joints held where they are (their Jacobian columns zeroed).
     Returns the final foot error ``|e|`` (m).
     """
     fx, fy, fz = _fk3_k(q[0], q[1], q[2], g)
@@ -61,6 +63,9 @@ def _polish_k(p, g, q, jac) -> float:
         if err <= _POLISH_DONE:
             break
         _jac3_k(q[0], q[1], q[2], g, jac)
+        for j in range(3):
+            if fixed & (1 << j):
+                jac[0, j] = jac[1, j] = jac[2, j] = 0.0
         # A = J J^T + lam^2 I (symmetric positive definite), solve A y = e by the adjugate, dq = J^T y
         a00 = jac[0, 0] ** 2 + jac[0, 1] ** 2 + jac[0, 2] ** 2 + lam2
         a11 = jac[1, 0] ** 2 + jac[1, 1] ** 2 + jac[1, 2] ** 2 + lam2
@@ -167,14 +172,14 @@ def _ik_all_k(p, g, ref, out, info) -> int:
             q2 = math.atan2(wy, wx) - math.atan2(vy, vx)
             b = 2 * ia + ik
             qb[0], qb[1], qb[2] = q1, q2, s3 * a
-            res = _polish_k(p, g, qb, jac)
+            res = _polish_k(p, g, qb, jac, 0)
             if res > REACH_TOL:  # near a fold of the ideal structure: restart off it (Newton stalls on a fold)
                 eta = 4.0 * math.sqrt(res / min(kn, ln))
                 q0, q1b, q2b = qb[0], qb[1], qb[2]
                 for jr in range(6):
                     qt[0], qt[1], qt[2] = q0, q1b, q2b
                     qt[jr // 2] += eta if jr % 2 == 0 else -eta
-                    rt = _polish_k(p, g, qt, jac)
+                    rt = _polish_k(p, g, qt, jac, 0)
                     if rt < res:
                         res = rt
                         qb[0], qb[1], qb[2] = qt[0], qt[1], qt[2]
@@ -214,6 +219,33 @@ def _in_limits_k(a, r, lo, hi):
     return best, miss
 
 
+@kernel
+def _repair_k(p, g, q, ref, jac) -> bool:
+    """A branch ``q`` (3,) at most :data:`LIMIT_SLACK` outside the limits, moved into them (rare path): each angle
+    at its representative nearest ``ref`` clipped onto the limits, the joints left alone re-solved by
+    :func:`_polish_k` with the clipped ones fixed; kept (True, ``q`` overwritten) if the result reproduces ``p``
+    within :data:`REACH_TOL`. Near the abduction singularity (foot on the cylinder ``r = |d|``) a branch's q1 errs
+    by up to ~1e-8 rad along the singular direction while its foot is exact: a target made with q1 on its limit
+    then comes back outside it, and the other joints absorb the clip."""
+    fixed = 0
+    for j in range(3):
+        lo, hi = g[_LO + j], g[_HI + j]
+        x = _near_k(q[j], lo if ref[j] < lo else (hi if ref[j] > hi else ref[j]))
+        for n in range(-1, 2):
+            y = x + _TWO_PI * n
+            if y >= lo - LIMIT_SLACK and y <= hi + LIMIT_SLACK:
+                x = y
+        if x < lo or x > hi:
+            x = lo if x < lo else hi
+            fixed |= 1 << j
+        q[j] = x
+    res = _polish_k(p, g, q, jac, fixed)
+    inside = True
+    for j in range(3):
+        inside = inside and q[j] >= g[_LO + j] and q[j] <= g[_HI + j]
+    return inside and res <= REACH_TOL
+
+
 @kernel(entry=True)
 def _ik_k(p, g, ref, out, info) -> int:
     """The branch of :func:`_ik_all_k` inside the limits nearest ``ref`` (least sum of squared joint differences;
@@ -237,7 +269,13 @@ def _ik_k(p, g, ref, out, info) -> int:
         if m < viol:
             viol = m
         if not (np.isfinite(x0) and np.isfinite(x1) and np.isfinite(x2)):
-            continue
+            if m > LIMIT_SLACK:
+                continue
+            qr = np.empty(3)  # the rare path allocates its own scratch
+            qr[0], qr[1], qr[2] = qa[b, 0], qa[b, 1], qa[b, 2]
+            if not _repair_k(p, g, qr, ref, np.empty((3, 3))):
+                continue
+            x0, x1, x2 = qr[0], qr[1], qr[2]
         cost = (x0 - ref[0]) ** 2 + (x1 - ref[1]) ** 2 + (x2 - ref[2]) ** 2
         if cost < best:
             best = cost

@@ -14,6 +14,9 @@ REACH_TOL = 1e-12
 #: A joint angle up to this far (rad) outside the URDF limits is clipped onto the limit (the foot then moves by
 #: at most LIMIT_TOL x the leg's reach, < 1e-10 m).
 LIMIT_TOL = 1e-10
+#: A branch up to this far (rad) outside the limits is moved into them and its other joints re-solved (kept if it
+#: still reaches the target within REACH_TOL): near the abduction singularity a branch's q1 errs by up to ~1e-8 rad.
+LIMIT_SLACK = 1e-7
 #: Damped Newton steps (at most) polishing each closed-form branch on the exact forward map (see _polish_k).
 POLISH_STEPS = 8
 #: Damping (m) of the polishing steps: bounds a step to ~|e| / (2 lambda) rad near a singularity.

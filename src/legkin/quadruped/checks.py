@@ -18,8 +18,8 @@ from ..validation import (
     sample_within_limits,
 )
 from . import kinematics as aq
-from .constants import L1
 from .configuration import leg_slice, made_joints, near_singular_joints, pinocchio_configuration, random_targets, rho
+from .constants import L1
 
 TOL = 1e-12
 #: Abduction-singularity band: below this distance rho (m) of the foot from the abduction cylinder

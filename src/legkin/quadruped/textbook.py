@@ -17,9 +17,9 @@ import numpy.typing as npt
 from .._batch import check_flag, check_number
 from .._kernels import OK, as_rows, batch_kernel, kernel, prange
 from .._rotations import wrap_k
+from ..legs._fk_kernels import _finite3
 from ._common import foot_z_of, leg_index, raise_bad, rows
 from .constants import BAD_INPUT, KNEE_OFFSET, PI, SX, SY, X01, X34, Y01, Z01
-from ..legs._fk_kernels import _finite3
 from .geometry import Geometry
 
 __all__ = ["textbook_ik", "textbook_frame", "textbook_to_joints"]

@@ -27,6 +27,8 @@ def test_urdf_limits_match_analytic_constants(quadruped):
             iq = quadruped.idx_q(f"{leg}_{joint}")
             assert quadruped.model.lowerPositionLimit[iq] == aq.JOINT_LIMITS[k, 0]
             assert quadruped.model.upperPositionLimit[iq] == pytest.approx(aq.JOINT_LIMITS[k, 1], abs=1e-15)
+        leg_model = aq.legs()[leg]  # the measured leg's limits: what ik keeps to
+        np.testing.assert_allclose(np.stack([leg_model.lower, leg_model.upper], 1), aq.JOINT_LIMITS, atol=1e-15, rtol=0)
 
 
 def test_folded_leg_at_zero_matches_reference():

@@ -68,7 +68,7 @@ def _reachable_target(leg, direction, radius_fraction, s_u):
     tilt=st.floats(-math.pi, math.pi),
 )
 def test_ik_all_branches_reach_target_everywhere(leg, direction, frac, s_u, tilt):
-    """Every branch of foot_ik_all lands on the target, over the whole workspace incl. its boundary."""
+    """Every branch of ik_all lands on the target, over the whole workspace incl. its boundary."""
     p = _reachable_target(leg, direction, frac, s_u)
     # rotate the target about the abduction axis: still reachable
     h = aq.hip_position(leg)
@@ -637,3 +637,22 @@ def test_package_attributes_resolve_once():
     assert set(aq.__all__) <= set(dir(pkg)) and "SPEC" in pkg.__all__
     with pytest.raises(AttributeError):
         pkg.no_such_name  # noqa: B018
+
+
+def test_legs_are_measured_once_per_geometry_from_the_models_urdf():
+    """``legs(geometry)``: the four :class:`legkin.legs.Leg` of the URDF ``legkin.load`` uses for that geometry,
+    measured once (equal geometries share them), and what fk/ik run on."""
+    from legkin import legs as generic
+
+    assert aq.legs(aq.Geometry(foot_z=-0.015)) is aq.legs(G015) is not aq.legs()
+    assert aq.legs(None) is aq.legs(aq.DEFAULT_GEOMETRY)
+    robot = legkin.load("quadruped", foot_z=-0.015)
+    floating = generic.from_model(robot.model)  # the loaded (floating-base) model, measured on its own
+    q = np.array([[0.1, 0.75, 1.5], [-0.3, 2.9, 0.4]])
+    for leg in LEGS:
+        mine = aq.legs(G015)[leg]
+        assert mine.foot_frame == f"{leg}_FOOT" and mine.joint_names == cfg.joint_names(leg)
+        np.testing.assert_allclose(mine.fk(q), floating[leg].fk(q), atol=1e-15, rtol=0)
+        np.testing.assert_array_equal(aq.fk(q, leg, geometry=G015), mine.fk(q))
+    with pytest.raises(legkin.InvalidParameterError, match="geometry must be"):
+        aq.legs(-0.015)

@@ -398,6 +398,8 @@ def _near_cylinder_joints(q, log_rho, sign):
 @example(leg="LF", q1=-0.4, q2=0.0, q3=1.5, log_rho=-8.0, sign=-1.0, with_ref=False)  # q1 1.3e-9 off its limit
 @example(leg="LF", q1=-0.4, q2=1.36, q3=0.26, log_rho=None, sign=1.0, with_ref=False)  # two joints on limits
 @example(leg="LF", q1=0.4, q2=0.0, q3=1.92, log_rho=-5.847934859038284, sign=1.0, with_ref=False)  # q3 1 ulp out
+@example(leg="LF", q1=0.399999999999999, q2=0.0, q3=0.26, log_rho=-8.0, sign=1.0, with_ref=False)  # q1 and q3 at
+# their limits, rho = 1e-8 m: the branch's q1 6e-10 rad out (the abduction singularity), the repair's step pushed q3
 @given(
     leg=st.sampled_from(LEGS),
     q1=_joint(0), q2=_joint(1), q3=_joint(2),

@@ -223,7 +223,8 @@ def _in_limits_k(a, r, lo, hi):
 def _repair_k(p, g, q, ref, jac) -> bool:
     """A branch ``q`` (3,) at most :data:`LIMIT_SLACK` outside the limits, moved into them (rare path): each angle
     at its representative nearest ``ref`` clipped onto the limits, the joints left alone re-solved by
-    :func:`_polish_k` with the clipped ones fixed; kept (True, ``q`` overwritten) if the result reproduces ``p``
+    :func:`_polish_k` with the clipped ones fixed (a joint the steps push outside is clipped and fixed in turn, as
+    when a target is made with two joints on their limits); kept (True, ``q`` overwritten) if it reproduces ``p``
     within :data:`REACH_TOL`. Near the abduction singularity (foot on the cylinder ``r = |d|``) a branch's q1 errs
     by up to ~1e-8 rad along the singular direction while its foot is exact: a target made with q1 on its limit
     then comes back outside it, and the other joints absorb the clip."""
@@ -239,11 +240,18 @@ def _repair_k(p, g, q, ref, jac) -> bool:
             x = lo if x < lo else hi
             fixed |= 1 << j
         q[j] = x
-    res = _polish_k(p, g, q, jac, fixed)
-    inside = True
-    for j in range(3):
-        inside = inside and q[j] >= g[_LO + j] and q[j] <= g[_HI + j]
-    return inside and res <= REACH_TOL
+    for _ in range(3):  # a free joint the steps push outside its limits is clipped and fixed in turn
+        res = _polish_k(p, g, q, jac, fixed)
+        inside = True
+        for j in range(3):
+            lo, hi = g[_LO + j], g[_HI + j]
+            if q[j] < lo or q[j] > hi:
+                q[j] = lo if q[j] < lo else hi
+                fixed |= 1 << j
+                inside = False
+        if inside:
+            return res <= REACH_TOL
+    return False
 
 
 @kernel(entry=True)
@@ -268,14 +276,15 @@ def _ik_k(p, g, ref, out, info) -> int:
         m = max(m0, max(m1, m2))
         if m < viol:
             viol = m
-        if not (np.isfinite(x0) and np.isfinite(x1) and np.isfinite(x2)):
-            if m > LIMIT_SLACK:
-                continue
+        if m > LIMIT_SLACK:
+            continue
+        if m > 0.0:  # a hair outside the limits: moved into them, the free joints re-solved (rare path)
             qr = np.empty(3)  # the rare path allocates its own scratch
             qr[0], qr[1], qr[2] = qa[b, 0], qa[b, 1], qa[b, 2]
-            if not _repair_k(p, g, qr, ref, np.empty((3, 3))):
-                continue
-            x0, x1, x2 = qr[0], qr[1], qr[2]
+            if _repair_k(p, g, qr, ref, np.empty((3, 3))):
+                x0, x1, x2 = qr[0], qr[1], qr[2]
+            elif not (np.isfinite(x0) and np.isfinite(x1) and np.isfinite(x2)):
+                continue  # (within LIMIT_TOL: the clipped angles, the foot within LIMIT_TOL x the reach)
         cost = (x0 - ref[0]) ** 2 + (x1 - ref[1]) ** 2 + (x2 - ref[2]) ** 2
         if cost < best:
             best = cost

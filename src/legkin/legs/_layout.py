@@ -11,8 +11,8 @@ PERPENDICULAR_TOL = 1e-9
 PARALLEL_TOL = 1e-9
 #: A target up to this far (m) outside the reachable set is solved on its boundary.
 REACH_TOL = 1e-12
-#: A joint angle up to this far (rad) outside the URDF limits is clipped onto the limit (the foot then moves by
-#: at most LIMIT_TOL x the leg's reach, < 1e-10 m).
+#: A joint angle up to this far (rad) outside the URDF limits is clipped onto the limit when re-solving the other
+#: joints (LIMIT_SLACK) does not reach the target (the foot then moves by at most LIMIT_TOL x the leg's reach).
 LIMIT_TOL = 1e-10
 #: A branch up to this far (rad) outside the limits is moved into them and its other joints re-solved (kept if it
 #: still reaches the target within REACH_TOL): near the abduction singularity a branch's q1 errs by up to ~1e-8 rad.

@@ -499,8 +499,11 @@ class Leg:
         """Joint values placing the foot at ``p``: the branch inside the URDF limits nearest ``q_near``.
 
         For each branch of :meth:`ik_all`, each joint takes its 2 pi representative inside ``[lower, upper]``
-        nearest ``q_near`` (an angle up to :data:`LIMIT_TOL` outside is clipped onto the limit); among the branches
-        inside the limits the one with the least ``|q - q_near|^2`` wins (ties: the earlier branch).
+        nearest ``q_near``; among the branches inside the limits the one with the least ``|q - q_near|^2`` wins
+        (ties: the earlier branch). A branch up to ``LIMIT_SLACK`` (1e-7 rad) outside the limits (rounding at a
+        limit, or the abduction singularity, where q1 errs along the singular direction) is moved onto them and
+        its other joints re-solved, kept if it reaches ``p`` within :data:`REACH_TOL`; failing that, a branch up
+        to :data:`LIMIT_TOL` outside is kept clipped onto the limit (foot within ``LIMIT_TOL`` x the reach).
 
         Args:
             p: targets (3,) or (..., 3), m, root frame.

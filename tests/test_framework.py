@@ -376,11 +376,11 @@ def test_no_foreign_exception_from_robot_methods(tripod):
 
 # ---------------------------------------------------------------------- external robots (legkin.legs)
 def test_the_nine_example_robot_data_quadrupeds_are_registered_and_load():
-    from legkin.legs import ERD_ROBOTS
+    from legkin.legs import ERD_ALL, ERD_ROBOTS
 
-    assert legkin.list_models("example-robot-data") == sorted(ERD_ROBOTS)
+    assert legkin.list_models("example-robot-data") == sorted(ERD_ALL)  # with the bipeds (tests/test_legs6.py)
     assert len(ERD_ROBOTS) == 9
-    assert set(legkin.list_models()) == set(ERD_ROBOTS) | set(legkin.list_models("legkin"))
+    assert set(legkin.list_models()) == set(ERD_ALL) | set(legkin.list_models("legkin"))
     with pytest.raises(legkin.InvalidParameterError, match="source"):
         legkin.list_models("ros")
     for name in ERD_ROBOTS:

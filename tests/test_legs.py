@@ -12,7 +12,7 @@ import pytest
 from hypothesis import assume, example, given
 from hypothesis import strategies as st
 
-from legkin import legs
+from legkin import errors, legs
 from legkin.errors import (
     InvalidInputError,
     InvalidParameterError,
@@ -240,7 +240,7 @@ def test_tilted_pitch_axis_raises_clear_error():
         legs.from_model(build_leg(tilt_hfe_deg=2.0))
     with pytest.raises(LegStructureError, match="off parallel"):
         legs.from_model(build_leg(tilt_kfe_deg=1e-6))  # 1.7e-8 rad > 1e-9
-    assert issubclass(LegStructureError, InvalidParameterError) and issubclass(LegStructureError, LegkinError)
+    assert LegStructureError is errors.LegStructureError and issubclass(LegStructureError, (LegkinError, ValueError))
     legs.from_model(build_leg(tilt_kfe_deg=1e-9))  # 1.7e-11 rad: within the 1e-9 tolerance
     with pytest.raises(LegStructureError, match="foot.*lies on the KFE axis"):
         legs.from_model(build_leg(foot=(0.0, 0.0, 0.0), t=((0.2, 0.1, 0.0), (0.05, 0.08, -0.02), (0.0, 0.0, -0.25))))
@@ -250,8 +250,10 @@ def test_no_leg_found():
     model = pin.Model()
     j = model.addJoint(0, pin.JointModelRY(), pin.SE3.Identity(), "only")
     model.addJointFrame(j, -1)
-    with pytest.raises(InvalidParameterError, match="no HAA-HFE-KFE leg found"):
+    with pytest.raises(LegStructureError, match=r"no leg found.*Found: only \(RY\): 1 joints.*Supported: HAA") as info:
         legs.from_model(model)
+    assert info.value.found == ["only (RY): 1 joints, ends at a leaf, foot frame 'only'"]
+    assert any("HAA-HFE-KFE" in e for e in info.value.expected) and any("6R" in e for e in info.value.expected)
 
 
 angles = st.floats(-math.pi, math.pi, allow_nan=False)
@@ -403,7 +405,7 @@ def test_unreachable_nan_mask_and_error(fl):
     with pytest.raises(UnreachableError, match=r"by 0\.0955 m: .*inside the abduction cylinder"):
         fl.ik(inside)
     with pytest.raises(UnreachableError):
-        fl.ik_all(far)
+        fl.ik_all(far, return_mask=True)
     try:
         fl.ik(far)
     except UnreachableError as exc:
@@ -550,3 +552,22 @@ def test_quadruped_check_has_the_generic_leg_rows():
     assert len(generic) == 4 and all(r.passed for r in generic), [(r.name, r.max_error) for r in generic]
     assert "400/400 solved" in generic[2].name
     assert len(rows) > len(generic)  # the quadruped's own rows are all still there
+
+
+def test_ik_all_returns_solutions_and_mask_only_when_asked(fl):
+    """legkin 0.2.0: ``ik_all`` returns the solutions; ``(solutions, mask)`` only with ``return_mask=True``; the
+    single-target fast path gives the batch row bit for bit."""
+    rng = np.random.default_rng(11)
+    p = fl.fk(rng.uniform(fl.lower, fl.upper, (50, 3)))
+    q_all = fl.ik_all(p)
+    assert isinstance(q_all, np.ndarray) and q_all.shape == (50, 4, 3)
+    both, mask = fl.ik_all(p, return_mask=True)
+    np.testing.assert_array_equal(both, q_all)
+    np.testing.assert_array_equal(mask, np.isfinite(q_all[..., 0]))
+    for i in range(0, 50, 7):
+        np.testing.assert_array_equal(fl.ik_all(p[i]), q_all[i])
+        one, m1 = fl.ik_all(p[i], return_mask=True)
+        assert m1.shape == (4,) and m1.dtype == bool
+        np.testing.assert_array_equal(m1, mask[i])
+    with pytest.raises(InvalidParameterError, match="return_mask"):
+        fl.ik_all(p[0], return_mask=1)

@@ -141,19 +141,19 @@ def _discover() -> dict[str, ModelSpec]:
 
 
 def _external() -> dict[str, ModelSpec]:
-    """The quadrupeds of example-robot-data (:data:`legkin.legs.ERD_ROBOTS`; their files are found when loaded)."""
-    from .legs.erd import ERD_ROBOTS
+    """The legged robots of example-robot-data (:data:`legkin.legs.ERD_ALL`; their files are found when loaded)."""
+    from .legs.erd import ERD_ALL
 
     return {
         r.name: ModelSpec(
             name=r.name,
-            title=f"{r.title}: closed-form leg IK measured from its URDF (legkin.legs)",
+            title=f"{r.title}: leg kinematics measured from its URDF (legkin.legs)",
             seed="",
             floating=True,
             reference_pose=r.reference_pose or "",
             source="example-robot-data",
         )
-        for r in ERD_ROBOTS.values()
+        for r in ERD_ALL.values()
     }
 
 

@@ -1,4 +1,4 @@
-"""Closed-form IK of any HAA-HFE-KFE quadruped leg, measured from its URDF (issue 13).
+"""Exact leg kinematics measured from any URDF: HAA-HFE-KFE legs (issue 13) and 6-DOF humanoid legs (issue 26).
 
 >>> from legkin import legs
 >>> model, urdf, dirs = legs.load_erd("go2")
@@ -17,25 +17,40 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # at run time the names load on first use: `import legkin` (its registry) imports no numba
-    from .erd import ERD_ROBOTS, ErdRobot, erd_files, external_models, load_erd, reference_configuration
+    from .erd import (
+        ERD_ALL,
+        ERD_BIPEDS,
+        ERD_ROBOTS,
+        ErdRobot,
+        erd_files,
+        external_models,
+        load_erd,
+        reference_configuration,
+    )
     from .extract import find_chains, from_model, from_urdf
     from .kinematics import BRANCHES, Leg, LegStructureError
     from .registry import erd_spec
+    from .sixdof import Leg6
 
 _WHERE = {
-    "ERD_ROBOTS": "erd", "ErdRobot": "erd", "erd_files": "erd", "external_models": "erd", "load_erd": "erd",
+    "ERD_ROBOTS": "erd", "ERD_BIPEDS": "erd", "ERD_ALL": "erd", "ErdRobot": "erd", "erd_files": "erd",
+    "external_models": "erd", "load_erd": "erd",
     "reference_configuration": "erd", "find_chains": "extract", "from_model": "extract", "from_urdf": "extract",
     "BRANCHES": "kinematics", "Leg": "kinematics", "LegStructureError": "kinematics", "erd_spec": "registry",
+    "Leg6": "sixdof",
 }
 
 __all__ = [
     "Leg",
+    "Leg6",
     "LegStructureError",
     "BRANCHES",
     "from_model",
     "from_urdf",
     "find_chains",
     "ERD_ROBOTS",
+    "ERD_BIPEDS",
+    "ERD_ALL",
     "ErdRobot",
     "erd_files",
     "load_erd",

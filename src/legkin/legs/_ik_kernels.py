@@ -107,14 +107,14 @@ def _near_k(a, r):
     return a + _TWO_PI * math.floor((r - a) / _TWO_PI + 0.5)
 
 
-@kernel
+@kernel(entry=True)
 def _ik_all_k(p, g, ref, out, info) -> int:
     """Every branch (rows in :data:`BRANCHES` order, NaN rows for absent ones) of the target ``p``.
 
     ``r^2 = y^2 + z^2``, ``u3 = s_a sqrt(r^2 - d^2)``, ``q1 = atan2(z, y) - atan2(u3, d)``;
     ``w = (u3, x1) - h``, ``cos beta = (|w|^2 - |k|^2 - |l|^2) / (2 |k||l|)``, ``beta = s_k acos(.)``,
-    ``q3 = s3 (beta - phi_l + phi_k)``, ``q2 = atan2(w) - atan2(k + Rot(s3 q3) l)``. Each angle is moved to
-    Each branch is then polished on the exact forward map (:func:`_polish_k`) and each angle moved to its
+    ``q3 = s3 (beta - phi_l + phi_k)``, ``q2 = atan2(w) - atan2(k + Rot(s3 q3) l)``. Each branch is then
+    polished on the exact forward map (:func:`_polish_k`) and each angle moved to its
     2 pi representative nearest ``ref``. ``info`` (2,): on failure the miss (m) and its reason.
     """
     for b in range(4):

@@ -24,11 +24,11 @@ TOL = 1e-12
 
 
 def load_model(robot_name: str):
-    """The Pinocchio model of ``robot_name``: an example-robot-data quadruped (:data:`legkin.legs.ERD_ROBOTS`),
-    else a legkin model (``legkin.load(robot_name).model``)."""
-    from .erd import ERD_ROBOTS, load_erd
+    """The Pinocchio model of ``robot_name``: an example-robot-data robot (:data:`legkin.legs.ERD_ALL`), else a
+    legkin model (``legkin.load(robot_name).model``)."""
+    from .erd import ERD_ALL, load_erd
 
-    if robot_name in ERD_ROBOTS:
+    if robot_name in ERD_ALL:
         return load_erd(robot_name)[0]
     from .. import load
 
@@ -84,6 +84,10 @@ def run(robot_name: str, samples: int, rng: np.random.Generator) -> list[CheckRe
 
     model = load_model(robot_name)
     legs = from_model(model)
+    if any(leg.dof == 6 for leg in legs.values()):
+        from .checks6 import rows6
+
+        return rows6(model, legs, samples, rng)
     nl = len(legs)
     qs = sample_legs(model, legs, samples, rng)
     pos, jac = pinocchio_feet(model, legs, qs, jacobians=True)

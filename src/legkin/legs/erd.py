@@ -1,4 +1,5 @@
-"""The nine 12-DOF quadrupeds of example-robot-data, located through the installed distribution's file list.
+"""The legged robots of example-robot-data (nine 12-DOF quadrupeds, six humanoids and the biped bolt), located
+through the installed distribution's file list.
 
 No absolute path is written here: every file is found with ``importlib.metadata.files("example-robot-data")``
 (the pip / cmeel wheel installs the robots under ``cmeel.prefix/share/example-robot-data/robots``; a
@@ -16,7 +17,10 @@ import numpy as np
 
 from ..errors import InvalidParameterError, UnknownModelError
 
-__all__ = ["ErdRobot", "ERD_ROBOTS", "erd_files", "load_erd", "external_models", "reference_configuration"]
+__all__ = [
+    "ErdRobot", "ERD_ROBOTS", "ERD_BIPEDS", "ERD_ALL", "erd_files", "load_erd", "external_models",
+    "reference_configuration",
+]
 
 _DIST = "example-robot-data"
 _ROBOTS = "example-robot-data/robots/"
@@ -66,6 +70,29 @@ ERD_ROBOTS: dict[str, ErdRobot] = {
     )
 }
 
+#: The six humanoids (6-DOF legs, :class:`legkin.legs.Leg6`) and the 3-DOF biped bolt, by legkin name.
+ERD_BIPEDS: dict[str, ErdRobot] = {
+    r.name: r
+    for r in (
+        ErdRobot("talos", "TALOS humanoid (PAL Robotics)", "talos_data/robots/talos_reduced.urdf",
+                 "talos_data/srdf/talos.srdf", "half_sitting"),
+        ErdRobot("romeo", "Romeo humanoid (Aldebaran)", "romeo_description/urdf/romeo.urdf",
+                 "romeo_description/srdf/romeo.srdf", "half_sitting"),
+        ErdRobot("icub", "iCub humanoid (IIT)", "icub_description/robots/icub_reduced.urdf",
+                 "icub_description/srdf/icub.srdf", "half_sitting"),
+        ErdRobot("simple_humanoid", "Simple humanoid (LAAS)", "simple_humanoid_description/urdf/simple_humanoid.urdf",
+                 "simple_humanoid_description/srdf/simple_humanoid.srdf", "half_sitting"),
+        ErdRobot("alexander", "Alexander lower body (PAL Robotics)",
+                 "alexander_description/urdf/alexander_v1.lowerBodyOnly.urdf",
+                 "alexander_description/srdf/alexander.srdf", "default"),
+        ErdRobot("g1", "G1 humanoid, 29 DOF (Unitree)", "g1_description/urdf/g1_29dof_rev_1_0.urdf", None, None),
+        ErdRobot("bolt", "Bolt biped (ODRI)", "bolt_description/robots/bolt.urdf", "bolt_description/srdf/bolt.srdf"),
+    )
+}
+
+#: Every legged robot of example-robot-data legkin knows: :data:`ERD_ROBOTS` then :data:`ERD_BIPEDS`.
+ERD_ALL: dict[str, ErdRobot] = {**ERD_ROBOTS, **ERD_BIPEDS}
+
 
 @functools.lru_cache(maxsize=1)
 def _installed() -> dict[str, Path]:
@@ -89,12 +116,12 @@ def _installed() -> dict[str, Path]:
 
 def _robot(name: str) -> ErdRobot:
     try:
-        return ERD_ROBOTS[name]
+        return ERD_ALL[name]
     except (KeyError, TypeError):
         raise UnknownModelError(
-            f"unknown example-robot-data quadruped {name!r}; known: {', '.join(ERD_ROBOTS)}",
+            f"unknown example-robot-data robot {name!r}; known: {', '.join(ERD_ALL)}",
             name=name,
-            known=sorted(ERD_ROBOTS),
+            known=sorted(ERD_ALL),
         ) from None
 
 
@@ -150,11 +177,12 @@ def reference_configuration(model, name: str) -> np.ndarray:
 
 
 def load_erd(name: str, *, free_flyer: bool | None = None):
-    """Load an example-robot-data quadruped with Pinocchio.
+    """Load an example-robot-data legged robot with Pinocchio.
 
     Args:
-        name: one of :data:`ERD_ROBOTS` (``"solo12"``, ``"anymal"``, ``"anymal_c"``, ``"hyq"``, ``"go1"``,
-            ``"go2"``, ``"a1"``, ``"b1"``, ``"laikago"``).
+        name: one of :data:`ERD_ALL`: the quadrupeds (``"solo12"``, ``"anymal"``, ``"anymal_c"``, ``"hyq"``,
+            ``"go1"``, ``"go2"``, ``"a1"``, ``"b1"``, ``"laikago"``), the humanoids (``"talos"``, ``"romeo"``,
+            ``"icub"``, ``"simple_humanoid"``, ``"alexander"``, ``"g1"``) and the biped ``"bolt"``.
         free_flyer: with a free-flyer root joint (default: the robot's :attr:`ErdRobot.free_flyer`, True).
 
     Returns:
@@ -179,7 +207,7 @@ def load_erd(name: str, *, free_flyer: bool | None = None):
 
 
 def external_models() -> dict[str, dict]:
-    """``{name: erd_spec(name)}`` for the nine robots (for legkin's registry)."""
+    """``{name: erd_spec(name)}`` for every robot of :data:`ERD_ALL` (for legkin's registry)."""
     from .registry import erd_spec
 
-    return {name: erd_spec(name) for name in ERD_ROBOTS}
+    return {name: erd_spec(name) for name in ERD_ALL}

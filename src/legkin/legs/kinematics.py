@@ -54,9 +54,10 @@ import numpy as np
 
 from .._batch import as_input, check_flag, finish
 from .._kernels import OK, as_rows
-from ..errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
+from ..errors import InvalidInputError, JointLimitError, UnreachableError
+from ..errors import LegStructureError as _LegStructureError
 from ._fk_kernels import _fk_batch, _fk_k, _jacobian_batch, _jacobian_k
-from ._ik_kernels import _ik_all_batch, _ik_batch, _ik_k
+from ._ik_kernels import _ik_all_batch, _ik_all_k, _ik_batch, _ik_k
 from ._layout import (
     _A1,
     _A2,
@@ -107,8 +108,8 @@ __all__ = [
 ]
 
 
-class LegStructureError(InvalidParameterError):
-    """A kinematic chain that is not an HAA-HFE-KFE leg (the message names the deviation)."""
+#: A kinematic chain that is not a supported leg (the message names the deviation): legkin.errors' class.
+LegStructureError = _LegStructureError
 
 
 _S3SHAPE = (3,)
@@ -191,6 +192,10 @@ class Leg:
     idx_q: tuple[int, int, int] = (-1, -1, -1)
     idx_v: tuple[int, int, int] = (-1, -1, -1)
     params: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # always set by from_geometry
+
+    #: The leg's structure (see :data:`legkin.legs.extract.EXPECTED`) and its number of joints.
+    structure = "HAA-HFE-KFE"
+    dof = 3
 
     # ------------------------------------------------------------ construction
     @classmethod
@@ -470,11 +475,11 @@ class Leg:
         Args:
             p: targets (3,) or (..., 3).
             q_near: reference joint values (3,) or broadcastable with ``p``.
-            return_mask: also return the mask of the branches that exist.
+            return_mask: also return the boolean mask of the branches that exist (legkin 0.2.0 convention).
 
         Returns:
             ``q_all`` (4, 3) or (..., 4, 3) (rad) with NaN rows for absent branches; with ``return_mask=True``
-            ``(q_all, mask)``, the (4,) or (..., 4) boolean mask of the branches that exist.
+            ``(q_all, mask)``, the mask (4,) or (..., 4).
 
         Raises:
             UnreachableError: a single target with no branch (the message says by how much it misses).
@@ -483,6 +488,14 @@ class Leg:
         """
         if return_mask is not False and return_mask is not True:
             return_mask = check_flag(return_mask, "return_mask")
+        if q_near is None and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast
+            out = np.empty((4, 3))
+            info = np.zeros(2)
+            st = _ik_all_k(p, self.params, self.q_ref, out, info)
+            if st == OK:
+                return (out, np.isfinite(out[:, 0])) if return_mask else out
+            if st != _BAD_INPUT:
+                raise self._error(st, info, p.copy())
         rows, ref, batch, single = self._prepare(p, q_near)
         n = rows.shape[0]
         out = np.empty((n, 4, 3))
@@ -491,9 +504,10 @@ class Leg:
         _ik_all_batch(rows, self.params, ref, out, status, info)
         if single and status[0] != OK:
             raise self._error(int(status[0]), info[0], rows[0])
+        q_all = out.reshape(batch + (4, 3))
         if not return_mask:
-            return out.reshape(batch + (4, 3))
-        return out.reshape(batch + (4, 3)), np.isfinite(out[..., 0]).reshape(batch + (4,))
+            return q_all
+        return q_all, np.isfinite(q_all[..., 0])
 
     def ik(self, p, *, q_near=None, return_mask: bool = False):
         """Joint values placing the foot at ``p``: the branch inside the URDF limits nearest ``q_near``.

@@ -1,4 +1,4 @@
-"""Registry descriptions of the example-robot-data quadrupeds (for ``legkin.load``, ``legkin check``, the bench)."""
+"""Registry descriptions of the example-robot-data legged robots (for ``legkin.load``, ``legkin check``, the bench)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ __all__ = ["erd_spec"]
 
 
 def erd_spec(name: str) -> dict:
-    """How to load the example-robot-data quadruped ``name``.
+    """How to load the example-robot-data robot ``name``.
 
     Returns:
         ``{"name", "title", "urdf" (absolute path, str), "srdf" (str or None), "reference_pose" (str or None),
@@ -17,7 +17,7 @@ def erd_spec(name: str) -> dict:
         "source" ("example-robot-data")}``.
 
     Raises:
-        UnknownModelError: ``name`` not in :data:`legkin.legs.ERD_ROBOTS`.
+        UnknownModelError: ``name`` not in :data:`legkin.legs.ERD_ALL`.
     """
     robot = _robot(name)
     urdf, srdf, dirs = erd_files(name)

@@ -1,0 +1,317 @@
+"""Kernels of a 6-DOF leg (:mod:`legkin.legs.sixdof`): forward map, Jacobian, Newton polish, every IK solution of
+a leg with intersecting hip axes (subproblems 3, 2, 2, 1 of :mod:`.subproblems`), the solution inside the limits.
+
+Poses travel as 16 floats (a 4x4 homogeneous matrix, row-major); the leg's geometry as the float64 array of
+:mod:`._sixdof_layout`. The forward map is the product of exponentials about the neutral configuration with the
+measured axes ``a_j`` through the measured origins ``o_j`` (root frame), which is what Pinocchio computes::
+
+    T(q) = E_1(q_1) ... E_6(q_6) M_0,    E_j(t) = (R(a_j, t), o_j - R(a_j, t) o_j)
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from .._kernels import OK, batch_kernel, kernel
+from ._sixdof_layout import (
+    _ANK,
+    _AX,
+    _BAD_INPUT,
+    _HIP,
+    _M0,
+    _OR,
+    POLISH_BELOW6,
+    POLISH_DAMPING6,
+    POLISH_STEPS6,
+)
+from .subproblems import cross, dot, rot, sp1, sp2, sp3
+
+_NAN = math.nan
+
+
+@kernel
+def _axis(g, j):
+    return g[_AX + 3 * j], g[_AX + 3 * j + 1], g[_AX + 3 * j + 2]
+
+
+@kernel
+def _origin(g, j):
+    return g[_OR + 3 * j], g[_OR + 3 * j + 1], g[_OR + 3 * j + 2]
+
+
+@kernel
+def _pose6(q, g, rot_out, pos_out, axes_w, orig_w) -> None:
+    """Foot rotation ``rot_out`` (3, 3) and position ``pos_out`` (3,) of ``T(q) = E_1 ... E_6 M_0``; with the world
+    axes ``axes_w`` (6, 3) and points ``orig_w`` (6, 3) of the joints at ``q`` (for the Jacobian). No allocation:
+    the running product ``(r, t)`` lives in ``rot_out`` and ``pos_out``."""
+    r, t = rot_out, pos_out
+    for i in range(3):
+        t[i] = 0.0
+        for c in range(3):
+            r[i, c] = 1.0 if i == c else 0.0
+    for j in range(6):
+        a0, a1, a2 = g[_AX + 3 * j], g[_AX + 3 * j + 1], g[_AX + 3 * j + 2]
+        o = (g[_OR + 3 * j], g[_OR + 3 * j + 1], g[_OR + 3 * j + 2])
+        for i in range(3):  # the joint's axis and a point of it, in the root frame at q
+            axes_w[j, i] = r[i, 0] * a0 + r[i, 1] * a1 + r[i, 2] * a2
+            orig_w[j, i] = r[i, 0] * o[0] + r[i, 1] * o[1] + r[i, 2] * o[2] + t[i]
+        # (r, t) <- (r, t) E_j = (r m, t + r (o - m o)) = (r m, t + r o - (r m) o), m = R(a_j, q_j)
+        cq, sq = math.cos(q[j]), math.sin(q[j])
+        v = 1.0 - cq
+        m00, m01, m02 = cq + v * a0 * a0, v * a0 * a1 - sq * a2, v * a0 * a2 + sq * a1
+        m10, m11, m12 = v * a0 * a1 + sq * a2, cq + v * a1 * a1, v * a1 * a2 - sq * a0
+        m20, m21, m22 = v * a0 * a2 - sq * a1, v * a1 * a2 + sq * a0, cq + v * a2 * a2
+        for i in range(3):
+            r0, r1, r2 = r[i, 0], r[i, 1], r[i, 2]
+            n0 = r0 * m00 + r1 * m10 + r2 * m20
+            n1 = r0 * m01 + r1 * m11 + r2 * m21
+            n2 = r0 * m02 + r1 * m12 + r2 * m22
+            t[i] = orig_w[j, i] - (n0 * o[0] + n1 * o[1] + n2 * o[2])
+            r[i, 0], r[i, 1], r[i, 2] = n0, n1, n2
+    for i in range(3):  # (r, t) M_0
+        r0, r1, r2 = r[i, 0], r[i, 1], r[i, 2]
+        t[i] += r0 * g[_M0 + 9] + r1 * g[_M0 + 10] + r2 * g[_M0 + 11]
+        for c in range(3):
+            r[i, c] = r0 * g[_M0 + c] + r1 * g[_M0 + 3 + c] + r2 * g[_M0 + 6 + c]
+
+
+@kernel
+def _finite(x, n) -> bool:
+    for i in range(n):
+        if not np.isfinite(x[i]):
+            return False
+    return True
+
+
+@kernel(entry=True)
+def _fk6_k(q, g, out) -> int:
+    """The foot pose ``T(q)`` (16 floats, row-major 4x4) in the root frame."""
+    if not _finite(q, 6):
+        return _BAD_INPUT
+    rm, p = np.empty((3, 3)), np.empty(3)
+    aw, ow = np.empty((6, 3)), np.empty((6, 3))
+    _pose6(q, g, rm, p, aw, ow)
+    for i in range(3):
+        for c in range(3):
+            out[4 * i + c] = rm[i, c]
+        out[4 * i + 3] = p[i]
+        out[12 + i] = 0.0
+    out[15] = 1.0
+    return OK
+
+
+@kernel
+def _jac6(q, g, jac, rm, p, aw, ow) -> None:
+    """Pinocchio's LOCAL_WORLD_ALIGNED foot Jacobian (6, 6): column j = ``(w_j x (p - o_j), w_j)`` with the joint's
+    axis ``w_j`` and point ``o_j`` at ``q`` (root frame); also the foot rotation ``rm`` and position ``p``
+    (``aw``, ``ow``: (6, 3) work arrays)."""
+    _pose6(q, g, rm, p, aw, ow)
+    for j in range(6):
+        w = (aw[j, 0], aw[j, 1], aw[j, 2])
+        lin = cross(w, (p[0] - ow[j, 0], p[1] - ow[j, 1], p[2] - ow[j, 2]))
+        for i in range(3):
+            jac[i, j] = lin[i]
+            jac[3 + i, j] = w[i]
+
+
+@kernel(entry=True)
+def _jacobian6_k(q, g, out) -> int:
+    """The (6, 6) foot Jacobian, linear rows then angular (LOCAL_WORLD_ALIGNED at the foot frame)."""
+    if not _finite(q, 6):
+        return _BAD_INPUT
+    _jac6(q, g, out, np.empty((3, 3)), np.empty(3), np.empty((6, 3)), np.empty((6, 3)))
+    return OK
+
+
+@kernel
+def _pose_error(tg, rm, p, e) -> float:
+    """``e`` (6,) = ``(p_target - p, log(R_target R^T))`` (m, rad; root frame) and its norm."""
+    for i in range(3):
+        e[i] = tg[4 * i + 3] - p[i]
+
+    # the entries of R_target R^T that the axis-angle needs
+    m00 = tg[0] * rm[0, 0] + tg[1] * rm[0, 1] + tg[2] * rm[0, 2]
+    m11 = tg[4] * rm[1, 0] + tg[5] * rm[1, 1] + tg[6] * rm[1, 2]
+    m22 = tg[8] * rm[2, 0] + tg[9] * rm[2, 1] + tg[10] * rm[2, 2]
+    m21 = tg[8] * rm[1, 0] + tg[9] * rm[1, 1] + tg[10] * rm[1, 2]
+    m12 = tg[4] * rm[2, 0] + tg[5] * rm[2, 1] + tg[6] * rm[2, 2]
+    m02 = tg[0] * rm[2, 0] + tg[1] * rm[2, 1] + tg[2] * rm[2, 2]
+    m20 = tg[8] * rm[0, 0] + tg[9] * rm[0, 1] + tg[10] * rm[0, 2]
+    m10 = tg[4] * rm[0, 0] + tg[5] * rm[0, 1] + tg[6] * rm[0, 2]
+    m01 = tg[0] * rm[1, 0] + tg[1] * rm[1, 1] + tg[2] * rm[1, 2]
+    vx, vy, vz = 0.5 * (m21 - m12), 0.5 * (m02 - m20), 0.5 * (m10 - m01)
+    sn = math.sqrt(vx * vx + vy * vy + vz * vz)
+    ang = math.atan2(sn, 0.5 * (m00 + m11 + m22 - 1.0))
+    f = ang / sn if sn > 1e-300 else 1.0
+    e[3], e[4], e[5] = f * vx, f * vy, f * vz
+    return math.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2 + e[3] ** 2 + e[4] ** 2 + e[5] ** 2)
+
+
+@kernel
+def _solve6(a, b, x) -> bool:
+    """Solve the symmetric positive definite ``a x = b`` (6, 6) by Cholesky (``a`` overwritten); False if not SPD."""
+    for j in range(6):
+        s = a[j, j]
+        for k in range(j):
+            s -= a[j, k] * a[j, k]
+        if not s > 0.0:
+            return False
+        a[j, j] = math.sqrt(s)
+        for i in range(j + 1, 6):
+            s = a[i, j]
+            for k in range(j):
+                s -= a[i, k] * a[j, k]
+            a[i, j] = s / a[j, j]
+    for i in range(6):
+        s = b[i]
+        for k in range(i):
+            s -= a[i, k] * x[k]
+        x[i] = s / a[i, i]
+    for i in range(5, -1, -1):
+        s = x[i]
+        for k in range(i + 1, 6):
+            s -= a[k, i] * x[k]
+        x[i] = s / a[i, i]
+    return True
+
+
+@kernel
+def _polish6(tg, g, q, ws) -> float:
+    """Damped Newton steps ``dq = (J^T J + lambda^2 I)^-1 J^T e`` on the exact forward map (at most
+    :data:`POLISH_STEPS6`, each kept only if it reduces ``|e|``) while ``|e|`` exceeds :data:`POLISH_BELOW6`.
+    ``ws``: a work array of at least 32 rows of 6. Returns the final ``|e|`` (m and rad combined)."""
+    jac, a, aw, ow = ws[0:6], ws[6:12], ws[12:18, 0:3], ws[18:24, 0:3]
+    rm, p, e, b, dq, qn = ws[24:27, 0:3], ws[27, 0:3], ws[28], ws[29], ws[30], ws[31]
+    _pose6(q, g, rm, p, aw, ow)
+    err = _pose_error(tg, rm, p, e)
+    lam2 = POLISH_DAMPING6 * POLISH_DAMPING6
+    for _ in range(POLISH_STEPS6):
+        if err <= POLISH_BELOW6:
+            break
+        _jac6(q, g, jac, rm, p, aw, ow)
+        for i in range(6):
+            b[i] = 0.0
+            for k in range(6):
+                b[i] += jac[k, i] * e[k]
+            for c in range(6):
+                s = lam2 if i == c else 0.0
+                for k in range(6):
+                    s += jac[k, i] * jac[k, c]
+                a[i, c] = s
+        if not _solve6(a, b, dq):
+            break
+        for i in range(6):
+            qn[i] = q[i] + dq[i]
+        _pose6(qn, g, rm, p, aw, ow)
+        new = _pose_error(tg, rm, p, e)
+        if not new < err:
+            break
+        err = new
+        for i in range(6):
+            q[i] = qn[i]
+    return err
+
+
+@kernel
+def _mat_vec(m, v):
+    """``m v`` for a (3, 3) array ``m``."""
+    return (m[0, 0] * v[0] + m[0, 1] * v[1] + m[0, 2] * v[2], m[1, 0] * v[0] + m[1, 1] * v[1] + m[1, 2] * v[2],
+            m[2, 0] * v[0] + m[2, 1] * v[1] + m[2, 2] * v[2])
+
+
+@kernel
+def _mat_t_vec(m, v):
+    """``m^T v`` for a (3, 3) array ``m``."""
+    return (m[0, 0] * v[0] + m[1, 0] * v[1] + m[2, 0] * v[2], m[0, 1] * v[0] + m[1, 1] * v[1] + m[2, 1] * v[2],
+            m[0, 2] * v[0] + m[1, 2] * v[1] + m[2, 2] * v[2])
+
+
+@kernel
+def _target_motion(tg, g, gr):
+    """``G = T M_0^-1`` of the target ``T`` (16 floats): its rotation into ``gr`` (3, 3), its translation returned."""
+    for i in range(3):
+        for k in range(3):  # R_G = R_T R_0^T
+            j = _M0 + 3 * k
+            gr[i, k] = tg[4 * i] * g[j] + tg[4 * i + 1] * g[j + 1] + tg[4 * i + 2] * g[j + 2]
+    gp0 = _mat_vec(gr, (g[_M0 + 9], g[_M0 + 10], g[_M0 + 11]))
+    return tg[3] - gp0[0], tg[7] - gp0[1], tg[11] - gp0[2]
+
+
+@kernel
+def _hip_candidates(tg, g, cand) -> int:
+    """The closed-form solutions (rows of ``cand`` (8, 6)) of a leg whose hip axes 1-3 meet at the hip centre
+    ``c`` and whose ankle axes 5, 6 meet at the ankle centre ``a``; returns how many rows are filled.
+
+    With ``G = T M_0^-1`` and ``d = G^-1 c``: ``E_4 E_5 E_6 d = c``. Then (i) SP3: ``|E_4^-1 c - a| = |d - a|``
+    gives ``q_4``; (ii) SP2: ``R(a_5, -q_5)(E_4^-1 c - a) = R(a_6, q_6)(d - a)`` gives ``(q_5, q_6)``; (iii) the hip
+    rotation ``R_h = R_G R_6^T R_5^T R_4^T``: SP2 ``R(a_1, -q_1) R_h a_3 = R(a_2, q_2) a_3`` gives ``(q_1, q_2)``,
+    SP1 ``R(a_3, q_3) v = R_2^T R_1^T R_h v`` (``v`` normal to ``a_3``) gives ``q_3``. Branches that the
+    subproblems find absent are filled with their least-squares angles (the polish and the residual decide)."""
+    gr = np.empty((3, 3))
+    gt = _target_motion(tg, g, gr)
+    c = (g[_HIP], g[_HIP + 1], g[_HIP + 2])
+    an = (g[_ANK], g[_ANK + 1], g[_ANK + 2])
+    d = _mat_t_vec(gr, (c[0] - gt[0], c[1] - gt[1], c[2] - gt[2]))
+    a1, a2, a3, a4, a5, a6 = _axis(g, 0), _axis(g, 1), _axis(g, 2), _axis(g, 3), _axis(g, 4), _axis(g, 5)
+    o4 = _origin(g, 3)
+    da = (d[0] - an[0], d[1] - an[1], d[2] - an[2])
+    _, t4a, t4b, _ = sp3((c[0] - o4[0], c[1] - o4[1], c[2] - o4[2]), (an[0] - o4[0], an[1] - o4[1], an[2] - o4[2]),
+                         a4, math.sqrt(dot(da, da)))
+    v = cross(a3, a2)
+    nv = math.sqrt(dot(v, v))
+    v = (v[0] / nv, v[1] / nv, v[2] / nv)
+    n = 0
+    for i4 in range(2):
+        q4 = -(t4a if i4 == 0 else t4b)
+        e = rot(a4, -q4, (c[0] - o4[0], c[1] - o4[1], c[2] - o4[2]))
+        ea = (e[0] + o4[0] - an[0], e[1] + o4[1] - an[1], e[2] + o4[2] - an[2])
+        _, t5a, t6a, t5b, t6b, _ = sp2(ea, da, a5, a6)
+        r4a3, r4v = rot(a4, -q4, a3), rot(a4, -q4, v)
+        for i56 in range(2):
+            q5, q6 = -(t5a if i56 == 0 else t5b), (t6a if i56 == 0 else t6b)
+            # R_h y = R_G R_6^T R_5^T R_4^T y
+            h3 = _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, r4a3)))
+            hv = _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, r4v)))
+            _, t1a, t2a, t1b, t2b, _ = sp2(h3, a3, a1, a2)
+            for i12 in range(2):
+                q1, q2 = -(t1a if i12 == 0 else t1b), (t2a if i12 == 0 else t2b)
+                q3 = sp1(v, rot(a2, -q2, rot(a1, -q1, hv)), a3)
+                cand[n, 0], cand[n, 1], cand[n, 2] = q1, q2, q3
+                cand[n, 3], cand[n, 4], cand[n, 5] = q4, q5, q6
+                n += 1
+    return n
+
+
+@kernel
+def _valid_pose(tg) -> bool:
+    """``tg`` (16) is a finite homogeneous transform: bottom row ``0 0 0 1`` (to 1e-12), ``R^T R = I`` and
+    ``det R = 1`` to 1e-6 (the same test as :func:`legkin.legs.sixdof._pose_input`)."""
+    if not _finite(tg, 16):
+        return False
+    if abs(tg[12]) > 1e-12 or abs(tg[13]) > 1e-12 or abs(tg[14]) > 1e-12 or abs(tg[15] - 1.0) > 1e-12:
+        return False
+    for i in range(3):
+        for c in range(3):
+            s = tg[i] * tg[c] + tg[4 + i] * tg[4 + c] + tg[8 + i] * tg[8 + c]
+            if abs(s - (1.0 if i == c else 0.0)) > 1e-6:
+                return False
+    det = dot((tg[0], tg[4], tg[8]), cross((tg[1], tg[5], tg[9]), (tg[2], tg[6], tg[10])))
+    return abs(det - 1.0) <= 1e-6
+
+
+@batch_kernel(rows="q out", min_parallel=2048)
+def _fk6_batch(q, g, out) -> int:
+    n, bad = q.shape[0], 0
+    for i in range(n):
+        bad += _fk6_k(q[i], g, out[i]) != OK
+    return bad
+
+
+@batch_kernel(rows="q out", min_parallel=1024)
+def _jacobian6_batch(q, g, out) -> int:
+    n, bad = q.shape[0], 0
+    for i in range(n):
+        bad += _jacobian6_k(q[i], g, out[i]) != OK
+    return bad

@@ -1,0 +1,379 @@
+"""Exact kinematics of a 6-DOF leg (a humanoid's) measured from any URDF (issue 26).
+
+The leg, in the model's root frame (the URDF root link) at the neutral configuration: six revolute joints with
+unit axes ``a_1 .. a_6`` through points ``o_1 .. o_6`` (the joint origins) and the foot frame's pose ``M_0``. The
+forward map is the product of exponentials (what Pinocchio computes, with the measured axes)::
+
+    T(q) = E_1(q_1) E_2(q_2) ... E_6(q_6) M_0,      E_j(t) = (R(a_j, t), o_j - R(a_j, t) o_j)
+
+**Structure** (:attr:`Leg6.structure`, classified from the measured axes with :data:`AXIS_TOL`):
+
+* ``"6R-spherical-hip"``: axes 1-3 meet at the hip centre ``c`` and axes 5, 6 at the ankle centre ``a`` (talos,
+  romeo, icub, simple_humanoid). Every solution in closed form, by subproblems (:mod:`.subproblems`): with
+  ``G = T M_0^-1`` and ``d = G^-1 c`` the knee and ankle satisfy ``E_4 E_5 E_6 d = c``, so
+
+  1. SP3: ``|E_4^-1 c - a| = |d - a|`` (the knee, 2 solutions);
+  2. SP2: ``R(a_5, -q_5) (E_4^-1 c - a) = R(a_6, q_6) (d - a)`` (the ankle, 2);
+  3. SP2 then SP1 on the hip rotation ``R_h = R_G R_6^T R_5^T R_4^T``: ``R(a_1, -q_1) R_h a_3 = R(a_2, q_2) a_3``
+     (2), ``R(a_3, q_3) v = R_2^T R_1^T R_h v`` for ``v`` normal to ``a_3``.
+
+  Up to 8 solutions (:attr:`Leg6.n_solutions` rows of :meth:`Leg6.ik_all`, in the order knee, ankle, hip
+  branch). Where URDF rounding leaves the axes up to :data:`AXIS_TOL` off meeting (icub's ``rpy="... 1.5708"``:
+  2e-6 m), the closed form lands that close and damped Newton steps on the exact forward map finish it.
+* ``"6R-general"``: any other 6R chain (alexander's three parallel pitch axes, g1's offset hip): ``fk`` and
+  ``jacobian`` only; :meth:`Leg6.ik` raises :class:`~legkin.errors.LegStructureError`.
+
+Every answer is polished and kept only if it reproduces the target to ``tol`` (default :data:`IK_TOL` = 1e-9,
+m and rad); a target within ``tol`` of the reachable set is solved at its nearest reachable pose (the polish's
+least-squares limit). Single/batch contract of :mod:`legkin._batch`; kernels in :mod:`._sixdof_kernels`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .._batch import as_input, check_flag, check_number, finish
+from .._kernels import OK, as_rows
+from ..errors import InvalidInputError, JointLimitError, LegStructureError, UnreachableError
+from ._ik6_kernels import _ik6_batch, _ik6_k, _ik_all6_batch, _ik_all6_k
+from ._sixdof_kernels import _fk6_batch, _fk6_k, _jacobian6_batch, _jacobian6_k
+from ._sixdof_layout import (
+    _ANK,
+    _AX,
+    _BAD_INPUT,
+    _HI6,
+    _HIP,
+    _JOINT_LIMIT,
+    _KIND,
+    _LO6,
+    _M0,
+    _NP6,
+    _NSOL,
+    _NSOL_SEARCH,
+    _NSOLS,
+    _OR,
+    AXIS_TOL,
+    HIP_SPHERICAL,
+    IK_TOL,
+    THREE_PARALLEL,
+)
+
+__all__ = ["Leg6", "AXIS_TOL", "IK_TOL", "STRUCTURES", "nearest_point"]
+
+#: The structures a 6-DOF leg is classified into (the first two have an IK: closed form, one-dimensional search).
+STRUCTURES = ("6R-spherical-hip", "6R-three-parallel", "6R-general")
+_KINDS = {STRUCTURES[0]: HIP_SPHERICAL, STRUCTURES[1]: THREE_PARALLEL, STRUCTURES[2]: 0.0}
+_ROWS = {STRUCTURES[0]: _NSOL, STRUCTURES[1]: _NSOL_SEARCH, STRUCTURES[2]: 0}
+_Q6 = (6,)
+_T44 = (4, 4)
+_F64 = np.dtype(np.float64)
+
+
+def nearest_point(origins, axes) -> tuple[np.ndarray, float]:
+    """The point nearest (least squares) the lines ``o_i + t a_i`` and its largest distance to them (m).
+
+    ``sum_i (I - a_i a_i^T) x = sum_i (I - a_i a_i^T) o_i``; the distance of ``x`` to line i is
+    ``|(I - a_i a_i^T)(x - o_i)|``. Parallel lines have no such point: ``(nan, inf)``.
+    """
+    o = np.asarray(origins, dtype=float).reshape(-1, 3)
+    a = np.asarray(axes, dtype=float).reshape(-1, 3)
+    proj = np.eye(3)[None] - a[:, :, None] * a[:, None, :]
+    m, rhs = proj.sum(axis=0), np.einsum("kij,kj->i", proj, o)
+    if np.linalg.cond(m) > 1e8:
+        return np.full(3, np.nan), math.inf
+    x = np.linalg.solve(m, rhs)
+    gap = float(np.linalg.norm(np.einsum("kij,kj->ki", proj, x[None] - o), axis=-1).max())
+    return x, gap
+
+
+def _classify(a: np.ndarray, hip_gap: float, ankle_gap: float) -> str:
+    """The structure of unit axes ``a`` (6, 3) with the given gaps (m): :data:`STRUCTURES`, within :data:`AXIS_TOL`."""
+    if hip_gap <= AXIS_TOL and ankle_gap <= AXIS_TOL:
+        return STRUCTURES[0]
+    par = max(np.linalg.norm(np.cross(a[2], a[3])), np.linalg.norm(np.cross(a[2], a[4])))
+    apart = min(np.linalg.norm(np.cross(a[0], a[1])), np.linalg.norm(np.cross(a[2], a[5])))
+    return STRUCTURES[1] if par <= AXIS_TOL and apart > 0.1 else STRUCTURES[2]
+
+
+def _frozen(a) -> np.ndarray:
+    arr = np.array(a, dtype=float)
+    arr.flags.writeable = False
+    return arr
+
+
+def _pose_input(target, name: str = "target") -> np.ndarray:
+    """``target`` (4, 4) or (..., 4, 4) as a checked float array: finite, bottom row ``(0, 0, 0, 1)``, rotation
+    orthonormal with determinant +1 to 1e-6."""
+    arr = as_input(target, name, _T44)
+    rot = arr[..., :3, :3]
+    bottom = np.abs(arr[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max(initial=0.0)
+    ortho = np.abs(np.einsum("...ji,...jk->...ik", rot, rot) - np.eye(3)).max(initial=0.0)
+    det = np.abs(np.linalg.det(rot) - 1.0).max(initial=0.0) if rot.size else 0.0
+    if not (bottom <= 1e-12 and ortho <= 1e-6 and det <= 1e-6):
+        raise InvalidInputError(
+            f"{name} must be 4x4 homogeneous transforms (bottom row 0 0 0 1, a rotation block with R^T R = I and "
+            f"det R = 1 to 1e-6): bottom row off by {bottom:.3g}, R^T R - I by {ortho:.3g}, det R - 1 by {det:.3g}"
+        )
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class Leg6:
+    """One 6-DOF leg, measured in the model's root frame at the neutral configuration.
+
+    Build one with :func:`legkin.legs.from_model` / :func:`legkin.legs.from_urdf` (or :meth:`from_geometry`).
+
+    Attributes:
+        name: the leg's name (``"left"``, ``"right"``, or the common prefix of its joint names).
+        joint_names: its six joints in model order (hip to ankle).
+        foot_frame: the frame whose pose :meth:`fk` gives (a sole frame when the URDF has one).
+        lower, upper: the URDF limits (rad) of the six joints.
+        axes, origins: (6, 3) the unit joint axes and the joint origins (root frame, neutral configuration).
+        foot_pose: (4, 4) the foot frame at the neutral configuration (root frame).
+        structure: one of :data:`STRUCTURES`.
+        hip_centre, ankle_centre: the points nearest axes 1-3 and axes 5-6 (m), and ``hip_gap``, ``ankle_gap``:
+            their largest distances to those axes (m; 0 for an exact spherical hip).
+        q_ref: the default reference of :meth:`ik` (mid-limit; 0 where a limit is infinite).
+        idx_q, idx_v: the joints' indices in the source model's configuration / velocity vectors (-1 if none).
+        params: the float64 geometry array the kernels read.
+    """
+
+    name: str
+    joint_names: tuple[str, ...]
+    foot_frame: str
+    lower: np.ndarray
+    upper: np.ndarray
+    axes: np.ndarray
+    origins: np.ndarray
+    foot_pose: np.ndarray
+    structure: str
+    hip_centre: np.ndarray
+    ankle_centre: np.ndarray
+    hip_gap: float
+    ankle_gap: float
+    q_ref: np.ndarray
+    idx_q: tuple[int, ...] = (-1,) * 6
+    idx_v: tuple[int, ...] = (-1,) * 6
+    params: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # always set by from_geometry
+
+    dof = 6
+
+    @property
+    def n_solutions(self) -> int:
+        """The rows of :meth:`ik_all`: 8 (spherical hip), 16 (three parallel axes), 0 (no IK)."""
+        return int(self.params[_NSOLS])
+
+    @classmethod
+    def from_geometry(
+        cls, name: str, joint_names, foot_frame: str, origins, axes, foot_pose, lower, upper, *,
+        idx_q=(-1,) * 6, idx_v=(-1,) * 6,
+    ) -> Leg6:
+        """A leg from its joint origins (6, 3), unit axes (6, 3), foot pose (4, 4) at the neutral configuration and
+        limits (6,) each (rad; infinite for a continuous joint); classifies :attr:`structure`.
+
+        Raises:
+            LegStructureError: non-finite geometry, an axis without direction, or bad limits.
+        """
+        o = np.asarray(origins, dtype=float).reshape(6, 3)
+        a = np.asarray(axes, dtype=float).reshape(6, 3)
+        m0 = np.asarray(foot_pose, dtype=float).reshape(4, 4)
+        lo = np.asarray(lower, dtype=float).reshape(6)
+        hi = np.asarray(upper, dtype=float).reshape(6)
+        if not (np.isfinite(o).all() and np.isfinite(a).all() and np.isfinite(m0).all()):
+            raise LegStructureError(f"leg {name}: non-finite joint origins, axes or foot pose", found=name)
+        norms = np.linalg.norm(a, axis=-1)
+        if not (norms > 1e-12).all():
+            raise LegStructureError(f"leg {name}: a joint axis has no direction (norms {norms.tolist()})", found=name)
+        a = a / norms[:, None]
+        if np.isnan(lo).any() or np.isnan(hi).any() or (lo > hi).any():
+            raise LegStructureError(f"leg {name}: bad joint limits lower={lo.tolist()}, upper={hi.tolist()}")
+        hip, hip_gap = nearest_point(o[:3], a[:3])
+        ank, ank_gap = nearest_point(o[4:], a[4:])
+        structure = _classify(a, hip_gap, ank_gap)
+        g = np.zeros(_NP6)
+        g[_AX:_AX + 18], g[_OR:_OR + 18] = a.ravel(), o.ravel()
+        g[_M0:_M0 + 9], g[_M0 + 9:_M0 + 12] = m0[:3, :3].ravel(), m0[:3, 3]
+        spherical = structure == STRUCTURES[0]
+        g[_HIP:_HIP + 3] = hip if spherical else 0.0
+        g[_ANK:_ANK + 3] = ank if spherical else 0.0
+        g[_LO6:_LO6 + 6], g[_HI6:_HI6 + 6] = lo, hi
+        g[_KIND], g[_NSOLS] = _KINDS[structure], _ROWS[structure]
+        mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), np.clip(0.0, lo, hi))
+        return cls(
+            name=str(name), joint_names=tuple(str(j) for j in joint_names), foot_frame=str(foot_frame),
+            lower=_frozen(lo), upper=_frozen(hi), axes=_frozen(a), origins=_frozen(o), foot_pose=_frozen(m0),
+            structure=structure, hip_centre=_frozen(hip),
+            ankle_centre=_frozen(ank), hip_gap=hip_gap, ankle_gap=ank_gap, q_ref=_frozen(mid),
+            idx_q=tuple(int(i) for i in idx_q), idx_v=tuple(int(i) for i in idx_v), params=_frozen(g),
+        )
+
+    def __repr__(self) -> str:
+        return (f"Leg6({self.name!r}, {self.structure}, joints={self.joint_names}, foot={self.foot_frame!r}, "
+                f"hip gap {self.hip_gap:.2g} m, ankle gap {self.ankle_gap:.2g} m)")
+
+    # ------------------------------------------------------------ forward
+    def fk(self, q, *, return_mask: bool = False):
+        """The foot frame's pose ``T(q)`` (4, 4) in the root frame, or (..., 4, 4) for ``q`` (..., 6) (rad).
+
+        Args:
+            q: joint values (6,) or (..., 6), rad.
+            return_mask: also return the mask (all True: every finite ``q`` has a pose).
+
+        Raises:
+            InvalidInputError: ``q`` not a finite real array (..., 6).
+        """
+        if q.__class__ is np.ndarray and q.shape == _Q6 and q.dtype is _F64 and return_mask is False:
+            one = np.empty(16)  # a single call: straight to the kernel
+            if _fk6_k(q, self.params, one) == OK:
+                return one.reshape(4, 4)
+        arr = as_input(q, "q", _Q6)
+        rows = as_rows(arr, 6)
+        out = np.empty((rows.shape[0], 16))
+        _fk6_batch(rows, self.params, out)
+        res = out.reshape(arr.shape[:-1] + _T44)
+        return finish(res, np.ones(arr.shape[:-1], dtype=bool), arr.ndim == 1, check_flag(return_mask, "return_mask"),
+                      lambda: AssertionError("unreachable"))
+
+    def jacobian(self, q, *, return_mask: bool = False):
+        """The foot Jacobian (6, 6) or (..., 6, 6): rows ``(v, w)`` = linear velocity of the foot frame's origin
+        (m/s) then angular velocity (rad/s), both in root-frame axes, per unit joint rate (Pinocchio's
+        ``getFrameJacobian(..., LOCAL_WORLD_ALIGNED)`` on the leg's columns, fixed base). Column j:
+        ``(w_j x (p - o_j), w_j)`` with joint j's axis ``w_j`` and origin ``o_j`` at ``q``.
+
+        Raises:
+            InvalidInputError: ``q`` not a finite real array (..., 6).
+        """
+        if q.__class__ is np.ndarray and q.shape == _Q6 and q.dtype is _F64 and return_mask is False:
+            one = np.empty((6, 6))  # a single call: straight to the kernel
+            if _jacobian6_k(q, self.params, one) == OK:
+                return one
+        arr = as_input(q, "q", _Q6)
+        rows = as_rows(arr, 6)
+        out = np.empty((rows.shape[0], 6, 6))
+        _jacobian6_batch(rows, self.params, out)
+        res = out.reshape(arr.shape[:-1] + (6, 6))
+        return finish(res, np.ones(arr.shape[:-1], dtype=bool), arr.ndim == 1, check_flag(return_mask, "return_mask"),
+                      lambda: AssertionError("unreachable"))
+
+    # ------------------------------------------------------------ inverse
+    def _prepare(self, target, q_near, tol):
+        if self.params[_KIND] == 0.0:
+            raise LegStructureError(
+                f"leg {self.name}: no IK for its structure {self.structure!r} (hip axes meet within "
+                f"{self.hip_gap:.3g} m, ankle axes within {self.ankle_gap:.3g} m; axes 3-5 not parallel; tolerance "
+                f"{AXIS_TOL:g})", found=self.structure, expected=list(STRUCTURES[:2]),
+            )
+        tol = check_number(tol, "tol", 0.0, 1e-3, low_open=True)
+        arr = _pose_input(target)
+        batch = arr.shape[:-2]
+        if q_near is None:
+            ref = self.q_ref.reshape(1, 6).copy()
+        else:
+            r = as_input(q_near, "q_near", _Q6)
+            try:
+                batch = np.broadcast_shapes(batch, r.shape[:-1])
+            except ValueError:
+                raise InvalidInputError(
+                    f"target (shape {arr.shape}) and q_near (shape {r.shape}) do not broadcast together"
+                ) from None
+            ref = as_rows(r, 6) if r.ndim == 1 else as_rows(np.broadcast_to(r, batch + _Q6), 6)
+        if arr.shape[:-2] != batch:
+            arr = np.broadcast_to(arr, batch + _T44)
+        return as_rows(arr, 16), ref, batch, len(batch) == 0, tol
+
+    def _error(self, status: int, info: np.ndarray, target: np.ndarray, tol: float):
+        t = target.reshape(4, 4)
+        if status == _JOINT_LIMIT:
+            return JointLimitError(
+                f"foot pose of leg {self.name} at {t[:3, 3].round(6).tolist()} is reachable only outside the joint "
+                f"limits (by {float(info[0]):.6g} rad at least, {int(info[1])} solutions)", target=t,
+                distance=float(info[0]),
+            )
+        return UnreachableError(
+            f"foot pose of leg {self.name} at {t[:3, 3].round(6).tolist()} is out of reach: the nearest pose the "
+            f"solutions reach misses it by {float(info[0]):.6g} (m and rad; tol {tol:g})", target=t,
+            distance=float(info[0]),
+        )
+
+    def ik_all(self, target, *, q_near=None, tol: float = IK_TOL, return_mask: bool = False):
+        """Every solution of the foot pose(s) ``target`` (4, 4) or (..., 4, 4), joint limits ignored.
+
+        Args:
+            target: foot poses in the root frame (m).
+            q_near: each angle is given as its 2 pi representative nearest ``q_near`` (default :attr:`q_ref`).
+            tol: a solution reproduces the target to this (m and rad); (0, 1e-3].
+            return_mask: also return the mask of the rows that exist.
+
+        Returns:
+            ``(8, 6)`` or ``(..., 8, 6)`` (rad), NaN rows where a branch does not exist (rows: knee, ankle, hip
+            branch, see the module docstring); with ``return_mask=True`` also the mask ``(8,)`` / ``(..., 8)``.
+
+        Raises:
+            UnreachableError: a single target with no solution.
+            LegStructureError: a leg without a closed form (:attr:`structure` ``"6R-general"``).
+            InvalidInputError, InvalidArgumentError: bad ``target`` / ``q_near`` / ``tol`` / ``return_mask``.
+        """
+        if q_near is None and tol is IK_TOL and return_mask is False and target.__class__ is np.ndarray \
+                and target.shape == _T44 and target.dtype is _F64 and self.params[_KIND] != 0.0:
+            fast, info1 = np.empty((self.n_solutions, 6)), np.zeros(2)  # a single target: straight to the kernel
+            st = _ik_all6_k(target.reshape(16), self.params, self.q_ref, IK_TOL, fast, info1)
+            if st == OK:
+                return fast
+            if st != _BAD_INPUT:
+                raise self._error(st, info1, target, IK_TOL)
+        rows, ref, batch, single, tol = self._prepare(target, q_near, tol)
+        flag = check_flag(return_mask, "return_mask")
+        n = rows.shape[0]
+        k = self.n_solutions
+        out, status, info = np.empty((n, k, 6)), np.empty(n, dtype=np.int64), np.zeros((n, 2))
+        _ik_all6_batch(rows, self.params, ref, tol, out, status, info)
+        if single and status[0] != OK:
+            raise self._error(int(status[0]), info[0], rows[0], tol)
+        q_all = out.reshape(batch + (k, 6))
+        return (q_all, np.isfinite(q_all[..., 0])) if flag else q_all
+
+    def ik(self, target, *, q_near=None, tol: float = IK_TOL, return_mask: bool = False):
+        """The solution inside the URDF limits nearest ``q_near`` (default :attr:`q_ref`, mid-limits).
+
+        Each solution of :meth:`ik_all` takes, joint by joint, its 2 pi representative inside the limits nearest
+        ``q_near``; the one with the least ``|q - q_near|^2`` wins.
+
+        Args:
+            target: foot poses (4, 4) or (..., 4, 4), root frame (m).
+            q_near: reference (6,) or broadcastable with the targets.
+            tol: as :meth:`ik_all`.
+            return_mask: also return the mask of the solved targets.
+
+        Returns:
+            ``q`` (6,) or (..., 6) (rad; NaN rows for unsolved batch items), and the mask if asked.
+
+        Raises:
+            UnreachableError: a single target out of reach; JointLimitError: reachable only outside the limits.
+            LegStructureError, InvalidInputError, InvalidArgumentError: as :meth:`ik_all`.
+        """
+        if q_near is None and tol is IK_TOL and return_mask is False and target.__class__ is np.ndarray \
+                and target.shape == _T44 and target.dtype is _F64 and self.params[_KIND] != 0.0:
+            fast, info1 = np.empty(6), np.zeros(2)  # a single target: straight to the kernel
+            st = _ik6_k(target.reshape(16), self.params, self.q_ref, IK_TOL, fast, info1)
+            if st == OK:
+                return fast
+            if st != _BAD_INPUT:
+                raise self._error(st, info1, target, IK_TOL)
+        rows, ref, batch, single, tol = self._prepare(target, q_near, tol)
+        flag = check_flag(return_mask, "return_mask")
+        n = rows.shape[0]
+        out, status, info = np.empty((n, 6)), np.empty(n, dtype=np.int64), np.zeros((n, 2))
+        _ik6_batch(rows, self.params, ref, tol, out, status, info)
+        ok = status == OK
+        if single:
+            return finish(out[0], ok[0], True, flag, lambda: self._error(int(status[0]), info[0], rows[0], tol))
+        return finish(out.reshape(batch + _Q6), ok.reshape(batch), False, flag, lambda: AssertionError("batch"))
+
+    def within_limits(self, q, tol: float = 0.0) -> np.ndarray | bool:
+        """Whether ``q`` (6,) or (..., 6) lies inside the URDF limits (widened by ``tol`` rad)."""
+        arr = as_input(q, "q", _Q6)
+        inside = np.all((arr >= self.lower - tol) & (arr <= self.upper + tol), axis=-1)
+        return bool(inside) if arr.ndim == 1 else inside

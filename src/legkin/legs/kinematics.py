@@ -63,12 +63,14 @@ from ._layout import (
     _A2,
     _A3,
     _BAD_INPUT,
+    _CD,
     _D,
     _E1,
     _E2,
     _E3,
     _H,
     _HI,
+    _IDEAL,
     _IN_CYLINDER,
     _JOINT_LIMIT,
     _K,
@@ -81,6 +83,7 @@ from ._layout import (
     _PK,
     _PL,
     _S3,
+    _SD,
     _SLACK,
     _TOO_FAR,
     _UNREACHABLE,
@@ -114,6 +117,19 @@ LegStructureError = _LegStructureError
 
 _S3SHAPE = (3,)
 _F64 = np.dtype(np.float64)
+
+
+def _vector3(x: object) -> np.ndarray | None:
+    """``x`` itself if it is a float64 array (3,) (a single call's reference, for the fast path), else None."""
+    if x.__class__ is np.ndarray and x.shape == _S3SHAPE and x.dtype is _F64:  # type: ignore[attr-defined]
+        return x  # type: ignore[return-value]
+    return None
+
+
+def _rows3(x: object) -> bool:
+    """Whether ``x`` is a C-contiguous writeable float64 array (n, 3), n >= 1 (a batch the kernels take as is)."""
+    return (x.__class__ is np.ndarray and x.ndim == 2 and x.shape[1] == 3 and x.dtype is _F64  # type: ignore[attr-defined]
+            and x.shape[0] > 0 and x.flags.c_contiguous and x.flags.writeable)  # type: ignore[attr-defined]
 
 
 # ---------------------------------------------------------------- geometry helpers (Python)
@@ -192,6 +208,12 @@ class Leg:
     idx_q: tuple[int, int, int] = (-1, -1, -1)
     idx_v: tuple[int, int, int] = (-1, -1, -1)
     params: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # always set by from_geometry
+    _ref: np.ndarray = field(init=False, repr=False)  # q_ref, writeable: the kernels' one type of reference array
+    _ref1: np.ndarray = field(init=False, repr=False)  # the same, one row (1, 3)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_ref", np.array(self.q_ref, dtype=float).reshape(3))
+        object.__setattr__(self, "_ref1", self._ref.reshape(1, 3))
 
     #: The leg's structure (see :data:`legkin.legs.extract.EXPECTED`) and its number of joints.
     structure = "HAA-HFE-KFE"
@@ -284,6 +306,8 @@ class Leg:
         # deviations (rad) times the lever arms: its reach boundaries get that much slack (then exact check).
         lever = float(np.linalg.norm(o[1] - o[0]) + np.linalg.norm(o[2] - o[1]) + np.linalg.norm(f - o[2]))
         g[_SLACK] = REACH_TOL + 4.0 * (abs(dot12) + cross23 + 1e-15) * lever
+        g[_IDEAL] = 1.0 if dot12 == 0.0 and cross23 == 0.0 else 0.0
+        g[_CD], g[_SD] = math.cos(g[_PK] - g[_PL]), math.sin(g[_PK] - g[_PL])
         return cls(
             name=str(name), joint_names=(str(j1), str(j2), str(j3)), foot_frame=str(foot_frame),
             lower=_frozen(lo), upper=_frozen(hi), origin=_frozen(o[0]), axes=_frozen(np.stack([a1, a2, a3])),
@@ -405,7 +429,7 @@ class Leg:
         """Checked target rows and reference rows (m = 1 or n), the batch shape and whether it is a single call."""
         arr = as_input(p, "p", _S3SHAPE)
         if q_near is None:
-            ref = self.q_ref.reshape(1, 3)
+            ref = self._ref1
             batch = arr.shape[:-1]
         else:
             r = as_input(q_near, "q_near", _S3SHAPE)
@@ -451,6 +475,14 @@ class Leg:
             )
         return InvalidInputError(f"p must be finite, got {tgt}")  # pragma: no cover - as_input caught it
 
+    def _single_error(self, batch_loop, width: tuple[int, ...], p: np.ndarray, ref: np.ndarray) -> Exception:
+        """The error of a failed single call: the batch loop run on its one row gives the failure's data."""
+        rows = np.array(p, dtype=float).reshape(1, 3)
+        status = np.empty(1, dtype=np.int64)
+        info = np.zeros((1, 2))
+        batch_loop(rows, self.params, np.array(ref, dtype=float).reshape(1, 3), np.empty((1,) + width), status, info)
+        return self._error(int(status[0]), info[0], rows[0])
+
     def _least_violation(self, branches: np.ndarray) -> tuple[int, float, np.ndarray]:
         """The branch least outside the limits (each angle's 2 pi representative nearest them): the index of its
         joint farthest outside, that joint's value (rad) and the branch (error path only)."""
@@ -488,14 +520,15 @@ class Leg:
         """
         if return_mask is not False and return_mask is not True:
             return_mask = check_flag(return_mask, "return_mask")
-        if q_near is None and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast
-            out = np.empty((4, 3))
-            info = np.zeros(2)
-            st = _ik_all_k(p, self.params, self.q_ref, out, info)
-            if st == OK:
-                return (out, np.isfinite(out[:, 0])) if return_mask else out
-            if st != _BAD_INPUT:
-                raise self._error(st, info, p.copy())
+        if p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # one target: the fast path
+            ref = self._ref if q_near is None else _vector3(q_near)
+            if ref is not None:
+                out = np.empty((4, 3))
+                st = _ik_all_k(p, self.params, ref, out)
+                if st == OK:
+                    return (out, np.isfinite(out[:, 0])) if return_mask else out
+                if st != _BAD_INPUT:
+                    raise self._single_error(_ik_all_batch, (4, 3), p, ref)
         rows, ref, batch, single = self._prepare(p, q_near)
         n = rows.shape[0]
         out = np.empty((n, 4, 3))
@@ -535,14 +568,22 @@ class Leg:
         """
         if return_mask is not False and return_mask is not True:
             return_mask = check_flag(return_mask, "return_mask")
-        if q_near is None and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast
-            out = np.empty(3)
-            info = np.zeros(2)
-            st = _ik_k(p, self.params, self.q_ref, out, info)
-            if st == OK:
-                return (out, np.array(True)) if return_mask else out
-            if st != _BAD_INPUT:
-                raise self._error(st, info, p.copy())
+        if p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # one target: the fast path
+            ref = self._ref if q_near is None else _vector3(q_near)
+            if ref is not None:
+                out = np.empty(3)
+                st = _ik_k(p, self.params, ref, out)
+                if st == OK:
+                    return (out, np.array(True)) if return_mask else out
+                if st != _BAD_INPUT:
+                    raise self._single_error(_ik_batch, (3,), p, ref)
+        if q_near is None and _rows3(p):  # a batch (n, 3) the kernels can read as is: no copy, no isfinite pass
+            out = np.empty(p.shape)
+            status = np.empty(p.shape[0], dtype=np.int64)
+            _ik_batch(p, self.params, self._ref1, out, status, np.empty((p.shape[0], 2)))
+            ok = status == OK
+            if ok.all() or not (status == _BAD_INPUT).any():
+                return (out, ok) if return_mask else out
         rows, ref, batch, single = self._prepare(p, q_near)
         n = rows.shape[0]
         out = np.empty((n, 3))

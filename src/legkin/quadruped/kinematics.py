@@ -42,6 +42,7 @@ from .constants import (
     Z23,
 )
 from .geometry import DEFAULT_GEOMETRY, Geometry
+from .measured import _LEGS as _MEASURED
 from .measured import SEED_ORDER, legs
 from .textbook import textbook_frame, textbook_ik, textbook_to_joints
 
@@ -80,7 +81,9 @@ _ORDER = {leg: np.array(order) for leg, order in SEED_ORDER.items()}
 
 def _leg(leg: object, geometry: Geometry | None) -> Leg:
     """The measured :class:`~legkin.legs.Leg` of ``leg`` for ``geometry`` (InvalidParameterError for a bad one)."""
-    found = legs(geometry)
+    found = _MEASURED.get(0.0) if geometry is None else None  # the default geometry's legs, once measured
+    if found is None:
+        found = legs(geometry)
     try:
         return found[leg]  # type: ignore[index]
     except (KeyError, TypeError):
@@ -231,10 +234,12 @@ def ik_all(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = No
         InvalidInputError: ``target`` or ``q_near`` not finite real arrays (..., 3), or not broadcastable.
         InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
     """
-    with_mask = _flag(return_mask)
-    q, mask = _leg(leg, geometry).ik_all(target, q_near=q_near, return_mask=True)
+    found = _leg(leg, geometry)
     order = _ORDER[leg]
-    return (q[..., order, :], mask[..., order]) if with_mask else q[..., order, :]
+    if not (return_mask if return_mask is False or return_mask is True else _flag(return_mask)):
+        return found.ik_all(target, q_near=q_near).take(order, axis=-2)  # type: ignore[no-any-return]
+    q, mask = found.ik_all(target, q_near=q_near, return_mask=True)
+    return q.take(order, axis=-2), mask.take(order, axis=-1)
 
 
 def hip_position(leg: str, *, geometry: Geometry | None = None) -> np.ndarray:

@@ -580,10 +580,10 @@ class Leg:
         if q_near is None and _rows3(p):  # a batch (n, 3) the kernels can read as is: no copy, no isfinite pass
             out = np.empty(p.shape)
             status = np.empty(p.shape[0], dtype=np.int64)
-            _ik_batch(p, self.params, self._ref1, out, status, np.empty((p.shape[0], 2)))
-            ok = status == OK
-            if ok.all() or not (status == _BAD_INPUT).any():
-                return (out, ok) if return_mask else out
+            if not _ik_batch(p, self.params, self._ref1, out, status, np.empty((p.shape[0], 2))):
+                return (out, np.ones(p.shape[0], dtype=bool)) if return_mask else out
+            if not (status == _BAD_INPUT).any():  # NaN rows for the targets that failed (else as_input raises)
+                return (out, status == OK) if return_mask else out
         rows, ref, batch, single = self._prepare(p, q_near)
         n = rows.shape[0]
         out = np.empty((n, 3))

@@ -42,7 +42,6 @@ from .constants import (
     Z23,
 )
 from .geometry import DEFAULT_GEOMETRY, Geometry
-from .measured import _LEGS as _MEASURED
 from .measured import SEED_ORDER, legs
 from .textbook import textbook_frame, textbook_ik, textbook_to_joints
 
@@ -79,11 +78,19 @@ _LO, _HI = tuple(JOINT_LIMITS[:, 0].tolist()), tuple(JOINT_LIMITS[:, 1].tolist()
 _ORDER = {leg: np.array(order) for leg, order in SEED_ORDER.items()}
 
 
+#: The default geometry's measured legs by name, once measured (the single calls' look-up: one dict access).
+_DEFAULT: dict[str, Leg] = {}
+
+
 def _leg(leg: object, geometry: Geometry | None) -> Leg:
     """The measured :class:`~legkin.legs.Leg` of ``leg`` for ``geometry`` (InvalidParameterError for a bad one)."""
-    found = _MEASURED.get(0.0) if geometry is None else None  # the default geometry's legs, once measured
-    if found is None:
-        found = legs(geometry)
+    if geometry is None and leg.__class__ is str:
+        found_leg = _DEFAULT.get(leg)  # type: ignore[call-overload]
+        if found_leg is not None:
+            return found_leg
+    found = legs(geometry)
+    if geometry is None:
+        _DEFAULT.update(found)
     try:
         return found[leg]  # type: ignore[index]
     except (KeyError, TypeError):

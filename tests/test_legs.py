@@ -64,7 +64,7 @@ def test_erd_files_come_from_the_installed_distribution():
     assert len(ROBOTS) == 9
     assert set(ROBOTS) == {"solo12", "anymal", "anymal_c", "hyq", "go1", "go2", "a1", "b1", "laikago"}
     specs = legs.external_models()
-    assert set(specs) == set(ROBOTS)
+    assert set(specs) == set(legs.ERD_ALL) and set(ROBOTS) < set(specs)
     for name in ROBOTS:
         spec = legs.erd_spec(name)
         assert spec == specs[name]
@@ -649,3 +649,70 @@ def test_ik_all_returns_solutions_and_mask_only_when_asked(fl):
         np.testing.assert_array_equal(m1, mask[i])
     with pytest.raises(InvalidParameterError, match="return_mask"):
         fl.ik_all(p[0], return_mask=1)
+
+
+# ------------------------------------------------------------------------------------------- issue 26: URDF gaps
+def test_continuous_joints_are_legs_with_unbounded_limits(tmp_path):
+    """go1's URDF with every joint ``continuous`` (as public aliengo / mini_cheetah descriptions write them): the same
+    legs, infinite limits, the same forward map, and IK answers nearest q_near with no limit to respect."""
+    text = legs.erd_files("go1")[0].read_text()
+    urdf = tmp_path / "go1_continuous.urdf"
+    urdf.write_text(text.replace('type="revolute"', 'type="continuous"'))
+    cont, orig = legs.from_urdf(urdf), legs.from_urdf(legs.erd_files("go1")[0])
+    assert list(cont) == list(orig)
+    rng = np.random.default_rng(12)
+    for name, leg in cont.items():
+        assert np.isinf(leg.lower).all() and np.isinf(leg.upper).all() and (leg.q_ref == 0).all()
+        q = rng.uniform(-3, 3, (200, 3))
+        np.testing.assert_allclose(leg.fk(q), orig[name].fk(q), atol=1e-15, rtol=0)
+        sol, ok = leg.ik(leg.fk(q), q_near=q, return_mask=True)
+        assert ok.all() and np.abs(sol - q).max() < 1e-9
+
+
+@pytest.mark.parametrize("name", ["go2", "anymal_c", "solo12"])
+def test_float32_targets_are_solved_within_tol(erd, name):
+    """Feet of in-limit joints rounded to float32 (a simulator's): none refused with tol=1e-9 ... unless the rounding
+    pushed them out of reach by more (then tol=1e-7 solves them at the nearest point, 1e-7 m away at most)."""
+    _, found = erd[name]
+    rng = np.random.default_rng(32)
+    for leg in found.values():
+        q = rng.uniform(leg.lower, leg.upper, (20_000, 3))
+        p32 = leg.fk(q).astype(np.float32).astype(float)
+        _, ok = leg.ik(p32, return_mask=True)
+        sol, ok7 = leg.ik(p32, tol=1e-7, return_mask=True)
+        assert ok7.all(), f"{name} {leg.name}: {int((~ok7).sum())} refused with tol=1e-7"
+        assert np.linalg.norm(leg.fk(sol) - p32, axis=-1).max() <= 1e-7
+        assert (~ok).sum() <= 20, f"{name} {leg.name}: {int((~ok).sum())} of 20000 refused with tol=1e-9"
+
+
+def test_tol_bounds_the_nearest_point_solution(erd):
+    fl = erd["solo12"][1]["FL"]  # limits +-10 rad: the straight knee is inside them
+    stretched = fl.fk(np.array([0.0, 0.0, 0.0]))  # knee straight: the full stretch
+    out = fl.origin + 1.0000001 * (stretched - fl.origin)  # ~4e-8 m beyond
+    with pytest.raises(UnreachableError):
+        fl.ik(out, tol=1e-9)
+    q = fl.ik(out, tol=1e-6)
+    miss = float(np.linalg.norm(fl.fk(q) - out))
+    assert 1e-9 < miss <= 1e-6
+    with pytest.raises(InvalidParameterError, match="tol"):
+        fl.ik(out, tol=-1.0)
+
+
+def test_quadruped_legs_named_by_hip_position_when_joint_names_share_no_prefix():
+    """Joints named '0' ... '11' (no common prefix): the legs are FL, FR, RL, RR from the hips' signs of x and y."""
+    model = pin.Model()
+    hips = {"RR": (-0.2, -0.1), "FL": (0.2, 0.1), "RL": (-0.2, 0.1), "FR": (0.2, -0.1)}
+    k = 0
+    for x, y in hips.values():
+        parent = 0
+        for jm, place in ((pin.JointModelRX(), (x, y, 0.0)), (pin.JointModelRY(), (0.0, 0.05 * np.sign(y), 0.0)),
+                          (pin.JointModelRY(), (0.0, 0.0, -0.2))):
+            parent = model.addJoint(parent, jm, pin.SE3(np.eye(3), np.array(place)), str(k))
+            model.addJointFrame(parent, -1)
+            k += 1
+        model.addFrame(pin.Frame(f"f{k}", parent, 0, pin.SE3(np.eye(3), np.array([0.0, 0.0, -0.2])),
+                                 pin.FrameType.OP_FRAME))
+    found = legs.from_model(model)
+    assert list(found) == list(hips)
+    for name, leg in found.items():
+        assert np.sign(leg.origin[:2]).tolist() == np.sign(hips[name]).tolist()

@@ -28,7 +28,7 @@ HUMANOIDS = {
                         ("l_ankle", "r_ankle")),
     "alexander": ("alexander_description/urdf/alexander_v1.lowerBodyOnly.urdf", "6R-three-parallel",
                   ("LEFT_FOOT", "RIGHT_FOOT")),
-    "g1": ("g1_description/urdf/g1_29dof_rev_1_0.urdf", "6R-general",
+    "g1": ("g1_description/urdf/g1_29dof_rev_1_0.urdf", "6R-offset-hip",
            ("left_ankle_roll_link", "right_ankle_roll_link")),
 }
 CLOSED = [n for n, (_, s, _) in HUMANOIDS.items() if s != "6R-general"]
@@ -132,11 +132,12 @@ def test_every_erd_legged_robot_has_its_legs(humanoids):
         assert tuple(leg.foot_frame for leg in found.values()) == feet, name
         for leg in found.values():
             assert isinstance(leg, Leg6) and leg.dof == 6 and leg.structure == structure, (name, leg)
+            assert leg.n_solutions == (8 if structure == "6R-spherical-hip" else 16)
     bolt = legs.from_urdf(_robots_dir() / "bolt_description/robots/bolt.urdf")
     assert list(bolt) == ["FL", "FR"] and all(leg.dof == 3 and leg.structure == "HAA-HFE-KFE" for leg in bolt.values())
     g1 = humanoids["g1"][1]
     assert list(g1) == ["left", "right"]
-    assert humanoids["g1"][1]["left"].hip_gap > 0.01  # g1's hip axes do not meet
+    assert g1["left"].hip_gap > 0.01  # g1's hip axes do not meet
 
 
 def test_foot_frames_choose_and_errors(humanoids):
@@ -203,13 +204,13 @@ def test_fk_and_jacobian_equal_pinocchio(humanoids, name):
 
 @pytest.mark.parametrize("name", CLOSED)
 def test_ik_round_trip_and_every_sample_among_ik_all(humanoids, name):
-    """2000 random in-limit configurations per leg (500 for alexander's search): every foot pose solved inside the
-    limits, reproduced by Pinocchio to 1e-12; the sampled configuration is one of ik_all's rows (mod 2 pi, to
-    1e-9 rad). (``legkin check`` and the issue's 10^4 per leg: see docs/legs.md.)"""
+    """2000 random in-limit configurations per leg (300 for alexander's and g1's search): every foot pose solved
+    inside the limits, reproduced by Pinocchio to 1e-12; the sampled configuration is one of ik_all's rows (mod
+    2 pi, to 1e-9 rad). (10^4 per leg: ``legkin check NAME --samples 10000``, docs/legs.md.)"""
     model, found = humanoids[name]
     rng = np.random.default_rng(2026)
     for leg in found.values():
-        qs = rng.uniform(leg.lower, leg.upper, (500 if leg.structure == "6R-three-parallel" else 2000, 6))
+        qs = rng.uniform(leg.lower, leg.upper, (2000 if leg.structure == "6R-spherical-hip" else 300, 6))
         poses, _ = _pin_feet(model, leg, qs)
         q, ok = leg.ik(poses, return_mask=True)
         assert ok.all() and leg.within_limits(q).all()
@@ -304,7 +305,33 @@ def test_bad_options_and_no_closed_form(talos_left, humanoids):
         talos_left.fk([0.0] * 5)
     with pytest.raises(InvalidInputError, match="q_near"):
         talos_left.ik(t, q_near=[0.0] * 3)
-    g1 = humanoids["g1"][1]["left"]
+    rng = np.random.default_rng(8)  # six skew axes: no structure legkin solves
+    general = Leg6.from_geometry("X", [f"j{i}" for i in range(6)], "foot", rng.normal(size=(6, 3)),
+                                 rng.normal(size=(6, 3)), np.eye(4), -np.ones(6), np.ones(6))
+    assert general.structure == "6R-general" and general.n_solutions == 0
     with pytest.raises(LegStructureError, match="no IK for its structure") as info:
-        g1.ik(g1.fk(np.zeros(6)))
+        general.ik(general.fk(np.zeros(6)))
     assert info.value.found == "6R-general"
+
+
+# ------------------------------------------------------------------------------------------- the squat clip
+@pytest.mark.parametrize("name", ["talos", "g1"])
+def test_squat_keeps_the_soles_on_the_floor(name):
+    """``legkin view NAME --animate squat --floating``: the pelvis goes SQUAT_DEPTH down and back, every sole stays
+    flat where it was (Pinocchio's oMf, 1e-9), every frame inside the joint limits."""
+    import legkin
+    from legkin.legs.clips import SQUAT_DEPTH, squat
+
+    robot = legkin.load(name, floating=True)
+    qs = np.array(squat(robot))
+    data = robot.model.createData()
+    soles = []
+    for q in qs:
+        pin.framesForwardKinematics(robot.model, data, q)
+        soles.append([data.oMf[robot.model.getFrameId(leg.foot_frame)].homogeneous.copy()
+                      for leg in robot.geometry.values()])
+    soles = np.array(soles)
+    assert np.abs(soles - soles[0]).max() <= 1e-9
+    assert abs(soles[0, :, 2, 3].min()) <= 1e-12  # the lowest sole on the floor
+    assert qs[0, 2] - qs[:, 2].min() == pytest.approx(SQUAT_DEPTH, rel=1e-3)
+    assert all(leg.within_limits(qs[:, list(leg.idx_q)]).all() for leg in robot.geometry.values())

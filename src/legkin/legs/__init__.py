@@ -4,11 +4,16 @@
 >>> model, urdf, dirs = legs.load_erd("go2")
 >>> go2 = legs.from_model(model)            # {"FL": Leg, "FR": Leg, "RL": Leg, "RR": Leg}
 >>> q = go2["FL"].ik([0.19, 0.14, -0.3])    # the branch inside the URDF limits
+>>> talos = legs.from_model(legs.load_erd("talos")[0])   # {"leg_left": Leg6, "leg_right": Leg6}
 
 Modules: :mod:`.kinematics` (the :class:`Leg`; its compiled kernels in :mod:`._fk_kernels` (forward map, Jacobian)
-and :mod:`._ik_kernels` (closed-form IK, Newton polish), constants in :mod:`._layout`), :mod:`.extract` (finding
-and measuring legs in a Pinocchio model), :mod:`.erd` (the nine quadrupeds of example-robot-data),
-:mod:`.registry`, :mod:`.checks` (rows of ``legkin check``), :mod:`.bench`.
+and :mod:`._ik_kernels` (closed-form IK, Newton polish), constants in :mod:`._layout`), :mod:`.sixdof` (the
+:class:`Leg6`; kernels in :mod:`._sixdof_kernels` (forward map, Jacobian, polish, the spherical hip's closed form),
+:mod:`._search_kernels` (the one-dimensional searches), :mod:`._ik6_kernels` (every solution, the one inside the
+limits); the subproblems SP1-SP4 in :mod:`.subproblems`, constants in :mod:`._sixdof_layout`), :mod:`.extract`
+(finding and measuring legs in a Pinocchio model), :mod:`.erd` (the legged robots of example-robot-data),
+:mod:`.registry`, :mod:`.checks` / :mod:`.checks6` (rows of ``legkin check``), :mod:`.bench` / :mod:`.bench6`,
+:mod:`.clips` (``feet_circles``, ``squat``), :mod:`.figures`.
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ import numpy as np
 
 from .._kernels import OK, batch_kernel, kernel
 from ._ik_kernels import _in_limits_k, _near_k
-from ._parallel_kernels import _parallel_candidates
+from ._search_kernels import _search_candidates
 from ._sixdof_kernels import _hip_candidates, _polish6, _valid_pose
 from ._sixdof_layout import (
     _BAD_INPUT,
@@ -21,10 +21,19 @@ from ._sixdof_layout import (
     _NSOLS,
     _UNREACHABLE,
     HIP_SPHERICAL,
-    THREE_PARALLEL,
 )
 
 _NAN = math.nan
+
+
+@kernel
+def _candidates(tg, g, cand) -> int:
+    """The candidate rows of the leg's structure (closed form or search) in ``cand``; returns how many."""
+    if g[_KIND] == HIP_SPHERICAL:
+        return _hip_candidates(tg, g, cand)
+    if g[_KIND] != 0.0:
+        return _search_candidates(tg, g, cand)
+    return 0
 
 
 @kernel(entry=True)
@@ -41,12 +50,7 @@ def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
         return _BAD_INPUT
     ws = np.empty((33 + k, 6))  # rows 0-31: the polish's work space, 32: the polished row, then the candidates
     cand, qb = ws[33:], ws[32]
-    if g[_KIND] == HIP_SPHERICAL:
-        n = _hip_candidates(tg, g, cand)
-    elif g[_KIND] == THREE_PARALLEL:
-        n = _parallel_candidates(tg, g, cand)
-    else:
-        n = 0
+    n = _candidates(tg, g, cand)
     best, found = math.inf, 0
     for b in range(n):
         for j in range(6):
@@ -64,42 +68,70 @@ def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
     return OK
 
 
+@kernel
+def _limited(q, ref, g, x) -> tuple[float, bool]:
+    """``x`` = each angle of ``q`` at its 2 pi representative inside the limits nearest ``ref``; returns the cost
+    ``|x - ref|^2`` and whether every angle has one (else the cost is the worst limit violation, rad)."""
+    worst, inside = 0.0, True
+    for j in range(6):
+        x[j], m = _in_limits_k(q[j], ref[j], g[_LO6 + j], g[_HI6 + j])
+        worst = max(worst, m)
+        inside = inside and np.isfinite(x[j])
+    if not inside:
+        return worst, False
+    cost = 0.0
+    for j in range(6):
+        cost += (x[j] - ref[j]) ** 2
+    return cost, True
+
+
 @kernel(entry=True)
 def _ik6_k(tg, g, ref, tol, out, info) -> int:
-    """The solution of :func:`_ik_all6_k` inside the limits nearest ``ref`` (least sum of squared differences;
-    ties to the earlier row). ``info``: the least residual, or the least limit violation (rad) and the count of
-    solutions."""
-    qa = np.empty((int(g[_NSOLS]), 6))
-    status = _ik_all6_k(tg, g, ref, tol, qa, info)
+    """The solution inside the limits nearest ``ref`` (least sum of squared differences): the candidates are ranked
+    by that cost first and polished in that order until one reproduces ``tg`` to ``tol`` (its angles then moved
+    inside the limits again), so a single answer costs one polish, not one per candidate. ``info``: the least
+    residual, or the least limit violation (rad) and the count of solutions."""
     for j in range(6):
         out[j] = _NAN
-    if status != OK:
-        return status
+    if not _valid_pose(tg):
+        return _BAD_INPUT
+    k = int(g[_NSOLS])
+    ws = np.empty((33 + 2 * k, 6))  # polish work space, polished row, candidates, their in-limit representatives
+    cand, lim, qb = ws[33:33 + k], ws[33 + k:], ws[32]
+    n = _candidates(tg, g, cand)
+    cost = np.empty(k)
+    for b in range(n):
+        c, inside = _limited(cand[b], ref, g, lim[b])
+        cost[b] = c if inside else math.inf
     best, viol, nb = math.inf, math.inf, 0
-    x = np.empty(6)
-    for b in range(qa.shape[0]):
-        if not np.isfinite(qa[b, 0]):
-            continue
-        nb += 1
-        worst, inside = 0.0, True
+    for _ in range(n):  # the in-limit candidates, cheapest first
+        i = int(np.argmin(cost[:n]))
+        if cost[i] == math.inf:
+            break
+        cost[i] = math.inf
         for j in range(6):
-            x[j], m = _in_limits_k(qa[b, j], ref[j], g[_LO6 + j], g[_HI6 + j])
-            worst = max(worst, m)
-            inside = inside and np.isfinite(x[j])
-        viol = min(viol, worst)
-        if not inside:
-            continue
-        cost = 0.0
-        for j in range(6):
-            cost += (x[j] - ref[j]) ** 2
-        if cost < best:
-            best = cost
+            qb[j] = lim[i, j]
+        res = _polish6(tg, g, qb, ws)
+        if res <= tol:
+            c, inside = _limited(qb, ref, g, out)
+            if inside:
+                return OK
             for j in range(6):
-                out[j] = x[j]
-    if best == math.inf:
-        info[0], info[1] = viol, nb
-        return _JOINT_LIMIT
-    return OK
+                out[j] = _NAN
+        best = min(best, res)
+    for b in range(n):  # none inside the limits: is any candidate a solution at all?
+        for j in range(6):
+            qb[j] = cand[b, j]
+        if _polish6(tg, g, qb, ws) <= tol:
+            nb += 1
+            viol = min(viol, _limited(qb, ref, g, lim[b])[0])
+        else:
+            best = min(best, _polish6(tg, g, qb, ws))
+    if nb == 0:
+        info[0], info[1] = best, 0.0
+        return _UNREACHABLE
+    info[0], info[1] = viol, nb
+    return _JOINT_LIMIT
 
 
 @batch_kernel(rows="tg ref out status info", min_parallel=256)

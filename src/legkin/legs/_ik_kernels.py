@@ -202,25 +202,27 @@ def _near_k(a, r):
 
 
 @kernel
-def _ik_all_core(p, g, ref, out):
+def _ik_all_core(p, g, ref, tol, out):
     """Every branch (rows in :data:`BRANCHES` order, NaN rows for absent ones) of the target ``p``.
 
     ``r^2 = y^2 + z^2``, ``u3 = s_a sqrt(r^2 - d^2)``, ``q1 = atan2(z, y) - atan2(u3, d)``;
     ``w = (u3, x1) - h``, ``cos beta = (|w|^2 - |k|^2 - |l|^2) / (2 |k||l|)``, ``beta = s_k acos(.)``,
     ``q3 = s3 (beta - phi_l + phi_k)``, ``q2 = atan2(w) - atan2(k + Rot(s3 q3) l)``. Each branch is then
     polished on the exact forward map (:func:`_settle_k`) and each angle moved to its 2 pi representative
-    nearest ``ref``. Returns ``(status, miss, reason)``: on failure the miss (m) and its reason.
+    nearest ``ref``. A target up to ``tol`` (m) outside the reachable set is solved at its nearest reachable point
+    (the clamped closed form, polished). Returns ``(status, miss, reason)``: on failure the miss (m) and its
+    reason.
     """
     for b in range(4):
         out[b, 0] = out[b, 1] = out[b, 2] = _NAN
     if not (_finite3(p) and _finite3(ref)):
         return _BAD_INPUT, 0.0, 0.0
     x, t, yz, cyl, clean_a = _target_k(p, g)
-    slack = g[_SLACK]
+    slack = g[_SLACK] - REACH_TOL + tol  # the ideal structure's deviation bound, plus tol
     if cyl > slack:
         return _UNREACHABLE, cyl, _IN_CYLINDER
     best, why = math.inf, 0.0
-    if cyl > REACH_TOL:
+    if cyl > tol:
         best, why = cyl, _IN_CYLINDER
     found = 0
     for ia in range(2):
@@ -231,13 +233,13 @@ def _ik_all_core(p, g, ref, out):
             if miss < best:
                 best, why = miss, reason
             continue
-        # within the slack of the ideal structure's boundary: kept only if the exact foot error is <= REACH_TOL
-        check = cyl > REACH_TOL or miss > REACH_TOL
+        # within the slack of the ideal structure's boundary: kept only if the exact foot error is <= tol
+        check = cyl > tol or miss > tol
         for ik in range(2):
             q3 = _knee_k(g, ik, acb)
             j1, j2, j3, res = _settle_k(p, g, q1, _hip_k(g, ik, wx, wy, c), q3, clean_a and clean_w and not check)
-            if check and res > REACH_TOL:  # clamped onto the ideal structure's boundary, and missing the target
-                if cyl <= REACH_TOL and res < best:
+            if check and res > tol:  # clamped onto the ideal structure's boundary, and missing the target
+                if cyl <= tol and res < best:
                     best, why = res, reason
                 continue
             b = 2 * ia + ik
@@ -333,13 +335,13 @@ def _accept_k(p, g, j1, j2, j3, ref):
 
 
 @kernel
-def _ik_every_k(p, g, ref, out):
+def _ik_every_k(p, g, ref, tol, out):
     """:func:`_ik_core`'s complete path: every branch of :func:`_ik_all_core` (all polished) put inside the limits
     by :func:`_accept_k`, the one nearest ``ref`` kept (least sum of squared joint differences; ties to the earlier
     branch). Returns ``(status, info0, info1)``: the miss (m) and reason, or the least limit violation (rad) and
     the number of geometric branches."""
     qa = np.empty((4, 3))  # the rare path allocates
-    status, i0, i1 = _ik_all_core(p, g, ref, qa)
+    status, i0, i1 = _ik_all_core(p, g, ref, tol, qa)
     if status != OK:
         return status, i0, i1
     best, viol, nb = math.inf, math.inf, 0
@@ -359,7 +361,7 @@ def _ik_every_k(p, g, ref, out):
 
 
 @kernel
-def _ik_core(p, g, ref, out):
+def _ik_core(p, g, ref, tol, out):
     """The branch of :func:`_ik_all_core` inside the limits nearest ``ref``, limits first, into ``out`` (3,).
 
     The fast path computes the closed form of each branch with scalars only, joint by joint in the order q1, q3,
@@ -374,7 +376,7 @@ def _ik_core(p, g, ref, out):
     if not (_finite3(p) and _finite3(ref)):
         return _BAD_INPUT, 0.0, 0.0
     x, t, yz, cyl, clean_a = _target_k(p, g)
-    slack = g[_SLACK]
+    slack = g[_SLACK] - REACH_TOL + tol
     best, c1, c2, c3, check, clean, inside = math.inf, 0.0, 0.0, 0.0, False, False, False
     y0 = y1 = y2 = 0.0
     pitched, clean_w = False, False  # the pitch-plane quantities computed (for one abduction branch)
@@ -402,7 +404,7 @@ def _ik_core(p, g, ref, out):
             cost += (x1 - ref[1]) ** 2
             if m1 <= CANDIDATE_SLACK and cost < best:
                 best, c1, c2, c3, y0, y1, y2 = cost, q1, q2, q3, x0, x1, x2
-                check = cyl > REACH_TOL or miss > REACH_TOL
+                check = cyl > tol or miss > tol
                 clean = clean_a and clean_w and not check
                 inside = m0 == 0.0 and m1 == 0.0 and m2 == 0.0 and not (k0 or k1 or k2)
     if clean and inside:  # well-conditioned, strictly inside the limits: the representatives found are the answer
@@ -410,44 +412,44 @@ def _ik_core(p, g, ref, out):
         return OK, 0.0, 0.0
     if best < math.inf:
         j1, j2, j3, res = _settle_k(p, g, c1, c2, c3, clean)
-        if res <= REACH_TOL or not check:
+        if res <= tol or not check:
             ok, _m, x0, x1, x2 = _accept_k(p, g, j1, j2, j3, ref)
             if ok:
                 out[0], out[1], out[2] = x0, x1, x2
                 return OK, 0.0, 0.0
-    return _ik_every_k(p, g, ref, out)
+    return _ik_every_k(p, g, ref, tol, out)
 
 
 @kernel(entry=True)
-def _ik_all_k(p, g, ref, out) -> int:
+def _ik_all_k(p, g, ref, tol, out) -> int:
     """:func:`_ik_all_core` of one target (the single call): its status."""
-    return _ik_all_core(p, g, ref, out)[0]
+    return _ik_all_core(p, g, ref, tol, out)[0]
 
 
 @kernel(entry=True)
-def _ik_k(p, g, ref, out) -> int:
+def _ik_k(p, g, ref, tol, out) -> int:
     """:func:`_ik_core` of one target (the single call): its status."""
-    return _ik_core(p, g, ref, out)[0]
+    return _ik_core(p, g, ref, tol, out)[0]
 
 
 @batch_kernel(rows="p ref out status info", min_parallel=512)
-def _ik_all_batch(p, g, ref, out, status, info) -> int:
+def _ik_all_batch(p, g, ref, tol, out, status, info) -> int:
     """:func:`_ik_all_core` over rows; returns the number of targets that failed (status != OK)."""
     # ref: one row for all targets (m = 1) or one per target; ``i - i`` keeps the index type of i
     n, m, bad = p.shape[0], ref.shape[0], 0
     for i in range(n):
-        s, a, b = _ik_all_core(p[i], g, ref[i if m > 1 else i - i], out[i])
+        s, a, b = _ik_all_core(p[i], g, ref[i if m > 1 else i - i], tol, out[i])
         status[i], info[i, 0], info[i, 1] = s, a, b
         bad += s != OK
     return bad
 
 
 @batch_kernel(rows="p ref out status info", min_parallel=1024)
-def _ik_batch(p, g, ref, out, status, info) -> int:
+def _ik_batch(p, g, ref, tol, out, status, info) -> int:
     """:func:`_ik_core` over rows; returns the number of targets that failed (status != OK)."""
     n, m, bad = p.shape[0], ref.shape[0], 0
     for i in range(n):
-        s, a, b = _ik_core(p[i], g, ref[i if m > 1 else i - i], out[i])
+        s, a, b = _ik_core(p[i], g, ref[i if m > 1 else i - i], tol, out[i])
         status[i], info[i, 0], info[i, 1] = s, a, b
         bad += s != OK
     return bad

@@ -9,8 +9,11 @@ import math
 PERPENDICULAR_TOL = 1e-9
 #: |a2 x a3| (HFE vs KFE axis) above this is "not parallel".
 PARALLEL_TOL = 1e-9
-#: A target up to this far (m) outside the reachable set is solved on its boundary.
+#: The closed form's own reach slack (m): a branch is polished until its foot is this close.
 REACH_TOL = 1e-12
+#: Default ``tol`` of :meth:`Leg.ik` / :meth:`Leg.ik_all` (m): a target up to this far outside the reachable set is
+#: solved at its nearest reachable point (float32 rounding of a 0.5 m foot position is ~3e-8 m, see docs/legs.md).
+IK_TOL = 1e-9
 #: A joint angle up to this far (rad) outside the URDF limits is clipped onto the limit when re-solving the other
 #: joints (LIMIT_SLACK) does not reach the target (the foot then moves by at most LIMIT_TOL x the leg's reach).
 LIMIT_TOL = 1e-10

@@ -3,17 +3,16 @@
 
 from __future__ import annotations
 
-from ._layout import _BAD_INPUT, _JOINT_LIMIT, _UNREACHABLE
+from ._layout import _BAD_INPUT, _JOINT_LIMIT, _UNREACHABLE, IK_TOL
 
-__all__ = ["_BAD_INPUT", "_JOINT_LIMIT", "_UNREACHABLE"]
+__all__ = ["_BAD_INPUT", "_JOINT_LIMIT", "_UNREACHABLE", "IK_TOL"]
 
 #: Two joint axes closer than this (m) count as intersecting; a unit-axis cross product below it, as parallel (rad).
 #: URDF angles written with 4-6 digits (icub: ``rpy="... 1.5708 ..."``) leave axes up to ~2e-5 m / rad off the
 #: ideal; the closed form then lands that close and the Newton polish (:data:`POLISH_STEPS6`) finishes the job.
 AXIS_TOL = 1e-4
-#: Default ``tol`` of :meth:`Leg6.ik` / :meth:`Leg6.ik_all`: a pose is solved when the polished answer reproduces
-#: it to this (m and rad, the norm of the 6-vector position error, rotation error).
-IK_TOL = 1e-9
+# IK_TOL (default ``tol`` of Leg6.ik / Leg6.ik_all, 1e-9): a pose is solved when the polished answer reproduces it
+# to this (m and rad, the norm of the 6-vector position error, rotation error); the same default as Leg's.
 #: Damped Newton steps (at most) of the polish on the exact forward map.
 POLISH_STEPS6 = 12
 #: Damping of the polish steps (m): bounds a step near a singularity.
@@ -34,6 +33,7 @@ TANGENT_TOL = 1e-9
 #: Structure codes (params[_KIND]).
 HIP_SPHERICAL = 1.0
 THREE_PARALLEL = 2.0
+OFFSET_HIP = 3.0
 
 # ---------------------------------------------------------------- layout of the geometry array (Leg6.params)
 _AX = 0  # the six unit axes a_j at the neutral configuration (root frame), 3 each

@@ -211,6 +211,10 @@ def build(name: str, n: int | None, rng: np.random.Generator, quick: bool) -> Mo
     legs = robot.geometry
     leg_name = LEG if LEG in legs else next(iter(legs))
     leg = legs[leg_name]
+    if leg.dof == 6:
+        from .bench6 import build6
+
+        return build6(robot, leg_name, n, rng, quick)
     foot = _Foot(robot.model, leg, np.array(robot.q0, dtype=float))
     q_true = rng.uniform(leg.lower, leg.upper, (n_batch, 3))
     targets = foot(q_true)

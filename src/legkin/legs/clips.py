@@ -1,4 +1,5 @@
-"""Clips of the external quadrupeds (``legkin view go2 --animate feet_circles``), driven by :meth:`Leg.ik`."""
+"""Clips of the external robots (``legkin view go2 --animate feet_circles``, ``legkin view g1 --animate squat``),
+driven by :meth:`Leg.ik` and :meth:`Leg6.ik`."""
 
 from __future__ import annotations
 
@@ -6,13 +7,15 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["ANIMATIONS", "feet_circles", "circle_points", "FRAMES", "RADIUS", "LIMIT_MARGIN"]
+__all__ = ["ANIMATIONS", "feet_circles", "squat", "circle_points", "FRAMES", "RADIUS", "LIMIT_MARGIN", "SQUAT_DEPTH"]
 
 #: Frames of one turn and the circles' radius (m).
 FRAMES = 60
 RADIUS = 0.03
 #: A standing pose outside the limits is moved this fraction of each limit range inside them.
 LIMIT_MARGIN = 0.1
+#: How far (m) the pelvis goes down in :func:`squat`.
+SQUAT_DEPTH = 0.08
 
 
 def circle_points(start, frames: int = FRAMES, radius: float = RADIUS) -> np.ndarray:
@@ -41,14 +44,60 @@ def feet_circles(robot: Any, frames: int = FRAMES, radius: float = RADIUS) -> li
     qs = np.tile(q0, (frames, 1))
     for leg in robot.geometry.values():
         cols = list(leg.idx_q)
-        q = q0[cols]
-        if not leg.within_limits(q):
-            margin = LIMIT_MARGIN * (leg.upper - leg.lower)
-            q = np.clip(q, leg.lower + margin, leg.upper - margin)
+        q = _start(leg, q0)
         for k, p in enumerate(circle_points(leg.fk(q), frames, radius)):
             q = leg.ik(p, q_near=q)
             qs[k, cols] = q
     return list(qs)
 
 
-ANIMATIONS = {"feet_circles": feet_circles}
+def _start(leg, q0: np.ndarray) -> np.ndarray:
+    """The leg's joints of ``q0``, moved :data:`LIMIT_MARGIN` of each limit range inside the limits if outside."""
+    q = q0[list(leg.idx_q)]
+    if not leg.within_limits(q):
+        margin = LIMIT_MARGIN * (leg.upper - leg.lower)
+        q = np.clip(q, leg.lower + margin, leg.upper - margin)
+    return q
+
+
+def _floor_offset(robot: Any, q: np.ndarray) -> float:
+    """How far (m) to raise a floating base at ``q`` so that the lowest foot frame is on the floor (z = 0)."""
+    import pinocchio as pin
+
+    data = robot.model.createData()
+    pin.framesForwardKinematics(robot.model, data, q)
+    return -min(float(data.oMf[robot.model.getFrameId(leg.foot_frame)].translation[2])
+                for leg in robot.geometry.values())
+
+
+def squat(robot: Any, frames: int = FRAMES, depth: float = SQUAT_DEPTH) -> list[np.ndarray]:
+    """The pelvis goes ``depth`` down and back up (``dz = depth (1 - cos t) / 2``, one period) with every foot
+    flat and fixed on the floor: each foot's target in the root frame is its pose (6-DOF legs: the 4x4 pose,
+    3-DOF legs: the position) at ``robot.q0`` raised by ``dz``, solved by ``ik(target, q_near=previous frame's)``.
+    With a free flyer (``legkin.load(name, floating=True)``, ``legkin view --floating``) the base is first raised
+    so that the lowest foot is on the floor, then goes down by ``dz``: the feet stay where they are in the world;
+    on a fixed base the feet rise instead.
+
+    Raises:
+        UnreachableError, JointLimitError: a target out of a leg's reach or limits (``depth`` too large).
+    """
+    q0 = np.array(robot.q0, dtype=float)
+    qs = np.tile(q0, (frames, 1))
+    dz = 0.5 * depth * (1.0 - np.cos(np.linspace(0.0, 2.0 * np.pi, frames, endpoint=False)))
+    if robot.model.njoints > 1 and robot.model.joints[1].shortname() == "JointModelFreeFlyer":
+        qs[:, 2] += _floor_offset(robot, q0) - dz
+    for leg in robot.geometry.values():
+        q = _start(leg, q0)
+        start = leg.fk(q)
+        for k in range(frames):
+            target = start.copy()
+            if leg.dof == 6:
+                target[2, 3] += dz[k]
+            else:
+                target[2] += dz[k]
+            q = leg.ik(target, q_near=q)
+            qs[k, list(leg.idx_q)] = q
+    return list(qs)
+
+
+ANIMATIONS = {"feet_circles": feet_circles, "squat": squat}

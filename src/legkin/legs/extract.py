@@ -32,6 +32,9 @@ __all__ = ["from_model", "from_urdf", "find_chains", "VERIFY_TOL", "REVOLUTE"]
 
 #: Pinocchio joint models that count as a revolute leg joint.
 REVOLUTE = ("JointModelRX", "JointModelRY", "JointModelRZ", "JointModelRevoluteUnaligned")
+#: URDF ``continuous`` joints: Pinocchio's unbounded revolute joints (two configuration entries, cos and sin; a
+#: leg's ``idx_q`` then points at the cos entry, its limits are infinite).
+CONTINUOUS = ("JointModelRUBX", "JointModelRUBY", "JointModelRUBZ", "JointModelRevoluteUnboundedUnaligned")
 #: Largest difference (m) allowed between the closed form and Pinocchio on the verification configurations.
 VERIFY_TOL = 1e-9
 #: The joint vectors (besides zero) on which the closed form is compared with Pinocchio at construction.
@@ -65,7 +68,33 @@ def _children(model, j: int) -> list[int]:
 
 
 def _is_revolute(model, j: int) -> bool:
-    return j > 0 and model.joints[j].shortname() in REVOLUTE and model.joints[j].nq == 1
+    """A revolute joint with limits (one configuration entry) or a continuous one (two: cos, sin)."""
+    if j <= 0:
+        return False
+    kind, nq = model.joints[j].shortname(), model.joints[j].nq
+    return (kind in REVOLUTE and nq == 1) or (kind in CONTINUOUS and nq == 2)
+
+
+def _set_angles(model, q: np.ndarray, chain, angles) -> np.ndarray:
+    """``q`` with the joints of ``chain`` at ``angles`` (rad): a continuous joint's entries are (cos, sin)."""
+    for j, a in zip(chain, angles):
+        i = model.joints[j].idx_q
+        if model.joints[j].nq == 2:
+            q[i], q[i + 1] = math.cos(a), math.sin(a)
+        else:
+            q[i] = a
+    return q
+
+
+def _limits(model, chain) -> tuple[np.ndarray, np.ndarray]:
+    """The URDF limits (rad) of the joints of ``chain``: infinite for a continuous joint."""
+    lo, hi = [], []
+    for j in chain:
+        i = model.joints[j].idx_q
+        unbounded = model.joints[j].nq == 2
+        lo.append(-math.inf if unbounded else model.lowerPositionLimit[i])
+        hi.append(math.inf if unbounded else model.upperPositionLimit[i])
+    return np.array(lo), np.array(hi)
 
 
 def _foot_frame(model, j: int) -> str | None:
@@ -219,16 +248,14 @@ def _foot_rel(model, data, root: int, fid: int, q) -> np.ndarray:
     return np.array((data.oMi[root].inverse() * data.oMf[fid]).homogeneous)
 
 
-def _verify_fk(model, root: int, leg, fk, q0, data) -> tuple[float, np.ndarray]:
+def _verify_fk(model, root: int, chain, leg, fk, q0, data) -> tuple[float, np.ndarray]:
     """The largest difference between ``fk(q_leg)`` and Pinocchio's foot (position (3,) or pose (4, 4)) over zero
     and :data:`_VERIFY_Q`, and where."""
     n = len(leg.idx_q)
     fid = model.getFrameId(leg.foot_frame)
     worst, where = 0.0, np.zeros(n)
     for qleg in np.vstack([np.zeros(n), np.resize(_VERIFY_Q.ravel(), (3, n))]):
-        q = q0.copy()
-        q[list(leg.idx_q)] = qleg
-        ref = _foot_rel(model, data, root, fid, q)
+        ref = _foot_rel(model, data, root, fid, _set_angles(model, q0.copy(), chain, qleg))
         got = fk(qleg)
         err = float(np.abs(got - (ref[:3, 3] if got.shape == (3,) else ref)).max())
         if not err <= worst:
@@ -246,8 +273,7 @@ def _build(model, root: int, chain: tuple[int, ...], foot: str, name: str) -> Le
     origins, axes, foot_pose = _measure(model, data, root, chain, foot)
     iq = tuple(model.joints[j].idx_q for j in chain)
     iv = tuple(model.joints[j].idx_v for j in chain)
-    lower = np.array([model.lowerPositionLimit[i] for i in iq])
-    upper = np.array([model.upperPositionLimit[i] for i in iq])
+    lower, upper = _limits(model, chain)
     names = tuple(model.names[j] for j in chain)
     leg: Leg | Leg6
     if len(chain) == 6:
@@ -255,7 +281,7 @@ def _build(model, root: int, chain: tuple[int, ...], foot: str, name: str) -> Le
     else:
         leg = Leg.from_geometry(name, names, foot, origins, axes, foot_pose[:3, 3], lower, upper,  # type: ignore[arg-type]
                                 idx_q=iq, idx_v=iv)  # type: ignore[arg-type]
-    worst, where = _verify_fk(model, root, leg, leg.fk, q0, data)
+    worst, where = _verify_fk(model, root, chain, leg, leg.fk, q0, data)
     if not worst <= VERIFY_TOL:
         raise LegStructureError(
             f"leg {name}: the forward map misses Pinocchio's {foot} by {worst:.3g} at joint values "

@@ -35,6 +35,10 @@ Pinocchio); each closed-form branch is polished by at most :data:`POLISH_STEPS` 
 its foot error exceeds :data:`POLISH_BELOW` (axes a few 1e-12 rad off the ideal structure, the knee's fold).
 Each angle is then moved by a multiple of 2 pi: in :meth:`Leg.ik_all` to the representative nearest the
 reference configuration, in :meth:`Leg.ik` to the representative inside the URDF limits nearest ``q_near``.
+:meth:`Leg.ik` is limits-first: the branches are pruned joint by joint (q1, q3, q2) by the limits and by their
+partial distance to ``q_near`` before any polish, and only the winner is polished. On a leg whose axes are
+exactly the ideal structure, a branch away from the singular sets (:data:`~._layout.WELL_CONDITIONED`) is exact
+to rounding and returned unpolished (docs/legs.md gives the measurement).
 
 Implementation (issue 16, :mod:`legkin._kernels`): each function is one compiled scalar kernel; a batch is a
 compiled loop over it. Where the code is: :mod:`._fk_kernels` (forward map, Jacobian), :mod:`._ik_kernels`
@@ -52,7 +56,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .._batch import as_input, check_flag, finish
+from .._batch import as_input, check_flag, check_number, finish
 from .._kernels import OK, as_rows
 from ..errors import InvalidInputError, JointLimitError, UnreachableError
 from ..errors import LegStructureError as _LegStructureError
@@ -91,6 +95,7 @@ from ._layout import (
     _V21,
     _V32,
     BRANCHES,
+    IK_TOL,
     LIMIT_TOL,
     PARALLEL_TOL,
     PERPENDICULAR_TOL,
@@ -107,6 +112,7 @@ __all__ = [
     "PERPENDICULAR_TOL",
     "PARALLEL_TOL",
     "REACH_TOL",
+    "IK_TOL",
     "LIMIT_TOL",
 ]
 
@@ -291,7 +297,8 @@ class Leg:
         hi = np.asarray(upper, dtype=float).reshape(3)
         if np.any(np.isnan(lo)) or np.any(np.isnan(hi)) or np.any(lo > hi):
             raise LegStructureError(f"leg {name}: bad joint limits lower={lo.tolist()}, upper={hi.tolist()}")
-        mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), np.clip(0.0, lo, hi))
+        finite = np.isfinite(lo) & np.isfinite(hi)
+        mid = np.where(finite, 0.5 * (np.where(finite, lo, 0.0) + np.where(finite, hi, 0.0)), np.clip(0.0, lo, hi))
         g = np.zeros(_NPARAMS)
         g[_O:_O + 3], g[_E1:_E1 + 3], g[_E2:_E2 + 3], g[_E3:_E3 + 3] = o[0], e1, e2, e3
         g[_D] = d
@@ -425,7 +432,7 @@ class Leg:
         _jacobian_batch(rows, self.params, out)
         return out.reshape(arr.shape + (3,))
 
-    def _prepare(self, p, q_near):
+    def _prepare(self, p, q_near, tol):
         """Checked target rows and reference rows (m = 1 or n), the batch shape and whether it is a single call."""
         arr = as_input(p, "p", _S3SHAPE)
         if q_near is None:
@@ -446,9 +453,9 @@ class Leg:
                 ref = as_rows(np.broadcast_to(r, batch + _S3SHAPE), 3)
             if arr.shape[:-1] != batch:
                 arr = np.broadcast_to(arr, batch + _S3SHAPE)
-        return as_rows(arr, 3), ref, batch, len(batch) == 0
+        return as_rows(arr, 3), ref, batch, len(batch) == 0, check_number(tol, "tol", 0.0, 1e-3, low_open=True)
 
-    def _error(self, status: int, info: np.ndarray, p: np.ndarray):
+    def _error(self, status: int, info: np.ndarray, p: np.ndarray, tol: float = IK_TOL):
         tgt = [float(x) for x in p]
         if status == _UNREACHABLE:
             miss, why = float(info[0]), info[1]
@@ -463,7 +470,7 @@ class Leg:
             return UnreachableError(f"target {tgt} is out of reach of leg {self.name} by {miss:.6g} m: {text}",
                                     target=p, distance=miss)
         if status == _JOINT_LIMIT:
-            branches = self.ik_all(p)
+            branches = self.ik_all(p, tol=tol)
             j, value, closest = self._least_violation(branches)
             return JointLimitError(
                 f"target {tgt} of leg {self.name} is reachable only outside the joint limits "
@@ -476,11 +483,12 @@ class Leg:
         return InvalidInputError(f"p must be finite, got {tgt}")  # pragma: no cover - as_input caught it
 
     def _single_error(self, batch_loop, width: tuple[int, ...], p: np.ndarray, ref: np.ndarray) -> Exception:
-        """The error of a failed single call: the batch loop run on its one row gives the failure's data."""
+        """The error of a failed single call (default ``tol``): the batch loop run on its one row gives its data."""
         rows = np.array(p, dtype=float).reshape(1, 3)
         status = np.empty(1, dtype=np.int64)
         info = np.zeros((1, 2))
-        batch_loop(rows, self.params, np.array(ref, dtype=float).reshape(1, 3), np.empty((1,) + width), status, info)
+        ref1 = np.array(ref, dtype=float).reshape(1, 3)
+        batch_loop(rows, self.params, ref1, IK_TOL, np.empty((1,) + width), status, info)
         return self._error(int(status[0]), info[0], rows[0])
 
     def _least_violation(self, branches: np.ndarray) -> tuple[int, float, np.ndarray]:
@@ -496,7 +504,7 @@ class Leg:
                 best = (float(out_by[j]), j, float(x[j]), x)
         return best[1], best[2], best[3]
 
-    def ik_all(self, p, *, q_near=None, return_mask: bool = False):
+    def ik_all(self, p, *, q_near=None, tol: float = IK_TOL, return_mask: bool = False):
         """Every IK branch of the target(s) ``p`` (m, root frame), joint limits ignored.
 
         Branches in :data:`BRANCHES` order ``(s_a, s_k)``: ``u3 = s_a sqrt(y^2 + z^2 - d^2)`` (abduction) and
@@ -507,6 +515,8 @@ class Leg:
         Args:
             p: targets (3,) or (..., 3).
             q_near: reference joint values (3,) or broadcastable with ``p``.
+            tol: a target up to ``tol`` (m; (0, 1e-3], default :data:`IK_TOL` = 1e-9) outside the reachable set
+                is solved at its nearest reachable point (a float32-rounded target, say); farther out it is not.
             return_mask: also return the boolean mask of the branches that exist (legkin 0.2.0 convention).
 
         Returns:
@@ -520,29 +530,29 @@ class Leg:
         """
         if return_mask is not False and return_mask is not True:
             return_mask = check_flag(return_mask, "return_mask")
-        if p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # one target: the fast path
+        if tol is IK_TOL and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast path
             ref = self._ref if q_near is None else _vector3(q_near)
             if ref is not None:
                 out = np.empty((4, 3))
-                st = _ik_all_k(p, self.params, ref, out)
+                st = _ik_all_k(p, self.params, ref, IK_TOL, out)
                 if st == OK:
                     return (out, np.isfinite(out[:, 0])) if return_mask else out
                 if st != _BAD_INPUT:
                     raise self._single_error(_ik_all_batch, (4, 3), p, ref)
-        rows, ref, batch, single = self._prepare(p, q_near)
+        rows, ref, batch, single, tol = self._prepare(p, q_near, tol)
         n = rows.shape[0]
         out = np.empty((n, 4, 3))
         status = np.empty(n, dtype=np.int64)
         info = np.zeros((n, 2))
-        _ik_all_batch(rows, self.params, ref, out, status, info)
+        _ik_all_batch(rows, self.params, ref, tol, out, status, info)
         if single and status[0] != OK:
-            raise self._error(int(status[0]), info[0], rows[0])
+            raise self._error(int(status[0]), info[0], rows[0], tol)
         q_all = out.reshape(batch + (4, 3))
         if not return_mask:
             return q_all
         return q_all, np.isfinite(q_all[..., 0])
 
-    def ik(self, p, *, q_near=None, return_mask: bool = False):
+    def ik(self, p, *, q_near=None, tol: float = IK_TOL, return_mask: bool = False):
         """Joint values placing the foot at ``p``: the branch inside the URDF limits nearest ``q_near``.
 
         For each branch of :meth:`ik_all`, each joint takes its 2 pi representative inside ``[lower, upper]``
@@ -555,6 +565,8 @@ class Leg:
         Args:
             p: targets (3,) or (..., 3), m, root frame.
             q_near: reference (3,) or broadcastable with ``p``; default :attr:`q_ref` (mid-limit).
+            tol: a target up to ``tol`` (m; (0, 1e-3], default :data:`IK_TOL`) outside the reachable set is solved
+                at its nearest reachable point (:meth:`ik_all`).
             return_mask: also return the boolean mask of the solved targets.
 
         Returns:
@@ -568,31 +580,31 @@ class Leg:
         """
         if return_mask is not False and return_mask is not True:
             return_mask = check_flag(return_mask, "return_mask")
-        if p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # one target: the fast path
+        if tol is IK_TOL and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast path
             ref = self._ref if q_near is None else _vector3(q_near)
             if ref is not None:
                 out = np.empty(3)
-                st = _ik_k(p, self.params, ref, out)
+                st = _ik_k(p, self.params, ref, IK_TOL, out)
                 if st == OK:
                     return (out, np.array(True)) if return_mask else out
                 if st != _BAD_INPUT:
                     raise self._single_error(_ik_batch, (3,), p, ref)
-        if q_near is None and _rows3(p):  # a batch (n, 3) the kernels can read as is: no copy, no isfinite pass
+        if q_near is None and tol is IK_TOL and _rows3(p):  # a batch (n, 3) the kernels read as is: no copy
             out = np.empty(p.shape)
             status = np.empty(p.shape[0], dtype=np.int64)
-            if not _ik_batch(p, self.params, self._ref1, out, status, np.empty((p.shape[0], 2))):
+            if not _ik_batch(p, self.params, self._ref1, IK_TOL, out, status, np.empty((p.shape[0], 2))):
                 return (out, np.ones(p.shape[0], dtype=bool)) if return_mask else out
             if not (status == _BAD_INPUT).any():  # NaN rows for the targets that failed (else as_input raises)
                 return (out, status == OK) if return_mask else out
-        rows, ref, batch, single = self._prepare(p, q_near)
+        rows, ref, batch, single, tol = self._prepare(p, q_near, tol)
         n = rows.shape[0]
         out = np.empty((n, 3))
         status = np.empty(n, dtype=np.int64)
         info = np.zeros((n, 2))
-        _ik_batch(rows, self.params, ref, out, status, info)
+        _ik_batch(rows, self.params, ref, tol, out, status, info)
         ok = status == OK
         if single:
-            return finish(out[0], ok[0], True, return_mask, lambda: self._error(int(status[0]), info[0], rows[0]))
+            return finish(out[0], ok[0], True, return_mask, lambda: self._error(int(status[0]), info[0], rows[0], tol))
         return finish(out.reshape(batch + (3,)), ok.reshape(batch), False, return_mask, _never)
 
     def within_limits(self, q, tol: float = 0.0) -> np.ndarray | bool:

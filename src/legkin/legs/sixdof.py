@@ -20,8 +20,11 @@ forward map is the product of exponentials (what Pinocchio computes, with the me
   Up to 8 solutions (:attr:`Leg6.n_solutions` rows of :meth:`Leg6.ik_all`, in the order knee, ankle, hip
   branch). Where URDF rounding leaves the axes up to :data:`AXIS_TOL` off meeting (icub's ``rpy="... 1.5708"``:
   2e-6 m), the closed form lands that close and damped Newton steps on the exact forward map finish it.
-* ``"6R-general"``: any other 6R chain (alexander's three parallel pitch axes, g1's offset hip): ``fk`` and
-  ``jacobian`` only; :meth:`Leg6.ik` raises :class:`~legkin.errors.LegStructureError`.
+* ``"6R-three-parallel"`` (alexander: joints 3-5 parallel) and ``"6R-offset-hip"`` (g1: axes 2, 3 meet, 4 and 5
+  parallel, the hip pitch axis 1 off them): every solution by a one-dimensional search (:mod:`._search_kernels`),
+  up to 16 rows.
+* ``"6R-general"``: any other 6R chain: ``fk`` and ``jacobian`` only; :meth:`Leg6.ik` raises
+  :class:`~legkin.errors.LegStructureError`.
 
 Every answer is polished and kept only if it reproduces the target to ``tol`` (default :data:`IK_TOL` = 1e-9,
 m and rad); a target within ``tol`` of the reachable set is solved at its nearest reachable pose (the polish's
@@ -58,15 +61,17 @@ from ._sixdof_layout import (
     AXIS_TOL,
     HIP_SPHERICAL,
     IK_TOL,
+    OFFSET_HIP,
     THREE_PARALLEL,
 )
 
 __all__ = ["Leg6", "AXIS_TOL", "IK_TOL", "STRUCTURES", "nearest_point"]
 
-#: The structures a 6-DOF leg is classified into (the first two have an IK: closed form, one-dimensional search).
-STRUCTURES = ("6R-spherical-hip", "6R-three-parallel", "6R-general")
-_KINDS = {STRUCTURES[0]: HIP_SPHERICAL, STRUCTURES[1]: THREE_PARALLEL, STRUCTURES[2]: 0.0}
-_ROWS = {STRUCTURES[0]: _NSOL, STRUCTURES[1]: _NSOL_SEARCH, STRUCTURES[2]: 0}
+#: The structures a 6-DOF leg is classified into (all but the last have an IK: a closed form, then two
+#: one-dimensional searches).
+STRUCTURES = ("6R-spherical-hip", "6R-three-parallel", "6R-offset-hip", "6R-general")
+_KINDS = dict(zip(STRUCTURES, (HIP_SPHERICAL, THREE_PARALLEL, OFFSET_HIP, 0.0)))
+_ROWS = dict(zip(STRUCTURES, (_NSOL, _NSOL_SEARCH, _NSOL_SEARCH, 0)))
 _Q6 = (6,)
 _T44 = (4, 4)
 _F64 = np.dtype(np.float64)
@@ -89,13 +94,20 @@ def nearest_point(origins, axes) -> tuple[np.ndarray, float]:
     return x, gap
 
 
-def _classify(a: np.ndarray, hip_gap: float, ankle_gap: float) -> str:
-    """The structure of unit axes ``a`` (6, 3) with the given gaps (m): :data:`STRUCTURES`, within :data:`AXIS_TOL`."""
+def _classify(a: np.ndarray, hip_gap: float, ankle_gap: float, gap23: float) -> str:
+    """The structure of unit axes ``a`` (6, 3) with the given gaps (m; ``gap23``: axes 2 and 3):
+    :data:`STRUCTURES`, within :data:`AXIS_TOL`."""
     if hip_gap <= AXIS_TOL and ankle_gap <= AXIS_TOL:
         return STRUCTURES[0]
-    par = max(np.linalg.norm(np.cross(a[2], a[3])), np.linalg.norm(np.cross(a[2], a[4])))
-    apart = min(np.linalg.norm(np.cross(a[0], a[1])), np.linalg.norm(np.cross(a[2], a[5])))
-    return STRUCTURES[1] if par <= AXIS_TOL and apart > 0.1 else STRUCTURES[2]
+
+    def sin(i: int, j: int) -> float:
+        return float(np.linalg.norm(np.cross(a[i], a[j])))
+
+    if max(sin(2, 3), sin(2, 4)) <= AXIS_TOL and min(sin(0, 1), sin(2, 5)) > 0.1:
+        return STRUCTURES[1]
+    if gap23 <= AXIS_TOL and sin(3, 4) <= AXIS_TOL and min(sin(1, 2), sin(3, 5)) > 0.1:
+        return STRUCTURES[2]
+    return STRUCTURES[3]
 
 
 def _frozen(a) -> np.ndarray:
@@ -163,7 +175,7 @@ class Leg6:
 
     @property
     def n_solutions(self) -> int:
-        """The rows of :meth:`ik_all`: 8 (spherical hip), 16 (three parallel axes), 0 (no IK)."""
+        """The rows of :meth:`ik_all`: 8 (spherical hip), 16 (the searched structures), 0 (no IK)."""
         return int(self.params[_NSOLS])
 
     @classmethod
@@ -192,16 +204,18 @@ class Leg6:
             raise LegStructureError(f"leg {name}: bad joint limits lower={lo.tolist()}, upper={hi.tolist()}")
         hip, hip_gap = nearest_point(o[:3], a[:3])
         ank, ank_gap = nearest_point(o[4:], a[4:])
-        structure = _classify(a, hip_gap, ank_gap)
+        h23, gap23 = nearest_point(o[1:3], a[1:3])
+        structure = _classify(a, hip_gap, ank_gap, gap23)
         g = np.zeros(_NP6)
         g[_AX:_AX + 18], g[_OR:_OR + 18] = a.ravel(), o.ravel()
         g[_M0:_M0 + 9], g[_M0 + 9:_M0 + 12] = m0[:3, :3].ravel(), m0[:3, 3]
         spherical = structure == STRUCTURES[0]
-        g[_HIP:_HIP + 3] = hip if spherical else 0.0
+        g[_HIP:_HIP + 3] = hip if spherical else (h23 if structure == STRUCTURES[2] else 0.0)
         g[_ANK:_ANK + 3] = ank if spherical else 0.0
         g[_LO6:_LO6 + 6], g[_HI6:_HI6 + 6] = lo, hi
         g[_KIND], g[_NSOLS] = _KINDS[structure], _ROWS[structure]
-        mid = np.where(np.isfinite(lo) & np.isfinite(hi), 0.5 * (lo + hi), np.clip(0.0, lo, hi))
+        finite = np.isfinite(lo) & np.isfinite(hi)
+        mid = np.where(finite, 0.5 * (np.where(finite, lo, 0.0) + np.where(finite, hi, 0.0)), np.clip(0.0, lo, hi))
         return cls(
             name=str(name), joint_names=tuple(str(j) for j in joint_names), foot_frame=str(foot_frame),
             lower=_frozen(lo), upper=_frozen(hi), axes=_frozen(a), origins=_frozen(o), foot_pose=_frozen(m0),

@@ -225,9 +225,14 @@ def _ik_all_core(p, g, ref, tol, out):
     if cyl > tol:
         best, why = cyl, _IN_CYLINDER
     found = 0
+    pitched, far, clean_w = False, False, False  # the pitch-plane quantities computed (for one abduction branch)
+    wx = wy = miss = c = acb = 0.0
     for ia in range(2):
         u3, q1 = _abduction_k(g, ia, t, yz)
-        wx, wy, miss, far, c, acb, clean_w = _pitch_k(g, x, u3)
+        if not pitched or g[_H] != 0.0:  # h_X = 0: |w|, so the knee, is the same on both abduction branches
+            wx, wy, miss, far, c, acb, clean_w = _pitch_k(g, x, u3)
+            pitched = True
+        wx = u3 - g[_H]
         reason = _TOO_FAR if far else _TOO_NEAR
         if miss > slack:
             if miss < best:

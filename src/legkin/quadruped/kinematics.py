@@ -75,7 +75,9 @@ __all__ = [
 Mask = tuple[np.ndarray, np.ndarray]
 #: POPI's limits as floats (equal to the URDF's, the measured legs' ``lower`` / ``upper``: tests/test_quadruped.py).
 _LO, _HI = tuple(JOINT_LIMITS[:, 0].tolist()), tuple(JOINT_LIMITS[:, 1].tolist())
-_ORDER = {leg: np.array(order) for leg, order in SEED_ORDER.items()}
+_REVERSED = np.array((3, 2, 1, 0))
+#: Per leg, the rows of Leg.ik_all in seed 004's order (the left legs' is reversed: that array itself, a slice serves).
+_ORDER = {leg: _REVERSED if order == (3, 2, 1, 0) else np.array(order) for leg, order in SEED_ORDER.items()}
 
 
 #: The default geometry's measured legs by name, once measured (the single calls' look-up: one dict access).
@@ -244,8 +246,11 @@ def ik_all(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = No
     found = _leg(leg, geometry)
     order = _ORDER[leg]
     if not (return_mask if return_mask is False or return_mask is True else _flag(return_mask)):
-        return found.ik_all(target, q_near=q_near).take(order, axis=-2)  # type: ignore[no-any-return]
+        q = found.ik_all(target, q_near=q_near)
+        return q[..., ::-1, :] if order is _REVERSED else q.take(order, axis=-2)  # type: ignore[no-any-return]
     q, mask = found.ik_all(target, q_near=q_near, return_mask=True)
+    if order is _REVERSED:  # the left legs: a view, cheaper than take
+        return q[..., ::-1, :], mask[..., ::-1]
     return q.take(order, axis=-2), mask.take(order, axis=-1)
 
 

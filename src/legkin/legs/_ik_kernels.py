@@ -39,6 +39,7 @@ from ._layout import (
     _TWO_PI,
     _UNREACHABLE,
     CANDIDATE_SLACK,
+    IK_TOL,
     LIMIT_SLACK,
     LIMIT_TOL,
     POLISH_DAMPING,
@@ -426,15 +427,16 @@ def _ik_core(p, g, ref, tol, out):
 
 
 @kernel(entry=True)
-def _ik_all_k(p, g, ref, tol, out) -> int:
-    """:func:`_ik_all_core` of one target (the single call): its status."""
-    return _ik_all_core(p, g, ref, tol, out)[0]
+def _ik_all_k(p, g, ref, out) -> int:
+    """:func:`_ik_all_core` of one target with the default ``tol`` (the single call; one argument fewer for numba's
+    dispatch): its status."""
+    return _ik_all_core(p, g, ref, IK_TOL, out)[0]
 
 
 @kernel(entry=True)
-def _ik_k(p, g, ref, tol, out) -> int:
-    """:func:`_ik_core` of one target (the single call): its status."""
-    return _ik_core(p, g, ref, tol, out)[0]
+def _ik_k(p, g, ref, out) -> int:
+    """:func:`_ik_core` of one target with the default ``tol`` (the single call): its status."""
+    return _ik_core(p, g, ref, IK_TOL, out)[0]
 
 
 @batch_kernel(rows="p ref out status info", min_parallel=512)

@@ -534,7 +534,7 @@ class Leg:
             ref = self._ref if q_near is None else _vector3(q_near)
             if ref is not None:
                 out = np.empty((4, 3))
-                st = _ik_all_k(p, self.params, ref, IK_TOL, out)
+                st = _ik_all_k(p, self.params, ref, out)
                 if st == OK:
                     return (out, np.isfinite(out[:, 0])) if return_mask else out
                 if st != _BAD_INPUT:
@@ -584,7 +584,7 @@ class Leg:
             ref = self._ref if q_near is None else _vector3(q_near)
             if ref is not None:
                 out = np.empty(3)
-                st = _ik_k(p, self.params, ref, IK_TOL, out)
+                st = _ik_k(p, self.params, ref, out)
                 if st == OK:
                     return (out, np.array(True)) if return_mask else out
                 if st != _BAD_INPUT:

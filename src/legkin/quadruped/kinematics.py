@@ -139,7 +139,8 @@ def fk(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
         InvalidInputError: ``q`` not a finite real array (..., 3).
         InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
     """
-    x = _leg(leg, geometry).fk(q)
+    found = _DEFAULT.get(leg) if geometry is None and leg.__class__ is str else None  # type: ignore[call-overload]
+    x = (found or _leg(leg, geometry)).fk(q)
     return x if return_mask is False else _with_mask(x, 1, return_mask)
 
 
@@ -168,7 +169,8 @@ def jacobian(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
         InvalidInputError: ``q`` not a finite real array (..., 3).
         InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
     """
-    x = _leg(leg, geometry).jacobian(q)
+    found = _DEFAULT.get(leg) if geometry is None and leg.__class__ is str else None  # type: ignore[call-overload]
+    x = (found or _leg(leg, geometry)).jacobian(q)
     return x if return_mask is False else _with_mask(x, 2, return_mask)
 
 
@@ -207,7 +209,8 @@ def ik(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = None, 
         InvalidInputError: ``target`` or ``q_near`` not finite real arrays (..., 3), or not broadcastable.
         InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
     """
-    return _leg(leg, geometry).ik(target, q_near=q_near, return_mask=return_mask)  # type: ignore[no-any-return]
+    found = _DEFAULT.get(leg) if geometry is None and leg.__class__ is str else None  # type: ignore[call-overload]
+    return (found or _leg(leg, geometry)).ik(target, q_near=q_near, return_mask=return_mask)  # type: ignore[no-any-return]
 
 
 @overload

@@ -155,16 +155,15 @@ def test_single_call_entries_run_and_name_known_yardsticks():
 
 
 def test_single_call_table_covers_every_public_function():
-    """Every public function of a mechanism (its kinematics module's ``__all__``, less the deprecated names) has a
-    row in its bench's single-call table."""
+    """Every public function of a mechanism (its kinematics module's ``__all__``) has a row in its bench's
+    single-call table."""
     import inspect
 
     for name, module in _bench_modules().items():
         if module is None or not hasattr(module, "single_calls"):
             continue
         kin = importlib.import_module(f"legkin.{name}.kinematics")
-        public = [n for n in kin.__all__ if inspect.isfunction(getattr(kin, n))
-                  and "deprecated" not in (getattr(kin, n).__doc__ or "").lower()]
+        public = [n for n in kin.__all__ if inspect.isfunction(getattr(kin, n))]
         timed = {e.name.split(" ")[0] for e in module.single_calls()}
         assert [n for n in public if n not in timed] == [], name
 

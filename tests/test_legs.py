@@ -443,6 +443,85 @@ def test_q_near_picks_the_branch(erd):
     np.testing.assert_allclose(leg.ik(p, q_near=q_all[1] + 2 * math.pi), q_all[1] + 2 * math.pi, atol=1e-12)
 
 
+def _nearest_inside(q_all: np.ndarray, ref: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """The rule of ``Leg.ik`` written plainly (numpy, per target): each branch's angles at their 2 pi
+    representative inside the limits nearest ``ref`` (NaN if none), the branch with the least squared distance."""
+    out = np.full(ref.shape, np.nan)
+    for i in range(len(ref)):
+        best = math.inf
+        for q in q_all[i]:
+            reps = q[:, None] + 2 * math.pi * np.arange(-3, 4)[None, :]  # (3, 7) candidates per joint
+            inside = (reps >= lower[:, None]) & (reps <= upper[:, None])
+            if not np.isfinite(q).all() or not inside.any(axis=1).all():
+                continue
+            x = np.array([r[m][np.argmin(np.abs(r[m] - ref[i, j]))] for j, (r, m) in enumerate(zip(reps, inside))])
+            cost = float(np.sum((x - ref[i]) ** 2))
+            if cost < best:
+                best, out[i] = cost, x
+    return out
+
+
+@pytest.mark.parametrize("name", ["go2", "solo12", "anymal"])
+def test_limits_first_ik_is_the_nearest_branch_inside_the_limits(erd, name):
+    """The limits-first kernel (branches pruned by the limits and the partial cost before any polish, only the
+    winner polished) returns what the plain rule picks among all of ik_all's branches, for random q_near."""
+    _, found = erd[name]
+    rng = np.random.default_rng(7)
+    for leg in found.values():
+        q = rng.uniform(np.clip(leg.lower, -4, 4), np.clip(leg.upper, -4, 4), (400, 3))
+        p = leg.fk(q)
+        ref = q + rng.normal(0.0, 0.8, q.shape)
+        got, ok = leg.ik(p, q_near=ref, return_mask=True)
+        want = _nearest_inside(leg.ik_all(p, q_near=ref), ref, leg.lower, leg.upper)
+        assert ok.all()
+        np.testing.assert_allclose(got, want, atol=1e-9, err_msg=f"{name} {leg.name}")
+        one = leg.ik(p[0], q_near=ref[0])  # the single-call fast path with q_near: the batch row
+        np.testing.assert_array_equal(one, got[0])
+
+
+def _well_conditioned_rows(leg, p: np.ndarray) -> np.ndarray:
+    """(n, 4): whether each ik_all branch is away from the abduction singularity and the knee's fold by the
+    factor WELL_CONDITIONED (``t >= c r``, ``|w| >= c (|k| + |l|)``), from the leg's public geometry."""
+    from legkin.legs._layout import WELL_CONDITIONED as c
+
+    e1, e2, e3 = leg.frame
+    v = p - leg.origin
+    x1, y, z = v @ e1, v @ e2, v @ e3
+    r = np.hypot(y, z)
+    t = np.sqrt(np.maximum(r * r - leg.lateral_offset**2, 0.0))
+    rows = []
+    for s_a in (-1.0, -1.0, 1.0, 1.0):  # BRANCHES order (s_a, s_k)
+        w = np.hypot(s_a * t - leg.hip_offset[0], x1 - leg.hip_offset[1])
+        rows.append((t >= c * r) & (w >= c * (leg.thigh_length + leg.shank_length)))
+    return np.stack(rows, axis=-1)
+
+
+@pytest.mark.parametrize("name", ["quadruped", "go2", "solo12", "anymal", "go1", "a1", "b1", "laikago"])
+def test_well_conditioned_branches_are_exact_without_polish(erd, name):
+    """On legs whose axes are exactly the ideal structure, a well-conditioned closed-form branch is returned without
+    the Newton polish: its foot error must stay below POLISH_BELOW (what the polish would aim for), on joint
+    vectors uniform in [-3.2, 3.2]^3 (every branch; every robot whose axes are exactly ideal: anymal_c's and hyq's
+    are 4.9e-12 rad off and always polished); the others (polished) within REACH_TOL."""
+    from legkin.legs._layout import POLISH_BELOW, REACH_TOL
+
+    if name == "quadruped":
+        from legkin.quadruped.measured import legs as popi
+
+        found = popi()
+    else:
+        found = erd[name][1]
+    rng = np.random.default_rng(11)
+    for leg in found.values():
+        assert leg.axis_deviation == (0.0, 0.0)
+        p = leg.fk(rng.uniform(-3.2, 3.2, (20_000, 3)))
+        q_all, mask = leg.ik_all(p, return_mask=True)
+        err = np.linalg.norm(leg.fk(np.where(mask[..., None], q_all, 0.0)) - p[:, None], axis=-1)
+        well = _well_conditioned_rows(leg, p) & mask
+        assert well.mean() > 0.9
+        assert err[well].max() <= POLISH_BELOW, f"{name} {leg.name}: {err[well].max():.3g} m unpolished"
+        assert err[mask].max() <= REACH_TOL
+
+
 # ------------------------------------------------------------------------------------------- legkin's POPI quadruped
 def _aq():
     """legkin's own quadruped closed form, wherever it lives now: ``(fk(q, leg), ik(p, leg, q_near))``."""

@@ -1,4 +1,4 @@
-"""Quadruped analytic kinematics: checks against Pinocchio, IK properties, seed 002, error paths."""
+"""The quadruped (POPI's legs as legs.Leg): IK properties, branch order, seed 002 cross-check, error paths."""
 
 from __future__ import annotations
 
@@ -14,7 +14,6 @@ from legkin._rotations import wrap
 from legkin.quadruped import checks as checks
 from legkin.quadruped import configuration as cfg
 from legkin.quadruped import kinematics as aq
-from legkin.quadruped.forward import _knee_vector
 
 LEGS = aq.LEGS
 L1 = math.hypot(aq.X23, aq.Z23)
@@ -28,6 +27,8 @@ def test_urdf_limits_match_analytic_constants(quadruped):
             iq = quadruped.idx_q(f"{leg}_{joint}")
             assert quadruped.model.lowerPositionLimit[iq] == aq.JOINT_LIMITS[k, 0]
             assert quadruped.model.upperPositionLimit[iq] == pytest.approx(aq.JOINT_LIMITS[k, 1], abs=1e-15)
+        leg_model = aq.legs()[leg]  # the measured leg's limits: what ik keeps to
+        np.testing.assert_allclose(np.stack([leg_model.lower, leg_model.upper], 1), aq.JOINT_LIMITS, atol=1e-15, rtol=0)
 
 
 def test_folded_leg_at_zero_matches_reference():
@@ -67,7 +68,7 @@ def _reachable_target(leg, direction, radius_fraction, s_u):
     tilt=st.floats(-math.pi, math.pi),
 )
 def test_ik_all_branches_reach_target_everywhere(leg, direction, frac, s_u, tilt):
-    """Every branch of foot_ik_all lands on the target, over the whole workspace incl. its boundary."""
+    """Every branch of ik_all lands on the target, over the whole workspace incl. its boundary."""
     p = _reachable_target(leg, direction, frac, s_u)
     # rotate the target about the abduction axis: still reachable
     h = aq.hip_position(leg)
@@ -135,19 +136,47 @@ def test_batch_returns_nan_and_mask():
     np.testing.assert_array_equal(np.isnan(q_plain), np.isnan(q))
 
 
-def test_scalar_errors_say_why_and_by_how_much():
+def test_scalar_errors_say_why_and_carry_by_how_much():
     h = aq.hip_position("LF")
-    with pytest.raises(legkin.UnreachableError, match="beyond full stretch") as info:
-        aq.ik(h + np.array([0.0, 0.0, -1.0]), "LF")
-    assert "by" in str(info.value)
-    with pytest.raises(legkin.UnreachableError, match="abduction cylinder"):
+    far = h + np.array([0.0, 0.0, -1.0])  # straight down: rho = sqrt(1 - y12^2) in the leg plane
+    stretch = math.sqrt(1.0 - aq.Y12**2) - (L1 + L2)
+    for call in (aq.ik, aq.ik_all):
+        with pytest.raises(legkin.UnreachableError, match="beyond the leg's full stretch") as info:
+            call(far, "LF")
+        assert not isinstance(info.value, legkin.JointLimitError)
+        assert info.value.distance == pytest.approx(stretch, abs=1e-12)
+        assert f"{stretch:.6g} m" in str(info.value) and np.array_equal(info.value.target, far)
+    with pytest.raises(legkin.UnreachableError, match="abduction cylinder") as info:
         aq.ik(h + np.array([0.0, 0.05, 0.0]), "LF")
-    with pytest.raises(legkin.UnreachableError, match="too close"):
+    assert info.value.distance == pytest.approx(aq.Y12 - 0.05, abs=1e-12)
+    with pytest.raises(legkin.UnreachableError, match="inner reach") as info:
         aq.ik(h + np.array([0.0, aq.Y12, -0.01]), "LF")
-    with pytest.raises(legkin.JointLimitError, match="outside the joint limits"):
+    assert info.value.distance == pytest.approx((L1 - L2) - 0.01, abs=1e-12)
+    with pytest.raises(legkin.JointLimitError, match="outside the joint limits") as info:
         aq.ik(aq.fk(np.array([0.0, -0.5, 1.0]), "LF"), "LF")
-    with pytest.raises(legkin.UnreachableError):
-        aq.ik_all(h + np.array([0.0, 0.0, -1.0]), "LF")
+    err = info.value
+    assert (err.joint, err.lower, err.upper) == ("LF_HFE", 0.0, math.pi)
+    assert err.value == pytest.approx(-0.5, abs=1e-12) and err.distance == pytest.approx(0.5, abs=1e-12)
+    np.testing.assert_allclose(err.closest, [0.0, -0.5, 1.0], atol=1e-12)
+
+
+@pytest.mark.parametrize("foot_z", [0.0, -0.015])
+def test_ik_all_rows_are_the_seed_branches_on_every_leg(foot_z, rng):
+    """Row b of ik_all is BRANCHES[b] = (s_u, k) on every leg: s_u the sign of u_z (the foot's height in the frame
+    turned by seed 004's R_x(s_y q1)), k the sign of acos K in q3 = (beta - alpha) + k acos K."""
+    g = aq.Geometry(foot_z=foot_z)
+    offset = math.atan2(foot_z, aq.X34) - math.atan2(aq.Z23, aq.X23)
+    for leg in LEGS:
+        sy = 1.0 if leg[0] == "L" else -1.0
+        p = aq.fk(cfg.sample_joints(rng, 500), leg, geometry=g)
+        d = p - aq.hip_position(leg)
+        q_all = aq.ik_all(p, leg, geometry=g)
+        for b, (s_u, k) in enumerate(aq.BRANCHES):
+            a = sy * q_all[:, b, 0]
+            u_z = np.sin(-a) * d[:, 1] + np.cos(-a) * d[:, 2]  # R_x(-s_y q1) d, z component
+            knee = wrap(q_all[:, b, 2] - offset)
+            assert np.all(np.sign(u_z) == s_u), (leg, b)
+            assert np.all(np.sign(knee) == k), (leg, b)
 
 
 def test_unknown_leg():
@@ -246,9 +275,6 @@ def test_geometry_is_validated(value, match):
         aq.Geometry(foot_z=value)
     with pytest.raises(legkin.InvalidParameterError, match=match):
         aq.Geometry.from_params({"foot_z": value})
-    p = aq.fk(np.array([0.0, 0.75, 1.5]), "LF")
-    with pytest.warns(DeprecationWarning), pytest.raises(legkin.InvalidParameterError, match=match):
-        aq.foot_ik(p, "LF", foot_z=value)  # the deprecated keyword, checked the same way
 
 
 @pytest.mark.parametrize("bad", [0.0, {"foot_z": 0.0}, "default", aq.DEFAULT_GEOMETRY.foot_z])
@@ -267,7 +293,9 @@ def test_geometry_keyword_takes_a_geometry_only(bad):
 
 def test_return_mask_is_validated():
     p = aq.fk(np.array([0.0, 0.75, 1.5]), "LF")
-    for call in (lambda: aq.ik(p, "LF", return_mask="yes"), lambda: aq.ik_all(p, "LF", return_mask="yes")):
+    q = np.array([0.0, 0.75, 1.5])
+    for call in (lambda: aq.ik(p, "LF", return_mask="yes"), lambda: aq.ik_all(p, "LF", return_mask="yes"),
+                 lambda: aq.fk(q, "LF", return_mask=1.5), lambda: aq.jacobian(q, "LF", return_mask="no")):
         with pytest.raises(legkin.InvalidParameterError, match="return_mask must be True or False"):
             call()
 
@@ -361,7 +389,7 @@ def _check_answer(q, p, leg, tol=ATOL_CONTRACT):
 
 def _near_cylinder_joints(q, log_rho, sign):
     """Replace q2 of q so that the foot is rho = sign 10**log_rho from the abduction cylinder (u_z = rho)."""
-    vx, vz = _knee_vector(q[2], 0.0)
+    vx, vz = cfg.knee_vector(q[2])
     r, rho = math.hypot(vx, vz), sign * 10.0**log_rho
     return np.array([q[0], float(wrap(math.atan2(rho, math.sqrt(r * r - rho * rho)) - math.atan2(vz, vx))), q[2]])
 
@@ -370,6 +398,8 @@ def _near_cylinder_joints(q, log_rho, sign):
 @example(leg="LF", q1=-0.4, q2=0.0, q3=1.5, log_rho=-8.0, sign=-1.0, with_ref=False)  # q1 1.3e-9 off its limit
 @example(leg="LF", q1=-0.4, q2=1.36, q3=0.26, log_rho=None, sign=1.0, with_ref=False)  # two joints on limits
 @example(leg="LF", q1=0.4, q2=0.0, q3=1.92, log_rho=-5.847934859038284, sign=1.0, with_ref=False)  # q3 1 ulp out
+@example(leg="LF", q1=0.399999999999999, q2=0.0, q3=0.26, log_rho=-8.0, sign=1.0, with_ref=False)  # q1 and q3 at
+# their limits, rho = 1e-8 m: the branch's q1 6e-10 rad out (the abduction singularity), the repair's step pushed q3
 @given(
     leg=st.sampled_from(LEGS),
     q1=_joint(0), q2=_joint(1), q3=_joint(2),
@@ -441,7 +471,7 @@ finite = st.floats(allow_nan=False, allow_infinity=False)
     p=st.tuples(finite, finite, finite),
     q_near=st.one_of(st.none(), st.tuples(finite, finite, finite)),
     leg=st.sampled_from(LEGS),
-    foot_z=st.floats(-0.1, 0.1),
+    foot_z=st.sampled_from([0.0, -0.015, 0.1]),  # each new foot_z measures a generated URDF (xacro, ~0.3 s)
 )
 def test_no_foreign_exception_or_warning_on_any_finite_input(p, q_near, leg, foot_z):
     """Huge or tiny finite inputs: only legkin errors, and no numpy warning (overflow etc.) either."""
@@ -481,10 +511,10 @@ def test_ik_robustness_row_passes():
 def test_batch_is_the_single_call_kernel_item_by_item(rng):
     """The batch is a compiled loop over the single-call kernel: identical answers, bit for bit, on both
     the serial (small) and the parallel (large) path, with and without q_near, and on non-contiguous input."""
-    from legkin.quadruped.inverse import _ik_batch
+    from legkin.legs._ik_kernels import _ik_batch
 
     lo, hi = aq.JOINT_LIMITS[:, 0], aq.JOINT_LIMITS[:, 1]
-    n = _ik_batch.min_parallel + 44
+    n = _ik_batch.min_parallel + 44  # the leg's batch loop runs on numba's threads from min_parallel items
     q = rng.uniform(lo - 0.05, hi + 0.05, (n, 3))
     p = aq.fk(q, "RH", geometry=G015)
     q_near = rng.uniform(lo, hi, (n, 3))
@@ -557,43 +587,6 @@ def test_importing_legkin_does_not_import_numba():
     subprocess.run([sys.executable, "-c", code], check=True)
 
 
-# ----------------------------------------------------------------------------- legkin 0.1 names (deprecated)
-def test_deprecated_names_warn_and_give_the_new_answers(rng):
-    q = cfg.sample_joints(rng, 5)
-    p = aq.fk(q, "RF", geometry=G015)
-    cases = [
-        (lambda: aq.foot_position(q, "RF", foot_z=-0.015), aq.fk(q, "RF", geometry=G015)),
-        (lambda: aq.foot_position(q, "RF", geometry=G015), aq.fk(q, "RF", geometry=G015)),
-        (lambda: aq.foot_jacobian(q, "RF"), aq.jacobian(q, "RF")),
-        (lambda: aq.foot_ik(p, "RF", q + 0.01, foot_z=-0.015), aq.ik(p, "RF", q_near=q + 0.01, geometry=G015)),
-        (lambda: aq.foot_ik(p, "RF", q_ref=q, foot_z=-0.015, return_mask=True)[0], aq.ik(p, "RF", geometry=G015)),
-        (lambda: aq.foot_ik_all(p, "RF", foot_z=-0.015), aq.ik_all(p, "RF", geometry=G015)),
-    ]
-    for old, new in cases:
-        with pytest.warns(DeprecationWarning, match="deprecated"):
-            np.testing.assert_array_equal(old(), new)
-    with pytest.warns(DeprecationWarning), pytest.raises(legkin.InvalidParameterError, match="not both"):
-        aq.foot_position(q, "RF", foot_z=0.0, geometry=G015)
-
-
-def test_deprecated_module_and_attribute_paths_still_work():
-    import importlib
-    import warnings
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", DeprecationWarning)
-        old = importlib.import_module("legkin.analytic.quadruped")
-    for name in aq.__all__:
-        assert getattr(old, name) is getattr(aq, name) is getattr(legkin.quadruped, name), name
-    assert legkin.quadruped.kinematics.fk is aq.fk
-
-
-def test_deprecation_warning_points_at_the_caller():
-    with pytest.warns(DeprecationWarning) as record:
-        aq.foot_position(np.zeros(3), "LF")
-    assert record[0].filename == __file__
-
-
 # ----------------------------------------------------------------------------- seed 002 with a geometry
 @pytest.mark.parametrize("foot_z", [-0.015, 0.05])
 def test_textbook_ik_with_a_foot_drop(foot_z, rng):
@@ -646,3 +639,22 @@ def test_package_attributes_resolve_once():
     assert set(aq.__all__) <= set(dir(pkg)) and "SPEC" in pkg.__all__
     with pytest.raises(AttributeError):
         pkg.no_such_name  # noqa: B018
+
+
+def test_legs_are_measured_once_per_geometry_from_the_models_urdf():
+    """``legs(geometry)``: the four :class:`legkin.legs.Leg` of the URDF ``legkin.load`` uses for that geometry,
+    measured once (equal geometries share them), and what fk/ik run on."""
+    from legkin import legs as generic
+
+    assert aq.legs(aq.Geometry(foot_z=-0.015)) is aq.legs(G015) is not aq.legs()
+    assert aq.legs(None) is aq.legs(aq.DEFAULT_GEOMETRY)
+    robot = legkin.load("quadruped", foot_z=-0.015)
+    floating = generic.from_model(robot.model)  # the loaded (floating-base) model, measured on its own
+    q = np.array([[0.1, 0.75, 1.5], [-0.3, 2.9, 0.4]])
+    for leg in LEGS:
+        mine = aq.legs(G015)[leg]
+        assert mine.foot_frame == f"{leg}_FOOT" and mine.joint_names == cfg.joint_names(leg)
+        np.testing.assert_allclose(mine.fk(q), floating[leg].fk(q), atol=1e-15, rtol=0)
+        np.testing.assert_array_equal(aq.fk(q, leg, geometry=G015), mine.fk(q))
+    with pytest.raises(legkin.InvalidParameterError, match="geometry must be"):
+        aq.legs(-0.015)

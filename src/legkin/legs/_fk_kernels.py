@@ -61,9 +61,10 @@ def _fk_k(q, g, out) -> int:
 
 
 @kernel
-def _jac3_k(q0, q1, q2, g, out) -> None:
-    """Columns ``a1 x R1 v1``, ``R1 (a2 x t2)``, ``R1 R2 (a3 x t3)`` (each joint: its spatial axis crossed with
-    the lever from its origin to the foot), with ``R_j = R(a_j, q_j)`` and ``t3, t2, v1`` of :func:`_fk3_k`."""
+def _jac3_t(q0, q1, q2, g):
+    """The Jacobian's nine entries, row-major: columns ``a1 x R1 v1``, ``R1 (a2 x t2)``, ``R1 R2 (a3 x t3)`` (each
+    joint: its spatial axis crossed with the lever from its origin to the foot), with ``R_j = R(a_j, q_j)`` and
+    ``t3, t2, v1`` of :func:`_fk3_k` (scalars: the Newton polish calls it without an array)."""
     c3, s3 = math.cos(q2), math.sin(q2)
     c2, s2 = math.cos(q1), math.sin(q1)
     c1, s1 = math.cos(q0), math.sin(q0)
@@ -71,20 +72,24 @@ def _jac3_k(q0, q1, q2, g, out) -> None:
     t2x, t2y, t2z = _rot_k(g, _A2, c2, s2, g[_V32] + t3x, g[_V32 + 1] + t3y, g[_V32 + 2] + t3z)
     # column 1: a1 x R1 v1 = R1 (a1 x v1)
     x, y, z = _cross_k(g, _A1, g[_V21] + t2x, g[_V21 + 1] + t2y, g[_V21 + 2] + t2z)
-    out[0, 0], out[1, 0], out[2, 0] = _rot_k(g, _A1, c1, s1, x, y, z)
+    j00, j10, j20 = _rot_k(g, _A1, c1, s1, x, y, z)
     x, y, z = _cross_k(g, _A2, t2x, t2y, t2z)
-    out[0, 1], out[1, 1], out[2, 1] = _rot_k(g, _A1, c1, s1, x, y, z)
+    j01, j11, j21 = _rot_k(g, _A1, c1, s1, x, y, z)
     x, y, z = _cross_k(g, _A3, t3x, t3y, t3z)
     x, y, z = _rot_k(g, _A2, c2, s2, x, y, z)
-    out[0, 2], out[1, 2], out[2, 2] = _rot_k(g, _A1, c1, s1, x, y, z)
+    j02, j12, j22 = _rot_k(g, _A1, c1, s1, x, y, z)
+    return j00, j01, j02, j10, j11, j12, j20, j21, j22
 
 
 @kernel(entry=True)
 def _jacobian_k(q, g, out) -> int:
-    """Foot Jacobian ``dp/dq`` (3, 3): :func:`_jac3_k`."""
+    """Foot Jacobian ``dp/dq`` (3, 3): :func:`_jac3_t`."""
     if not _finite3(q):
         return _BAD_INPUT
-    _jac3_k(q[0], q[1], q[2], g, out)
+    j = _jac3_t(q[0], q[1], q[2], g)
+    out[0, 0], out[0, 1], out[0, 2] = j[0], j[1], j[2]
+    out[1, 0], out[1, 1], out[1, 2] = j[3], j[4], j[5]
+    out[2, 0], out[2, 1], out[2, 2] = j[6], j[7], j[8]
     return OK
 
 

@@ -8,15 +8,17 @@ import math
 import numpy as np
 
 from .._kernels import OK, batch_kernel, kernel
-from ._fk_kernels import _finite3, _fk3_k, _jac3_k
+from ._fk_kernels import _finite3, _fk3_k, _jac3_t
 from ._layout import (
     _BAD_INPUT,
+    _CD,
     _D,
     _E1,
     _E2,
     _E3,
     _H,
     _HI,
+    _IDEAL,
     _IN_CYLINDER,
     _JOINT_LIMIT,
     _K,
@@ -30,20 +32,25 @@ from ._layout import (
     _PL,
     _POLISH_DONE,
     _S3,
+    _SD,
     _SLACK,
     _TOO_FAR,
     _TOO_NEAR,
     _TWO_PI,
     _UNREACHABLE,
+    CANDIDATE_SLACK,
+    IK_TOL,
+    LIMIT_SLACK,
     LIMIT_TOL,
     POLISH_DAMPING,
     POLISH_STEPS,
     REACH_TOL,
+    WELL_CONDITIONED,
 )
 
 
 @kernel
-def _polish_k(p, g, q, jac) -> float:
+def _polish_k(p, g, q0, q1, q2, fixed):
     """At most :data:`POLISH_STEPS` damped Newton steps on the exact forward map while the foot error exceeds
     :data:`POLISH_BELOW`, each kept only if it reduces the error: ``e = p - fk(q)``,
     ``dq = J^T (J J^T + lambda^2 I)^-1 e`` (``lambda`` = :data:`POLISH_DAMPING`).
@@ -51,23 +58,31 @@ def _polish_k(p, g, q, jac) -> float:
     The closed form is exact for the ideal structure (a1 perpendicular to a2 = +-a3); URDF angles written
     with 11 digits (``rpy="0 1.57079632679 0"``) leave axes ~5e-12 off, i.e. ~1e-12 m at the foot, and near the
     fold of the knee (|w| -> 0 when |k| = |l|) the law of cosines loses digits: the steps remove both.
-    Returns the final foot error ``|e|`` (m).
+    ``fixed`` (bits 1, 2, 4 for q1, q2, q3): joints held where they are (their Jacobian columns zeroed).
+    Scalars in, scalars out (no array): returns the polished ``(q1, q2, q3)`` and the final foot error ``|e|`` (m).
     """
-    fx, fy, fz = _fk3_k(q[0], q[1], q[2], g)
+    fx, fy, fz = _fk3_k(q0, q1, q2, g)
     ex, ey, ez = p[0] - fx, p[1] - fy, p[2] - fz
     err = ex * ex + ey * ey + ez * ez
     lam2 = POLISH_DAMPING * POLISH_DAMPING
+    f0, f1, f2 = (fixed & 1) == 0, (fixed & 2) == 0, (fixed & 4) == 0
     for _ in range(POLISH_STEPS):
         if err <= _POLISH_DONE:
             break
-        _jac3_k(q[0], q[1], q[2], g, jac)
+        j00, j01, j02, j10, j11, j12, j20, j21, j22 = _jac3_t(q0, q1, q2, g)
+        if not f0:
+            j00 = j10 = j20 = 0.0
+        if not f1:
+            j01 = j11 = j21 = 0.0
+        if not f2:
+            j02 = j12 = j22 = 0.0
         # A = J J^T + lam^2 I (symmetric positive definite), solve A y = e by the adjugate, dq = J^T y
-        a00 = jac[0, 0] ** 2 + jac[0, 1] ** 2 + jac[0, 2] ** 2 + lam2
-        a11 = jac[1, 0] ** 2 + jac[1, 1] ** 2 + jac[1, 2] ** 2 + lam2
-        a22 = jac[2, 0] ** 2 + jac[2, 1] ** 2 + jac[2, 2] ** 2 + lam2
-        a01 = jac[0, 0] * jac[1, 0] + jac[0, 1] * jac[1, 1] + jac[0, 2] * jac[1, 2]
-        a02 = jac[0, 0] * jac[2, 0] + jac[0, 1] * jac[2, 1] + jac[0, 2] * jac[2, 2]
-        a12 = jac[1, 0] * jac[2, 0] + jac[1, 1] * jac[2, 1] + jac[1, 2] * jac[2, 2]
+        a00 = j00 * j00 + j01 * j01 + j02 * j02 + lam2
+        a11 = j10 * j10 + j11 * j11 + j12 * j12 + lam2
+        a22 = j20 * j20 + j21 * j21 + j22 * j22 + lam2
+        a01 = j00 * j10 + j01 * j11 + j02 * j12
+        a02 = j00 * j20 + j01 * j21 + j02 * j22
+        a12 = j10 * j20 + j11 * j21 + j12 * j22
         c00, c11, c22 = a11 * a22 - a12 * a12, a00 * a22 - a02 * a02, a00 * a11 - a01 * a01
         c01, c02, c12 = a02 * a12 - a01 * a22, a01 * a12 - a02 * a11, a01 * a02 - a00 * a12
         det = a00 * c00 + a01 * c01 + a02 * c02
@@ -76,24 +91,109 @@ def _polish_k(p, g, q, jac) -> float:
         yx = (c00 * ex + c01 * ey + c02 * ez) / det
         yy = (c01 * ex + c11 * ey + c12 * ez) / det
         yz = (c02 * ex + c12 * ey + c22 * ez) / det
-        n0 = q[0] + jac[0, 0] * yx + jac[1, 0] * yy + jac[2, 0] * yz
-        n1 = q[1] + jac[0, 1] * yx + jac[1, 1] * yy + jac[2, 1] * yz
-        n2 = q[2] + jac[0, 2] * yx + jac[1, 2] * yy + jac[2, 2] * yz
+        n0 = q0 + j00 * yx + j10 * yy + j20 * yz
+        n1 = q1 + j01 * yx + j11 * yy + j21 * yz
+        n2 = q2 + j02 * yx + j12 * yy + j22 * yz
         fx, fy, fz = _fk3_k(n0, n1, n2, g)
         nx, ny, nz = p[0] - fx, p[1] - fy, p[2] - fz
         new = nx * nx + ny * ny + nz * nz
         if not new < err:
             break
-        q[0], q[1], q[2] = n0, n1, n2
+        q0, q1, q2 = n0, n1, n2
         ex, ey, ez, err = nx, ny, nz, new
-    return math.sqrt(err)
+    return q0, q1, q2, math.sqrt(err)
 
 
 @kernel
-def _residual_k(p, g, q) -> float:
-    """``|p - fk(q)|`` on the exact forward map."""
-    fx, fy, fz = _fk3_k(q[0], q[1], q[2], g)
-    return math.sqrt((p[0] - fx) ** 2 + (p[1] - fy) ** 2 + (p[2] - fz) ** 2)
+def _settle_k(p, g, q0, q1, q2, clean):
+    """A closed-form branch as is when ``clean`` (well-conditioned on the exact ideal structure, see
+    :data:`WELL_CONDITIONED`; the foot error is then not evaluated and returned as 0), else polished
+    (:func:`_polish_k`); if its foot error stays above :data:`REACH_TOL` (near a
+    fold of the ideal structure, where Newton stalls) it is restarted off the fold, each joint moved by
+    ``+-eta = +-4 sqrt(|e| / min(|k|, |l|))`` in turn, keeping the best. Returns ``(q1, q2, q3, |e|)``."""
+    if clean:
+        return q0, q1, q2, 0.0
+    q0, q1, q2, res = _polish_k(p, g, q0, q1, q2, 0)
+    if res <= REACH_TOL:
+        return q0, q1, q2, res
+    eta = 4.0 * math.sqrt(res / min(g[_KN], g[_LN]))
+    b0, b1, b2 = q0, q1, q2
+    for jr in range(6):
+        step = eta if jr % 2 == 0 else -eta
+        d0 = step if jr < 2 else 0.0
+        d1 = step if jr // 2 == 1 else 0.0
+        d2 = step if jr > 3 else 0.0
+        t0, t1, t2, rt = _polish_k(p, g, b0 + d0, b1 + d1, b2 + d2, 0)
+        if rt < res:
+            q0, q1, q2, res = t0, t1, t2, rt
+        if res <= REACH_TOL:
+            break
+    return q0, q1, q2, res
+
+
+@kernel
+def _target_k(p, g):
+    """The target in the abduction frame: ``x1 = p'.e1``, ``t = sqrt(y^2 + z^2 - d^2)`` (0 inside the cylinder),
+    ``y``, ``z``, ``cyl = |d| - r`` (> 0: inside the abduction cylinder), with ``p' = p - o1``, and
+    whether the leg has the exact ideal structure with ``t >= WELL_CONDITIONED r`` (away from the abduction
+    singularity: see :data:`WELL_CONDITIONED`)."""
+    px, py, pz = p[0] - g[_O], p[1] - g[_O + 1], p[2] - g[_O + 2]
+    x1 = px * g[_E1] + py * g[_E1 + 1] + pz * g[_E1 + 2]
+    y = px * g[_E2] + py * g[_E2 + 1] + pz * g[_E2 + 2]
+    z = px * g[_E3] + py * g[_E3 + 1] + pz * g[_E3 + 2]
+    ad = abs(g[_D])
+    r = math.sqrt(y * y + z * z)  # (hypot costs ~7x a sqrt; no overflow at leg scales)
+    disc = (r - ad) * (r + ad)
+    t = math.sqrt(disc) if disc > 0.0 else 0.0
+    return x1, t, (y, z), ad - r, g[_IDEAL] > 0.0 and t >= WELL_CONDITIONED * r
+
+
+@kernel
+def _abduction_k(g, ia, t, yz):
+    """Abduction branch ``ia`` (0: ``s_a = -1``, 1: ``+1``): ``u3 = s_a t`` and ``q1 = atan2(z, y) - atan2(u3, d)``
+    as one ``atan2`` (the angle from ``(d, u3)`` to ``(y, z)``)."""
+    u3 = t if ia == 1 else -t
+    d, y, z = g[_D], yz[0], yz[1]
+    return u3, math.atan2(d * z - u3 * y, d * y + u3 * z)
+
+
+@kernel
+def _pitch_k(g, x1, u3):
+    """The pitch-plane vector ``w = (u3, x1) - h``, its miss of the knee's reach ``max(|w| - |k| - |l|,
+    | |k| - |l| | - |w|)`` (m, <= 0 inside), whether it is beyond full stretch, the knee's
+    ``c = cos beta = (|w|^2 - |k|^2 - |l|^2) / (2 |k||l|)`` (clipped to [-1, 1]) and ``acos c``, and whether
+    ``|w| >= WELL_CONDITIONED (|k| + |l|)`` (away from the knee's fold)."""
+    kn, ln = g[_KN], g[_LN]
+    wx, wy = u3 - g[_H], x1 - g[_H + 1]
+    wn = math.sqrt(wx * wx + wy * wy)
+    far = wn - (kn + ln)
+    near = abs(kn - ln) - wn
+    c = (wn * wn - kn * kn - ln * ln) / (2.0 * kn * ln)
+    c = 1.0 if c > 1.0 else (-1.0 if c < -1.0 else c)
+    return wx, wy, (far if far > near else near), far > near, c, math.acos(c), wn >= WELL_CONDITIONED * (kn + ln)
+
+
+@kernel
+def _knee_k(g, ik, acb):
+    """Knee branch ``ik`` (0: ``s_k = -1``, 1: ``+1``): ``q3 = s3 a`` with ``a = beta - phi_l + phi_k``,
+    ``beta = s_k acb``."""
+    return g[_S3] * ((acb if ik == 1 else -acb) - g[_PL] + g[_PK])
+
+
+@kernel
+def _hip_k(g, ik, wx, wy, c):
+    """Hip pitch of knee branch ``ik``: ``q2 = atan2(w) - atan2(v)`` (one ``atan2``: the angle from ``v`` to ``w``)
+    with ``v = k + Rot(a) l``; ``cos a`` and
+    ``sin a`` from ``cos beta = c``, ``sin beta = s_k sqrt(1 - c^2)`` and the stored ``cos, sin (phi_k - phi_l)``
+    (no trigonometric call)."""
+    sb = math.sqrt(max(0.0, (1.0 - c) * (1.0 + c)))
+    if ik == 0:
+        sb = -sb
+    ca = c * g[_CD] - sb * g[_SD]
+    sa = sb * g[_CD] + c * g[_SD]
+    vx = g[_K] + ca * g[_L] - sa * g[_L + 1]
+    vy = g[_K + 1] + sa * g[_L] + ca * g[_L + 1]
+    return math.atan2(vx * wy - vy * wx, vx * wx + vy * wy)
 
 
 @kernel
@@ -102,164 +202,261 @@ def _near_k(a, r):
     return a + _TWO_PI * math.floor((r - a) / _TWO_PI + 0.5)
 
 
-@kernel(entry=True)
-def _ik_all_k(p, g, ref, tol, out, info) -> int:
+@kernel
+def _ik_all_core(p, g, ref, tol, out):
     """Every branch (rows in :data:`BRANCHES` order, NaN rows for absent ones) of the target ``p``.
 
     ``r^2 = y^2 + z^2``, ``u3 = s_a sqrt(r^2 - d^2)``, ``q1 = atan2(z, y) - atan2(u3, d)``;
     ``w = (u3, x1) - h``, ``cos beta = (|w|^2 - |k|^2 - |l|^2) / (2 |k||l|)``, ``beta = s_k acos(.)``,
     ``q3 = s3 (beta - phi_l + phi_k)``, ``q2 = atan2(w) - atan2(k + Rot(s3 q3) l)``. Each branch is then
-    polished on the exact forward map (:func:`_polish_k`) and each angle moved to its
-    2 pi representative nearest ``ref``. A target up to ``tol`` (m) outside the reachable set is solved at its
-    nearest reachable point (the clamped closed form, polished). ``info`` (2,): on failure the miss (m) and its
+    polished on the exact forward map (:func:`_settle_k`) and each angle moved to its 2 pi representative
+    nearest ``ref``. A target up to ``tol`` (m) outside the reachable set is solved at its nearest reachable point
+    (the clamped closed form, polished). Returns ``(status, miss, reason)``: on failure the miss (m) and its
     reason.
     """
     for b in range(4):
-        for j in range(3):
-            out[b, j] = _NAN
-    if not _finite3(p):
-        return _BAD_INPUT
-    px, py, pz = p[0] - g[_O], p[1] - g[_O + 1], p[2] - g[_O + 2]
-    x1 = px * g[_E1] + py * g[_E1 + 1] + pz * g[_E1 + 2]
-    y = px * g[_E2] + py * g[_E2 + 1] + pz * g[_E2 + 2]
-    z = px * g[_E3] + py * g[_E3 + 1] + pz * g[_E3 + 2]
-    d = g[_D]
-    ad = abs(d)
-    r = math.hypot(y, z)
+        out[b, 0] = out[b, 1] = out[b, 2] = _NAN
+    if not (_finite3(p) and _finite3(ref)):
+        return _BAD_INPUT, 0.0, 0.0
+    x, t, yz, cyl, clean_a = _target_k(p, g)
     slack = g[_SLACK] - REACH_TOL + tol  # the ideal structure's deviation bound, plus tol
-    cyl = ad - r
     if cyl > slack:
-        info[0], info[1] = cyl, _IN_CYLINDER
-        return _UNREACHABLE
-    disc = (r - ad) * (r + ad)
-    t = math.sqrt(disc) if disc > 0.0 else 0.0
-    phi = math.atan2(z, y)
-    kn, ln = g[_KN], g[_LN]
-    s3 = g[_S3]
+        return _UNREACHABLE, cyl, _IN_CYLINDER
     best, why = math.inf, 0.0
     if cyl > tol:
         best, why = cyl, _IN_CYLINDER
     found = 0
-    qb = np.empty(3)
-    qt = np.empty(3)
-    jac = np.empty((3, 3))
+    pitched, far, clean_w = False, False, False  # the pitch-plane quantities computed (for one abduction branch)
+    wx = wy = miss = c = acb = 0.0
     for ia in range(2):
-        u3 = t if ia == 1 else -t
-        q1 = phi - math.atan2(u3, d)
-        wx, wy = u3 - g[_H], x1 - g[_H + 1]
-        wn = math.hypot(wx, wy)
-        far = wn - (kn + ln)
-        near = abs(kn - ln) - wn
-        miss = far if far > near else near
+        u3, q1 = _abduction_k(g, ia, t, yz)
+        if not pitched or g[_H] != 0.0:  # h_X = 0: |w|, so the knee, is the same on both abduction branches
+            wx, wy, miss, far, c, acb, clean_w = _pitch_k(g, x, u3)
+            pitched = True
+        wx = u3 - g[_H]
+        reason = _TOO_FAR if far else _TOO_NEAR
         if miss > slack:
             if miss < best:
-                best, why = miss, (_TOO_FAR if far > near else _TOO_NEAR)
+                best, why = miss, reason
             continue
         # within the slack of the ideal structure's boundary: kept only if the exact foot error is <= tol
         check = cyl > tol or miss > tol
-        c = (wn * wn - kn * kn - ln * ln) / (2.0 * kn * ln)
-        c = 1.0 if c > 1.0 else (-1.0 if c < -1.0 else c)
-        acb = math.acos(c)
         for ik in range(2):
-            beta = acb if ik == 1 else -acb
-            a = beta - g[_PL] + g[_PK]  # = s3 q3
-            ca, sa = math.cos(a), math.sin(a)
-            vx = g[_K] + ca * g[_L] - sa * g[_L + 1]
-            vy = g[_K + 1] + sa * g[_L] + ca * g[_L + 1]
-            q2 = math.atan2(wy, wx) - math.atan2(vy, vx)
-            b = 2 * ia + ik
-            qb[0], qb[1], qb[2] = q1, q2, s3 * a
-            res = _polish_k(p, g, qb, jac)
-            if res > REACH_TOL:  # near a fold of the ideal structure: restart off it (Newton stalls on a fold)
-                eta = 4.0 * math.sqrt(res / min(kn, ln))
-                q0, q1b, q2b = qb[0], qb[1], qb[2]
-                for jr in range(6):
-                    qt[0], qt[1], qt[2] = q0, q1b, q2b
-                    qt[jr // 2] += eta if jr % 2 == 0 else -eta
-                    rt = _polish_k(p, g, qt, jac)
-                    if rt < res:
-                        res = rt
-                        qb[0], qb[1], qb[2] = qt[0], qt[1], qt[2]
-                    if res <= REACH_TOL:
-                        break
-            # a branch clamped onto the ideal structure's boundary is kept only if it reaches the target
-            if check and res > tol:
+            q3 = _knee_k(g, ik, acb)
+            j1, j2, j3, res = _settle_k(p, g, q1, _hip_k(g, ik, wx, wy, c), q3, clean_a and clean_w and not check)
+            if check and res > tol:  # clamped onto the ideal structure's boundary, and missing the target
                 if cyl <= tol and res < best:
-                    best, why = res, (_TOO_FAR if far > near else _TOO_NEAR)
+                    best, why = res, reason
                 continue
-            out[b, 0] = _near_k(qb[0], ref[0])
-            out[b, 1] = _near_k(qb[1], ref[1])
-            out[b, 2] = _near_k(qb[2], ref[2])
+            b = 2 * ia + ik
+            out[b, 0], out[b, 1], out[b, 2] = _near_k(j1, ref[0]), _near_k(j2, ref[1]), _near_k(j3, ref[2])
             found += 1
     if found == 0:
-        info[0], info[1] = best, why
-        return _UNREACHABLE
-    return OK
+        return _UNREACHABLE, best, why
+    return OK, 0.0, 0.0
 
 
 @kernel(inline=True)
-def _in_limits_k(a, r, lo, hi):
-    """The representative ``a + 2 pi n`` inside ``[lo, hi]`` (slack :data:`LIMIT_TOL`, then clipped) nearest ``r``;
-    NaN if none. Also returns the distance to the limits of the nearest representative (0 when inside)."""
+def _within_k(a, r, lo, hi, tol):
+    """The representative ``a + 2 pi n`` inside ``[lo, hi]`` (slack ``tol``, then clipped) nearest ``r``; NaN if
+    none. Also returns the distance to the limits of the nearest representative (0 when inside) and whether the
+    one returned was clipped."""
     rc = lo if r < lo else (hi if r > hi else r)
     base = _near_k(a, rc)
-    best, dist, miss = _NAN, math.inf, math.inf
+    best, dist, miss, clipped = _NAN, math.inf, math.inf, False
     for n in range(-1, 2):
         x = base + _TWO_PI * n
         out_by = lo - x if x < lo else (x - hi if x > hi else 0.0)
         if out_by < miss:
             miss = out_by
-        if out_by <= LIMIT_TOL:
+        if out_by <= tol:
             x = lo if x < lo else (hi if x > hi else x)
             if abs(x - r) < dist:
-                best, dist = x, abs(x - r)
-    return best, miss
+                best, dist, clipped = x, abs(x - r), out_by > 0.0
+    return best, miss, clipped
 
 
-@kernel(entry=True)
-def _ik_k(p, g, ref, tol, out, info) -> int:
-    """The branch of :func:`_ik_all_k` inside the limits nearest ``ref`` (least sum of squared joint differences;
-    ties to the earlier branch). ``info``: the miss (m) and reason, or the least limit violation (rad) and the
-    number of geometric branches."""
-    qa = np.empty((4, 3))
-    status = _ik_all_k(p, g, ref, tol, qa, info)
+@kernel(inline=True)
+def _in_limits_k(a, r, lo, hi):
+    """:func:`_within_k` with the slack :data:`LIMIT_TOL`: the representative and the distance."""
+    x, miss, _clipped = _within_k(a, r, lo, hi, LIMIT_TOL)
+    return x, miss
+
+
+@kernel
+def _repair_k(p, g, q, ref) -> bool:
+    """A branch ``q`` (3,) at most :data:`LIMIT_SLACK` outside the limits, moved into them (rare path): each angle
+    at its representative nearest ``ref`` clipped onto the limits, the joints left alone re-solved by
+    :func:`_polish_k` with the clipped ones fixed (a joint the steps push outside is clipped and fixed in turn, as
+    when a target is made with two joints on their limits); kept (True, ``q`` overwritten) if it reproduces ``p``
+    within :data:`REACH_TOL`. Near the abduction singularity (foot on the cylinder ``r = |d|``) a branch's q1 errs
+    by up to ~1e-8 rad along the singular direction while its foot is exact: a target made with q1 on its limit
+    then comes back outside it, and the other joints absorb the clip."""
+    fixed = 0
     for j in range(3):
-        out[j] = _NAN
+        lo, hi = g[_LO + j], g[_HI + j]
+        x = _near_k(q[j], lo if ref[j] < lo else (hi if ref[j] > hi else ref[j]))
+        for n in range(-1, 2):
+            y = x + _TWO_PI * n
+            if y >= lo - LIMIT_SLACK and y <= hi + LIMIT_SLACK:
+                x = y
+        if x < lo or x > hi:
+            x = lo if x < lo else hi
+            fixed |= 1 << j
+        q[j] = x
+    for _ in range(3):  # a free joint the steps push outside its limits is clipped and fixed in turn
+        q[0], q[1], q[2], res = _polish_k(p, g, q[0], q[1], q[2], fixed)
+        inside = True
+        for j in range(3):
+            lo, hi = g[_LO + j], g[_HI + j]
+            if q[j] < lo or q[j] > hi:
+                q[j] = lo if q[j] < lo else hi
+                fixed |= 1 << j
+                inside = False
+        if inside:
+            return res <= REACH_TOL
+    return False
+
+
+@kernel
+def _accept_k(p, g, j1, j2, j3, ref):
+    """A polished branch ``(j1, j2, j3)`` put inside the limits: each angle at its representative inside them
+    nearest ``ref``; a branch up to :data:`LIMIT_SLACK` outside is moved into them by :func:`_repair_k` (rare
+    path), failing that one up to :data:`LIMIT_TOL` outside is kept clipped onto them. Returns ``(ok, violation,
+    x1, x2, x3)``: whether it is kept, by how much (rad) it was outside, and the angles kept."""
+    x0, m0 = _in_limits_k(j1, ref[0], g[_LO], g[_HI])
+    x1, m1 = _in_limits_k(j2, ref[1], g[_LO + 1], g[_HI + 1])
+    x2, m2 = _in_limits_k(j3, ref[2], g[_LO + 2], g[_HI + 2])
+    m = max(m0, max(m1, m2))
+    if m > LIMIT_SLACK:
+        return False, m, x0, x1, x2
+    if m > 0.0:  # a hair outside the limits: moved into them, the free joints re-solved (rare path)
+        qr = np.empty(3)  # the rare path allocates its own scratch
+        qr[0], qr[1], qr[2] = j1, j2, j3
+        if _repair_k(p, g, qr, ref):
+            return True, m, qr[0], qr[1], qr[2]
+        if not (np.isfinite(x0) and np.isfinite(x1) and np.isfinite(x2)):
+            return False, m, x0, x1, x2
+    return True, m, x0, x1, x2
+
+
+@kernel
+def _ik_every_k(p, g, ref, tol, out):
+    """:func:`_ik_core`'s complete path: every branch of :func:`_ik_all_core` (all polished) put inside the limits
+    by :func:`_accept_k`, the one nearest ``ref`` kept (least sum of squared joint differences; ties to the earlier
+    branch). Returns ``(status, info0, info1)``: the miss (m) and reason, or the least limit violation (rad) and
+    the number of geometric branches."""
+    qa = np.empty((4, 3))  # the rare path allocates
+    status, i0, i1 = _ik_all_core(p, g, ref, tol, qa)
     if status != OK:
-        return status
+        return status, i0, i1
     best, viol, nb = math.inf, math.inf, 0
     for b in range(4):
         if not np.isfinite(qa[b, 0]):
             continue
         nb += 1
-        x0, m0 = _in_limits_k(qa[b, 0], ref[0], g[_LO], g[_HI])
-        x1, m1 = _in_limits_k(qa[b, 1], ref[1], g[_LO + 1], g[_HI + 1])
-        x2, m2 = _in_limits_k(qa[b, 2], ref[2], g[_LO + 2], g[_HI + 2])
-        m = max(m0, max(m1, m2))
-        if m < viol:
-            viol = m
-        if not (np.isfinite(x0) and np.isfinite(x1) and np.isfinite(x2)):
-            continue
+        ok, m, x0, x1, x2 = _accept_k(p, g, qa[b, 0], qa[b, 1], qa[b, 2], ref)
+        viol = min(viol, m)
         cost = (x0 - ref[0]) ** 2 + (x1 - ref[1]) ** 2 + (x2 - ref[2]) ** 2
-        if cost < best:
+        if ok and cost < best:
             best = cost
             out[0], out[1], out[2] = x0, x1, x2
     if best == math.inf:
-        info[0], info[1] = viol, nb
-        return _JOINT_LIMIT
-    return OK
+        return _JOINT_LIMIT, viol, float(nb)
+    return OK, 0.0, 0.0
 
 
-@batch_kernel(rows="p ref out status info", min_parallel=4096)
-def _ik_all_batch(p, g, ref, tol, out, status, info) -> None:
+@kernel
+def _ik_core(p, g, ref, tol, out):
+    """The branch of :func:`_ik_all_core` inside the limits nearest ``ref``, limits first, into ``out`` (3,).
+
+    The fast path computes the closed form of each branch with scalars only, joint by joint in the order q1, q3,
+    q2, and drops a branch as soon as a joint's representative nearest ``ref`` is more than
+    :data:`CANDIDATE_SLACK` outside the limits or its partial cost ``sum (x_j - ref_j)^2`` exceeds the best's;
+    only the best candidate is polished (:func:`_settle_k`, unless well-conditioned) and put inside the limits
+    (:func:`_accept_k`). When it fails (no candidate, a branch off the ideal structure's reach, a polish leaving
+    the limits) the complete path :func:`_ik_every_k` decides (every branch polished; the failure's data). Ties go
+    to the earlier branch (costs of the closed-form angles before the polish). Returns ``(status, info0, info1)`` as
+    :func:`_ik_every_k`."""
+    out[0] = out[1] = out[2] = _NAN
+    if not (_finite3(p) and _finite3(ref)):
+        return _BAD_INPUT, 0.0, 0.0
+    x, t, yz, cyl, clean_a = _target_k(p, g)
+    slack = g[_SLACK] - REACH_TOL + tol
+    best, c1, c2, c3, check, clean, inside = math.inf, 0.0, 0.0, 0.0, False, False, False
+    y0 = y1 = y2 = 0.0
+    pitched, clean_w = False, False  # the pitch-plane quantities computed (for one abduction branch)
+    wx = wy = miss = c = acb = 0.0
+    for ia in range(2 if cyl <= slack else 0):
+        u3, q1 = _abduction_k(g, ia, t, yz)
+        x0, m0, k0 = _within_k(q1, ref[0], g[_LO], g[_HI], CANDIDATE_SLACK)
+        cost0 = (x0 - ref[0]) ** 2
+        if m0 > CANDIDATE_SLACK or not cost0 < best:
+            continue
+        if not pitched or g[_H] != 0.0:  # h_X = 0: |w|, so the knee, is the same on both abduction branches
+            wx, wy, miss, far, c, acb, clean_w = _pitch_k(g, x, u3)
+            pitched = True
+        wx = u3 - g[_H]
+        if miss > slack:
+            continue
+        for ik in range(2):
+            q3 = _knee_k(g, ik, acb)
+            x2, m2, k2 = _within_k(q3, ref[2], g[_LO + 2], g[_HI + 2], CANDIDATE_SLACK)
+            cost = cost0 + (x2 - ref[2]) ** 2
+            if m2 > CANDIDATE_SLACK or not cost < best:
+                continue
+            q2 = _hip_k(g, ik, wx, wy, c)
+            x1, m1, k1 = _within_k(q2, ref[1], g[_LO + 1], g[_HI + 1], CANDIDATE_SLACK)
+            cost += (x1 - ref[1]) ** 2
+            if m1 <= CANDIDATE_SLACK and cost < best:
+                best, c1, c2, c3, y0, y1, y2 = cost, q1, q2, q3, x0, x1, x2
+                check = cyl > tol or miss > tol
+                clean = clean_a and clean_w and not check
+                inside = m0 == 0.0 and m1 == 0.0 and m2 == 0.0 and not (k0 or k1 or k2)
+    if clean and inside:  # well-conditioned, strictly inside the limits: the representatives found are the answer
+        out[0], out[1], out[2] = y0, y1, y2
+        return OK, 0.0, 0.0
+    if best < math.inf:
+        j1, j2, j3, res = _settle_k(p, g, c1, c2, c3, clean)
+        if res <= tol or not check:
+            ok, _m, x0, x1, x2 = _accept_k(p, g, j1, j2, j3, ref)
+            if ok:
+                out[0], out[1], out[2] = x0, x1, x2
+                return OK, 0.0, 0.0
+    return _ik_every_k(p, g, ref, tol, out)
+
+
+@kernel(entry=True)
+def _ik_all_k(p, g, ref, out) -> int:
+    """:func:`_ik_all_core` of one target with the default ``tol`` (the single call; one argument fewer for numba's
+    dispatch): its status."""
+    return _ik_all_core(p, g, ref, IK_TOL, out)[0]
+
+
+@kernel(entry=True)
+def _ik_k(p, g, ref, out) -> int:
+    """:func:`_ik_core` of one target with the default ``tol`` (the single call): its status."""
+    return _ik_core(p, g, ref, IK_TOL, out)[0]
+
+
+@batch_kernel(rows="p ref out status info", min_parallel=512)
+def _ik_all_batch(p, g, ref, tol, out, status, info) -> int:
+    """:func:`_ik_all_core` over rows; returns the number of targets that failed (status != OK)."""
     # ref: one row for all targets (m = 1) or one per target; ``i - i`` keeps the index type of i
-    n, m = p.shape[0], ref.shape[0]
+    n, m, bad = p.shape[0], ref.shape[0], 0
     for i in range(n):
-        status[i] = _ik_all_k(p[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])
+        s, a, b = _ik_all_core(p[i], g, ref[i if m > 1 else i - i], tol, out[i])
+        status[i], info[i, 0], info[i, 1] = s, a, b
+        bad += s != OK
+    return bad
 
 
-@batch_kernel(rows="p ref out status info", min_parallel=4096)
-def _ik_batch(p, g, ref, tol, out, status, info) -> None:
-    n, m = p.shape[0], ref.shape[0]
+@batch_kernel(rows="p ref out status info", min_parallel=1024)
+def _ik_batch(p, g, ref, tol, out, status, info) -> int:
+    """:func:`_ik_core` over rows; returns the number of targets that failed (status != OK)."""
+    n, m, bad = p.shape[0], ref.shape[0], 0
     for i in range(n):
-        status[i] = _ik_k(p[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])
+        s, a, b = _ik_core(p[i], g, ref[i if m > 1 else i - i], tol, out[i])
+        status[i], info[i, 0], info[i, 1] = s, a, b
+        bad += s != OK
+    return bad

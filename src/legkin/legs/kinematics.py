@@ -35,6 +35,10 @@ Pinocchio); each closed-form branch is polished by at most :data:`POLISH_STEPS` 
 its foot error exceeds :data:`POLISH_BELOW` (axes a few 1e-12 rad off the ideal structure, the knee's fold).
 Each angle is then moved by a multiple of 2 pi: in :meth:`Leg.ik_all` to the representative nearest the
 reference configuration, in :meth:`Leg.ik` to the representative inside the URDF limits nearest ``q_near``.
+:meth:`Leg.ik` is limits-first: the branches are pruned joint by joint (q1, q3, q2) by the limits and by their
+partial distance to ``q_near`` before any polish, and only the winner is polished. On a leg whose axes are
+exactly the ideal structure, a branch away from the singular sets (:data:`~._layout.WELL_CONDITIONED`) is exact
+to rounding and returned unpolished (docs/legs.md gives the measurement).
 
 Implementation (issue 16, :mod:`legkin._kernels`): each function is one compiled scalar kernel; a batch is a
 compiled loop over it. Where the code is: :mod:`._fk_kernels` (forward map, Jacobian), :mod:`._ik_kernels`
@@ -63,12 +67,14 @@ from ._layout import (
     _A2,
     _A3,
     _BAD_INPUT,
+    _CD,
     _D,
     _E1,
     _E2,
     _E3,
     _H,
     _HI,
+    _IDEAL,
     _IN_CYLINDER,
     _JOINT_LIMIT,
     _K,
@@ -81,6 +87,7 @@ from ._layout import (
     _PK,
     _PL,
     _S3,
+    _SD,
     _SLACK,
     _TOO_FAR,
     _UNREACHABLE,
@@ -116,6 +123,19 @@ LegStructureError = _LegStructureError
 
 _S3SHAPE = (3,)
 _F64 = np.dtype(np.float64)
+
+
+def _vector3(x: object) -> np.ndarray | None:
+    """``x`` itself if it is a float64 array (3,) (a single call's reference, for the fast path), else None."""
+    if x.__class__ is np.ndarray and x.shape == _S3SHAPE and x.dtype is _F64:  # type: ignore[attr-defined]
+        return x  # type: ignore[return-value]
+    return None
+
+
+def _rows3(x: object) -> bool:
+    """Whether ``x`` is a C-contiguous writeable float64 array (n, 3), n >= 1 (a batch the kernels take as is)."""
+    return (x.__class__ is np.ndarray and x.ndim == 2 and x.shape[1] == 3 and x.dtype is _F64  # type: ignore[attr-defined]
+            and x.shape[0] > 0 and x.flags.c_contiguous and x.flags.writeable)  # type: ignore[attr-defined]
 
 
 # ---------------------------------------------------------------- geometry helpers (Python)
@@ -194,6 +214,12 @@ class Leg:
     idx_q: tuple[int, int, int] = (-1, -1, -1)
     idx_v: tuple[int, int, int] = (-1, -1, -1)
     params: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # always set by from_geometry
+    _ref: np.ndarray = field(init=False, repr=False)  # q_ref, writeable: the kernels' one type of reference array
+    _ref1: np.ndarray = field(init=False, repr=False)  # the same, one row (1, 3)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "_ref", np.array(self.q_ref, dtype=float).reshape(3))
+        object.__setattr__(self, "_ref1", self._ref.reshape(1, 3))
 
     #: The leg's structure (see :data:`legkin.legs.extract.EXPECTED`) and its number of joints.
     structure = "HAA-HFE-KFE"
@@ -287,6 +313,8 @@ class Leg:
         # deviations (rad) times the lever arms: its reach boundaries get that much slack (then exact check).
         lever = float(np.linalg.norm(o[1] - o[0]) + np.linalg.norm(o[2] - o[1]) + np.linalg.norm(f - o[2]))
         g[_SLACK] = REACH_TOL + 4.0 * (abs(dot12) + cross23 + 1e-15) * lever
+        g[_IDEAL] = 1.0 if dot12 == 0.0 and cross23 == 0.0 else 0.0
+        g[_CD], g[_SD] = math.cos(g[_PK] - g[_PL]), math.sin(g[_PK] - g[_PL])
         return cls(
             name=str(name), joint_names=(str(j1), str(j2), str(j3)), foot_frame=str(foot_frame),
             lower=_frozen(lo), upper=_frozen(hi), origin=_frozen(o[0]), axes=_frozen(np.stack([a1, a2, a3])),
@@ -408,7 +436,7 @@ class Leg:
         """Checked target rows and reference rows (m = 1 or n), the batch shape and whether it is a single call."""
         arr = as_input(p, "p", _S3SHAPE)
         if q_near is None:
-            ref = self.q_ref.reshape(1, 3)
+            ref = self._ref1
             batch = arr.shape[:-1]
         else:
             r = as_input(q_near, "q_near", _S3SHAPE)
@@ -440,16 +468,41 @@ class Leg:
             else:
                 text = f"it lies {miss:.6g} m inside the knee's inner reach (| |k| - |l| | = {lo:.6g} m)"
             return UnreachableError(f"target {tgt} is out of reach of leg {self.name} by {miss:.6g} m: {text}",
-                                    target=p)
+                                    target=p, distance=miss)
         if status == _JOINT_LIMIT:
             branches = self.ik_all(p, tol=tol)
+            j, value, closest = self._least_violation(branches)
             return JointLimitError(
                 f"target {tgt} of leg {self.name} is reachable only outside the joint limits "
-                f"[{self.lower.tolist()}, {self.upper.tolist()}] (by {float(info[0]):.6g} rad at least); "
+                f"[{self.lower.tolist()}, {self.upper.tolist()}] (by {float(info[0]):.6g} rad at least: joint "
+                f"{self.joint_names[j]} = {value:.6g} rad in the closest branch); "
                 f"branches {np.round(branches, 6).tolist()}",
-                target=p,
+                target=p, closest=closest, distance=float(info[0]), joint=self.joint_names[j], value=value,
+                lower=float(self.lower[j]), upper=float(self.upper[j]),
             )
         return InvalidInputError(f"p must be finite, got {tgt}")  # pragma: no cover - as_input caught it
+
+    def _single_error(self, batch_loop, width: tuple[int, ...], p: np.ndarray, ref: np.ndarray) -> Exception:
+        """The error of a failed single call (default ``tol``): the batch loop run on its one row gives its data."""
+        rows = np.array(p, dtype=float).reshape(1, 3)
+        status = np.empty(1, dtype=np.int64)
+        info = np.zeros((1, 2))
+        ref1 = np.array(ref, dtype=float).reshape(1, 3)
+        batch_loop(rows, self.params, ref1, IK_TOL, np.empty((1,) + width), status, info)
+        return self._error(int(status[0]), info[0], rows[0])
+
+    def _least_violation(self, branches: np.ndarray) -> tuple[int, float, np.ndarray]:
+        """The branch least outside the limits (each angle's 2 pi representative nearest them): the index of its
+        joint farthest outside, that joint's value (rad) and the branch (error path only)."""
+        best: tuple[float, int, float, np.ndarray] = (math.inf, 0, math.nan, branches[0])
+        mid = 0.5 * (np.clip(self.lower, -1e9, 1e9) + np.clip(self.upper, -1e9, 1e9))
+        for q in branches[np.isfinite(branches[:, 0])]:
+            x = q + 2.0 * math.pi * np.round((mid - q) / (2.0 * math.pi))
+            out_by = np.maximum(np.maximum(self.lower - x, x - self.upper), 0.0)
+            j = int(np.argmax(out_by))
+            if out_by[j] < best[0]:
+                best = (float(out_by[j]), j, float(x[j]), x)
+        return best[1], best[2], best[3]
 
     def ik_all(self, p, *, q_near=None, tol: float = IK_TOL, return_mask: bool = False):
         """Every IK branch of the target(s) ``p`` (m, root frame), joint limits ignored.
@@ -477,15 +530,15 @@ class Leg:
         """
         if return_mask is not False and return_mask is not True:
             return_mask = check_flag(return_mask, "return_mask")
-        if q_near is None and tol is IK_TOL and p.__class__ is np.ndarray and p.shape == _S3SHAPE \
-                and p.dtype is _F64:  # fast
-            out = np.empty((4, 3))
-            info = np.zeros(2)
-            st = _ik_all_k(p, self.params, self.q_ref, IK_TOL, out, info)
-            if st == OK:
-                return (out, np.isfinite(out[:, 0])) if return_mask else out
-            if st != _BAD_INPUT:
-                raise self._error(st, info, p.copy())
+        if tol is IK_TOL and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast path
+            ref = self._ref if q_near is None else _vector3(q_near)
+            if ref is not None:
+                out = np.empty((4, 3))
+                st = _ik_all_k(p, self.params, ref, out)
+                if st == OK:
+                    return (out, np.isfinite(out[:, 0])) if return_mask else out
+                if st != _BAD_INPUT:
+                    raise self._single_error(_ik_all_batch, (4, 3), p, ref)
         rows, ref, batch, single, tol = self._prepare(p, q_near, tol)
         n = rows.shape[0]
         out = np.empty((n, 4, 3))
@@ -503,12 +556,17 @@ class Leg:
         """Joint values placing the foot at ``p``: the branch inside the URDF limits nearest ``q_near``.
 
         For each branch of :meth:`ik_all`, each joint takes its 2 pi representative inside ``[lower, upper]``
-        nearest ``q_near`` (an angle up to :data:`LIMIT_TOL` outside is clipped onto the limit); among the branches
-        inside the limits the one with the least ``|q - q_near|^2`` wins (ties: the earlier branch).
+        nearest ``q_near``; among the branches inside the limits the one with the least ``|q - q_near|^2`` wins
+        (ties: the earlier branch). A branch up to ``LIMIT_SLACK`` (1e-7 rad) outside the limits (rounding at a
+        limit, or the abduction singularity, where q1 errs along the singular direction) is moved onto them and
+        its other joints re-solved, kept if it reaches ``p`` within :data:`REACH_TOL`; failing that, a branch up
+        to :data:`LIMIT_TOL` outside is kept clipped onto the limit (foot within ``LIMIT_TOL`` x the reach).
 
         Args:
             p: targets (3,) or (..., 3), m, root frame.
             q_near: reference (3,) or broadcastable with ``p``; default :attr:`q_ref` (mid-limit).
+            tol: a target up to ``tol`` (m; (0, 1e-3], default :data:`IK_TOL`) outside the reachable set is solved
+                at its nearest reachable point (:meth:`ik_all`).
             return_mask: also return the boolean mask of the solved targets.
 
         Returns:
@@ -522,15 +580,22 @@ class Leg:
         """
         if return_mask is not False and return_mask is not True:
             return_mask = check_flag(return_mask, "return_mask")
-        if q_near is None and tol is IK_TOL and p.__class__ is np.ndarray and p.shape == _S3SHAPE \
-                and p.dtype is _F64:  # fast
-            out = np.empty(3)
-            info = np.zeros(2)
-            st = _ik_k(p, self.params, self.q_ref, IK_TOL, out, info)
-            if st == OK:
-                return (out, np.array(True)) if return_mask else out
-            if st != _BAD_INPUT:
-                raise self._error(st, info, p.copy())
+        if tol is IK_TOL and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast path
+            ref = self._ref if q_near is None else _vector3(q_near)
+            if ref is not None:
+                out = np.empty(3)
+                st = _ik_k(p, self.params, ref, out)
+                if st == OK:
+                    return (out, np.array(True)) if return_mask else out
+                if st != _BAD_INPUT:
+                    raise self._single_error(_ik_batch, (3,), p, ref)
+        if q_near is None and tol is IK_TOL and _rows3(p):  # a batch (n, 3) the kernels read as is: no copy
+            out = np.empty(p.shape)
+            status = np.empty(p.shape[0], dtype=np.int64)
+            if not _ik_batch(p, self.params, self._ref1, IK_TOL, out, status, np.empty((p.shape[0], 2))):
+                return (out, np.ones(p.shape[0], dtype=bool)) if return_mask else out
+            if not (status == _BAD_INPUT).any():  # NaN rows for the targets that failed (else as_input raises)
+                return (out, status == OK) if return_mask else out
         rows, ref, batch, single, tol = self._prepare(p, q_near, tol)
         n = rows.shape[0]
         out = np.empty((n, 3))

@@ -19,8 +19,8 @@ if TYPE_CHECKING:  # the names a type checker and an IDE see; at run time they l
     from .kinematics import *  # noqa: F403
 
 _SUBMODULES = (
-    "kinematics", "geometry", "constants", "forward", "closed_form", "inverse", "repair", "limits", "textbook",
-    "deprecated", "configuration", "contract", "checks", "bench", "figures", "clips",
+    "kinematics", "geometry", "constants", "measured", "textbook", "configuration", "contract", "checks", "bench",
+    "figures", "clips",
 )
 #: Names served without importing the kernels (numba).
 _LIGHT = {"Geometry": "geometry", "DEFAULT_GEOMETRY": "geometry"}

@@ -1,9 +1,6 @@
-"""What every wrapper of the quadruped's kinematics shares: the leg lookup, the array fast path, the geometry
-check and the deprecation helpers (private)."""
+"""What the quadruped's wrappers share: the leg look-up, the geometry check and the array fast path (private)."""
 
 from __future__ import annotations
-
-import warnings
 
 import numpy as np
 
@@ -15,8 +12,6 @@ from .geometry import Geometry
 LEG_INDEX = {leg: i for i, leg in enumerate(LEGS)}
 F64 = np.dtype(np.float64)
 S3 = (3,)
-S33 = (3, 3)
-S43 = (4, 3)
 
 
 def leg_index(leg: object) -> int:
@@ -48,24 +43,3 @@ def raise_bad(x: object, name: str) -> None:
     """Raise the error of :func:`as_input` for an array a kernel found NaN/inf in."""
     as_input(x, name, S3)
     raise AssertionError(f"{name}: a kernel reported a non-finite entry that as_input accepts")  # pragma: no cover
-
-
-def deprecated(old: str, new: str) -> None:
-    """Warn that ``old`` (a legkin 0.1 name) is deprecated in favour of ``new`` (kept for one release)."""
-    warnings.warn(
-        f"legkin.quadruped.{old} is deprecated (legkin 0.2); use {new}", DeprecationWarning, stacklevel=3
-    )
-
-
-def legacy_geometry(foot_z: object, geometry: Geometry | None) -> Geometry | None:
-    """The geometry of a call with the deprecated ``foot_z=`` keyword (None: not given, ``geometry`` as it is)."""
-    if foot_z is None:
-        return geometry
-    warnings.warn(
-        "the foot_z= keyword is deprecated (legkin 0.2); use geometry=legkin.quadruped.Geometry(foot_z=...)",
-        DeprecationWarning,
-        stacklevel=3,
-    )
-    if geometry is not None:
-        raise InvalidParameterError("give geometry= or the deprecated foot_z=, not both")
-    return Geometry(foot_z=foot_z)  # type: ignore[arg-type]  # checked in __post_init__

@@ -6,9 +6,10 @@ method's answer is scored the same way: Pinocchio's foot position at the returne
 into the limits) against the target; solved = error <= SOLVE_TOL and joints inside the limits.
 
 The floor of the batch closed form is its transcendental calls alone (:func:`transcendental_floor`: per
-target the 2 sqrt, 1 acos and 2 atan2 calls of ``ik``'s first branch, in the same compiled ``prange``
-loop shape), not ``fk`` (which needs no inverse trig). :func:`single_calls` gives the single-call
-table (one entry per public function of :mod:`legkin.quadruped`).
+target the 2 sqrt, 1 acos and 2 atan2 calls one branch of an HAA-HFE-KFE leg's closed form needs, in the same
+compiled ``prange`` loop shape; ``ik`` is :meth:`legkin.legs.Leg.ik`, which computes four branches), not ``fk``
+(which needs no inverse trig). :func:`single_calls` gives the single-call table (one entry per public function
+of :mod:`legkin.quadruped`).
 """
 
 from __future__ import annotations
@@ -96,7 +97,7 @@ _FLOOR = None
 
 def transcendental_floor() -> Callable[[np.ndarray, np.ndarray], None]:
     """The compiled floor loop ``floor(p, out)``: per target row of ``p`` (n, 3), the transcendental calls of
-    ``ik``'s closed form alone (2 sqrt, 1 acos, 2 atan2, on the target's coordinates), written to ``out``
+    one branch of the leg's closed form alone (2 sqrt, 1 acos, 2 atan2, on the target's coordinates), written to ``out``
     (n, 3); a ``prange`` loop like the batch kernels (numba's thread count), compiled on first use."""
     global _FLOOR
     if _FLOOR is None:
@@ -283,8 +284,8 @@ def _notes(n_batch: int, n_scalar: int, n_iter: int) -> list[str]:
         f"targets: Pinocchio FK of {LEG}_FOOT for {n_batch} joint vectors of leg {LEG} uniform in its limits "
         f"(the other legs at q0); slow methods solve the first {n_scalar} (scalar loop) or {n_iter} (iterative) "
         "of the same targets",
-        "floor: a compiled prange loop making, per target, the transcendental calls of ik's closed form "
-        "(first branch: 2 sqrt, 1 acos, 2 atan2) and nothing else; no answer to score (time only); threads: "
+        "floor: a compiled prange loop making, per target, the transcendental calls of one closed-form branch "
+        "(2 sqrt, 1 acos, 2 atan2) and nothing else; no answer to score (time only); threads: "
         "numba's setting (numba.set_num_threads / NUMBA_NUM_THREADS), the same for the batch rows",
         "errors: Pinocchio FK of the returned joints vs the target; FK/solve = mean forward-kinematics "
         "evaluations per target; reached = error <= "

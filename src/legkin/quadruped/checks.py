@@ -19,6 +19,7 @@ from .._rotations import wrap
 from ..robot import load
 from . import kinematics as aq
 from .configuration import leg_slice, made_joints, near_singular_joints, pinocchio_configuration, random_targets, rho
+from .constants import L1
 
 TOL = 1e-12
 #: Abduction-singularity band: below this distance rho (m) of the foot from the abduction cylinder
@@ -56,10 +57,27 @@ def run(samples: int, rng: np.random.Generator) -> list[CheckResult]:
         rows.append(compare(f"{leg} IK round trip, joints (rho >= 1 mm)", jerr[~near], TOL))
         rows.append(compare(f"{leg} IK round trip, joints (rho < 1 mm, near-singular)", jerr[near], TOL_NEAR))
         rows.append(compare(f"{leg} IK round trip, foot position", per_sample(aq.fk(q_ik, leg) - p_all), TOL))
+        rows += _textbook_rows(leg, p_all, near)
     rows += _geometry_rows(samples, rng)
     rows.append(_yourdfpy_row(robot, qs[: min(samples, YOURDFPY_SAMPLES)], pos, frames))
     rows += _generic_leg_rows(samples, rng)
     return rows
+
+
+def _textbook_rows(leg: str, p: np.ndarray, near: np.ndarray) -> list[CheckResult]:
+    """Seed 002's textbook IK (:mod:`legkin.quadruped.textbook`) vs :func:`~legkin.quadruped.ik_all`'s branch
+    (s_u, k) = (-1, -1) on the Pinocchio feet ``p`` (max joint difference, rad), split like the IK rows at
+    rho = 1 mm: the seed's ``acos(a / sqrt(x_f^2 + z_f^2))`` loses digits as the foot nears the abduction
+    cylinder (measured: 1.1e-11 rad at rho = 6e-6 m, error * rho <= 1e-16 m rad)."""
+    fz = aq.DEFAULT_GEOMETRY.foot_z
+    theta = aq.textbook_ik(aq.textbook_frame(p, leg), aq.Y12, L1, float(np.hypot(aq.X34, fz)))
+    err = np.abs(wrap(aq.textbook_to_joints(theta, leg) - aq.ik_all(p, leg)[:, 0])).max(axis=-1)
+    err = np.where(np.isnan(err), np.inf, err)  # the seed's acos/asin out of range: a failure of the row
+    name = f"{leg} seed 002 textbook IK = ik_all branch (s_u, k) = (-1, -1), joints"
+    return [
+        compare(f"{name} (rho >= 1 mm)", err[~near], TOL),
+        compare(f"{name} (rho < 1 mm, near-singular)", err[near], TOL_NEAR),
+    ]
 
 
 #: Prefix of the rows of the generic leg (:mod:`legkin.legs`, measured from POPI's model).

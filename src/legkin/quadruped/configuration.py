@@ -2,7 +2,7 @@
 a Pinocchio configuration from leg angles, and samplers of in-limit joints and of foot targets.
 
 The samplers draw from a ``numpy.random.Generator``; nothing here is a kinematic function of its own (they
-call :func:`~legkin.quadruped.fk` and the kernels of :mod:`legkin.quadruped.forward`).
+call :func:`~legkin.quadruped.fk`).
 """
 
 from __future__ import annotations
@@ -14,9 +14,8 @@ import numpy.typing as npt
 
 from .._rotations import wrap
 from ._common import leg_index
-from .constants import JOINT_LIMITS, L1, LEGS, X34, Y12
-from .forward import _knee_vector, fk, hip_position
-from .limits import within_limits
+from .constants import JOINT_LIMITS, L1, LEGS, X23, X34, Y12, Z23
+from .kinematics import fk, hip_position, within_limits
 
 __all__ = [
     "JOINTS",
@@ -28,6 +27,7 @@ __all__ = [
     "made_joints",
     "random_targets",
     "rho",
+    "knee_vector",
 ]
 
 #: The joint names of a leg, in the order of ``q``: (``<LEG>_HAA``, ``<LEG>_HFE``, ``<LEG>_KFE``).
@@ -75,9 +75,16 @@ def rho(p: npt.ArrayLike, leg: str) -> np.ndarray:
     return np.sqrt(np.maximum(d[..., 1] ** 2 + d[..., 2] ** 2 - Y12**2, 0.0))
 
 
+def knee_vector(q3: npt.ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+    """Seed 004's knee-to-foot vector in the thigh's x-z plane, ``v = t23 + R_y(q3) t34`` (foot_z = 0), for
+    knee angles ``q3`` (rad, any shape): ``(v_x, v_z)`` in metres (a sampler's helper, not a kinematic function)."""
+    q3 = np.asarray(q3, dtype=float)
+    return X23 + X34 * np.cos(q3), Z23 - X34 * np.sin(q3)
+
+
 def _q2_at_rho(q3: np.ndarray, signed_rho: np.ndarray) -> np.ndarray:
     """q2 putting the foot (foot_z = 0) ``signed_rho`` from the abduction cylinder (u_z = rho) for knee ``q3``."""
-    vx, vz = _knee_vector(q3, 0.0)
+    vx, vz = knee_vector(q3)
     r = np.hypot(vx, vz)
     return wrap(np.arctan2(signed_rho, np.sqrt(r * r - signed_rho * signed_rho)) - np.arctan2(vz, vx))
 

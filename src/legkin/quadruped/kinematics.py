@@ -1,50 +1,38 @@
-"""Closed-form kinematics of the quadruped's legs (seeds 004 and 002): the public API, re-exported.
+"""The quadruped's leg kinematics (seeds 004 and 002): thin wrappers over the generic :class:`legkin.legs.Leg`.
 
 Conventions (base frame: x forward, y left, z up; metres, radians):
 
-* legs ``"LF"``, ``"LH"``, ``"RF"``, ``"RH"``; ``sx = +1`` front / ``-1`` hind, ``sy = +1`` left / ``-1`` right;
-* joint vector ``q = (q1, q2, q3)`` = (``<LEG>_HAA``, ``<LEG>_HFE``, ``<LEG>_KFE``), the seed's
-  (aile, epaule, coude) angles; the foot frame ``<LEG>_FOOT`` is the seed's "pied";
-* seed 004's transforms with its sign typo resolved: ``T01 = Tr(h) Rx(sy q1)``, ``T12 = Tr(0, sy y12, 0) Ry(-q2)``,
-  ``T23 = Tr(x23, 0, z23) Ry(q3)``, ``T34 = Tr(x34, 0, foot_z)``; ``foot_z`` is the one xacro argument
-  (:class:`Geometry`), the offsets are POPI's constants (:mod:`legkin.quadruped.constants`).
+* legs ``"LF"``, ``"LH"``, ``"RF"``, ``"RH"``; joint vector ``q = (q1, q2, q3)`` = (``<LEG>_HAA``,
+  ``<LEG>_HFE``, ``<LEG>_KFE``), the seed's (aile, epaule, coude) angles; the foot is the frame ``<LEG>_FOOT``;
+* the foot position is seed 004's product ``T01 T12 T23 T34`` with ``foot_z`` the one xacro argument
+  (:class:`Geometry`) and POPI's offsets (:mod:`legkin.quadruped.constants`)::
 
-Where the code is, by concept: :mod:`~legkin.quadruped.forward` (``fk``, ``jacobian``, ``hip_position``),
-:mod:`~legkin.quadruped.closed_form` (``ik_all``), :mod:`~legkin.quadruped.inverse` (``ik``, the branch choice),
-:mod:`~legkin.quadruped.repair` (the clip-into-limits repair), :mod:`~legkin.quadruped.limits`
-(``within_limits``), :mod:`~legkin.quadruped.textbook` (seed 002), :mod:`~legkin.quadruped.deprecated`
-(the 0.1 names).
+      p = h + R_x(s_y q_1) [(0, s_y y12, 0) + R_y(-q_2) (t23 + R_y(q_3) t34)],  t34 = (x34, 0, foot_z)
 
-Every function takes arrays with leading batch dimensions. A single input (``q`` or ``p`` of shape (3,))
-returns plain arrays and raises on failure; a batch returns NaN rows where an item fails, and
-``return_mask=True`` also returns the boolean mask of successes. Where two arrays come in (``ik``'s ``p``
-and ``q_near``) their leading shapes broadcast, and the call is a single one only if the broadcast shape is
-``()`` (a single target with a batch of ``q_near`` is a batch).
-
-Implementation (issue 16, see :mod:`legkin._kernels`): every function is a compiled numba kernel,
-written once beside its seed equations; a batch is a compiled loop over the same kernel (``prange``, threads:
-``numba.set_num_threads`` or ``NUMBA_NUM_THREADS``; batches below the loop's ``min_parallel`` (256) items run
-on the calling thread). The Python wrappers only check the inputs and apply the single/batch rule.
-
-Inputs are checked at every public function: arrays as by :func:`legkin._batch.as_input` (wrong shape,
-NaN/inf, complex, strings, ragged: ``InvalidInputError``; a float64 array of the right shape goes straight to
-the kernel, which tests finiteness and reports it by its status code), keyword parameters for kind and range
-(``InvalidParameterError`` naming the value and the valid range). No numpy exception escapes: a failed item
-is NaN in a batch (mask False) and a legkin error in a single call.
+One implementation: :func:`fk`, :func:`jacobian`, :func:`ik` and :func:`ik_all` call the :class:`~legkin.legs.Leg`
+of ``leg`` that :func:`legkin.legs.from_urdf` measures from the quadruped's URDF for ``geometry``
+(:func:`~legkin.quadruped.measured.legs`): its compiled kernels, its input checks and its single/batch rule (a
+single input (3,) returns plain arrays and raises a legkin error on failure; a batch (..., 3) returns NaN rows where
+an item fails, and ``return_mask=True`` also returns the mask). Seed 002's law-of-cosines IK stays as a textbook
+cross-check (:mod:`legkin.quadruped.textbook`), not used by these functions.
 """
 
 from __future__ import annotations
 
-from .closed_form import ik_all
+from typing import Literal, overload
+
+import numpy as np
+import numpy.typing as npt
+
+from .._batch import check_flag, check_number
+from ..legs.kinematics import Leg
+from ._common import foot_z_of, leg_index, rows
 from .constants import (
     BRANCHES,
-    CLIP_TOL,
     JOINT_LIMITS,
     KNEE_OFFSET,
     LEGS,
-    LIMIT_SLACK,
     LIMIT_TOL,
-    REACH_TOL,
     X01,
     X23,
     X34,
@@ -53,11 +41,8 @@ from .constants import (
     Z01,
     Z23,
 )
-from .deprecated import foot_ik, foot_ik_all, foot_jacobian, foot_position
-from .forward import fk, hip_position, jacobian
 from .geometry import DEFAULT_GEOMETRY, Geometry
-from .inverse import ik
-from .limits import within_limits
+from .measured import SEED_ORDER, legs
 from .textbook import textbook_frame, textbook_ik, textbook_to_joints
 
 __all__ = [
@@ -72,11 +57,8 @@ __all__ = [
     "Z23",
     "X34",
     "JOINT_LIMITS",
-    "REACH_TOL",
     "BRANCHES",
     "LIMIT_TOL",
-    "LIMIT_SLACK",
-    "CLIP_TOL",
     "KNEE_OFFSET",
     "fk",
     "jacobian",
@@ -84,12 +66,238 @@ __all__ = [
     "ik_all",
     "hip_position",
     "within_limits",
+    "legs",
     "textbook_ik",
     "textbook_frame",
     "textbook_to_joints",
-    # deprecated (legkin 0.1 names, kept for one release)
-    "foot_position",
-    "foot_jacobian",
-    "foot_ik",
-    "foot_ik_all",
 ]
+
+Mask = tuple[np.ndarray, np.ndarray]
+#: POPI's limits as floats (equal to the URDF's, the measured legs' ``lower`` / ``upper``: tests/test_quadruped.py).
+_LO, _HI = tuple(JOINT_LIMITS[:, 0].tolist()), tuple(JOINT_LIMITS[:, 1].tolist())
+_REVERSED = np.array((3, 2, 1, 0))
+#: Per leg, the rows of Leg.ik_all in seed 004's order (the left legs' is reversed: that array itself, a slice serves).
+_ORDER = {leg: _REVERSED if order == (3, 2, 1, 0) else np.array(order) for leg, order in SEED_ORDER.items()}
+
+
+#: The default geometry's measured legs by name, once measured (the single calls' look-up: one dict access).
+_DEFAULT: dict[str, Leg] = {}
+
+
+def _leg(leg: object, geometry: Geometry | None) -> Leg:
+    """The measured :class:`~legkin.legs.Leg` of ``leg`` for ``geometry`` (InvalidParameterError for a bad one)."""
+    if geometry is None and leg.__class__ is str:
+        found_leg = _DEFAULT.get(leg)  # type: ignore[call-overload]
+        if found_leg is not None:
+            return found_leg
+    found = legs(geometry)
+    if geometry is None:
+        _DEFAULT.update(found)
+    try:
+        return found[leg]  # type: ignore[index]
+    except (KeyError, TypeError):
+        leg_index(leg)  # raises, naming the legs
+        raise  # pragma: no cover
+
+
+def _flag(value: object) -> bool:
+    return value if value is True or value is False else check_flag(value, "return_mask")
+
+
+def _with_mask(x: np.ndarray, tail: int, return_mask: object) -> np.ndarray | Mask:
+    """``x``, or ``(x, mask)`` with an all-True mask (a finite input always has an answer)."""
+    if not _flag(return_mask):
+        return x
+    return x, np.ones(x.shape[: x.ndim - tail], dtype=bool)
+
+
+@overload
+def fk(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
+       return_mask: Literal[False] = False) -> np.ndarray: ...
+@overload
+def fk(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None, return_mask: Literal[True]) -> Mask: ...
+
+
+def fk(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
+       return_mask: bool = False) -> np.ndarray | Mask:
+    """Foot position (m, base frame) of the joint angles ``q``: seed 004's product ``T01 T12 T23 T34``.
+
+    Computed by :meth:`legkin.legs.Leg.fk` (the product of exponentials with the joint axes measured from the
+    URDF, as Pinocchio). Seed 004 prints T01 with the ``+-`` signs stacked identically in rows 2 and 3 (not a
+    rotation); the URDF, and this function, read it as Rx(+q1) for left legs and Rx(-q1) for right legs.
+
+    Args:
+        q: joint angles (..., 3) (rad): (``<LEG>_HAA``, ``<LEG>_HFE``, ``<LEG>_KFE``).
+        leg: ``"LF"``, ``"LH"``, ``"RF"`` or ``"RH"``.
+        geometry: the :class:`~legkin.quadruped.Geometry` (None: the default, ``foot_z = 0``).
+        return_mask: also return the mask (...) of the answers (all True: every finite ``q`` has one).
+
+    Returns:
+        Foot positions (..., 3) in metres (and the mask).
+
+    Raises:
+        InvalidInputError: ``q`` not a finite real array (..., 3).
+        InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
+    """
+    found = _DEFAULT.get(leg) if geometry is None and leg.__class__ is str else None  # type: ignore[call-overload]
+    x = (found or _leg(leg, geometry)).fk(q)
+    return x if return_mask is False else _with_mask(x, 1, return_mask)
+
+
+@overload
+def jacobian(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
+             return_mask: Literal[False] = False) -> np.ndarray: ...
+@overload
+def jacobian(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
+             return_mask: Literal[True]) -> Mask: ...
+
+
+def jacobian(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
+             return_mask: bool = False) -> np.ndarray | Mask:
+    """Jacobian ``dp/dq`` of :func:`fk` (m/rad): :meth:`legkin.legs.Leg.jacobian`, column j = ``a_j x (p - o_j)``.
+
+    Args:
+        q: joint angles (..., 3) (rad).
+        leg: ``"LF"``, ``"LH"``, ``"RF"`` or ``"RH"``.
+        geometry: the :class:`~legkin.quadruped.Geometry` (None: the default).
+        return_mask: also return the mask (...) of the answers (all True).
+
+    Returns:
+        Jacobians (..., 3, 3), columns q1, q2, q3, in m/rad (and the mask).
+
+    Raises:
+        InvalidInputError: ``q`` not a finite real array (..., 3).
+        InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
+    """
+    found = _DEFAULT.get(leg) if geometry is None and leg.__class__ is str else None  # type: ignore[call-overload]
+    x = (found or _leg(leg, geometry)).jacobian(q)
+    return x if return_mask is False else _with_mask(x, 2, return_mask)
+
+
+@overload
+def ik(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = None, geometry: Geometry | None = None,
+       return_mask: Literal[False] = False) -> np.ndarray: ...
+@overload
+def ik(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = None, geometry: Geometry | None = None,
+       return_mask: Literal[True]) -> Mask: ...
+
+
+def ik(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = None, geometry: Geometry | None = None,
+       return_mask: bool = False) -> np.ndarray | Mask:
+    """Joint angles placing the foot at ``target``: the branch inside POPI's joint limits nearest ``q_near``.
+
+    :meth:`legkin.legs.Leg.ik`: among the branches of :func:`ik_all`, each angle at its 2 pi representative inside
+    :data:`JOINT_LIMITS` (an angle up to ``legkin.legs.LIMIT_TOL`` outside is clipped onto its limit), the branch
+    with the least ``|q - q_near|^2``; ``q_near`` defaults to the middle of the limits, (0, pi/2, 1.09). Inside
+    POPI's limits only one knee branch occurs, but both abduction branches do (s_u = +1 for large q2).
+
+    Args:
+        target: foot targets (..., 3) in the base frame (m).
+        leg: ``"LF"``, ``"LH"``, ``"RF"`` or ``"RH"``.
+        q_near: configurations (..., 3) (rad) to stay near; its leading shape broadcasts with the target's (a
+            single target with a batch of ``q_near`` is a batch).
+        geometry: the :class:`~legkin.quadruped.Geometry` (None: the default).
+        return_mask: also return the boolean mask of the targets solved inside the limits.
+
+    Returns:
+        Joint angles (..., 3) (rad), NaN rows for unsolved batch items (and the mask).
+
+    Raises:
+        UnreachableError: a single target out of reach (``distance``: by how much, m; the message says why).
+        JointLimitError: a single target reachable only outside the joint limits (``joint``, ``value``,
+            ``lower``, ``upper`` of the closest branch's joint farthest outside, ``distance`` in rad).
+        InvalidInputError: ``target`` or ``q_near`` not finite real arrays (..., 3), or not broadcastable.
+        InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
+    """
+    found = _DEFAULT.get(leg) if geometry is None and leg.__class__ is str else None  # type: ignore[call-overload]
+    return (found or _leg(leg, geometry)).ik(target, q_near=q_near, return_mask=return_mask)  # type: ignore[no-any-return]
+
+
+@overload
+def ik_all(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = None,
+           geometry: Geometry | None = None, return_mask: Literal[False] = False) -> np.ndarray: ...
+@overload
+def ik_all(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = None,
+           geometry: Geometry | None = None, return_mask: Literal[True]) -> Mask: ...
+
+
+def ik_all(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = None,
+           geometry: Geometry | None = None, return_mask: bool = False) -> np.ndarray | Mask:
+    """Every IK branch of the foot targets, joint limits ignored: :meth:`legkin.legs.Leg.ik_all` in seed order.
+
+    Rows in :data:`BRANCHES` order ``(s_u, k)`` = (-1, -1), (-1, 1), (1, -1), (1, 1): ``s_u = -1`` the foot below
+    the hip plane (``u_z < 0`` in the abduction-rotated frame), ``k`` the sign of ``acos K`` in
+    ``q3 = (beta - alpha) + k acos K`` (see :data:`~legkin.quadruped.measured.SEED_ORDER`); each angle is the 2 pi
+    representative nearest ``q_near`` (default: the middle of the limits). On the singular sets (foot on the
+    abduction cylinder, knee straight or folded) two rows coincide.
+
+    Args:
+        target: foot targets (..., 3) in the base frame (m).
+        leg: ``"LF"``, ``"LH"``, ``"RF"`` or ``"RH"``.
+        q_near: configurations (..., 3) (rad) the representatives stay near (broadcast with the targets).
+        geometry: the :class:`~legkin.quadruped.Geometry` (None: the default).
+        return_mask: also return the mask (..., 4) of the branches that exist.
+
+    Returns:
+        Joint angles (..., 4, 3) (rad), NaN rows where a branch does not exist (and the mask).
+
+    Raises:
+        UnreachableError: a single target out of reach (``distance``: by how much, m).
+        InvalidInputError: ``target`` or ``q_near`` not finite real arrays (..., 3), or not broadcastable.
+        InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
+    """
+    found = _leg(leg, geometry)
+    order = _ORDER[leg]
+    if not (return_mask if return_mask is False or return_mask is True else _flag(return_mask)):
+        q = found.ik_all(target, q_near=q_near)
+        return q[..., ::-1, :] if order is _REVERSED else q.take(order, axis=-2)  # type: ignore[no-any-return]
+    q, mask = found.ik_all(target, q_near=q_near, return_mask=True)
+    if order is _REVERSED:  # the left legs: a view, cheaper than take
+        return q[..., ::-1, :], mask[..., ::-1]
+    return q.take(order, axis=-2), mask.take(order, axis=-1)
+
+
+def hip_position(leg: str, *, geometry: Geometry | None = None) -> np.ndarray:
+    """The origin (3,) of ``leg``'s abduction joint (``<LEG>_HAA``) in the base frame (m): seed 004's ``h``.
+
+    Args:
+        leg: ``"LF"``, ``"LH"``, ``"RF"`` or ``"RH"``.
+        geometry: the :class:`~legkin.quadruped.Geometry` (checked; the hip does not depend on it).
+
+    Returns:
+        ``(s_x x01, s_y y01, z01)`` as measured from the URDF (m).
+
+    Raises:
+        InvalidParameterError: bad ``leg`` or ``geometry``.
+    """
+    return _leg(leg, geometry).origin.copy()
+
+
+def within_limits(q: npt.ArrayLike, tol: float = LIMIT_TOL, *,
+                  geometry: Geometry | None = None) -> np.ndarray | bool:
+    """Whether joint vectors (..., 3) lie inside :data:`JOINT_LIMITS` widened by ``tol`` (rad).
+
+    NaN and infinite entries (e.g. the NaN rows of :func:`ik_all`) count as outside.
+
+    Args:
+        q: joint angles (..., 3) (rad).
+        tol: slack (rad), a finite number >= 0.
+        geometry: the :class:`~legkin.quadruped.Geometry` (checked; the limits do not depend on it).
+
+    Returns:
+        A bool for a single ``q`` (3,), a bool array (...) for a batch.
+
+    Raises:
+        InvalidInputError: ``q`` not a real array of shape (..., 3).
+        InvalidParameterError: ``tol`` not a finite number >= 0; bad ``geometry``.
+    """
+    if type(tol) is not float or not 0.0 <= tol < np.inf:
+        tol = check_number(tol, "tol", 0.0)
+    if geometry is not None:
+        foot_z_of(geometry)
+    arr = rows(q, "q")
+    if arr.ndim == 1:  # a single call: plain floats (numpy's elementwise calls cost ~1 us each on (3,))
+        q1, q2, q3 = arr.tolist()
+        return (_LO[0] - tol <= q1 <= _HI[0] + tol and _LO[1] - tol <= q2 <= _HI[1] + tol
+                and _LO[2] - tol <= q3 <= _HI[2] + tol)
+    return np.all((arr >= JOINT_LIMITS[:, 0] - tol) & (arr <= JOINT_LIMITS[:, 1] + tol), axis=-1)

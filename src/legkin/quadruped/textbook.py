@@ -2,7 +2,9 @@
 :func:`textbook_frame` (base frame -> seed 002's frame) and :func:`textbook_to_joints` (its angles -> q).
 
 The names keep the seed's word on purpose: these functions are the seed as printed (fixed), beside the
-closed form of :func:`legkin.quadruped.ik_all`, whose (s_u, k) = (-1, -1) branch they reproduce.
+closed form of :func:`legkin.quadruped.ik_all` (the generic :class:`legkin.legs.Leg`), whose (s_u, k) = (-1, -1)
+branch they reproduce: a textbook cross-check (``legkin check quadruped``'s "seed 002" row and
+``tests/test_quadruped.py``), not an implementation the other functions use.
 """
 
 from __future__ import annotations
@@ -15,9 +17,9 @@ import numpy.typing as npt
 from .._batch import check_flag, check_number
 from .._kernels import OK, as_rows, batch_kernel, kernel, prange
 from .._rotations import wrap_k
+from ..legs._fk_kernels import _finite3
 from ._common import foot_z_of, leg_index, raise_bad, rows
 from .constants import BAD_INPUT, KNEE_OFFSET, PI, SX, SY, X01, X34, Y01, Z01
-from .forward import _finite3
 from .geometry import Geometry
 
 __all__ = ["textbook_ik", "textbook_frame", "textbook_to_joints"]

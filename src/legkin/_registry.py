@@ -174,14 +174,20 @@ def _discover() -> dict[str, ModelSpec]:
 MODELS: Mapping[str, ModelSpec] = _discover()
 
 
-def get_spec(name: str) -> ModelSpec:
+def get_spec(name: object) -> ModelSpec:
     """Return the registry entry of ``name``.
+
+    Args:
+        name: a registered model's name (anything else is refused with the known names).
+
+    Returns:
+        Its registry entry.
 
     Raises:
         UnknownModelError: the name is not registered (the message lists the known names).
     """
     try:
-        return MODELS[name]
+        return MODELS[name]  # type: ignore[index]  # a non-str key is a KeyError or TypeError, refused below
     except (KeyError, TypeError):
         raise UnknownModelError(
             f"unknown model {name!r}; known models: {', '.join(sorted(MODELS))}", name=name, known=sorted(MODELS)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import difflib
 import importlib
+import os
 from types import ModuleType
 from typing import Any, Iterable, Literal, Mapping, overload
 
@@ -133,7 +134,7 @@ class Robot(ClosedLoopMixin):
             name: a joint of the model.
 
         Returns:
-            Its index in ``model.joints`` (the universe is 0).
+            Its index in ``model.joints`` (unitless; the universe is 0).
 
         Raises:
             InvalidInputError: ``name`` is not a string or not a joint of the model (the message lists them).
@@ -174,7 +175,7 @@ class Robot(ClosedLoopMixin):
             name: a frame of the model.
 
         Returns:
-            Its index in ``model.frames``.
+            Its index in ``model.frames`` (unitless).
 
         Raises:
             InvalidInputError: ``name`` is not a string or not a frame of the model (with close matches).
@@ -362,7 +363,7 @@ class Robot(ClosedLoopMixin):
 
     def solve_loops(
         self,
-        q_init=None,
+        q_init: Any = None,
         fixed: Mapping[str, float] | Iterable[str] | None = None,
         *,
         tol: float = 1e-12,
@@ -382,6 +383,9 @@ class Robot(ClosedLoopMixin):
             max_iter: iteration cap (an integer >= 0; 0 only tests whether ``q_init`` closes).
             damping: the smallest Levenberg-Marquardt damping tried when the Gauss-Newton step fails (> 0).
             return_info: also return a :class:`LoopSolveInfo` (iterations, residual).
+
+        Returns:
+            The closed configuration ``(nq,)`` (rad, m), and the :class:`LoopSolveInfo` if asked.
 
         Raises:
             InvalidInputError: (a ``ValueError``) a bad ``q_init`` (shape, NaN/inf, complex), an unknown joint
@@ -413,7 +417,7 @@ def _is_path(name: object) -> bool:
     )
 
 
-def load(name, *, floating: bool = False, **params) -> Robot:
+def load(name: str | os.PathLike[str], *, floating: bool = False, **params: Any) -> Robot:
     """Load a registered mechanism, or a robot from its own files, in Pinocchio.
 
     Args:
@@ -421,7 +425,11 @@ def load(name, *, floating: bool = False, **params) -> Robot:
             or ``.xml`` suffix, or a ``pathlib.Path``): a robot from its own files, read by
             :func:`legkin.loaders.load_file` (its keyword ``loops=``: a YAML sidecar path).
         floating: add a free-flyer root joint (only for models where that makes sense).
-        **params: xacro arguments; validated before any file is written.
+        **params: xacro arguments (in the units of the model's :class:`~legkin._registry.Param`, m or rad);
+            validated before any file is written.
+
+    Returns:
+        The loaded :class:`Robot` (its model, loops, poses and geometry).
 
     Raises:
         UnknownModelError: ``name`` is not registered.

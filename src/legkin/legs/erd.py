@@ -12,6 +12,7 @@ from __future__ import annotations
 import functools
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -126,7 +127,13 @@ def _robot(name: str) -> ErdRobot:
 
 
 def erd_files(name: str) -> tuple[Path, Path | None, list[str]]:
-    """``(urdf path, srdf path or None, package dirs)`` of the robot ``name`` as installed.
+    """Where the files of an example-robot-data robot are, as installed.
+
+    Args:
+        name: the robot's name in :data:`ERD_ALL`.
+
+    Returns:
+        ``(urdf path, srdf path or None, package dirs)``: the package dirs resolve its ``package://`` mesh URIs.
 
     Raises:
         UnknownModelError: ``name`` is not one of :data:`ERD_ROBOTS`.
@@ -162,9 +169,17 @@ def standing_pose(model, name: str) -> np.ndarray | None:
     return q
 
 
-def reference_configuration(model, name: str) -> np.ndarray:
+def reference_configuration(model: Any, name: str) -> np.ndarray:
     """The robot's SRDF reference pose (legkin's :func:`standing_pose`, else ``model``'s neutral configuration,
-    if it has none)."""
+    if it has none).
+
+    Args:
+        model: the robot's ``pinocchio.Model`` (as :func:`load_erd` builds it).
+        name: the robot's name in :data:`ERD_ALL`.
+
+    Returns:
+        The configuration ``(model.nq,)`` (rad, m).
+    """
     import pinocchio as pin
 
     robot = _robot(name)
@@ -176,7 +191,7 @@ def reference_configuration(model, name: str) -> np.ndarray:
     return np.array(model.referenceConfigurations[robot.reference_pose])
 
 
-def load_erd(name: str, *, free_flyer: bool | None = None):
+def load_erd(name: str, *, free_flyer: bool | None = None) -> tuple[Any, Path, list[str]]:
     """Load an example-robot-data legged robot with Pinocchio.
 
     Args:

@@ -21,6 +21,7 @@ import os
 import re
 from collections.abc import Iterable, Mapping
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -154,7 +155,7 @@ def _above(model, name: str, root: int) -> tuple[int, ...]:
     return tuple(chain)
 
 
-def find_chains(model, foot_frames: Iterable[str] | None = None) -> list[tuple[tuple[int, ...], str]]:
+def find_chains(model: Any, foot_frames: Iterable[str] | None = None) -> list[tuple[tuple[int, ...], str]]:
     """The candidate legs of ``model``: ``[((j1, ..., jn), foot frame name), ...]`` in model order, n in
     :data:`SUPPORTED_DOF`.
 
@@ -162,6 +163,13 @@ def find_chains(model, foot_frames: Iterable[str] | None = None) -> list[tuple[t
     previous, whose 3rd or 6th joint carries a sole / foot / toe frame (a sole frame preferred), or that ends at
     a leaf joint after 3 or 6 joints (its last BODY frame is the foot). With ``foot_frames``: exactly the chains
     ending at those frames.
+
+    Args:
+        model: a ``pinocchio.Model``.
+        foot_frames: the foot frames' names to use instead of the name search.
+
+    Returns:
+        The chains: each its joint ids from the root and its foot frame's name.
 
     Raises:
         LegStructureError: a given foot frame that does not hang from 3 or 6 revolute joints under the root.
@@ -324,7 +332,9 @@ def _named(model, chains) -> list[tuple[str, tuple[int, ...], str]]:
     return [(model.names[c[0]], c, f) for c, f in chains]
 
 
-def from_model(model, name: str | None = None, *, foot_frames: Iterable[str] | Mapping[str, str] | None = None):
+def from_model(
+    model: Any, name: str | None = None, *, foot_frames: Iterable[str] | Mapping[str, str] | None = None
+) -> Any:
     """Every leg of a Pinocchio model, measured at its neutral configuration: HAA-HFE-KFE legs (:class:`Leg`) and
     6-DOF legs (:class:`Leg6`).
 
@@ -375,8 +385,16 @@ def from_urdf(
     name: str | None = None,
     *,
     foot_frames: Iterable[str] | Mapping[str, str] | None = None,
-):
+) -> Any:
     """:func:`from_model` of the URDF file at ``path`` (built with a fixed base: the root frame is the base link).
+
+    Args:
+        path: the URDF file.
+        name: one leg to return, as :func:`from_model`'s ``name``.
+        foot_frames: the foot frames to use, as :func:`from_model`'s.
+
+    Returns:
+        ``{leg name: Leg or Leg6}`` (positions in m, angles in rad, in the URDF root link's frame), or one leg.
 
     Raises:
         InvalidParameterError: the file is missing or Pinocchio cannot parse it (its message included).

@@ -53,8 +53,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any, Literal, overload
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._batch import as_input, check_flag, check_number, finish
 from .._kernels import OK, as_rows
@@ -364,8 +366,13 @@ class Leg:
         """``(| |k| - |l| |, |k| + |l|)``: the knee's inner and outer reach (m) in the pitch plane."""
         return abs(self.thigh_length - self.shank_length), self.thigh_length + self.shank_length
 
-    def summary(self) -> dict:
-        """The extracted geometry as plain numbers (for tables)."""
+    def summary(self) -> dict[str, Any]:
+        """The extracted geometry as plain numbers (for tables).
+
+        Returns:
+            The leg's name, joints, foot frame, axis labels, knee sign and its link vectors (m) and offset angles
+            (rad), as JSON-friendly values.
+        """
         tz, kz = self.knee_offset_angles
         return {
             "leg": self.name, "joints": list(self.joint_names), "foot": self.foot_frame,
@@ -384,11 +391,17 @@ class Leg:
         )
 
     # ------------------------------------------------------------ kinematics
-    def fk(self, q) -> np.ndarray:
-        """Foot position (m, root frame) of the joint values ``q`` (3,) or (..., 3).
+    def fk(self, q: ArrayLike) -> np.ndarray:
+        """Foot position (m, root frame) of joint values.
 
         ``p = o1 + u1 e1 + (cos q1 d - sin q1 u3) e2 + (sin q1 d + cos q1 u3) e3`` with
         ``(u3, u1) = h + Rot(q2) [k + Rot(s3 q3) l]`` (see the module docstring).
+
+        Args:
+            q: joint values (3,) or (..., 3) (rad).
+
+        Returns:
+            The foot position (3,) or (..., 3) (m, root frame).
 
         Raises:
             InvalidInputError: ``q`` not a finite real array (..., 3).
@@ -407,13 +420,19 @@ class Leg:
         _fk_batch(rows, self.params, out)
         return out.reshape(arr.shape)
 
-    def jacobian(self, q) -> np.ndarray:
+    def jacobian(self, q: ArrayLike) -> np.ndarray:
         """``dp/dq`` (3, 3) or (..., 3, 3): column j is the foot velocity (root frame) per unit rate of joint j.
 
         ``dp/dq1 = e1 x (p - o1)``; with ``perp(X, Y) = (-Y, X)`` and the pitch-plane vectors
         ``w = Rot(q2) v``, ``g = Rot(q2) s3 perp(Rot(s3 q3) l)``: ``d(u3, u1)/dq2 = perp(w)``,
         ``d(u3, u1)/dq3 = g``, each mapped to the root frame by ``(X, Y) -> Y e1 - sin q1 X e2 + cos q1 X e3``.
         Equal to Pinocchio's LOCAL_WORLD_ALIGNED translational rows of the leg's columns (fixed base).
+
+        Args:
+            q: joint values (3,) or (..., 3) (rad).
+
+        Returns:
+            ``dp/dq`` (3, 3) or (..., 3, 3) (m/rad).
 
         Raises:
             InvalidInputError: ``q`` not a finite real array (..., 3).
@@ -504,8 +523,21 @@ class Leg:
                 best = (float(out_by[j]), j, float(x[j]), x)
         return best[1], best[2], best[3]
 
-    def ik_all(self, p, *, q_near=None, tol: float = IK_TOL, return_mask: bool = False):
-        """Every IK branch of the target(s) ``p`` (m, root frame), joint limits ignored.
+    @overload
+    def ik_all(self, target: ArrayLike, *, q_near: ArrayLike | None = ..., tol: float = ...,
+               return_mask: Literal[False] = ...) -> np.ndarray: ...
+
+    @overload
+    def ik_all(self, target: ArrayLike, *, q_near: ArrayLike | None = ..., tol: float = ...,
+               return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+
+    @overload
+    def ik_all(self, target: ArrayLike, *, q_near: ArrayLike | None = ..., tol: float = ...,
+               return_mask: bool = ...) -> np.ndarray | tuple[np.ndarray, np.ndarray]: ...
+
+    def ik_all(self, target: ArrayLike, *, q_near: ArrayLike | None = None, tol: float = IK_TOL,
+               return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+        """Every IK branch of the target(s) ``target`` (m, root frame), joint limits ignored.
 
         Branches in :data:`BRANCHES` order ``(s_a, s_k)``: ``u3 = s_a sqrt(y^2 + z^2 - d^2)`` (abduction) and
         ``beta = s_k acos((|w|^2 - |k|^2 - |l|^2) / (2 |k||l|))`` (knee); each angle is the 2 pi representative
@@ -513,8 +545,8 @@ class Leg:
         singular sets ``u3 = 0`` or ``beta in {0, pi}``) appear twice.
 
         Args:
-            p: targets (3,) or (..., 3).
-            q_near: reference joint values (3,) or broadcastable with ``p``.
+            target: targets (3,) or (..., 3).
+            q_near: reference joint values (3,) or broadcastable with ``target``.
             tol: a target up to ``tol`` (m; (0, 1e-3], default :data:`IK_TOL` = 1e-9) outside the reachable set
                 is solved at its nearest reachable point (a float32-rounded target, say); farther out it is not.
             return_mask: also return the boolean mask of the branches that exist (legkin 0.2.0 convention).
@@ -525,9 +557,10 @@ class Leg:
 
         Raises:
             UnreachableError: a single target with no branch (the message says by how much it misses).
-            InvalidInputError: ``p`` or ``q_near`` not finite real arrays (..., 3), or not broadcastable.
+            InvalidInputError: ``target`` or ``q_near`` not finite real arrays (..., 3), or not broadcastable.
             InvalidParameterError: ``return_mask`` not a bool.
         """
+        p: Any = target  # the fast paths below test its class, shape and dtype first
         if return_mask is not False and return_mask is not True:
             return_mask = check_flag(return_mask, "return_mask")
         if tol is IK_TOL and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast path
@@ -552,19 +585,32 @@ class Leg:
             return q_all
         return q_all, np.isfinite(q_all[..., 0])
 
-    def ik(self, p, *, q_near=None, tol: float = IK_TOL, return_mask: bool = False):
-        """Joint values placing the foot at ``p``: the branch inside the URDF limits nearest ``q_near``.
+    @overload
+    def ik(self, target: ArrayLike, *, q_near: ArrayLike | None = ..., tol: float = ...,
+           return_mask: Literal[False] = ...) -> np.ndarray: ...
+
+    @overload
+    def ik(self, target: ArrayLike, *, q_near: ArrayLike | None = ..., tol: float = ...,
+           return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+
+    @overload
+    def ik(self, target: ArrayLike, *, q_near: ArrayLike | None = ..., tol: float = ...,
+           return_mask: bool = ...) -> np.ndarray | tuple[np.ndarray, np.ndarray]: ...
+
+    def ik(self, target: ArrayLike, *, q_near: ArrayLike | None = None, tol: float = IK_TOL,
+           return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+        """Joint values placing the foot at ``target``: the branch inside the URDF limits nearest ``q_near``.
 
         For each branch of :meth:`ik_all`, each joint takes its 2 pi representative inside ``[lower, upper]``
         nearest ``q_near``; among the branches inside the limits the one with the least ``|q - q_near|^2`` wins
         (ties: the earlier branch). A branch up to ``LIMIT_SLACK`` (1e-7 rad) outside the limits (rounding at a
         limit, or the abduction singularity, where q1 errs along the singular direction) is moved onto them and
-        its other joints re-solved, kept if it reaches ``p`` within :data:`REACH_TOL`; failing that, a branch up
+        its other joints re-solved, kept if it reaches ``target`` within :data:`REACH_TOL`; failing that, a branch up
         to :data:`LIMIT_TOL` outside is kept clipped onto the limit (foot within ``LIMIT_TOL`` x the reach).
 
         Args:
-            p: targets (3,) or (..., 3), m, root frame.
-            q_near: reference (3,) or broadcastable with ``p``; default :attr:`q_ref` (mid-limit).
+            target: targets (3,) or (..., 3), m, root frame.
+            q_near: reference (3,) or broadcastable with ``target``; default :attr:`q_ref` (mid-limit).
             tol: a target up to ``tol`` (m; (0, 1e-3], default :data:`IK_TOL`) outside the reachable set is solved
                 at its nearest reachable point (:meth:`ik_all`).
             return_mask: also return the boolean mask of the solved targets.
@@ -575,9 +621,10 @@ class Leg:
         Raises:
             UnreachableError: a single target out of reach (the message says by how much, and why).
             JointLimitError: a single target reachable only outside the joint limits.
-            InvalidInputError: ``p`` / ``q_near`` not finite real arrays (..., 3), or not broadcastable.
+            InvalidInputError: ``target`` / ``q_near`` not finite real arrays (..., 3), or not broadcastable.
             InvalidParameterError: ``return_mask`` not a bool.
         """
+        p: Any = target  # the fast paths below test its class, shape and dtype first
         if return_mask is not False and return_mask is not True:
             return_mask = check_flag(return_mask, "return_mask")
         if tol is IK_TOL and p.__class__ is np.ndarray and p.shape == _S3SHAPE and p.dtype is _F64:  # fast path
@@ -607,8 +654,16 @@ class Leg:
             return finish(out[0], ok[0], True, return_mask, lambda: self._error(int(status[0]), info[0], rows[0], tol))
         return finish(out.reshape(batch + (3,)), ok.reshape(batch), False, return_mask, _never)
 
-    def within_limits(self, q, tol: float = 0.0) -> np.ndarray | bool:
-        """Whether the joint values ``q`` (3,) or (..., 3) lie inside the URDF limits (widened by ``tol`` rad)."""
+    def within_limits(self, q: ArrayLike, tol: float = 0.0) -> np.ndarray | bool:
+        """Whether joint values lie inside the URDF limits.
+
+        Args:
+            q: joint values (3,) or (..., 3) (rad; m for a prismatic joint).
+            tol: how far outside a limit still counts as inside (rad or m).
+
+        Returns:
+            A bool for a single ``q``, else the mask (...,).
+        """
         arr = as_input(q, "q", _S3SHAPE)
         inside = np.all((arr >= self.lower - tol) & (arr <= self.upper + tol), axis=-1)
         return bool(inside) if arr.ndim == 1 else inside

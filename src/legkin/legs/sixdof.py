@@ -35,8 +35,10 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from .._batch import as_input, check_flag, check_number, finish
 from .._kernels import OK, as_rows
@@ -229,12 +231,15 @@ class Leg6:
                 f"hip gap {self.hip_gap:.2g} m, ankle gap {self.ankle_gap:.2g} m)")
 
     # ------------------------------------------------------------ forward
-    def fk(self, q, *, return_mask: bool = False):
+    def fk(self, q: ArrayLike, *, return_mask: bool = False) -> Any:
         """The foot frame's pose ``T(q)`` (4, 4) in the root frame, or (..., 4, 4) for ``q`` (..., 6) (rad).
 
         Args:
             q: joint values (6,) or (..., 6), rad.
             return_mask: also return the mask (all True: every finite ``q`` has a pose).
+
+        Returns:
+            ``T`` (4, 4) or (..., 4, 4) (translation in m), and the mask if asked.
 
         Raises:
             InvalidInputError: ``q`` not a finite real array (..., 6).
@@ -251,11 +256,18 @@ class Leg6:
         return finish(res, np.ones(arr.shape[:-1], dtype=bool), arr.ndim == 1, check_flag(return_mask, "return_mask"),
                       lambda: AssertionError("unreachable"))
 
-    def jacobian(self, q, *, return_mask: bool = False):
+    def jacobian(self, q: ArrayLike, *, return_mask: bool = False) -> Any:
         """The foot Jacobian (6, 6) or (..., 6, 6): rows ``(v, w)`` = linear velocity of the foot frame's origin
         (m/s) then angular velocity (rad/s), both in root-frame axes, per unit joint rate (Pinocchio's
         ``getFrameJacobian(..., LOCAL_WORLD_ALIGNED)`` on the leg's columns, fixed base). Column j:
         ``(w_j x (p - o_j), w_j)`` with joint j's axis ``w_j`` and origin ``o_j`` at ``q``.
+
+        Args:
+            q: joint values (6,) or (..., 6), rad.
+            return_mask: also return the mask (all True: every finite ``q`` has a Jacobian).
+
+        Returns:
+            ``J`` (6, 6) or (..., 6, 6) (m/rad rows, then rad/rad rows), and the mask if asked.
 
         Raises:
             InvalidInputError: ``q`` not a finite real array (..., 6).
@@ -312,7 +324,8 @@ class Leg6:
             distance=float(info[0]),
         )
 
-    def ik_all(self, target, *, q_near=None, tol: float = IK_TOL, return_mask: bool = False):
+    def ik_all(self, target: ArrayLike, *, q_near: ArrayLike | None = None, tol: float = IK_TOL,
+               return_mask: bool = False) -> Any:
         """Every solution of the foot pose(s) ``target`` (4, 4) or (..., 4, 4), joint limits ignored.
 
         Args:
@@ -349,7 +362,8 @@ class Leg6:
         q_all = out.reshape(batch + (k, 6))
         return (q_all, np.isfinite(q_all[..., 0])) if flag else q_all
 
-    def ik(self, target, *, q_near=None, tol: float = IK_TOL, return_mask: bool = False):
+    def ik(self, target: ArrayLike, *, q_near: ArrayLike | None = None, tol: float = IK_TOL,
+           return_mask: bool = False) -> Any:
         """The solution inside the URDF limits nearest ``q_near`` (default :attr:`q_ref`, mid-limits).
 
         Each solution of :meth:`ik_all` takes, joint by joint, its 2 pi representative inside the limits nearest
@@ -386,8 +400,16 @@ class Leg6:
             return finish(out[0], ok[0], True, flag, lambda: self._error(int(status[0]), info[0], rows[0], tol))
         return finish(out.reshape(batch + _Q6), ok.reshape(batch), False, flag, lambda: AssertionError("batch"))
 
-    def within_limits(self, q, tol: float = 0.0) -> np.ndarray | bool:
-        """Whether ``q`` (6,) or (..., 6) lies inside the URDF limits (widened by ``tol`` rad)."""
+    def within_limits(self, q: ArrayLike, tol: float = 0.0) -> np.ndarray | bool:
+        """Whether joint values lie inside the URDF limits.
+
+        Args:
+            q: joint values (6,) or (..., 6) (rad).
+            tol: how far outside a limit still counts as inside (rad).
+
+        Returns:
+            A bool for a single ``q``, else the mask (...,).
+        """
         arr = as_input(q, "q", _Q6)
         inside = np.all((arr >= self.lower - tol) & (arr <= self.upper + tol), axis=-1)
         return bool(inside) if arr.ndim == 1 else inside

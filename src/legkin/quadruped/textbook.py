@@ -49,6 +49,14 @@ def textbook_frame(p: npt.ArrayLike, leg: str, *, geometry: Geometry | None = No
     Seed 002 works from the abduction axis with x lateral (towards the hip offset, so mirrored on right
     legs: x_f -> -x_f), y forward and z down: ``(x_f, y_f, z_f) = (s_y d_y, d_x, -d_z)`` with ``d = p - h``.
     ``geometry`` is accepted like everywhere (checked; the frame does not depend on it).
+
+    Args:
+        p: foot targets (3,) or (..., 3) in the base frame (m).
+        leg: ``"LF"``, ``"RF"``, ``"LH"`` or ``"RH"``.
+        geometry: the quadruped's geometry (checked only).
+
+    Returns:
+        The targets in seed 002's frame of ``leg``, same shape (m).
     """
     if geometry is not None:
         foot_z_of(geometry)
@@ -105,6 +113,17 @@ def textbook_ik(p: npt.ArrayLike, a: float, b: float, c: float, *, literal: bool
     (a transcription of the seed: it does not follow the single-call-raises rule of the other functions).
     The seed's own geometry is ``(a, b, c)`` (a = y12, b = L1 = |t23|, c = L2 = |t34| = hypot(x34, foot_z)).
 
+    Args:
+        p: targets (3,) or (..., 3) in seed 002's frame (m).
+        a: the abduction offset y12 (m).
+        b: the thigh length L1 (m).
+        c: the shank length L2 (m).
+        literal: keep the printed ``atan(x_f / z_f)`` (to show its failure).
+
+    Returns:
+        (theta_abad, theta_hip, theta_knee) (3,) or (..., 3) (rad), NaN where the seed's formulas leave their
+        domain.
+
     Raises:
         InvalidInputError: ``p`` not a finite real array (..., 3).
         InvalidParameterError: ``a`` not a finite number >= 0, ``b`` or ``c`` not finite and > 0, ``literal``
@@ -150,6 +169,14 @@ def textbook_to_joints(theta: npt.ArrayLike, leg: str, *, geometry: Geometry | N
     ``beta = atan2(foot_z, x34)`` the foot's, 0 for the default geometry); this is :func:`ik_all`'s branch
     (s_u, k) = (-1, -1). The same formulas hold on both sides because seed 002's frame is mirrored on right
     legs (see :func:`textbook_frame`). NaN entries (``textbook_ik`` out of range) map to NaN.
+
+    Args:
+        theta: seed 002's angles (3,) or (..., 3) (rad).
+        leg: ``"LF"``, ``"RF"``, ``"LH"`` or ``"RH"``.
+        geometry: the quadruped's geometry (its ``foot_z`` sets ``beta``); None: the default.
+
+    Returns:
+        The joint values (q1, q2, q3), same shape (rad).
     """
     fz = 0.0 if geometry is None else foot_z_of(geometry)
     leg_index(leg)

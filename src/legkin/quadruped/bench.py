@@ -76,6 +76,7 @@ def single_calls() -> list[SingleCall]:
     geometry = aq.Geometry(foot_z=-0.015)
     fk, jac, ik, ik_all, wl = aq.fk, aq.jacobian, aq.ik, aq.ik_all, aq.within_limits
     hp, tf, ti, tj = aq.hip_position, aq.textbook_frame, aq.textbook_ik, aq.textbook_to_joints
+    legs = aq.legs
     return [
         SingleCall("fk", lambda: fk(q, LEG), "quadruped_fk"),
         SingleCall("fk (geometry)", lambda: fk(q, LEG, geometry=geometry), "quadruped_fk"),
@@ -85,6 +86,7 @@ def single_calls() -> list[SingleCall]:
         SingleCall("ik, batch of 8", lambda: ik(batch, LEG), "quadruped_fk"),
         SingleCall("ik_all", lambda: ik_all(p, LEG), "quadruped_fk"),
         SingleCall("within_limits", lambda: wl(q), "quadruped_fk"),
+        SingleCall("legs", lambda: legs(), "quadruped_fk"),
         SingleCall("hip_position", lambda: hp(LEG), "quadruped_fk"),
         SingleCall("textbook_frame", lambda: tf(p, LEG), "quadruped_fk"),
         SingleCall("textbook_ik", lambda: ti(pf, a, b, c), "quadruped_fk"),

@@ -24,7 +24,7 @@ import numpy as np
 
 from .._kernels import kernel
 from .._rotations import wrap_k
-from .chains import AX0, AX1, AY0, AY1, AZ0, AZ1, CX, CY, CZ, L, chain_k, rod_system_k, rot_k, sgn_k, tips_k
+from .chains import AX0, AX1, AY0, AY1, AZ0, AZ1, CX, CY, CZ, L, chain_k, rod_rate_k, rod_system_k, rot_k, sgn_k, tips_k
 from .geometry import BOUNDARY_TOL, K_TOL, LIMIT_TOL, PLATFORM_LIMIT
 
 _TWO_PI = 2.0 * math.pi
@@ -393,15 +393,8 @@ def label_k(tip, dtip, x, err, m, tol, xs, bl, sdet):
         xs[out, 0], xs[out, 1] = r_, p_
         cr, sr, cp, sp = math.cos(r_), math.sin(r_), math.cos(p_), math.sin(p_)
         for i in range(2):
-            if i == 0:
-                ax, ay, az, sg = AX0, AY0, AZ0, 1.0
-            else:
-                ax, ay, az, sg = AX1, AY1, AZ1, -1.0
-            rx = cp * ax + sp * az
-            ry = sr * sp * ax + cr * ay - sr * cp * az
-            rz = -cr * sp * ax + sr * ay + cr * cp * az
-            dd = ((CX + rx - tip[i, 0]) * dtip[i, 0] + (CY + ry - tip[i, 1]) * dtip[i, 1]
-                  + (CZ + rz - tip[i, 2]) * dtip[i, 2])
+            sg = 1.0 if i == 0 else -1.0
+            dd = rod_rate_k(i, cr, sr, cp, sp, tip, dtip)
             bl[out, i] = 0.0 if abs(abs(kk[i]) - 1.0) <= BOUNDARY_TOL else -sg * sgn_k(dd)
         sdet[out] = sgn_k(nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0])
         out += 1

@@ -261,6 +261,15 @@ def null_k(nm, v):
     return smax, smin
 
 
+@kernel(inline=True)
+def quadratics_at_k(al, be, ga, t):
+    """The per-rod quadratics al, be, ga (2, 3) of :func:`roll_poly_k` at t = tan(roll / 2): (a_0, a_1, b_0, b_1,
+    g_0, g_1), rod i's equation in pitch being ``a_i cos(pitch) + b_i sin(pitch) = g_i`` (times (1 + t^2))."""
+    return ((al[0, 2] * t + al[0, 1]) * t + al[0, 0], (al[1, 2] * t + al[1, 1]) * t + al[1, 0],
+            (be[0, 2] * t + be[0, 1]) * t + be[0, 0], (be[1, 2] * t + be[1, 1]) * t + be[1, 0],
+            (ga[0, 2] * t + ga[0, 1]) * t + ga[0, 0], (ga[1, 2] * t + ga[1, 1]) * t + ga[1, 0])
+
+
 #: Most seeds per motor pair: 8 roots (x3 where the rod equations are parallel), and the fold seeds of each.
 MAX_SEEDS = 24
 MAX_SOL = MAX_SEEDS * (1 + 2 * len(FOLD_OFFSETS))
@@ -290,12 +299,7 @@ def seeds_k(tip, x0, imag):
         if not (abs(zi) <= 1e-2 * (1.0 + abs(z[j])) and abs(zr) <= 1.0 + 1e-3):
             continue
         t = zr
-        a0 = (al[0, 2] * t + al[0, 1]) * t + al[0, 0]
-        a1 = (al[1, 2] * t + al[1, 1]) * t + al[1, 0]
-        b0 = (be[0, 2] * t + be[0, 1]) * t + be[0, 0]
-        b1 = (be[1, 2] * t + be[1, 1]) * t + be[1, 0]
-        g0 = (ga[0, 2] * t + ga[0, 1]) * t + ga[0, 0]
-        g1 = (ga[1, 2] * t + ga[1, 1]) * t + ga[1, 0]
+        a0, a1, b0, b1, g0, g1 = quadratics_at_k(al, be, ga, t)
         det = a0 * b1 - a1 * b0
         cp = (b0 * g1 - b1 * g0) / det
         sp = (a1 * g0 - a0 * g1) / det

@@ -11,12 +11,15 @@ from typing import Any, Callable
 
 import numpy as np
 
+from .errors import LegkinError
+
 __all__ = [
     "Score",
     "Method",
     "ModelBench",
     "MethodResult",
-    "missing", "quiet_stdout", "pinocchio_positions", "levenberg_marquardt", "rotation_error", "SOLVE_TOL"]
+    "missing", "quiet_stdout", "pinocchio_positions", "levenberg_marquardt", "rotation_error", "scalar_loop",
+    "SOLVE_TOL"]
 
 #: A target counts as solved when the method's result is within this distance (m or rad) of it.
 SOLVE_TOL = 1e-9
@@ -86,6 +89,26 @@ def sizes(n: int | None, quick: bool, full: tuple[int, int, int], small: tuple[i
     batch, scalar, iterative = small if quick else full
     n = n or batch
     return n, min(n, scalar), min(n, iterative)
+
+
+def scalar_loop(call: Callable[[np.ndarray], Any], rows: np.ndarray, width: int) -> np.ndarray:
+    """``call`` on one row at a time (a Python loop of single calls), the way a user calls a function once.
+
+    Args:
+        call: the single call, ``row -> (width,)`` result (units those of the method).
+        rows: (n, ...) the inputs.
+        width: the length of one result.
+
+    Returns:
+        (n, width) the results, NaN rows where ``call`` raised a legkin error.
+    """
+    out = np.full((len(rows), width), np.nan)
+    for i, row in enumerate(rows):
+        try:
+            out[i] = call(row)
+        except LegkinError:
+            pass
+    return out
 
 
 def rotation_error(r1: np.ndarray, r2: np.ndarray) -> np.ndarray:

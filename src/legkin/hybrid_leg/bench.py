@@ -21,10 +21,10 @@ from .._benchkit import (
     Score,
     levenberg_marquardt,
     pinocchio_positions,
+    scalar_loop,
     sizes,
 )
 from .._single_call import SingleCall
-from ..errors import LegkinError
 from ..robot import Robot, load
 from . import kinematics as ah
 from .configuration import LL_RANGE, closed_configuration, sample_workspace
@@ -111,13 +111,7 @@ def _score_motors(p: np.ndarray, motors: np.ndarray, residual: np.ndarray | None
 
 def _scalar_ik(p: np.ndarray) -> np.ndarray:
     """ik one target at a time (a Python loop of single calls), NaN where it raises."""
-    out = np.full((len(p), 3), np.nan)
-    for i, pi in enumerate(p):
-        try:
-            out[i] = ah.ik(pi)
-        except LegkinError:
-            pass
-    return out
+    return scalar_loop(ah.ik, p, 3)
 
 
 def _pinocchio_ik(robot: Robot) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]:

@@ -10,8 +10,18 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._benchkit import SOLVE_TOL, Method, MethodResult, ModelBench, Score, levenberg_marquardt, rotation_error, sizes
-from ..errors import LegkinError, LoopClosureError
+from .._benchkit import (
+    SOLVE_TOL,
+    Method,
+    MethodResult,
+    ModelBench,
+    Score,
+    levenberg_marquardt,
+    rotation_error,
+    scalar_loop,
+    sizes,
+)
+from ..errors import LoopClosureError
 from ..robot import load
 from . import kinematics as at
 from .configuration import MOTOR_COLUMNS, sample_workspace
@@ -61,13 +71,7 @@ def _fk_methods(robot, motors: np.ndarray, r_true: np.ndarray, n_batch: int, n_s
         return at.fk(m, tol=TOL)
 
     def fk_scalar(m):
-        out = np.full((len(m), 2), np.nan)
-        for i, row in enumerate(m):
-            try:
-                out[i] = at.fk(row, tol=TOL)
-            except LegkinError:
-                pass
-        return out
+        return scalar_loop(lambda row: at.fk(row, tol=TOL), m, 2)
 
     def fk_score(m, u) -> Score:
         k = len(m)
@@ -143,13 +147,7 @@ def _ik_methods(robot, orient: np.ndarray, r_true: np.ndarray, n_batch: int, n_s
         return at.ik_joints(u)
 
     def ik_scalar(u):
-        out = np.full((len(u), 12), np.nan)
-        for i, row in enumerate(u):
-            try:
-                out[i] = at.ik_joints(row)
-            except LegkinError:
-                pass
-        return out
+        return scalar_loop(at.ik_joints, u, 12)
 
     pin_inverse = _pin_inverse(robot)
 

@@ -10,17 +10,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._benchkit import (
-    SOLVE_TOL,
-    Method,
-    MethodResult,
-    ModelBench,
-    Score,
-    levenberg_marquardt,
-    rotation_error,
-    scalar_loop,
-    sizes,
-)
+from .. import _benchkit
+from .._benchkit import SOLVE_TOL, Method, MethodResult, ModelBench, Score, levenberg_marquardt, rotation_error, sizes
 from ..errors import LoopClosureError
 from ..robot import load
 from . import kinematics as at
@@ -71,7 +62,7 @@ def _fk_methods(robot, motors: np.ndarray, r_true: np.ndarray, n_batch: int, n_s
         return at.fk(m, tol=TOL)
 
     def fk_scalar(m):
-        return scalar_loop(lambda row: at.fk(row, tol=TOL), m, 2)
+        return _benchkit.scalar_loop(lambda row: at.fk(row, tol=TOL), m, 2)
 
     def fk_score(m, u) -> Score:
         k = len(m)
@@ -147,7 +138,7 @@ def _ik_methods(robot, orient: np.ndarray, r_true: np.ndarray, n_batch: int, n_s
         return at.ik_joints(u)
 
     def ik_scalar(u):
-        return scalar_loop(at.ik_joints, u, 12)
+        return _benchkit.scalar_loop(at.ik_joints, u, 12)
 
     pin_inverse = _pin_inverse(robot)
 

@@ -7,16 +7,20 @@ import importlib.util
 import os
 import sys
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any, Callable, Iterable
 
 import numpy as np
+
+from .errors import LegkinError
 
 __all__ = [
     "Score",
     "Method",
     "ModelBench",
     "MethodResult",
-    "missing", "quiet_stdout", "pinocchio_positions", "levenberg_marquardt", "rotation_error", "SOLVE_TOL"]
+    "missing", "quiet_stdout", "pinocchio_positions", "levenberg_marquardt", "rotation_error", "scalar_loop",
+    "levenberg_marquardt_rows",
+    "SOLVE_TOL"]
 
 #: A target counts as solved when the method's result is within this distance (m or rad) of it.
 SOLVE_TOL = 1e-9
@@ -80,12 +84,57 @@ def levenberg_marquardt(model, residual_and_jacobian, q: np.ndarray, free: np.nd
     return lm(model, residual_and_jacobian, q, free, tol, max_iter)[:4]
 
 
+def levenberg_marquardt_rows(model, problems: Iterable[tuple[Callable, np.ndarray]], n: int, free: np.ndarray,
+                             tol: float, max_iter: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`levenberg_marquardt` on each of ``n`` problems, a Pinocchio peer's Python loop over the targets.
+
+    Args:
+        model: the Pinocchio model.
+        problems: ``n`` pairs ``(residual_and_jacobian, q_start)``, one a target.
+        n: how many problems.
+        free: (nv,) the velocity coordinates the solver moves.
+        tol: the stopping tolerance on the residual (its units: m or rad).
+        max_iter: the most iterations a problem.
+
+    Returns:
+        ``(qs (n, nq), iterations (n,), residual evaluations (n,))``; qs NaN rows where the solver did not converge.
+    """
+    qs = np.full((n, model.nq), np.nan)
+    iters, evals = np.full(n, np.nan), np.full(n, np.nan)
+    for i, (residual_and_jacobian, q_start) in enumerate(problems):
+        q, it, ev, ok = levenberg_marquardt(model, residual_and_jacobian, q_start, free, tol, max_iter)
+        iters[i], evals[i] = it, ev
+        if ok:
+            qs[i] = q
+    return qs, iters, evals
+
+
 def sizes(n: int | None, quick: bool, full: tuple[int, int, int], small: tuple[int, int, int]) -> tuple[int, int, int]:
     """(batch targets, scalar-loop targets, iterative-solver targets): ``full`` or, with ``quick``, ``small``;
     ``n`` overrides the batch size and caps the others."""
     batch, scalar, iterative = small if quick else full
     n = n or batch
     return n, min(n, scalar), min(n, iterative)
+
+
+def scalar_loop(call: Callable[[np.ndarray], Any], rows: np.ndarray, width: int) -> np.ndarray:
+    """``call`` on one row at a time (a Python loop of single calls), the way a user calls a function once.
+
+    Args:
+        call: the single call, ``row -> (width,)`` result (units those of the method).
+        rows: (n, ...) the inputs.
+        width: the length of one result.
+
+    Returns:
+        (n, width) the results, NaN rows where ``call`` raised a legkin error.
+    """
+    out = np.full((len(rows), width), np.nan)
+    for i, row in enumerate(rows):
+        try:
+            out[i] = call(row)
+        except LegkinError:
+            pass
+    return out
 
 
 def rotation_error(r1: np.ndarray, r2: np.ndarray) -> np.ndarray:

@@ -251,6 +251,20 @@ def _step(jac, res, cols, jp, a, y, dv):
         dv[cols[c]] = x
 
 
+@kernel(inline=True)
+def _passive_columns(passive):
+    """The indices of the ``passive`` (True) velocity coordinates, in order (int64)."""
+    n_free = 0
+    for v in range(passive.shape[0]):
+        n_free += 1 if passive[v] else 0
+    cols, k = np.empty(n_free, dtype=np.int64), 0
+    for v in range(passive.shape[0]):
+        if passive[v]:
+            cols[k] = v
+            k += 1
+    return cols
+
+
 @kernel(entry=True)
 def solve_passive(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t, loop_six,
                   passive, tol, max_iter, q_out, info):
@@ -267,14 +281,8 @@ def solve_passive(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j,
     o_r[0] = np.eye(3)
     res, jac, dv = np.zeros(rows), np.zeros((rows, nv)), np.zeros(nv)
     res2, jac2, trial = np.zeros(rows), np.zeros((rows, nv)), np.empty_like(q)
-    n_free = 0
-    for v in range(nv):
-        n_free += 1 if passive[v] else 0
-    cols, k = np.empty(n_free, dtype=np.int64), 0
-    for v in range(nv):
-        if passive[v]:
-            cols[k] = v
-            k += 1
+    cols = _passive_columns(passive)
+    n_free = cols.shape[0]
     jp, a, y = np.empty((rows, n_free)), np.empty((rows, rows)), np.empty(rows)
     mats, vecs = np.empty((5, 3, 3)), np.empty((4, 3))
     for i in range(q.shape[0]):
@@ -336,14 +344,8 @@ def closed_jacobian_k(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loo
         placement[a, 3] = p[a]
         placement[3, a] = 0.0
     placement[3, 3] = 1.0
-    n_free = 0
-    for v in range(nv):
-        n_free += 1 if passive[v] else 0
-    cols, k = np.empty(n_free, dtype=np.int64), 0
-    for v in range(nv):
-        if passive[v]:
-            cols[k] = v
-            k += 1
+    cols = _passive_columns(passive)
+    n_free = cols.shape[0]
     jp, a2, y = np.empty((rows, n_free)), np.empty((rows, rows)), np.empty(rows)
     dv, ddv = np.zeros(nv), np.empty(nv)
     for m in range(motor_v.shape[0]):

@@ -12,6 +12,7 @@ row with the reason.
 from __future__ import annotations
 
 import warnings
+from typing import Any, Callable
 
 import numpy as np
 
@@ -74,6 +75,39 @@ def _rtb():
 
 
 # ------------------------------------------------------------------------------------------- mink
+def _differential_ik(p: np.ndarray, iq: int, dt: float, start: Callable[[np.ndarray], Any],
+                     foot: Callable[[Any], np.ndarray], velocity: Callable[[Any], np.ndarray]
+                     ) -> tuple[np.ndarray, np.ndarray]:
+    """mink's and pink's loop: per target, ``conf = start(target)``, then ``conf.integrate_inplace(velocity(conf),
+    dt)`` until ``|foot(conf) - target| < PEER_TOL`` (m) or PEER_MAX_ITER steps.
+
+    Args:
+        p: (n, 3) foot targets (m).
+        iq: the leg's first joint in the configuration ``conf.q``.
+        dt: the integration step (s).
+        start: the configuration at the start of one target's solve (the target set in its task).
+        foot: the foot position (3,) of a configuration (m).
+        velocity: the joint velocity (rad/s) the peer's QP asks of a configuration.
+
+    Returns:
+        ``(q (n, 3) the leg's joints (rad), iterations (n,))``.
+    """
+    out = np.full((len(p), 3), np.nan)
+    iters = np.zeros(len(p))
+    for k, target in enumerate(p):
+        conf = start(target)
+        i = 0
+        while True:
+            err = foot(conf) - target
+            if np.linalg.norm(err) < PEER_TOL or i >= PEER_MAX_ITER:
+                break
+            conf.integrate_inplace(velocity(conf), dt)
+            i += 1
+        out[k] = conf.q[iq : iq + 3]
+        iters[k] = i
+    return out, iters
+
+
 def _mink():
     import mink
     import mujoco
@@ -95,23 +129,15 @@ def _mink():
     limits = [mink.ConfigurationLimit(model)]
     dt = 1.0
 
+    def start(target):
+        conf.update(q0)
+        task.set_target(mink.SE3.from_translation(target))
+        return conf
+
     def run(p):
-        out = np.full((len(p), 3), np.nan)
-        iters = np.zeros(len(p))
-        for k, target in enumerate(p):
-            conf.update(q0)
-            task.set_target(mink.SE3.from_translation(target))
-            i = 0
-            while True:
-                err = conf.get_transform_frame_to_world(f"{LEG}_FOOT", "body").translation() - target
-                if np.linalg.norm(err) < PEER_TOL or i >= PEER_MAX_ITER:
-                    break
-                vel = mink.solve_ik(conf, [task], dt, "daqp", damping=PEER_DAMPING, limits=limits)
-                conf.integrate_inplace(vel, dt)
-                i += 1
-            out[k] = conf.q[iq : iq + 3]
-            iters[k] = i
-        return out, iters
+        return _differential_ik(
+            p, iq, dt, start, lambda c: c.get_transform_frame_to_world(f"{LEG}_FOOT", "body").translation(),
+            lambda c: mink.solve_ik(c, [task], dt, "daqp", damping=PEER_DAMPING, limits=limits))
 
     note = (f"mink: the URDF in MuJoCo (fusestatic off), FrameTask({LEG}_FOOT, position_cost 1, orientation_cost "
             f"0), loop solve_ik(daqp, damping {PEER_DAMPING:g}, ConfigurationLimit) + integrate_inplace with dt = 1 "
@@ -133,23 +159,15 @@ def _pink():
     dt = 1.0
     eye = np.eye(3)
 
+    def start(target):
+        conf = pink.Configuration(model, data, q0)
+        task.set_target(pin.SE3(eye, target))
+        return conf
+
     def run(p):
-        out = np.full((len(p), 3), np.nan)
-        iters = np.zeros(len(p))
-        for k, target in enumerate(p):
-            conf = pink.Configuration(model, data, q0)
-            task.set_target(pin.SE3(eye, target))
-            i = 0
-            while True:
-                err = conf.get_transform_frame_to_world(f"{LEG}_FOOT").translation - target
-                if np.linalg.norm(err) < PEER_TOL or i >= PEER_MAX_ITER:
-                    break
-                vel = pink.solve_ik(conf, [task], dt, solver="daqp", damping=PEER_DAMPING, safety_break=False)
-                conf.integrate_inplace(vel, dt)
-                i += 1
-            out[k] = conf.q[iq : iq + 3]
-            iters[k] = i
-        return out, iters
+        return _differential_ik(
+            p, iq, dt, start, lambda c: c.get_transform_frame_to_world(f"{LEG}_FOOT").translation,
+            lambda c: pink.solve_ik(c, [task], dt, solver="daqp", damping=PEER_DAMPING, safety_break=False))
 
     note = (f"pink: Configuration(model, data, q0), FrameTask({LEG}_FOOT, position_cost 1, orientation_cost 0), "
             f"loop solve_ik(daqp, damping {PEER_DAMPING:g}, its default configuration and velocity limits) + "

@@ -21,7 +21,7 @@ import numpy as np
 from .._kernels import kernel
 from .chains import chain_k, ref_of, rod_system_rates_k, rot_k, sgn_k, tips_k
 from .geometry import K_TOL, PLATFORM_LIMIT
-from .polynomial import roll_poly_k
+from .polynomial import quadratics_at_k, roll_poly_k
 
 __all__ = ["certify_k", "CERTIFY_WORK"]
 
@@ -139,12 +139,7 @@ def classify_k(t, tip, dtip, al, be, ga, pose, b1, b2, s, rc, work):
     """What the pose at the root t = tan(roll / 2) is to the candidate pose (3,) (theta_LL, roll, pitch) of mode
     (b1, b2), s at distance rc from R_P = I: SELF, NOT_NEARER (outside the limits, farther, or in another mode) or
     UNKNOWN (possibly a nearer pose of the mode: the forward kinematics decides). work (21,)."""
-    a0 = (al[0, 2] * t + al[0, 1]) * t + al[0, 0]
-    a1 = (al[1, 2] * t + al[1, 1]) * t + al[1, 0]
-    c0 = (be[0, 2] * t + be[0, 1]) * t + be[0, 0]
-    c1 = (be[1, 2] * t + be[1, 1]) * t + be[1, 0]
-    g0 = (ga[0, 2] * t + ga[0, 1]) * t + ga[0, 0]
-    g1 = (ga[1, 2] * t + ga[1, 1]) * t + ga[1, 0]
+    a0, a1, c0, c1, g0, g1 = quadratics_at_k(al, be, ga, t)
     det = a0 * c1 - a1 * c0
     if not (abs(det) > CRAMER_MARGIN * (abs(a0 * c1) + abs(a1 * c0))):
         return UNKNOWN  # parallel rod equations: more than one pitch at this roll

@@ -9,7 +9,7 @@ assembly mode (:func:`legkin.hybrid_leg.fk`, validated against Pinocchio) vs the
 
 from __future__ import annotations
 
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
 
@@ -19,12 +19,12 @@ from .._benchkit import (
     MethodResult,
     ModelBench,
     Score,
-    levenberg_marquardt,
+    levenberg_marquardt_rows,
     pinocchio_positions,
+    scalar_loop,
     sizes,
 )
 from .._single_call import SingleCall
-from ..errors import LegkinError
 from ..robot import Robot, load
 from . import kinematics as ah
 from .configuration import LL_RANGE, closed_configuration, sample_workspace
@@ -111,13 +111,7 @@ def _score_motors(p: np.ndarray, motors: np.ndarray, residual: np.ndarray | None
 
 def _scalar_ik(p: np.ndarray) -> np.ndarray:
     """ik one target at a time (a Python loop of single calls), NaN where it raises."""
-    out = np.full((len(p), 3), np.nan)
-    for i, pi in enumerate(p):
-        try:
-            out[i] = ah.ik(pi)
-        except LegkinError:
-            pass
-    return out
+    return scalar_loop(ah.ik, p, 3)
 
 
 def _pinocchio_ik(robot: Robot) -> Callable[[np.ndarray], tuple[np.ndarray, np.ndarray, np.ndarray]]:
@@ -130,11 +124,8 @@ def _pinocchio_ik(robot: Robot) -> Callable[[np.ndarray], tuple[np.ndarray, np.n
     fid = robot.frame_id("FCS")
     free = np.ones(model.nv, dtype=bool)
 
-    def solve(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        k = len(p)
-        qs = np.full((k, model.nq), np.nan)
-        iters, evals = np.full(k, np.nan), np.full(k, np.nan)
-        for i, target in enumerate(p):
+    def problems(p: np.ndarray) -> Iterator[tuple[Callable, np.ndarray]]:
+        for target in p:
 
             def residual_and_jacobian(q: np.ndarray, target: np.ndarray = target) -> tuple[np.ndarray, np.ndarray]:
                 r, jc = robot.constraint_residual(q), robot.constraint_jacobian(q)
@@ -143,11 +134,10 @@ def _pinocchio_ik(robot: Robot) -> Callable[[np.ndarray], tuple[np.ndarray, np.n
                 jf = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
                 return np.concatenate([r, data.oMf[fid].translation - target]), np.vstack([jc, jf])
 
-            q, it, ev, ok = levenberg_marquardt(model, residual_and_jacobian, robot.q0.copy(), free, TOL, MAX_ITER)
-            iters[i], evals[i] = it, ev
-            if ok:
-                qs[i] = q
-        return qs, iters, evals
+            yield residual_and_jacobian, robot.q0.copy()
+
+    def solve(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        return levenberg_marquardt_rows(model, problems(p), len(p), free, TOL, MAX_ITER)
 
     return solve
 

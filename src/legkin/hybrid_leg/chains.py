@@ -140,18 +140,32 @@ def rod_system_k(x0, x1, tip, g, nm):
     return rod_system_cs_k(math.cos(x0), math.sin(x0), math.cos(x1), math.sin(x1), tip, g, nm)
 
 
+@kernel(inline=True)
+def rod_arm_k(i, cr, sr, cp, sp):
+    """``R_P a_i`` (m), chain i's platform attachment rotated by ``R_P = Rx(roll) Ry(pitch)`` given by the
+    cosines and sines of roll and pitch (eqs 9, 16 less the centre c)."""
+    if i == 0:
+        ax, ay, az = AX0, AY0, AZ0
+    else:
+        ax, ay, az = AX1, AY1, AZ1
+    return (cp * ax + sp * az, sr * sp * ax + cr * ay - sr * cp * az, -cr * sp * ax + sr * ay + cr * cp * az)
+
+
+@kernel(inline=True)
+def rod_rate_k(i, cr, sr, cp, sp, tip, dtip):
+    """``D_i = (A_i - tip_i) . dtip_i``, the rate of rod i's residual per motor radian (m^2/rad), from the
+    cosines and sines of roll and pitch."""
+    rx, ry, rz = rod_arm_k(i, cr, sr, cp, sp)
+    return ((CX + rx - tip[i, 0]) * dtip[i, 0] + (CY + ry - tip[i, 1]) * dtip[i, 1]
+            + (CZ + rz - tip[i, 2]) * dtip[i, 2])
+
+
 @kernel
 def rod_system_cs_k(cr, sr, cp, sp, tip, g, nm):
     """:func:`rod_system_k` from the cosines and sines of roll and pitch."""
     worst = 0.0
     for i in range(2):
-        if i == 0:
-            ax, ay, az = AX0, AY0, AZ0
-        else:
-            ax, ay, az = AX1, AY1, AZ1
-        rx = cp * ax + sp * az
-        ry = sr * sp * ax + cr * ay - sr * cp * az
-        rz = -cr * sp * ax + sr * ay + cr * cp * az
+        rx, ry, rz = rod_arm_k(i, cr, sr, cp, sp)
         d0, d1, d2 = CX + rx - tip[i, 0], CY + ry - tip[i, 1], CZ + rz - tip[i, 2]
         g[i] = 0.5 * ((d0 * d0 + d1 * d1 + d2 * d2) - L * L)
         nm[i, 0] = -d1 * rz + d2 * ry
@@ -186,15 +200,7 @@ def rod_system_rates_cs_k(cr, sr, cp, sp, tip, dtip, g, nm, dd):
     """:func:`rod_system_rates_k` from the cosines and sines of roll and pitch."""
     rod_system_cs_k(cr, sr, cp, sp, tip, g, nm)
     for i in range(2):
-        if i == 0:
-            ax, ay, az = AX0, AY0, AZ0
-        else:
-            ax, ay, az = AX1, AY1, AZ1
-        rx = cp * ax + sp * az
-        ry = sr * sp * ax + cr * ay - sr * cp * az
-        rz = -cr * sp * ax + sr * ay + cr * cp * az
-        dd[i] = ((CX + rx - tip[i, 0]) * dtip[i, 0] + (CY + ry - tip[i, 1]) * dtip[i, 1]
-                 + (CZ + rz - tip[i, 2]) * dtip[i, 2])
+        dd[i] = rod_rate_k(i, cr, sr, cp, sp, tip, dtip)
 
 
 @kernel(entry=True)

@@ -24,7 +24,7 @@ import numpy as np
 
 from .._kernels import kernel
 from .._rotations import wrap_k
-from .chains import AX0, AX1, AY0, AY1, AZ0, AZ1, CX, CY, CZ, L, chain_k, rod_system_k, rot_k, sgn_k, tips_k
+from .chains import AX0, AX1, AY0, AY1, AZ0, AZ1, CX, CY, CZ, L, chain_k, rod_rate_k, rod_system_k, rot_k, sgn_k, tips_k
 from .geometry import BOUNDARY_TOL, K_TOL, LIMIT_TOL, PLATFORM_LIMIT
 
 _TWO_PI = 2.0 * math.pi
@@ -261,6 +261,15 @@ def null_k(nm, v):
     return smax, smin
 
 
+@kernel(inline=True)
+def quadratics_at_k(al, be, ga, t):
+    """The per-rod quadratics al, be, ga (2, 3) of :func:`roll_poly_k` at t = tan(roll / 2): (a_0, a_1, b_0, b_1,
+    g_0, g_1), rod i's equation in pitch being ``a_i cos(pitch) + b_i sin(pitch) = g_i`` (times (1 + t^2))."""
+    return ((al[0, 2] * t + al[0, 1]) * t + al[0, 0], (al[1, 2] * t + al[1, 1]) * t + al[1, 0],
+            (be[0, 2] * t + be[0, 1]) * t + be[0, 0], (be[1, 2] * t + be[1, 1]) * t + be[1, 0],
+            (ga[0, 2] * t + ga[0, 1]) * t + ga[0, 0], (ga[1, 2] * t + ga[1, 1]) * t + ga[1, 0])
+
+
 #: Most seeds per motor pair: 8 roots (x3 where the rod equations are parallel), and the fold seeds of each.
 MAX_SEEDS = 24
 MAX_SOL = MAX_SEEDS * (1 + 2 * len(FOLD_OFFSETS))
@@ -290,12 +299,7 @@ def seeds_k(tip, x0, imag):
         if not (abs(zi) <= 1e-2 * (1.0 + abs(z[j])) and abs(zr) <= 1.0 + 1e-3):
             continue
         t = zr
-        a0 = (al[0, 2] * t + al[0, 1]) * t + al[0, 0]
-        a1 = (al[1, 2] * t + al[1, 1]) * t + al[1, 0]
-        b0 = (be[0, 2] * t + be[0, 1]) * t + be[0, 0]
-        b1 = (be[1, 2] * t + be[1, 1]) * t + be[1, 0]
-        g0 = (ga[0, 2] * t + ga[0, 1]) * t + ga[0, 0]
-        g1 = (ga[1, 2] * t + ga[1, 1]) * t + ga[1, 0]
+        a0, a1, b0, b1, g0, g1 = quadratics_at_k(al, be, ga, t)
         det = a0 * b1 - a1 * b0
         cp = (b0 * g1 - b1 * g0) / det
         sp = (a1 * g0 - a0 * g1) / det
@@ -393,15 +397,8 @@ def label_k(tip, dtip, x, err, m, tol, xs, bl, sdet):
         xs[out, 0], xs[out, 1] = r_, p_
         cr, sr, cp, sp = math.cos(r_), math.sin(r_), math.cos(p_), math.sin(p_)
         for i in range(2):
-            if i == 0:
-                ax, ay, az, sg = AX0, AY0, AZ0, 1.0
-            else:
-                ax, ay, az, sg = AX1, AY1, AZ1, -1.0
-            rx = cp * ax + sp * az
-            ry = sr * sp * ax + cr * ay - sr * cp * az
-            rz = -cr * sp * ax + sr * ay + cr * cp * az
-            dd = ((CX + rx - tip[i, 0]) * dtip[i, 0] + (CY + ry - tip[i, 1]) * dtip[i, 1]
-                  + (CZ + rz - tip[i, 2]) * dtip[i, 2])
+            sg = 1.0 if i == 0 else -1.0
+            dd = rod_rate_k(i, cr, sr, cp, sp, tip, dtip)
             bl[out, i] = 0.0 if abs(abs(kk[i]) - 1.0) <= BOUNDARY_TOL else -sg * sgn_k(dd)
         sdet[out] = sgn_k(nm[0, 0] * nm[1, 1] - nm[0, 1] * nm[1, 0])
         out += 1

@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._benchkit import SOLVE_TOL, Method, MethodResult, ModelBench, Score, levenberg_marquardt, rotation_error, sizes
-from ..errors import LegkinError, LoopClosureError
+from .. import _benchkit
+from .._benchkit import SOLVE_TOL, Method, MethodResult, ModelBench, Score, rotation_error, sizes
+from ..errors import LoopClosureError
 from ..robot import load
 from . import kinematics as at
 from .configuration import MOTOR_COLUMNS, sample_workspace
@@ -61,13 +62,7 @@ def _fk_methods(robot, motors: np.ndarray, r_true: np.ndarray, n_batch: int, n_s
         return at.fk(m, tol=TOL)
 
     def fk_scalar(m):
-        out = np.full((len(m), 2), np.nan)
-        for i, row in enumerate(m):
-            try:
-                out[i] = at.fk(row, tol=TOL)
-            except LegkinError:
-                pass
-        return out
+        return _benchkit.scalar_loop(lambda row: at.fk(row, tol=TOL), m, 2)
 
     def fk_score(m, u) -> Score:
         k = len(m)
@@ -110,14 +105,11 @@ def _pin_inverse(robot):
     ldata = loopset.data
     free = np.ones(model.nv, dtype=bool)
 
-    def pin_inverse(u):
-        qs = np.full((len(u), model.nq), np.nan)
-        iters = np.full(len(u), np.nan)
-        evals = np.full(len(u), np.nan)
-        for i, (a, b) in enumerate(u):
+    def problems(u):
+        for a, b in u:
             r_t = at.platform_rotation(a, b)
 
-            def residual_and_jacobian(q):
+            def residual_and_jacobian(q, r_t=r_t):
                 r, jac = loopset.residual_and_jacobian(q)  # forward kinematics + joint Jacobians in ldata
                 pin.updateFramePlacement(model, ldata, fid)
                 r_err = r_t.T @ ldata.oMf[fid].rotation
@@ -125,11 +117,10 @@ def _pin_inverse(robot):
                 j_rot = pin.Jlog3(r_err) @ pin.getFrameJacobian(model, ldata, fid, pin.LOCAL)[3:]
                 return np.concatenate([r, e]), np.vstack([jac, j_rot])
 
-            q, it, ev, ok = levenberg_marquardt(model, residual_and_jacobian, robot.q0.copy(), free, TOL, MAX_ITER)
-            iters[i], evals[i] = it, ev
-            if ok:
-                qs[i] = q
-        return qs, iters, evals
+            yield residual_and_jacobian, robot.q0.copy()
+
+    def pin_inverse(u):
+        return _benchkit.levenberg_marquardt_rows(model, problems(u), len(u), free, TOL, MAX_ITER)
 
     return pin_inverse
 
@@ -143,13 +134,7 @@ def _ik_methods(robot, orient: np.ndarray, r_true: np.ndarray, n_batch: int, n_s
         return at.ik_joints(u)
 
     def ik_scalar(u):
-        out = np.full((len(u), 12), np.nan)
-        for i, row in enumerate(u):
-            try:
-                out[i] = at.ik_joints(row)
-            except LegkinError:
-                pass
-        return out
+        return _benchkit.scalar_loop(at.ik_joints, u, 12)
 
     pin_inverse = _pin_inverse(robot)
 

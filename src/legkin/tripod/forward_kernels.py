@@ -80,6 +80,19 @@ def _k_initial_guess(qa, qb, qc, G):  # type: ignore[no-untyped-def]
     return ay, az, det3 / 3.0
 
 
+@kernel(inline=True)
+def _k_rank1(a1, a2, r, f):  # type: ignore[no-untyped-def]
+    """The rank-1 step's pieces for A = [a1 a2] of squared Frobenius norm ``f``: ``(a1 . r, a2 . r, fs)`` with
+    ``fs = f`` (1 where f is not > 0), so that ``A^+ r ~ A^T r / fs`` where ``sigma_2 <= STEP_RCOND sigma_1``."""
+    fs = f if f > 0 else 1.0
+    u0 = 0.0
+    u1 = 0.0
+    for K in range(3):
+        u0 += a1[K] * r[K]
+        u1 += a2[K] * r[K]
+    return u0, u1, fs
+
+
 @kernel
 def _k_gn_step(a1, a2, r):  # type: ignore[no-untyped-def]
     """``-pinv([a1 a2]) r`` in closed form (the module docstring, "Step") for (3,) columns: (s0, s1)."""
@@ -96,12 +109,7 @@ def _k_gn_step(a1, a2, r):  # type: ignore[no-untyped-def]
         f += a1[K] * a1[K] + a2[K] * a2[K]
     s0, s1 = t0 / nn, t1 / nn
     if nn <= (STEP_RCOND * STEP_RCOND) * f * f:
-        fs = f if f > 0 else 1.0
-        u0 = 0.0
-        u1 = 0.0
-        for K in range(3):
-            u0 += a1[K] * r[K]
-            u1 += a2[K] * r[K]
+        u0, u1, fs = _k_rank1(a1, a2, r, f)
         s0, s1 = -u0 / fs, -u1 / fs
     return s0, s1
 
@@ -121,12 +129,7 @@ def _k_normal_residual(a1, a2, r):  # type: ignore[no-untyped-def]
         f += a1[K] * a1[K] + a2[K] * a2[K]
     out = abs(rn) / np.sqrt(nn)
     if not nn > (STEP_RCOND * STEP_RCOND) * f * f:
-        fs = f if f > 0 else 1.0
-        u0 = 0.0
-        u1 = 0.0
-        for K in range(3):
-            u0 += a1[K] * r[K]
-            u1 += a2[K] * r[K]
+        u0, u1, fs = _k_rank1(a1, a2, r, f)
         pp = 0.0
         for K in range(3):
             p = r[K] - (a1[K] * u0 + a2[K] * u1) / fs

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .._benchkit import SOLVE_TOL, Method, MethodResult, ModelBench, Score, levenberg_marquardt, sizes
+from .._benchkit import SOLVE_TOL, Method, MethodResult, ModelBench, Score, levenberg_marquardt_rows, sizes
 from .._single_call import SingleCall
 from ..errors import UnreachableError
 from ..robot import load
@@ -191,26 +191,24 @@ class _Setup:
         t, a, ww = inp
         k = len(t)
         starts = ik_start(t, LEG, alpha=a, w=ww, geometry=self.geo)
-        qs = np.full((k, model.nq), np.nan)
-        iters, evals = np.full(k, np.nan), np.full(k, np.nan)
         q_start = self.full_config(np.column_stack([np.clip(starts[:, 0], wl.THETA_MIN, wl.THETA_MAX), starts[:, 1:]]))
-        for i in range(k):
-            fid, loc, target = int(self.frame_ids[i]), self.local[i], t[i]
 
-            def residual_and_jacobian(q, fid=fid, loc=loc, target=target):
-                r, jc = loopset.residual_and_jacobian(q)  # forwardKinematics + computeJointJacobians in ldata
-                pin.updateFramePlacement(model, ldata, fid)
-                M = ldata.oMf[fid]
-                rr = M.rotation @ loc
-                j6 = pin.getFrameJacobian(model, ldata, fid, pin.LOCAL_WORLD_ALIGNED)
-                jp = j6[:3] - np.cross(rr, j6[3:].T).T  # velocity of the contact point: v + w x r
-                return np.concatenate([r, M.translation + rr - target]), np.vstack([jc, jp])
+        def problems():
+            for i in range(k):
+                fid, loc, target = int(self.frame_ids[i]), self.local[i], t[i]
 
-            q, it, ev, ok = levenberg_marquardt(model, residual_and_jacobian, q_start[i], free, TOL, MAX_ITER)
-            iters[i], evals[i] = it, ev
-            if ok:
-                qs[i] = q
-        return qs, iters, evals
+                def residual_and_jacobian(q, fid=fid, loc=loc, target=target):
+                    r, jc = loopset.residual_and_jacobian(q)  # forwardKinematics + computeJointJacobians in ldata
+                    pin.updateFramePlacement(model, ldata, fid)
+                    M = ldata.oMf[fid]
+                    rr = M.rotation @ loc
+                    j6 = pin.getFrameJacobian(model, ldata, fid, pin.LOCAL_WORLD_ALIGNED)
+                    jp = j6[:3] - np.cross(rr, j6[3:].T).T  # velocity of the contact point: v + w x r
+                    return np.concatenate([r, M.translation + rr - target]), np.vstack([jc, jp])
+
+                yield residual_and_jacobian, q_start[i]
+
+        return levenberg_marquardt_rows(model, problems(), k, free, TOL, MAX_ITER)
 
     def pin_score(self, inp, out) -> Score:
         qs, iters, evals = out

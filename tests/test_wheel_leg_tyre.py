@@ -11,6 +11,7 @@ from hypothesis import strategies as st
 
 from legkin.errors import InvalidInputError, InvalidParameterError, JointLimitError, UnreachableError
 from legkin.wheel_leg import ground as gd
+from legkin.wheel_leg import stance as sk
 from legkin.wheel_leg import tyre as ty
 from legkin.wheel_leg import tyre_checks as tc
 from legkin.wheel_leg.frames import leg_frame_to_robot
@@ -154,9 +155,9 @@ def test_bad_inputs():
     with pytest.raises(InvalidInputError):
         ty.tyre_point(1.0, 0.0, np.nan)
     with pytest.raises(InvalidInputError):
-        gd.stance_ik(np.array([np.nan, 0, 0]), "FL")
+        sk.stance_ik(np.array([np.nan, 0, 0]), "FL")
     with pytest.raises(InvalidInputError):
-        gd.stance_ik(np.zeros(2), "FL")
+        sk.stance_ik(np.zeros(2), "FL")
 
 
 # ---------------------------------------------------------------- stance IK
@@ -167,16 +168,16 @@ def test_stance_ik_round_trip_and_all_solutions():
                   rng.uniform(-1.4, 1.4, n)], -1)
     for leg in ("FL", "FR"):
         target = gd.ground_contact(q, leg).point
-        qs, ok = gd.stance_ik(target, leg, return_mask=True)
+        qs, ok = sk.stance_ik(target, leg, return_mask=True)
         assert ok.all()
         assert np.abs(qs[:, 2]).max() <= ABAD_LIMIT
         np.testing.assert_allclose(gd.ground_contact(qs, leg).point, target, atol=1e-12, rtol=0)
-        allq = gd.stance_ik_all(target, leg)
+        allq = sk.stance_ik_all(target, leg)
         d = allq - q[:, None, :]
         d[..., 1:] = np.pi - np.mod(np.pi - d[..., 1:], 2 * np.pi)
         assert np.nanmin(np.abs(d).max(-1), axis=1).max() < 1e-9
         for i in range(n):  # q_near: the sampled q itself (it is among the in-limit solutions)
-            near = gd.stance_ik(target[i], leg, q_near=q[i])
+            near = sk.stance_ik(target[i], leg, q_near=q[i])
             d = near - q[i]
             d[1:] = np.pi - np.mod(np.pi - d[1:], 2 * np.pi)
             assert np.abs(d).max() < 1e-9
@@ -185,9 +186,9 @@ def test_stance_ik_round_trip_and_all_solutions():
 def test_stance_ik_unreachable():
     far = np.array([2.0, 2.0, -2.0])
     with pytest.raises(UnreachableError):
-        gd.stance_ik(far, "FL")
+        sk.stance_ik(far, "FL")
     t = np.stack([far, gd.ground_contact(np.array([1.0, 0.2, 0.1]), "FL").point])
-    qs, ok = gd.stance_ik(t, "FL", return_mask=True)
+    qs, ok = sk.stance_ik(t, "FL", return_mask=True)
     assert ok.tolist() == [False, True] and np.isnan(qs[0]).all() and np.isfinite(qs[1]).all()
 
 
@@ -201,36 +202,36 @@ def test_stance_ik_single_equals_batch_and_rules():
                   rng.uniform(-1.4, 1.4, n)], -1)
     for leg in ("RR", "RL"):
         target = gd.ground_contact(q, leg).point
-        batch = gd.stance_ik(target, leg)
-        batch_all = gd.stance_ik_all(target, leg, limits=True)
-        near_b = gd.stance_ik(target, leg, q_near=q)
+        batch = sk.stance_ik(target, leg)
+        batch_all = sk.stance_ik_all(target, leg, limits=True)
+        near_b = sk.stance_ik(target, leg, q_near=q)
         for i in range(n):
-            single = gd.stance_ik(target[i].copy(), leg)
+            single = sk.stance_ik(target[i].copy(), leg)
             assert np.array_equal(single, batch[i])
             assert np.array_equal(single, batch_all[i, 0])
-            s_all = gd.stance_ik_all(target[i].copy(), leg, limits=True)
+            s_all = sk.stance_ik_all(target[i].copy(), leg, limits=True)
             k = s_all.shape[0]
             assert np.array_equal(s_all, batch_all[i, :k]) and np.isnan(batch_all[i, k:]).all()
-            assert np.array_equal(gd.stance_ik(target[i].copy(), leg, q_near=q[i].copy()), near_b[i])
-            lst = gd.stance_ik(target[i].tolist(), leg)  # a list: the checked path, the same answer
+            assert np.array_equal(sk.stance_ik(target[i].copy(), leg, q_near=q[i].copy()), near_b[i])
+            lst = sk.stance_ik(target[i].tolist(), leg)  # a list: the checked path, the same answer
             assert np.array_equal(lst, single)
     tilt = np.array([0.1, -0.2, 1.0])
     tq = np.array([1.0, 0.4, 0.2])
     t = gd.ground_contact(tq, "FL", tilt).point
-    sol = gd.stance_ik(t, "FL", normal=tilt)
+    sol = sk.stance_ik(t, "FL", normal=tilt)
     np.testing.assert_allclose(gd.ground_contact(sol, "FL", tilt).point, t, atol=1e-12, rtol=0)
     # a target reached only with |gamma| > ABAD_LIMIT (the leg swung over the top, gamma ~ 2.6 rad)
     t_out = gd.ground_contact(np.array([1.2, 0.3, 2.6]), "FL").point
-    sols = gd.stance_ik_all(t_out, "FL")
-    same, mask = gd.stance_ik_all(t_out, "FL", return_mask=True)
+    sols = sk.stance_ik_all(t_out, "FL")
+    same, mask = sk.stance_ik_all(t_out, "FL", return_mask=True)
     assert np.array_equal(same, sols, equal_nan=True) and np.array_equal(mask, ~np.isnan(sols).any(-1))
-    both, masks = gd.stance_ik_all(np.stack([t_out, t_out]), "FL", return_mask=True)
+    both, masks = sk.stance_ik_all(np.stack([t_out, t_out]), "FL", return_mask=True)
     assert masks.shape == both.shape[:-1] and np.array_equal(masks[0], ~np.isnan(both[0]).any(-1)) and masks.any()
     assert sols.shape[0] >= 1 and np.all(np.abs(sols[:, 2]) > ABAD_LIMIT)
     with pytest.raises(JointLimitError) as info:
-        gd.stance_ik(t_out, "FL")
+        sk.stance_ik(t_out, "FL")
     assert (info.value.joint, info.value.upper) == ("FL_abad", ABAD_LIMIT) and np.array_equal(info.value.target, t_out)
-    assert gd.stance_ik(t_out, "FL", limits=False)[2] == pytest.approx(2.6, abs=1e-9)
+    assert sk.stance_ik(t_out, "FL", limits=False)[2] == pytest.approx(2.6, abs=1e-9)
 
 
 def test_tyre_point_batch_reuses_the_pieces_of_equal_theta_bit_for_bit():

@@ -180,3 +180,14 @@ def test_sim_video(tmp_path):
         pytest.skip(f"no OpenGL here: {exc}")
     out = write_video(images, tmp_path / "stand.mp4", fps=6)
     assert out.stat().st_size > 1000 and out.read_bytes()[4:8] == b"ftyp"
+
+
+@pytest.mark.parametrize("name", ["talos", "g1", "bolt", "tripod"])
+def test_models_without_a_ground_model_have_no_ground_rows(name):
+    """The bipeds of legkin.legs (flat feet, or bolt's point feet) and the fixed mechanisms have no ground model
+    yet: `legkin check` gives them no ground rows instead of failing."""
+    from legkin.mjcf.ground import has_ground_model
+    from legkin.mjcf.scenarios import ground_rows
+
+    assert not has_ground_model(name)
+    assert ground_rows(name) == []

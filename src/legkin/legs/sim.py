@@ -10,7 +10,22 @@ import numpy as np
 from ..mjcf.ground import Foot, FootGround, sphere_radius
 from .extract import from_model
 
-__all__ = ["ground_model"]
+__all__ = ["ground_model", "supports"]
+
+
+def supports(name: str) -> bool:
+    """Whether the foot-sphere ground model serves the robot ``name``.
+
+    Args:
+        name: a registry name of :mod:`legkin.legs`.
+
+    Returns:
+        True for the quadrupeds (:data:`legkin.legs.ERD_ROBOTS`: four point feet); the bipeds (flat feet, or
+        bolt's point feet, which cannot stand) have no ground model yet.
+    """
+    from .erd import ERD_ROBOTS
+
+    return name in ERD_ROBOTS
 
 
 def ground_model(robot: Any) -> FootGround:

@@ -238,11 +238,16 @@ def sphere_radius(robot: "Robot", frame: str, default: float = 0.02) -> float:
 
 
 def has_ground_model(robot: "Robot | str") -> bool:
-    """Whether the package of a robot (or registered model name) provides a ``sim`` module (:func:`ground_model`)."""
+    """Whether the package of a robot (or registered model name) provides a ``sim`` module (:func:`ground_model`)
+    that serves it: a shared package's ``sim.supports(name)`` says which of its models it serves (legkin.legs: the
+    quadrupeds; the humanoids' flat feet have no ground model yet)."""
     from .._registry import get_spec
 
     spec = get_spec(robot) if isinstance(robot, str) else robot.spec
-    return importlib.util.find_spec(f"{spec.package}.sim") is not None
+    if importlib.util.find_spec(f"{spec.package}.sim") is None:
+        return False
+    supports = getattr(importlib.import_module(f"{spec.package}.sim"), "supports", None)
+    return supports is None or bool(supports(spec.name))
 
 
 def ground_model(robot: "Robot") -> GroundModel:

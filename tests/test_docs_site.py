@@ -82,15 +82,18 @@ def test_api_page_lists_its_functions(site: Path, page: Path) -> None:
 
 
 def public_api(module: object) -> list[str]:
-    """The public functions and classes of ``module`` (its ``__all__``, else what it defines), with the public
-    methods each class defines, as dotted names relative to the module."""
+    """The public functions and classes of ``module`` (its ``__all__``, else what it defines) that its package
+    defines, with the public methods each class defines, as dotted names relative to the module."""
     names = getattr(module, "__all__", None)
     if names is None:
         names = [n for n, v in vars(module).items() if not n.startswith("_") and getattr(v, "__module__", None)
                  == module.__name__]  # type: ignore[attr-defined]
     out = []
+    package = module.__name__.rsplit(".", 1)[0]  # type: ignore[attr-defined]
     for n in names:
         obj = getattr(module, n, None)
+        if not str(getattr(obj, "__module__", "")).startswith(package):
+            continue  # re-exported from elsewhere (an error class of legkin.errors): documented on its own page
         if inspect.isfunction(obj):
             out.append(n)
         elif inspect.isclass(obj):

@@ -13,11 +13,14 @@ limits, the floating base, if any, at its neutral pose, so that the world frame 
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from .._checkkit import CheckResult, compare
+from ._reference import pinocchio_poses
 
-__all__ = ["run", "TOL", "load_model", "sample_legs", "pinocchio_feet"]
+__all__ = ["run", "TOL", "load_model", "sample_legs", "pinocchio_poses", "pinocchio_feet"]
 
 #: Tolerance (m, or m/rad for the Jacobian) of every row.
 TOL = 1e-12
@@ -46,28 +49,12 @@ def sample_legs(model, legs: dict, n: int, rng: np.random.Generator) -> np.ndarr
     return qs
 
 
-def pinocchio_feet(model, legs: dict, qs: np.ndarray, jacobians: bool = False):
-    """Pinocchio's feet (N, L, 3) in the world frame, and with ``jacobians`` the (N, L, 3, 3) LOCAL_WORLD_ALIGNED
-    translational rows of each leg's three columns."""
-    import pinocchio as pin
-
-    data = model.createData()
-    fids = [model.getFrameId(leg.foot_frame) for leg in legs.values()]
-    cols = [list(leg.idx_v) for leg in legs.values()]
-    n = len(qs)
-    pos = np.empty((n, len(fids), 3))
-    jac = np.empty((n if jacobians else 0, len(fids), 3, 3))
-    for i, q in enumerate(qs):
-        if jacobians:
-            pin.computeJointJacobians(model, data, q)
-        else:
-            pin.forwardKinematics(model, data, q)
-        pin.updateFramePlacements(model, data)
-        for k, fid in enumerate(fids):
-            pos[i, k] = data.oMf[fid].translation
-            if jacobians:
-                jac[i, k] = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)[:3, cols[k]]
-    return (pos, jac) if jacobians else pos
+def pinocchio_feet(model: Any, legs: dict, qs: np.ndarray, jacobians: bool = False) -> Any:
+    """Pinocchio's feet (N, L, 3) in the world frame (m), and with ``jacobians`` the (N, L, 3, 3)
+    LOCAL_WORLD_ALIGNED translational rows of each leg's three columns (:func:`pinocchio_poses`)."""
+    poses, jac = pinocchio_poses(model, legs, qs, jacobians)
+    pos = poses[..., :3, 3]
+    return (pos, jac[..., :3, :]) if jacobians else pos
 
 
 def _with_legs(model, legs: dict, q0: np.ndarray, qleg: np.ndarray) -> np.ndarray:

@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from .._checkkit import CheckResult, compare
+from ._reference import pinocchio_poses
 
 __all__ = ["rows6", "TOL6", "TOL_AMONG"]
 
@@ -26,28 +27,6 @@ TOL6 = 1e-12
 #: The sampled configuration is among ik_all's rows to this (rad). Measured <= 2e-11 on 10^4 samples per leg (the
 #: conditioning of the knee near full stretch: a pose error of 1e-15 moves the angles by ~1e-15 / sin(knee)).
 TOL_AMONG = 1e-9
-
-
-def _pin_poses(model, legs: dict, qs: np.ndarray, jacobians: bool):
-    """Pinocchio's foot poses (N, L, 4, 4) and (N, L, 6, 6) LOCAL_WORLD_ALIGNED Jacobians of the leg columns."""
-    import pinocchio as pin
-
-    data = model.createData()
-    fids = [model.getFrameId(leg.foot_frame) for leg in legs.values()]
-    cols = [list(leg.idx_v) for leg in legs.values()]
-    poses = np.empty((len(qs), len(fids), 4, 4))
-    jac = np.empty((len(qs) if jacobians else 0, len(fids), 6, 6))
-    for i, q in enumerate(qs):
-        if jacobians:
-            pin.computeJointJacobians(model, data, q)
-        else:
-            pin.forwardKinematics(model, data, q)
-        pin.updateFramePlacements(model, data)
-        for k, fid in enumerate(fids):
-            poses[i, k] = data.oMf[fid].homogeneous
-            if jacobians:
-                jac[i, k] = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)[:, cols[k]]
-    return poses, jac
 
 
 def _with(model, legs: dict, qleg: np.ndarray) -> np.ndarray:
@@ -78,12 +57,12 @@ def _ik_rows(model, legs: dict, qleg: np.ndarray, poses: np.ndarray) -> list[Che
         q_all[:, k, :leg.n_solutions], mask[:, k, :leg.n_solutions] = leg.ik_all(poses[:, k], return_mask=True)
         gap = np.abs(np.angle(np.exp(1j * (q_all[:, k] - qleg[:, k, None])))).max(axis=-1)
         among.append(np.nanmin(np.where(mask[:, k], gap, np.inf), axis=-1))
-    back, _ = _pin_poses(model, legs, _with(model, legs, np.where(ok[..., None], q_ik, 0.0)), False)
+    back, _ = pinocchio_poses(model, legs, _with(model, legs, np.where(ok[..., None], q_ik, 0.0)), False)
     err = np.where(ok, np.abs(back - poses).max(axis=(-1, -2)), np.inf)[:, closed]
     errs = []
     for b in range(rows):
         qb = np.where(mask[:, :, b, None], q_all[:, :, b], 0.0)
-        back_b, _ = _pin_poses(model, legs, _with(model, legs, qb), False)
+        back_b, _ = pinocchio_poses(model, legs, _with(model, legs, qb), False)
         errs.append(np.abs(back_b - poses).max(axis=(-1, -2))[:, closed][mask[:, closed, b]])
     n_closed = len(closed)
     return [
@@ -98,7 +77,7 @@ def _ik_rows(model, legs: dict, qleg: np.ndarray, poses: np.ndarray) -> list[Che
 def rows6(model, legs: dict, samples: int, rng: np.random.Generator) -> list[CheckResult]:
     """The check rows (see the module docstring) of the 6-DOF ``legs`` of ``model`` on ``samples`` configurations."""
     qleg = np.stack([rng.uniform(leg.lower, leg.upper, (samples, 6)) for leg in legs.values()], axis=1)
-    poses, jac = _pin_poses(model, legs, _with(model, legs, qleg), True)
+    poses, jac = pinocchio_poses(model, legs, _with(model, legs, qleg), True)
     fk = np.stack([leg.fk(qleg[:, k]) for k, leg in enumerate(legs.values())], axis=1)
     jk = np.stack([leg.jacobian(qleg[:, k]) for k, leg in enumerate(legs.values())], axis=1)
     structures = sorted({leg.structure for leg in legs.values()})

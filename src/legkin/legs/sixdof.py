@@ -310,6 +310,25 @@ class Leg6:
             arr = np.broadcast_to(arr, batch + _T44)
         return as_rows(arr, 16), ref, batch, len(batch) == 0, tol
 
+    def _single(self, kernel: Any, shape: tuple[int, ...], target: Any) -> np.ndarray | None:
+        """The fast path of :meth:`ik` and :meth:`ik_all` for one float64 pose with the default options: the
+        kernel's answer of ``shape``, or None when ``target`` is not such a pose or the kernel saw bad input (the
+        full checks then run and say why).
+
+        Raises:
+            UnreachableError, JointLimitError: the pose has no answer (:meth:`_error`).
+        """
+        if not (target.__class__ is np.ndarray and target.shape == _T44 and target.dtype is _F64
+                and self.params[_KIND] != 0.0):
+            return None
+        out, info = np.empty(shape), np.zeros(2)
+        st = kernel(target.reshape(16), self.params, self.q_ref, IK_TOL, out, info)
+        if st == OK:
+            return out
+        if st != _BAD_INPUT:
+            raise self._error(st, info, target, IK_TOL)
+        return None
+
     def _error(self, status: int, info: np.ndarray, target: np.ndarray, tol: float):
         t = target.reshape(4, 4)
         if status == _JOINT_LIMIT:
@@ -343,14 +362,10 @@ class Leg6:
             LegStructureError: a leg without a closed form (:attr:`structure` ``"6R-general"``).
             InvalidInputError, InvalidArgumentError: bad ``target`` / ``q_near`` / ``tol`` / ``return_mask``.
         """
-        if q_near is None and tol is IK_TOL and return_mask is False and target.__class__ is np.ndarray \
-                and target.shape == _T44 and target.dtype is _F64 and self.params[_KIND] != 0.0:
-            fast, info1 = np.empty((self.n_solutions, 6)), np.zeros(2)  # a single target: straight to the kernel
-            st = _ik_all6_k(target.reshape(16), self.params, self.q_ref, IK_TOL, fast, info1)
-            if st == OK:
+        if q_near is None and tol is IK_TOL and return_mask is False:  # a single float64 pose: the kernel directly
+            fast = self._single(_ik_all6_k, (self.n_solutions, 6), target)
+            if fast is not None:
                 return fast
-            if st != _BAD_INPUT:
-                raise self._error(st, info1, target, IK_TOL)
         rows, ref, batch, single, tol = self._prepare(target, q_near, tol)
         flag = check_flag(return_mask, "return_mask")
         n = rows.shape[0]
@@ -382,14 +397,10 @@ class Leg6:
             UnreachableError: a single target out of reach; JointLimitError: reachable only outside the limits.
             LegStructureError, InvalidInputError, InvalidArgumentError: as :meth:`ik_all`.
         """
-        if q_near is None and tol is IK_TOL and return_mask is False and target.__class__ is np.ndarray \
-                and target.shape == _T44 and target.dtype is _F64 and self.params[_KIND] != 0.0:
-            fast, info1 = np.empty(6), np.zeros(2)  # a single target: straight to the kernel
-            st = _ik6_k(target.reshape(16), self.params, self.q_ref, IK_TOL, fast, info1)
-            if st == OK:
+        if q_near is None and tol is IK_TOL and return_mask is False:  # a single float64 pose: the kernel directly
+            fast = self._single(_ik6_k, _Q6, target)
+            if fast is not None:
                 return fast
-            if st != _BAD_INPUT:
-                raise self._error(st, info1, target, IK_TOL)
         rows, ref, batch, single, tol = self._prepare(target, q_near, tol)
         flag = check_flag(return_mask, "return_mask")
         n = rows.shape[0]

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from .._kernels import OK, batch_kernel, kernel
+from .._kernels import OK, batch_kernel, kernel, prange
 from ._fk_kernels import _finite3, _fk3_k, _jac3_t
 from ._layout import (
     _BAD_INPUT,
@@ -20,6 +20,7 @@ from ._layout import (
     _HI,
     _IDEAL,
     _IN_CYLINDER,
+    _INV_TWO_PI,
     _JOINT_LIMIT,
     _K,
     _KN,
@@ -199,7 +200,7 @@ def _hip_k(g, ik, wx, wy, c):
 @kernel
 def _near_k(a, r):
     """The representative ``a + 2 pi n`` nearest ``r``."""
-    return a + _TWO_PI * math.floor((r - a) / _TWO_PI + 0.5)
+    return a + _TWO_PI * math.floor((r - a) * _INV_TWO_PI + 0.5)
 
 
 @kernel
@@ -451,11 +452,11 @@ def _ik_all_batch(p, g, ref, tol, out, status, info) -> int:
     return bad
 
 
-@batch_kernel(rows="p ref out status info", min_parallel=1024)
+@batch_kernel(rows="p ref out status info", min_parallel=1024, parfor=True)
 def _ik_batch(p, g, ref, tol, out, status, info) -> int:
     """:func:`_ik_core` over rows; returns the number of targets that failed (status != OK)."""
     n, m, bad = p.shape[0], ref.shape[0], 0
-    for i in range(n):
+    for i in prange(n):
         s, a, b = _ik_core(p[i], g, ref[i if m > 1 else i - i], tol, out[i])
         status[i], info[i, 0], info[i, 1] = s, a, b
         bad += s != OK

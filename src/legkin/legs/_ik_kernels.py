@@ -440,12 +440,12 @@ def _ik_k(p, g, ref, out) -> int:
     return _ik_core(p, g, ref, IK_TOL, out)[0]
 
 
-@batch_kernel(rows="p ref out status info", min_parallel=512)
+@batch_kernel(rows="p ref out status info", min_parallel=512, parfor=True)
 def _ik_all_batch(p, g, ref, tol, out, status, info) -> int:
     """:func:`_ik_all_core` over rows; returns the number of targets that failed (status != OK)."""
     # ref: one row for all targets (m = 1) or one per target; ``i - i`` keeps the index type of i
     n, m, bad = p.shape[0], ref.shape[0], 0
-    for i in range(n):
+    for i in prange(n):
         s, a, b = _ik_all_core(p[i], g, ref[i if m > 1 else i - i], tol, out[i])
         status[i], info[i, 0], info[i, 1] = s, a, b
         bad += s != OK

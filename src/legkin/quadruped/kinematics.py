@@ -27,8 +27,8 @@ import numpy.typing as npt
 from .._batch import check_flag, check_number
 from .._kernels import OK
 from ..legs._fk_kernels import _fk_k, _jacobian_k
-from ..legs._ik_kernels import _ik_k
-from ..legs.kinematics import Leg
+from ..legs._ik_kernels import _ik_all_k, _ik_k
+from ..legs.kinematics import Leg, _vector3
 from ._common import foot_z_of, leg_index, rows
 from .constants import (
     BRANCHES,
@@ -240,14 +240,14 @@ def ik(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = None, 
         InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
     """
     p: Any = target
-    if q_near is None and return_mask is False and geometry is None and p.__class__ is _ND and p.shape == _S3 \
-            and p.dtype is _F64:
+    if return_mask is False and geometry is None and p.__class__ is _ND and p.shape == _S3 and p.dtype is _F64:
         args = _KERNEL_ARGS.get(leg) or _kernel_args(leg)
+        ref = None if args is None else args[1] if q_near is None else _vector3(q_near)
     else:
-        args = None
-    if args is not None:
+        args = ref = None
+    if args is not None and ref is not None:
         out = np.empty(3)
-        if _ik_k(p, args[0], args[1], out) == OK:
+        if _ik_k(p, args[0], ref, out) == OK:
             return out
     return _leg(leg, geometry).ik(target, q_near=q_near, return_mask=return_mask)  # type: ignore[no-any-return]
 
@@ -285,6 +285,14 @@ def ik_all(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = No
         InvalidInputError: ``target`` or ``q_near`` not finite real arrays (..., 3), or not broadcastable.
         InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
     """
+    p: Any = target
+    if q_near is None and return_mask is False and geometry is None and p.__class__ is _ND and p.shape == _S3 \
+            and p.dtype is _F64:
+        args = _KERNEL_ARGS.get(leg) or _kernel_args(leg)
+        if args is not None:
+            out = np.empty((4, 3))
+            if _ik_all_k(p, args[0], args[1], out) == OK:
+                return out[::-1] if _ORDER[leg] is _REVERSED else out.take(_ORDER[leg], axis=0)
     found = _leg(leg, geometry)
     order = _ORDER[leg]
     if not (return_mask if return_mask is False or return_mask is True else _flag(return_mask)):

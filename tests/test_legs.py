@@ -718,3 +718,36 @@ def test_quadruped_legs_named_by_hip_position_when_joint_names_share_no_prefix()
     assert list(found) == list(hips)
     for name, leg in found.items():
         assert np.sign(leg.origin[:2]).tolist() == np.sign(hips[name]).tolist()
+
+
+def test_haa_arc_test_drops_only_angles_off_the_limits():
+    """The limits-first IK skips an abduction branch when its q1 lies off the HAA limits' arc (``_on_arc_k``, two
+    cross products, no atan2). It must keep every angle within CANDIDATE_SLACK of the limits (else ``ik`` would miss
+    an answer the exact test keeps) and drop those beyond ARC_SLACK (else the test saves nothing): narrow, wide,
+    whole-circle, infinite and one-point limits, angles uniform on the circle and at the limits."""
+    import numba
+
+    from legkin.legs._ik_kernels import _on_arc_k
+    from legkin.legs._layout import _ARC, _NPARAMS, ARC_SLACK, CANDIDATE_SLACK
+    from legkin.legs.kinematics import _limit_arc
+
+    @numba.njit
+    def on_arc(g, c, s):
+        return _on_arc_k(g, c, s)
+
+    rng = np.random.default_rng(7)
+    two_pi = 2.0 * np.pi
+    for lo, hi in [(-0.4, 0.4), (-2.0, 2.0), (0.0, 3.2), (-3.0, 3.5), (-np.inf, np.inf), (1.0, 1.0), (-4.0, -3.0)]:
+        g = np.zeros(_NPARAMS)
+        g[_ARC:_ARC + 5] = _limit_arc(lo, hi)
+        at = [lo - CANDIDATE_SLACK, hi + CANDIDATE_SLACK, lo, hi, lo - 2 * ARC_SLACK, hi + 2 * ARC_SLACK]
+        theta = np.concatenate([rng.uniform(-7.0, 7.0, 4000), [a for a in at if np.isfinite(a)]])
+        for th in theta:
+            r = rng.uniform(1e-3, 10.0)
+            kept = on_arc(g, r * np.cos(th), r * np.sin(th))
+            reps = th + two_pi * np.arange(-3, 4)
+            out_by = np.min(np.maximum(np.maximum(lo - reps, reps - hi), 0.0)) if np.isfinite(lo) else 0.0
+            if out_by <= CANDIDATE_SLACK:
+                assert kept, (lo, hi, th, out_by)
+            elif out_by > ARC_SLACK + 1e-9:
+                assert not kept, (lo, hi, th, out_by)

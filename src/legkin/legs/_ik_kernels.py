@@ -10,6 +10,7 @@ import numpy as np
 from .._kernels import OK, batch_kernel, kernel, prange
 from ._fk_kernels import _finite3, _fk3_k, _jac3_t
 from ._layout import (
+    _ARC,
     _BAD_INPUT,
     _CD,
     _D,
@@ -28,6 +29,7 @@ from ._layout import (
     _LN,
     _LO,
     _NAN,
+    _NARROW,
     _O,
     _PK,
     _PL,
@@ -39,6 +41,7 @@ from ._layout import (
     _TOO_NEAR,
     _TWO_PI,
     _UNREACHABLE,
+    _WHOLE,
     CANDIDATE_SLACK,
     IK_TOL,
     LIMIT_SLACK,
@@ -149,13 +152,35 @@ def _target_k(p, g):
     return x1, t, (y, z), ad - r, g[_IDEAL] > 0.0 and t >= WELL_CONDITIONED * r
 
 
-@kernel
-def _abduction_k(g, ia, t, yz):
-    """Abduction branch ``ia`` (0: ``s_a = -1``, 1: ``+1``): ``u3 = s_a t`` and ``q1 = atan2(z, y) - atan2(u3, d)``
-    as one ``atan2`` (the angle from ``(d, u3)`` to ``(y, z)``)."""
+@kernel(inline=True)
+def _abduction_vec_k(g, ia, t, yz):
+    """Abduction branch ``ia`` (0: ``s_a = -1``, 1: ``+1``): ``u3 = s_a t`` and the vector ``(c, s)`` whose angle is
+    ``q1 = atan2(z, y) - atan2(u3, d)`` (the angle from ``(d, u3)`` to ``(y, z)``): ``c = d y + u3 z``,
+    ``s = d z - u3 y``."""
     u3 = t if ia == 1 else -t
     d, y, z = g[_D], yz[0], yz[1]
-    return u3, math.atan2(d * z - u3 * y, d * y + u3 * z)
+    return u3, d * y + u3 * z, d * z - u3 * y
+
+
+@kernel
+def _abduction_k(g, ia, t, yz):
+    """Abduction branch ``ia``: ``u3`` and ``q1`` (one ``atan2`` of :func:`_abduction_vec_k`'s vector)."""
+    u3, c, s = _abduction_vec_k(g, ia, t, yz)
+    return u3, math.atan2(s, c)
+
+
+@kernel(inline=True)
+def _on_arc_k(g, c, s) -> bool:
+    """Whether the angle of the vector ``(c, s)`` lies on the HAA limits' arc widened by :data:`ARC_SLACK`
+    (:data:`_ARC`): by the signs of cross products with the arc's ends, no angle computed. The zero vector passes."""
+    kind = g[_ARC + 4]
+    if kind == _WHOLE:
+        return True
+    after_a = g[_ARC] * s - g[_ARC + 1] * c  # e_a x v
+    before_b = c * g[_ARC + 3] - s * g[_ARC + 2]  # v x e_b
+    if kind == _NARROW:
+        return after_a >= 0.0 and before_b >= 0.0
+    return after_a >= 0.0 or before_b >= 0.0
 
 
 @kernel
@@ -389,7 +414,10 @@ def _ik_core(p, g, ref, tol, out):
     pitched, clean_w = False, False  # the pitch-plane quantities computed (for one abduction branch)
     wx = wy = miss = c = acb = 0.0
     for ia in range(2 if cyl <= slack else 0):
-        u3, q1 = _abduction_k(g, ia, t, yz)
+        u3, vc, vs = _abduction_vec_k(g, ia, t, yz)
+        if not _on_arc_k(g, vc, vs):  # q1 off the limits (by more than ARC_SLACK): no atan2
+            continue
+        q1 = math.atan2(vs, vc)
         x0, m0, k0 = _within_k(q1, ref[0], g[_LO], g[_HI], CANDIDATE_SLACK)
         cost0 = (x0 - ref[0]) ** 2
         if m0 > CANDIDATE_SLACK or not cost0 < best:

@@ -23,6 +23,9 @@ LIMIT_SLACK = 1e-7
 #: A closed-form branch (before its polish) up to this far (rad) outside the limits is a candidate of the limits-first
 #: :meth:`Leg.ik` (the polish moves an angle by ~1e-15 rad, up to ~1e-8 near the abduction singularity).
 CANDIDATE_SLACK = LIMIT_SLACK + 1e-6
+#: How far (rad) beyond the HAA limits the arc test of the limits-first IK (:data:`_ARC`) still keeps a branch: more
+#: than CANDIDATE_SLACK, so that the exact test on the angle, not the rounding of a cross product, decides there.
+ARC_SLACK = CANDIDATE_SLACK + 1e-6
 #: Damped Newton steps (at most) polishing each closed-form branch on the exact forward map (see _polish_k).
 POLISH_STEPS = 8
 #: Damping (m) of the polishing steps: bounds a step to ~|e| / (2 lambda) rad near a singularity.
@@ -52,7 +55,12 @@ _V21, _V32, _V3F = 39, 42, 45  # o2 - o1, o3 - o2, f - o3
 _SLACK = 48  # reach slack of the ideal structure: REACH_TOL + its deviation bound (see Leg.from_geometry)
 _IDEAL = 49  # 1.0 if the measured axes are exactly (in floats) the ideal structure: a1 . a2 = 0 and a2 x a3 = 0
 _CD, _SD = 50, 51  # cos, sin (phi_k - phi_l): the knee's offset angle (the hip pitch without trigonometric calls)
-_NPARAMS = 52
+#: The HAA limits as an arc of the circle, widened by ARC_SLACK: cos, sin of its start and end, and its kind
+#: (_WHOLE, _NARROW: shorter than pi, _WIDE: from pi to 2 pi); the limits-first IK drops an abduction branch whose
+#: q1 lies off the arc before computing the angle (two cross products instead of an atan2).
+_ARC = 52
+_NPARAMS = 57
+_WHOLE, _NARROW, _WIDE = 0.0, 1.0, 2.0
 
 _TWO_PI = 2.0 * math.pi
 _INV_TWO_PI = 1.0 / _TWO_PI  # (a product: a division costs ~20 cycles of latency in the branch choice)

@@ -68,6 +68,7 @@ from ._layout import (
     _A1,
     _A2,
     _A3,
+    _ARC,
     _BAD_INPUT,
     _CD,
     _D,
@@ -84,6 +85,7 @@ from ._layout import (
     _L,
     _LN,
     _LO,
+    _NARROW,
     _NPARAMS,
     _O,
     _PK,
@@ -96,6 +98,9 @@ from ._layout import (
     _V3F,
     _V21,
     _V32,
+    _WHOLE,
+    _WIDE,
+    ARC_SLACK,
     BRANCHES,
     IK_TOL,
     LIMIT_TOL,
@@ -141,6 +146,15 @@ def _rows3(x: object) -> bool:
 
 
 # ---------------------------------------------------------------- geometry helpers (Python)
+def _limit_arc(lo: float, hi: float) -> tuple[float, float, float, float, float]:
+    """The HAA limits ``[lo, hi]`` (rad) widened by :data:`ARC_SLACK` as an arc of the circle (see :data:`_ARC`):
+    ``(cos a, sin a, cos b, sin b, kind)``."""
+    a, b = lo - ARC_SLACK, hi + ARC_SLACK
+    if not (math.isfinite(a) and math.isfinite(b)) or b - a >= 2.0 * math.pi:
+        return 1.0, 0.0, 1.0, 0.0, _WHOLE
+    return math.cos(a), math.sin(a), math.cos(b), math.sin(b), (_NARROW if b - a < math.pi else _WIDE)
+
+
 def _never() -> Exception:  # pragma: no cover - a batch call never raises
     raise AssertionError("finish() asked a batch call for its error")
 
@@ -317,6 +331,7 @@ class Leg:
         g[_SLACK] = REACH_TOL + 4.0 * (abs(dot12) + cross23 + 1e-15) * lever
         g[_IDEAL] = 1.0 if dot12 == 0.0 and cross23 == 0.0 else 0.0
         g[_CD], g[_SD] = math.cos(g[_PK] - g[_PL]), math.sin(g[_PK] - g[_PL])
+        g[_ARC:_ARC + 5] = _limit_arc(float(lo[0]), float(hi[0]))
         return cls(
             name=str(name), joint_names=(str(j1), str(j2), str(j3)), foot_frame=str(foot_frame),
             lower=_frozen(lo), upper=_frozen(hi), origin=_frozen(o[0]), axes=_frozen(np.stack([a1, a2, a3])),

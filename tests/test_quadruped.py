@@ -291,6 +291,35 @@ def test_geometry_keyword_takes_a_geometry_only(bad):
             call()
 
 
+@pytest.mark.parametrize("bad", [["LF"], {"LF": 1}, "XX", None, 3, b"LF"])
+@pytest.mark.parametrize("geometry", [None, aq.Geometry(foot_z=0.01)])
+def test_bad_leg_is_a_legkin_error_on_every_path(bad, geometry):
+    """The single-call fast paths look the leg up in a dict: an unhashable or unknown leg still gets the legkin
+    error naming the legs (not numpy's or Python's TypeError), with and without a geometry."""
+    q = np.array([0.0, 0.75, 1.5])
+    p = aq.fk(q, "LF")
+    for call in (lambda: aq.fk(q, bad, geometry=geometry), lambda: aq.jacobian(q, bad, geometry=geometry),
+                 lambda: aq.ik(p, bad, geometry=geometry), lambda: aq.ik(p, bad, q_near=q, geometry=geometry),
+                 lambda: aq.ik_all(p, bad, geometry=geometry)):
+        with pytest.raises(legkin.InvalidParameterError, match="LF, LH, RF, RH"):
+            call()
+
+
+def test_geometry_single_calls_equal_the_measured_legs():
+    """The fast path of a non-default geometry uses that geometry's measured leg (not the default's)."""
+    q = np.array([0.1, 0.75, 1.5])
+    for foot_z in (0.02, -0.03):
+        g = aq.Geometry(foot_z=foot_z)
+        for leg in aq.LEGS:
+            measured = aq.legs(g)[leg]
+            p = aq.fk(q, leg, geometry=g)
+            np.testing.assert_array_equal(p, measured.fk(q))
+            np.testing.assert_array_equal(aq.jacobian(q, leg, geometry=g), measured.jacobian(q))
+            np.testing.assert_array_equal(aq.ik(p, leg, geometry=g), measured.ik(p))
+            np.testing.assert_array_equal(aq.ik(p, leg, q_near=q, geometry=g), measured.ik(p, q_near=q))
+            assert np.abs(aq.fk(q, leg) - p).max() > 0.01  # the default geometry's foot is elsewhere
+
+
 def test_return_mask_is_validated():
     p = aq.fk(np.array([0.0, 0.75, 1.5]), "LF")
     q = np.array([0.0, 0.75, 1.5])

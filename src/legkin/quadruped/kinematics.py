@@ -45,7 +45,7 @@ from .constants import (
     Z23,
 )
 from .geometry import DEFAULT_GEOMETRY, Geometry
-from .measured import SEED_ORDER, legs
+from .measured import CACHE_SIZE, SEED_ORDER, legs
 from .textbook import textbook_frame, textbook_ik, textbook_to_joints
 
 __all__ = [
@@ -88,15 +88,24 @@ _DEFAULT: dict[str, Leg] = {}
 #: Their kernels' arrays by leg name, ``(params, q_ref)``: the single-call fast paths below call the compiled
 #: kernels of :class:`~legkin.legs.Leg` directly (one Python call fewer: ~100-200 ns of a ~1 us call).
 _KERNEL_ARGS: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+#: The same for other geometries, by ``(leg, foot_z)`` (as many as :func:`legs` keeps).
+_KERNEL_ARGS_OF: dict[tuple[str, float], tuple[np.ndarray, np.ndarray]] = {}
 _F64, _S3, _ND = np.dtype(np.float64), (3,), np.ndarray
 
 
-def _kernel_args(leg: object) -> tuple[np.ndarray, np.ndarray] | None:
-    """The default leg's kernel arrays ``(params, q_ref)``, measuring the legs on first use (None for a bad leg:
-    the general path then raises its error)."""
-    if leg.__class__ is str and leg in LEGS:
-        _leg(leg, None)
-    return _KERNEL_ARGS.get(leg)  # type: ignore[call-overload]
+def _kernel_args(leg: object, geometry: object) -> tuple[np.ndarray, np.ndarray] | None:
+    """The kernel arrays ``(params, q_ref)`` of ``leg`` for a :class:`Geometry` (measured on first use), or None
+    (a bad leg or geometry: the general path then raises its error)."""
+    if leg.__class__ is not str or leg not in LEGS or geometry.__class__ is not Geometry:
+        return None
+    key = (leg, geometry.foot_z)  # type: ignore[attr-defined]
+    found = _KERNEL_ARGS_OF.get(key)
+    if found is None:
+        one = legs(geometry)[leg]  # type: ignore[arg-type]
+        if len(_KERNEL_ARGS_OF) >= 4 * CACHE_SIZE:  # a sweep over foot_z: keep the memory bounded
+            _KERNEL_ARGS_OF.clear()
+        found = _KERNEL_ARGS_OF[key] = (one.params, one.q_ref.copy())
+    return found
 
 
 def _leg(leg: object, geometry: Geometry | None) -> Leg:
@@ -155,8 +164,8 @@ def fk(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
         InvalidInputError: ``q`` not a finite real array (..., 3).
         InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
     """
-    if return_mask is False and geometry is None and q.__class__ is _ND and q.shape == _S3 and q.dtype is _F64:
-        args = _KERNEL_ARGS.get(leg) or _kernel_args(leg)
+    if return_mask is False and q.__class__ is _ND and q.shape == _S3 and q.dtype is _F64:
+        args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
     else:
         args = None
     if args is not None:
@@ -192,8 +201,8 @@ def jacobian(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
         InvalidInputError: ``q`` not a finite real array (..., 3).
         InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
     """
-    if return_mask is False and geometry is None and q.__class__ is _ND and q.shape == _S3 and q.dtype is _F64:
-        args = _KERNEL_ARGS.get(leg) or _kernel_args(leg)
+    if return_mask is False and q.__class__ is _ND and q.shape == _S3 and q.dtype is _F64:
+        args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
     else:
         args = None
     if args is not None:
@@ -240,8 +249,8 @@ def ik(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = None, 
         InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
     """
     p: Any = target
-    if return_mask is False and geometry is None and p.__class__ is _ND and p.shape == _S3 and p.dtype is _F64:
-        args = _KERNEL_ARGS.get(leg) or _kernel_args(leg)
+    if return_mask is False and p.__class__ is _ND and p.shape == _S3 and p.dtype is _F64:
+        args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
         ref = None if args is None else args[1] if q_near is None else _vector3(q_near)
     else:
         args = ref = None
@@ -286,9 +295,9 @@ def ik_all(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = No
         InvalidParameterError: bad ``leg``, ``geometry`` or ``return_mask``.
     """
     p: Any = target
-    if q_near is None and return_mask is False and geometry is None and p.__class__ is _ND and p.shape == _S3 \
+    if q_near is None and return_mask is False and p.__class__ is _ND and p.shape == _S3 \
             and p.dtype is _F64:
-        args = _KERNEL_ARGS.get(leg) or _kernel_args(leg)
+        args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
         if args is not None:
             out = np.empty((4, 3))
             if _ik_all_k(p, args[0], args[1], out) == OK:

@@ -751,3 +751,30 @@ def test_haa_arc_test_drops_only_angles_off_the_limits():
                 assert kept, (lo, hi, th, out_by)
             elif out_by > ARC_SLACK + 1e-9:
                 assert not kept, (lo, hi, th, out_by)
+
+
+@pytest.mark.parametrize("robot", ["quadruped", "go2", "solo12"])
+def test_out_of_reach_exit_gives_the_complete_paths_verdict(robot):
+    """``Leg.ik`` decides a target out of reach beyond doubt without its complete path (``_out_of_reach_k``: the
+    workspace study's common case). Its status and data must be those of the complete path (``_ik_all_core``, whose
+    ``UNREACHABLE`` they copy): on targets in a box around each leg's hip (most out of reach), every row that
+    ``ik_all`` finds out of reach is out of reach for ``ik`` with the same miss and reason, and every row ``ik``
+    finds out of reach is one that ``ik_all`` does."""
+    import legkin
+    from legkin.legs._ik_kernels import _ik_all_batch, _ik_batch
+    from legkin.legs._layout import _UNREACHABLE, IK_TOL
+
+    found = legkin.quadruped.legs() if robot == "quadruped" else legs.from_model(legkin.load(robot).model)
+    rng = np.random.default_rng(11)
+    for leg in found.values():
+        reach = leg.thigh_length + leg.shank_length + abs(leg.lateral_offset)
+        p = leg.origin + rng.uniform(-1.3 * reach, 1.3 * reach, (20_000, 3))
+        n = len(p)
+        st, info, st_all, info_all = (np.empty(n, dtype=np.int64), np.zeros((n, 2)),
+                                      np.empty(n, dtype=np.int64), np.zeros((n, 2)))
+        _ik_batch(p, leg.params, leg._ref1, IK_TOL, np.empty((n, 3)), st, info)
+        _ik_all_batch(p, leg.params, leg._ref1, IK_TOL, np.empty((n, 4, 3)), st_all, info_all)
+        out = st_all == _UNREACHABLE
+        assert out.sum() > n // 4  # the box is mostly out of reach: the exit is exercised
+        np.testing.assert_array_equal(st == _UNREACHABLE, out)
+        np.testing.assert_array_equal(info[out], info_all[out])

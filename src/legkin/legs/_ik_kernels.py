@@ -393,6 +393,27 @@ def _ik_every_k(p, g, ref, tol, out):
 
 
 @kernel
+def _out_of_reach_k(g, x, t, cyl, tol, slack):
+    """Whether the target is out of reach beyond doubt: inside the abduction cylinder, or beyond the knee's reach
+    on both abduction branches, each by more than ``slack`` (the cases :func:`_ik_all_core` skips without a polish).
+    Returns ``(_UNREACHABLE, miss, reason)`` with the data :func:`_ik_all_core` gives (the least miss, m, and its
+    reason), or ``(OK, 0, 0)`` when it is not that clear (the complete path decides). A cheap exit for the
+    targets of a workspace study, most of them out of reach."""
+    if cyl > slack:
+        return _UNREACHABLE, cyl, _IN_CYLINDER
+    best, why = math.inf, 0.0
+    if cyl > tol:
+        best, why = cyl, _IN_CYLINDER
+    for ia in range(1 if g[_H] == 0.0 else 2):  # h_X = 0: the knee's miss is the same on both abduction branches
+        _wx, _wy, miss, far, _c, _acb, _clean = _pitch_k(g, x, t if ia == 1 else -t)
+        if not miss > slack:
+            return OK, 0.0, 0.0
+        if miss < best:
+            best, why = miss, (_TOO_FAR if far else _TOO_NEAR)
+    return _UNREACHABLE, best, why
+
+
+@kernel
 def _ik_core(p, g, ref, tol, out):
     """The branch of :func:`_ik_all_core` inside the limits nearest ``ref``, limits first, into ``out`` (3,).
 
@@ -445,7 +466,11 @@ def _ik_core(p, g, ref, tol, out):
     if clean and inside:  # well-conditioned, strictly inside the limits: the representatives found are the answer
         out[0], out[1], out[2] = y0, y1, y2
         return OK, 0.0, 0.0
-    if best < math.inf:
+    if best == math.inf:  # no candidate: out of reach (decided here when it is clear), else the complete path
+        status, i0, i1 = _out_of_reach_k(g, x, t, cyl, tol, slack)
+        if status == _UNREACHABLE:
+            return status, i0, i1
+    else:
         j1, j2, j3, res = _settle_k(p, g, c1, c2, c3, clean)
         if res <= tol or not check:
             ok, _m, x0, x1, x2 = _accept_k(p, g, j1, j2, j3, ref)

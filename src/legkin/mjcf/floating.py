@@ -14,7 +14,6 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping
 
-import numpy as np
 import pinocchio as pin
 
 from .._batch import check_number
@@ -22,7 +21,7 @@ from ..errors import InvalidParameterError
 from ._base import _MESH_EXTENSIONS, DEFAULTS, _options, _robot, _set_pose, _vec
 from .ground import GroundModel, ground_model
 from .mechanism import MujocoMechanism, load_mujoco
-from .writer import _build_xml, _geom
+from .writer import _build_xml, _geom, _joint, _qpos
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..robot import Robot
@@ -57,10 +56,21 @@ def _split(options: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
     return o, c
 
 
+def _ascii_stl(path: str) -> bool:
+    """Whether an ``.stl`` file is ASCII (its size is not a binary STL's 84 + 50 x its triangle count), which
+    MuJoCo does not read (simple_humanoid's ``box.stl``)."""
+    file = Path(path)
+    if file.suffix.lower() != ".stl" or not file.is_file():
+        return False
+    with file.open("rb") as f:
+        head = f.read(84)
+    return len(head) < 84 or file.stat().st_size != 84 + 50 * int.from_bytes(head[80:84], "little")
+
+
 def _unreadable(g: Any) -> bool:
-    """Whether a geometry object is a mesh in a format MuJoCo does not read (``.dae``)."""
-    return bool(g.meshPath) and type(g.geometry).__name__.startswith("BVH") and not g.meshPath.lower().endswith(
-        _MESH_EXTENSIONS)
+    """Whether a geometry object is a mesh MuJoCo does not read (``.dae``, ASCII ``.stl``)."""
+    return bool(g.meshPath) and type(g.geometry).__name__.startswith(("BVH", "Convex")) and (
+        not g.meshPath.lower().endswith(_MESH_EXTENSIONS) or _ascii_stl(g.meshPath))
 
 
 def _readable(model: pin.GeometryModel) -> pin.GeometryModel:
@@ -139,11 +149,14 @@ def _floor_and_key(root: ET.Element, robot: "Robot", ground: GroundModel, c: Map
                         friction=_vec(c["friction"]), solref=_vec(c["contact_solref"]),
                         solimp=_vec(c["contact_solimp"]))
     poses = {**robot.poses, robot.spec.reference_pose: robot.q0}
+    joints = [None] + [_joint(robot.model, i) for i in range(1, robot.model.njoints)]
     for key in root.iter("key"):
-        qpos = np.array(key.get("qpos", "").split(), dtype=float)
-        qpos[2] = ground.standing_height(poses[key.get("name")])
+        q = ground.pose(poses[key.get("name")])
+        qpos = _qpos(joints, q)
+        qpos[2] = ground.standing_height(q)
         key.set("qpos", _vec(qpos))
-    return ground.standing_height(robot.q0)
+        key.set("ctrl", _vec(q[robot.idx_q(a)] for a in robot.actuated_joints))
+    return ground.standing_height(ground.pose(robot.q0))
 
 
 def to_ground_mjcf(robot_or_name: "Robot | str", *, ground: GroundModel | None = None, **options: Any) -> str:
@@ -166,11 +179,16 @@ def to_ground_mjcf(robot_or_name: "Robot | str", *, ground: GroundModel | None =
         InvalidParameterError: an unknown or bad option, a model without a ground model.
     """
     robot = _floating(robot_or_name)
-    o, c = _split(options)
     ground = ground_model(robot) if ground is None else ground
+    o, c = _split({"timestep": ground.timestep or GROUND_DEFAULTS["timestep"], **options})
     root = ET.fromstring(_build_xml(_visual_robot(robot), {**o, "floor": True}))
     _contact_class(root, c)
     n = _add_geoms(root, robot, ground)
+    gains = {} if "kp" in options else ground.stiffness()  # the ground model's smallest gains (flat feet)
+    for act in root.iter("position"):
+        kp = gains.get(str(act.get("joint")), 0.0)
+        if kp > float(act.get("kp", "0")):
+            act.set("kp", f"{kp:.3g}")
     height = _floor_and_key(root, robot, ground, c)
     root.insert(1, ET.Comment(
         f" ground export: {n} contact geoms (class contact), floor at z = 0, keyframe 0 standing at base height "
@@ -206,7 +224,7 @@ def load_ground(robot_or_name: "Robot | str", *, ground: GroundModel | None = No
     out = GroundMechanism.__new__(GroundMechanism)
     out.__dict__.update(mech.__dict__)
     out.ground = ground
-    out.height = out.ground.standing_height(robot.q0)
+    out.height = out.ground.standing_height(ground.pose(robot.q0))
     return out
 
 

@@ -116,7 +116,8 @@ class _Runner:
         tau = self.mech.ground.static_torques(self.mech.q(d.qpos))
         if tau is not None:  # a fixed offset holding the weight (feedforward) instead of the integral term
             vadr = m.jnt_dofadr[m.actuator_trnid[:, 0]]
-            self.feedforward = tau[vadr] / m.actuator_gainprm[:, 0]
+            gain = m.actuator_gainprm[:, 0]  # 0 for a joint carrying no inertia (romeo's fingers): no offset
+            self.feedforward = np.divide(tau[vadr], gain, out=np.zeros(m.nu), where=gain > 0.0)
             self.integrate = False
         self.mujoco.mj_forward(m, d)
 
@@ -233,10 +234,10 @@ def _key(mech: GroundMechanism, pose: str | None) -> tuple[int, np.ndarray]:
     mujoco = _mujoco()
     robot = mech.robot
     pose = robot.spec.reference_pose if pose is None else pose
-    key = mujoco.mj_name2id(mech.model, mujoco.mjtObj.mjOBJ_KEY, pose)
+    key = mujoco.mj_name2id(mech.model, mujoco.mjtObj.mjOBJ_KEY, pose) if pose else 0  # g1: no SRDF, key 0 is q0
     if key < 0:
         raise InvalidParameterError(f"{robot.name} has no pose {pose!r}; poses: {', '.join(robot.poses)}")
-    return key, {**robot.poses, robot.spec.reference_pose: robot.q0}[pose]
+    return key, mech.ground.pose({**robot.poses, robot.spec.reference_pose: robot.q0}[pose])
 
 
 def _stand(run: _Runner, pose: str | None, seconds: float, drop: float) -> list["CheckResult"]:
@@ -303,12 +304,9 @@ def _squat(run: _Runner, pose: str | None, seconds: float, depth: float) -> list
         return 0.5 * depth * (1.0 - np.cos(2.0 * np.pi * min(1.0, (t - t0) / seconds)))
 
     ticks = np.linspace(0.0, seconds, 201)  # legkin's IK every 10 ms of a 2 s squat, interpolated between
-    ctrl = np.array([mech.ctrl(mech.ground.hold_rolling(q, ground + np.array([0.0, 0.0, lowered(t0 + t)])))
-                     for t in ticks])
+    target = _interpolator(t0, ticks, [mech.ctrl(mech.ground.hold_rolling(
+        q, ground + np.array([0.0, 0.0, lowered(t0 + t)]))) for t in ticks])
     run.track_slip(run.predicted())
-
-    def target(t: float) -> np.ndarray:
-        return np.array([np.interp(t - t0, ticks, c) for c in ctrl.T])
 
     for _ in range(20):
         run.run(seconds / 20, target)
@@ -344,6 +342,8 @@ def run_scenario(model: "str | GroundMechanism", scenario: str, *, seconds: floa
     if scenario not in SCENARIOS:
         raise InvalidParameterError(f"unknown scenario {scenario!r}; scenarios: {', '.join(SCENARIOS)}")
     mech = load_ground(model, **options) if isinstance(model, str) else model
+    if scenario == "squat" and mech.ground.no_squat:
+        raise InvalidParameterError(f"{mech.robot.name} does not squat: {mech.ground.no_squat}")
     if scenario == "squat" and pose is None:
         pose = mech.ground.squat_pose
     run = _Runner(mech, fps)
@@ -368,7 +368,8 @@ def ground_rows(name: str) -> list["CheckResult"]:
     mech = load_ground(load(name, floating=True))
     rows: list["CheckResult"] = []
     for scenario in SCENARIOS:
-        if scenario == "roll" and mech.ground.rolling_radius is None:
+        no_wheels = scenario == "roll" and mech.ground.rolling_radius is None
+        if no_wheels or (scenario == "squat" and mech.ground.no_squat):
             continue
         rows += run_scenario(mech, scenario).rows
     return rows

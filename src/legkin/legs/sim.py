@@ -4,6 +4,7 @@ humanoids, :func:`sole_spheres`); legkin's leg FK for where they touch the groun
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -29,8 +30,6 @@ DEFAULT_SOLE = (-0.1095, 0.0987, -0.0620, 0.0621, -0.107)
 #: The robots of :mod:`legkin.legs` without a ground model, and why.
 UNSUPPORTED = {
     "bolt": "a biped on two point feet: it cannot stand without a balance controller",
-    "icub": "its foot meshes (.dae) load turned a quarter turn (their sole 0.06 m long and 0.157 m wide), so no sole "
-            "is measured from them; on that one it falls backwards",
     "simple_humanoid": "its SRDF half_sitting lies outside its URDF ankle-pitch limits (-0.419 rad, range [0, 2.618]): "
                        "MuJoCo's joint limit throws it off its feet, and no flat-foot squat stays in the range",
 }
@@ -60,13 +59,26 @@ def supports(name: str) -> bool:
     return name in ERD_ALL and name not in UNSUPPORTED
 
 
+def _y_up(path: str) -> bool:
+    """Whether a mesh is a Collada file declaring ``<up_axis>Y_UP</up_axis>`` (icub's)."""
+    file = Path(path)
+    if file.suffix.lower() != ".dae" or not file.is_file():
+        return False
+    with file.open("rb") as f:
+        return b"<up_axis>Y_UP</up_axis>" in f.read(4096)
+
+
 def _mesh_points(robot: Any, joint: int, frame: Any) -> np.ndarray | None:
     """The vertices (n, 3) of the first mesh on ``joint`` (collision shapes first, then visuals) in ``frame``'s
-    coordinates (m), or None."""
+    coordinates (m), or None. A Y-up Collada mesh is turned back by -90 deg about x: Pinocchio's loader (assimp)
+    turns it Z-up, where the URDF's origin expects the file's own axes (icub's feet: loaded, their sole is
+    0.06 m long and 0.157 m wide, turned back 0.157 m long, and the centre of mass of half_sitting is above it)."""
     for geometry in (robot.collision_model, robot.visual_model):
         for g in geometry.geometryObjects:
             if g.parentJoint == joint and hasattr(g.geometry, "vertices"):
                 pts = np.asarray(g.geometry.vertices()) * np.asarray(g.meshScale).ravel()
+                if _y_up(g.meshPath):
+                    pts = pts[:, [0, 2, 1]] * np.array([1.0, 1.0, -1.0])  # (x, y, z) -> (x, z, -y)
                 pts = pts @ g.placement.rotation.T + g.placement.translation  # in the joint frame
                 return (pts - frame.placement.translation) @ frame.placement.rotation
     return None

@@ -268,3 +268,20 @@ def test_ascii_stl_is_left_out():
     assert _ascii_stl(str(root / "meshes" / "box.stl"))
     mesh = legkin.load("talos").collision_model.geometryObjects[0].meshPath
     assert mesh.lower().endswith(".stl") and not _ascii_stl(mesh)
+
+
+# ------------------------------------------------------------------------------------ the hybrid leg: a fixed leg
+def test_hybrid_leg_presses_its_foot_on_the_floor():
+    """A fixed mechanism: its foot sphere alone on a floor put under it, the IK target 5 mm into the floor; the
+    floating scenarios are refused. Without the contact the foot goes through and the row fails."""
+    mech = load_ground("hybrid_leg")
+    assert not mech.robot.floating and mech.ground.fixed_base
+    names = [mech.model.geom(i).name for i in range(mech.model.ngeom) if mech.model.geom_contype[i]]
+    assert names == ["foot_contact"]
+    assert mech.model.geom("floor").pos[2] == pytest.approx(-0.041, abs=1e-12)  # FCS z - 0.018 at q0
+    _passed(run_scenario(mech, "press", seconds=0.5))
+    with pytest.raises(legkin.errors.InvalidParameterError, match="for a floating robot"):
+        run_scenario(mech, "stand")
+    mech.model.geom("foot_contact").contype[0] = 0
+    res = run_scenario(mech, "press", seconds=0.5)
+    assert not res.rows[0].passed

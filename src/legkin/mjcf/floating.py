@@ -95,11 +95,12 @@ def _visual_robot(robot: "Robot") -> "Robot":
 
 
 def _floating(robot_or_name: "Robot | str") -> "Robot":
-    """The robot, loaded floating when given by name."""
+    """The robot, loaded floating when given by name (fixed when its registry spec is: the hybrid leg)."""
     if isinstance(robot_or_name, str):
+        from .._registry import get_spec
         from ..robot import load
 
-        return load(robot_or_name, floating=True)
+        return load(robot_or_name, floating=get_spec(robot_or_name).floating)
     return _robot(robot_or_name, {})
 
 
@@ -139,7 +140,9 @@ def _add_geoms(root: ET.Element, robot: "Robot", ground: GroundModel) -> int:
 
 
 def _floor_and_key(root: ET.Element, robot: "Robot", ground: GroundModel, c: Mapping[str, Any]) -> float:
-    """The floor at z = 0 made to collide; keyframe 0 standing on it; returns the standing height (m)."""
+    """The floor at z = 0 made to collide, keyframe 0 standing on it; returns the standing height (m). A fixed
+    base: the floor at the lowest predicted contact of the reference pose instead, the keyframes as they are;
+    returns the floor's height (m)."""
     asset = root.find("asset")
     assert asset is not None
     ET.SubElement(asset, "texture", name="sky", type="skybox", builtin="gradient", rgb1="0.75 0.82 0.9",
@@ -148,6 +151,9 @@ def _floor_and_key(root: ET.Element, robot: "Robot", ground: GroundModel, c: Map
     floor.attrib.update(pos="0 0 0", contype="0", conaffinity="1", condim=str(c["condim"]),
                         friction=_vec(c["friction"]), solref=_vec(c["contact_solref"]),
                         solimp=_vec(c["contact_solimp"]))
+    if ground.fixed_base:
+        floor.set("pos", _vec([0.0, 0.0, -ground.standing_height(robot.q0)]))
+        return -ground.standing_height(robot.q0)
     poses = {**robot.poses, robot.spec.reference_pose: robot.q0}
     joints = [None] + [_joint(robot.model, i) for i in range(1, robot.model.njoints)]
     for key in root.iter("key"):
@@ -190,10 +196,10 @@ def to_ground_mjcf(robot_or_name: "Robot | str", *, ground: GroundModel | None =
         if kp > float(act.get("kp", "0")):
             act.set("kp", f"{kp:.3g}")
     height = _floor_and_key(root, robot, ground, c)
-    root.insert(1, ET.Comment(
-        f" ground export: {n} contact geoms (class contact), floor at z = 0, keyframe 0 standing at base height "
-        f"{height:.6f} m (legkin's prediction) "
-    ))
+    where = (f"fixed base, floor at z = {height:.6f} m under the lowest contact (legkin's prediction)"
+             if ground.fixed_base else
+             f"floor at z = 0, keyframe 0 standing at base height {height:.6f} m (legkin's prediction)")
+    root.insert(1, ET.Comment(f" ground export: {n} contact geoms (class contact), {where} "))
     ET.indent(root, space="  ")
     return ET.tostring(root, encoding="unicode") + "\n"
 

@@ -65,6 +65,8 @@ class GroundModel(ABC):
         rolls_sideways: whether a contact rolls about the base x axis too (a sphere) or only about y (a tyre).
         timestep: the export's time step (s) for this mechanism, or None (the ground default, 1 ms).
         no_squat: why the ``squat`` scenario cannot run on this robot, or None.
+        fixed_base: a fixed mechanism (its registry spec not floating: the hybrid leg), whose floor is put under its
+            contacts and whose scenario is ``press``.
     """
 
     robot: "Robot"
@@ -77,6 +79,7 @@ class GroundModel(ABC):
     rolls_sideways: bool = True
     timestep: float | None = None
     no_squat: str | None = None
+    fixed_base: bool = False
 
     @abstractmethod
     def geoms(self) -> list[ContactGeom]:
@@ -332,10 +335,12 @@ def ground_model(robot: "Robot") -> GroundModel:
     """The :class:`GroundModel` of a floating robot, from its package's ``sim`` module.
 
     Raises:
-        InvalidParameterError: the robot is not floating, or its package has no ground model.
+        InvalidParameterError: the robot is not floating (a fixed mechanism: is floating), or its package has no
+            ground model.
     """
-    if not robot.floating:
-        raise InvalidParameterError(f"{robot.name}: the ground simulation needs legkin.load(name, floating=True)")
+    if robot.floating != robot.spec.floating:  # a fixed mechanism (the hybrid leg) presses on the floor fixed
+        raise InvalidParameterError(
+            f"{robot.name}: the ground simulation needs legkin.load(name, floating={robot.spec.floating})")
     if not has_ground_model(robot):
         raise InvalidParameterError(f"{robot.name} has no ground model ({robot.spec.package}.sim)")
     module = importlib.import_module(f"{robot.spec.package}.sim")

@@ -36,7 +36,7 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["SCENARIOS", "ScenarioResult", "run_scenario", "TOL_HEIGHT", "TOL_CONTACT", "TOL_PENETRATION",
            "TOL_ROLL", "TOL_SLIP"]
 
-SCENARIOS = ("stand", "roll", "squat")
+SCENARIOS = ("stand", "roll", "squat", "press")
 TOL_HEIGHT = 2e-3
 TOL_CONTACT = 2e-3
 TOL_PENETRATION = 1e-3
@@ -212,6 +212,8 @@ class _Runner:
         """legkin's contact points at MuJoCo's configuration, in the world (MuJoCo's base pose)."""
         d = self.mech.data
         q = self.mech.q(d.qpos)
+        if self.mech.ground.fixed_base:  # the base frame is the world's
+            return self.mech.ground.contacts(q)
         rot = d.xmat[self.mech.body_ids[1]].reshape(3, 3)
         return self.mech.ground.contacts(q) @ rot.T + d.qpos[:3]
 
@@ -321,6 +323,27 @@ def _squat(run: _Runner, pose: str | None, seconds: float, depth: float) -> list
     ]
 
 
+def _press(run: _Runner, pose: str | None, seconds: float, depth: float) -> list["CheckResult"]:
+    """A fixed mechanism's foot on the floor under it (the reference pose), its IK target moved ``depth`` below the
+    floor over 0.2 s and held: where it presses against legkin's contact, and the penetration."""
+    from .._checkkit import compare
+
+    mech = run.mech
+    key, q = _key(mech, pose)
+    run.start(key, 0.0)
+    run.integrate = False  # an integral term would wind up against the floor
+    run.run(_SETTLE)
+    pressed = mech.ctrl(mech.ground.hold(q, mech.ground.contacts(q) - np.array([0.0, 0.0, depth])))
+    run.run(seconds, _interpolator(run.time, np.array([0.0, 0.2]), [mech.ctrl(q), pressed]))
+    pred = run.predicted()
+    name = mech.robot.name
+    return [
+        compare(f"{name} press: foot commanded {depth:g} m into the floor, centre of pressure - legkin's contact at "
+                "MuJoCo's motor angles (m)", np.linalg.norm(run.pressure(pred) - pred, axis=1), TOL_CONTACT),
+        compare(f"{name} press: deepest penetration over the run (m)", np.array([run.penetration]), TOL_PENETRATION),
+    ]
+
+
 def run_scenario(model: "str | GroundMechanism", scenario: str, *, seconds: float = 2.0, pose: str | None = None,
                  fps: float | None = None, **options: Any) -> ScenarioResult:
     """Run one ground scenario (module docstring) and measure it.
@@ -342,6 +365,9 @@ def run_scenario(model: "str | GroundMechanism", scenario: str, *, seconds: floa
     if scenario not in SCENARIOS:
         raise InvalidParameterError(f"unknown scenario {scenario!r}; scenarios: {', '.join(SCENARIOS)}")
     mech = load_ground(model, **options) if isinstance(model, str) else model
+    if (scenario == "press") != mech.ground.fixed_base:
+        raise InvalidParameterError(f"{mech.robot.name}: scenario {scenario!r} is for "
+                                    f"{'a fixed mechanism' if scenario == 'press' else 'a floating robot'}")
     if scenario == "squat" and mech.ground.no_squat:
         raise InvalidParameterError(f"{mech.robot.name} does not squat: {mech.ground.no_squat}")
     if scenario == "squat" and pose is None:
@@ -351,6 +377,8 @@ def run_scenario(model: "str | GroundMechanism", scenario: str, *, seconds: floa
         rows = _stand(run, pose, seconds, 0.01)
     elif scenario == "roll":
         rows = _roll(run, pose, seconds, 2.0 * np.pi)
+    elif scenario == "press":
+        rows = _press(run, pose, seconds, 0.005)
     else:
         rows = _squat(run, pose, seconds, 0.05)
     return ScenarioResult(scenario, mech.robot.name, rows, run.time, run.wall, run.time / max(run.wall, 1e-9),
@@ -359,15 +387,17 @@ def run_scenario(model: "str | GroundMechanism", scenario: str, *, seconds: floa
 
 def ground_rows(name: str) -> list["CheckResult"]:
     """The ``legkin check`` rows of the ground scenarios of ``name``: ``stand``, ``roll`` (wheels) and ``squat``
-    (none for a model without a ground model)."""
-    from ..robot import load
+    (unless the ground model says why not); ``press`` for a fixed mechanism (the hybrid leg); none for a model
+    without a ground model."""
     from .ground import has_ground_model
 
     if not has_ground_model(name):
         return []
-    mech = load_ground(load(name, floating=True))
+    mech = load_ground(name)
+    if mech.ground.fixed_base:
+        return run_scenario(mech, "press").rows
     rows: list["CheckResult"] = []
-    for scenario in SCENARIOS:
+    for scenario in SCENARIOS[:3]:
         no_wheels = scenario == "roll" and mech.ground.rolling_radius is None
         if no_wheels or (scenario == "squat" and mech.ground.no_squat):
             continue

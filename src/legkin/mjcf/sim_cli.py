@@ -25,7 +25,8 @@ _FPS = 30.0
 
 def render_frames(mech: GroundMechanism, frames: Sequence[np.ndarray], *, width: int = 640, height: int = 480,
                   azimuth: float = 135.0, elevation: float = -15.0, distance: float = 1.6) -> list[np.ndarray]:
-    """RGB images (height, width, 3) of ``qpos`` frames, the camera following the base (``MUJOCO_GL=egl``)."""
+    """RGB images (height, width, 3) of ``qpos`` frames, the camera following the base, half way down to the floor
+    (a fixed mechanism: at its base) (``MUJOCO_GL=egl``)."""
     mujoco = _mujoco()
     try:
         renderer = mujoco.Renderer(mech.model, height, width)
@@ -38,7 +39,8 @@ def render_frames(mech: GroundMechanism, frames: Sequence[np.ndarray], *, width:
         for qpos in frames:
             mech.data.qpos[:] = qpos
             mujoco.mj_forward(mech.model, mech.data)
-            cam.lookat[:] = [qpos[0], qpos[1], 0.5 * qpos[2]]
+            base = mech.data.xpos[mech.body_ids[1]]  # a fixed mechanism's qpos starts with joint angles
+            cam.lookat[:] = [base[0], base[1], 0.5 * base[2]] if not mech.ground.fixed_base else base
             renderer.update_scene(mech.data, camera=cam)
             out.append(renderer.render().copy())
     finally:

@@ -275,7 +275,7 @@ class FootGround(GroundModel):
         """:data:`STIFFNESS` ``m g h`` for every joint of a leg on a flat foot: ``m`` the robot's mass, ``h`` its
         centre of mass's height above the soles in the reference pose. The robot standing on its soles is an
         inverted pendulum that an ankle softer than ``m g h`` lets topple (g1's 98.7 N m / rad from its foot's
-        inertia, for m g h = 250 N m / rad: it fell forwards 0.04 rad in 2 s)."""
+        inertia, for m g h = 230 N m / rad: it fell forwards 0.04 rad in 2 s)."""
         model, q = self.robot.model, self.pose(self.robot.q0)
         data = model.createData()
         height = float(pin.centerOfMass(model, data, q)[2]) + self.standing_height(q)
@@ -332,11 +332,11 @@ def has_ground_model(robot: "Robot | str") -> bool:
 
 
 def ground_model(robot: "Robot") -> GroundModel:
-    """The :class:`GroundModel` of a floating robot, from its package's ``sim`` module.
+    """The :class:`GroundModel` of a floating robot (or a fixed mechanism), from its package's ``sim`` module.
 
     Raises:
-        InvalidParameterError: the robot is not floating (a fixed mechanism: is floating), or its package has no
-            ground model.
+        InvalidParameterError: the robot is not loaded as its registry spec says (floating; fixed for a fixed
+            mechanism, the hybrid leg), or its package has no ground model.
     """
     if robot.floating != robot.spec.floating:  # a fixed mechanism (the hybrid leg) presses on the floor fixed
         raise InvalidParameterError(

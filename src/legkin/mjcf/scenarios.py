@@ -1,4 +1,5 @@
-"""Ground scenarios of a floating mechanism in MuJoCo, measured against legkin (:func:`run_scenario`).
+"""Ground scenarios of a floating mechanism (or a fixed one pressing) in MuJoCo, measured against legkin
+(:func:`run_scenario`).
 
 * ``stand``: dropped from ``drop`` (1 cm) above its standing height in a pose, after ``seconds`` (2 s): the base
   height against legkin's prediction (:meth:`~legkin.mjcf.ground.GroundModel.standing_height`), each centre of
@@ -8,6 +9,9 @@
 * ``squat``: after 0.5 s standing, the base lowered by ``depth`` (5 cm) and raised back (a cosine), the joints
   from legkin's IK holding the contacts on their ground points (:meth:`~legkin.mjcf.ground.GroundModel.hold`);
   the slip (largest horizontal drift of a centre of pressure) and the base height against the commanded one.
+* ``press`` (a fixed mechanism only, :attr:`~legkin.mjcf.ground.GroundModel.fixed_base`: the hybrid leg): the
+  foot on the floor under it, its IK target moved 5 mm into the floor; the centre of pressure against legkin's
+  contact at MuJoCo's configuration, and the deepest penetration (no feedforward, no integral term).
 
 The controller is the export's position actuators with an offset holding the weight: where the ground model
 knows the static joint torques (:meth:`~legkin.mjcf.ground.GroundModel.static_torques`: legs), ``tau / kp`` is

@@ -196,7 +196,8 @@ def test_models_without_a_ground_model_have_no_ground_rows(name):
 # ---------------------------------------------------------------------------------------- humanoids: flat feet
 def test_sole_spheres_from_the_foot_shapes(monkeypatch):
     """g1: its URDF's four 5 mm spheres; talos: four spheres inside its collision mesh's sole (0.208 x 0.124 m),
-    bottoms on its lowest vertex; icub: its Y-up Collada foot turned back (long along x), sideways without."""
+    bottoms on its lowest vertex; simple_humanoid (no foot shape): DEFAULT_SOLE; icub: its Y-up Collada foot turned
+    back (long along x), sideways without."""
     import legkin.legs.sim as sim
 
     g1 = legkin.load("g1", floating=True)
@@ -208,6 +209,11 @@ def test_sole_spheres_from_the_foot_shapes(monkeypatch):
     size = c[:, :2].max(axis=0) - c[:, :2].min(axis=0) + 2 * sim.SOLE_RADIUS
     assert size == pytest.approx([0.208, 0.124], abs=1e-3)
     assert np.ptp(c[:, 2]) == 0.0 and abs(c[0, 2] - sim.SOLE_RADIUS) < 1e-3  # the sole frame is on the sole
+    simple = legkin.load("simple_humanoid", floating=True)  # no foot shape: DEFAULT_SOLE
+    c = np.array([c for c, _ in sim.sole_spheres(simple, "l_ankle")])
+    x0, x1, y0, y1, z = sim.DEFAULT_SOLE
+    np.testing.assert_allclose(c.min(axis=0), [x0 + 0.005, y0 + 0.005, z + 0.005], atol=1e-15)
+    np.testing.assert_allclose(c.max(axis=0), [x1 - 0.005, y1 - 0.005, z + 0.005], atol=1e-15)
     icub = legkin.load("icub", floating=True)
     for turned in (True, False):
         monkeypatch.setattr(sim, "_y_up", lambda path, turned=turned: turned and str(path).endswith(".dae"))

@@ -182,12 +182,112 @@ def test_sim_video(tmp_path):
     assert out.stat().st_size > 1000 and out.read_bytes()[4:8] == b"ftyp"
 
 
-@pytest.mark.parametrize("name", ["talos", "g1", "bolt", "tripod"])
+@pytest.mark.parametrize("name", ["bolt", "simple_humanoid", "tripod"])
 def test_models_without_a_ground_model_have_no_ground_rows(name):
-    """The bipeds of legkin.legs (flat feet, or bolt's point feet) and the fixed mechanisms have no ground model
-    yet: `legkin check` gives them no ground rows instead of failing."""
+    """bolt (two point feet), simple_humanoid (its SRDF pose outside its URDF limits) and the fixed mechanisms have
+    no ground model: `legkin check` gives them no ground rows instead of failing."""
     from legkin.mjcf.ground import has_ground_model
     from legkin.mjcf.scenarios import ground_rows
 
     assert not has_ground_model(name)
     assert ground_rows(name) == []
+
+
+# ---------------------------------------------------------------------------------------- humanoids: flat feet
+def test_sole_spheres_from_the_foot_shapes(monkeypatch):
+    """g1: its URDF's four 5 mm spheres; talos: four spheres inside its collision mesh's sole (0.208 x 0.124 m),
+    bottoms on its lowest vertex; simple_humanoid (no foot shape): DEFAULT_SOLE; icub: its Y-up Collada foot turned
+    back (long along x), sideways without."""
+    import legkin.legs.sim as sim
+
+    g1 = legkin.load("g1", floating=True)
+    spheres = sim.sole_spheres(g1, "left_ankle_roll_link")
+    assert len(spheres) == 4 and all(r == 0.005 for _, r in spheres)
+    assert {round(c[0], 9) for c, _ in spheres} == {-0.05, 0.12}
+    talos = legkin.load("talos", floating=True)
+    c = np.array([c for c, _ in sim.sole_spheres(talos, "left_sole_link")])
+    size = c[:, :2].max(axis=0) - c[:, :2].min(axis=0) + 2 * sim.SOLE_RADIUS
+    assert size == pytest.approx([0.208, 0.124], abs=1e-3)
+    assert np.ptp(c[:, 2]) == 0.0 and abs(c[0, 2] - sim.SOLE_RADIUS) < 1e-3  # the sole frame is on the sole
+    simple = legkin.load("simple_humanoid", floating=True)  # no foot shape: DEFAULT_SOLE
+    c = np.array([c for c, _ in sim.sole_spheres(simple, "l_ankle")])
+    x0, x1, y0, y1, z = sim.DEFAULT_SOLE
+    np.testing.assert_allclose(c.min(axis=0), [x0 + 0.005, y0 + 0.005, z + 0.005], atol=1e-15)
+    np.testing.assert_allclose(c.max(axis=0), [x1 - 0.005, y1 - 0.005, z + 0.005], atol=1e-15)
+    icub = legkin.load("icub", floating=True)
+    for turned in (True, False):
+        monkeypatch.setattr(sim, "_y_up", lambda path, turned=turned: turned and str(path).endswith(".dae"))
+        c = np.array([c for c, _ in sim.sole_spheres(icub, "l_sole")])
+        length, width = c[:, :2].max(axis=0) - c[:, :2].min(axis=0)
+        assert (length > 2 * width) == turned
+
+
+def test_flat_feet_are_levelled():
+    """icub's half_sitting pitches its soles 0.063 rad (9 mm from toe to heel): the ground model's pose levels them
+    by Leg6.ik, the joints other than the legs' untouched."""
+    robot = legkin.load("icub", floating=True)
+    ground = ground_model(robot)
+    before, q = ground.contacts(robot.q0)[:, 2], ground.pose(robot.q0)
+    after = ground.contacts(q)[:, 2]
+    for leg in ground.legs:
+        rows = [k for k, f in enumerate(ground.feet) if f.leg == leg]
+        assert np.ptp(before[rows]) > 5e-3 and np.ptp(after[rows]) < 1e-9
+    legs = sorted({i for f in ground.feet for i in f.idx_q})
+    others = np.setdiff1d(np.arange(7, robot.model.nq), legs)
+    np.testing.assert_array_equal(q[others], robot.q0[others])
+
+
+@pytest.mark.parametrize("name", ["talos", "icub", "alexander"])
+def test_humanoids_stand(name):
+    _passed(run_scenario(name, "stand", seconds=1.0))
+
+
+def test_humanoids_squat():
+    """talos from half_sitting; g1 (no SRDF: straight knees) from 2 cm below its zero pose."""
+    _passed(run_scenario("talos", "squat", seconds=1.0))
+    _passed(run_scenario("g1", "squat", seconds=1.0))
+
+
+def test_romeo_has_no_squat():
+    mech = load_ground("romeo")
+    assert mech.ground.no_squat and "joint limits" in mech.ground.no_squat
+    with pytest.raises(legkin.errors.InvalidParameterError, match="romeo does not squat"):
+        run_scenario(mech, "squat")
+
+
+def test_without_the_stiffness_floor_g1_topples(monkeypatch):
+    """The legs' gains >= 2 m g h matter: with the export's own (g1's ankle 98.7 N m / rad, from its foot's inertia)
+    g1 pitches forwards and is mm low after 2 s; with them it stands (test_humanoids_squat)."""
+    from legkin.mjcf.ground import FootGround
+
+    monkeypatch.setattr(FootGround, "stiffness", lambda self: {})
+    res = run_scenario("g1", "stand")
+    assert not res.rows[0].passed and res.rows[0].max_error > 2e-3
+
+
+def test_ascii_stl_is_left_out():
+    """simple_humanoid's box.stl is ASCII, which MuJoCo does not read; talos's binary STL is kept."""
+    from legkin.legs.erd import erd_files
+    from legkin.mjcf.floating import _ascii_stl
+
+    root = erd_files("simple_humanoid")[0].parents[1]
+    assert _ascii_stl(str(root / "meshes" / "box.stl"))
+    mesh = legkin.load("talos").collision_model.geometryObjects[0].meshPath
+    assert mesh.lower().endswith(".stl") and not _ascii_stl(mesh)
+
+
+# ------------------------------------------------------------------------------------ the hybrid leg: a fixed leg
+def test_hybrid_leg_presses_its_foot_on_the_floor():
+    """A fixed mechanism: its foot sphere alone on a floor put under it, the IK target 5 mm into the floor; the
+    floating scenarios are refused. Without the contact the foot goes through and the row fails."""
+    mech = load_ground("hybrid_leg")
+    assert not mech.robot.floating and mech.ground.fixed_base
+    names = [mech.model.geom(i).name for i in range(mech.model.ngeom) if mech.model.geom_contype[i]]
+    assert names == ["foot_contact"]
+    assert mech.model.geom("floor").pos[2] == pytest.approx(-0.041, abs=1e-12)  # FCS z - 0.018 at q0
+    _passed(run_scenario(mech, "press", seconds=0.5))
+    with pytest.raises(legkin.errors.InvalidParameterError, match="for a floating robot"):
+        run_scenario(mech, "stand")
+    mech.model.geom("foot_contact").contype[0] = 0
+    res = run_scenario(mech, "press", seconds=0.5)
+    assert not res.rows[0].passed

@@ -364,7 +364,7 @@ def build_parser() -> argparse.ArgumentParser:
     add_export_command(sub)  # legkin mjcf MODEL [-o FILE] [--floating] [--timestep S] [--png FILE]
     from .mjcf.sim_cli import add_sim_command
 
-    add_sim_command(sub)  # legkin sim MODEL --scenario stand|roll|squat [--video PATH | --html PATH]
+    add_sim_command(sub)  # legkin sim MODEL --scenario stand|roll|squat|press [--video PATH | --html PATH]
     from .study.cli import add_study_command
 
     add_study_command(sub, output_file, positive_int, nonnegative_int, _show_progress)  # legkin study (docs/study.md)

@@ -25,7 +25,8 @@ def add_export_command(subparsers: "argparse._SubParsersAction") -> "argparse.Ar
     p.add_argument("model")
     p.add_argument("-o", "--output", metavar="PATH", help="write the MJCF to PATH (default: stdout)")
     p.add_argument("--floating", action="store_true",
-                   help="a free base standing on a floor, with contacts (models with a ground model: docs/mujoco.md)")
+                   help="a free base standing on a floor, with contacts (models with a ground model: docs/mujoco.md; "
+                        "the hybrid leg, a fixed mechanism: its base fixed, a floor under its foot)")
     p.add_argument(
         "--timestep", type=float, default=None,
         help=f"simulation step, s (default {DEFAULTS['timestep']:g}; {GROUND_DEFAULTS['timestep']:g} with --floating)",
@@ -39,9 +40,10 @@ def run_export(args: "argparse.Namespace") -> int:
     """Run ``legkin mjcf``: write the MJCF (compiled once by MuJoCo first, when it is installed); with
     ``--floating`` and a model that has a ground model, the ground export
     (:func:`~legkin.mjcf.floating.to_ground_mjcf`)."""
+    from .._registry import get_spec
     from ..robot import load
 
-    robot = load(args.model, floating=bool(args.floating))
+    robot = load(args.model, floating=bool(args.floating) and get_spec(args.model).floating)
     step = {} if args.timestep is None else {"timestep": args.timestep}
     if args.floating and has_ground_model(robot):
         xml = to_ground_mjcf(robot, **step)  # contacts, a floor that collides, keyframes standing on it

@@ -14,7 +14,6 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Mapping
 
-import numpy as np
 import pinocchio as pin
 
 from .._batch import check_number
@@ -22,7 +21,7 @@ from ..errors import InvalidParameterError
 from ._base import _MESH_EXTENSIONS, DEFAULTS, _options, _robot, _set_pose, _vec
 from .ground import GroundModel, ground_model
 from .mechanism import MujocoMechanism, load_mujoco
-from .writer import _build_xml, _geom
+from .writer import _build_xml, _geom, _joint, _qpos
 
 if TYPE_CHECKING:  # pragma: no cover
     from ..robot import Robot
@@ -57,10 +56,21 @@ def _split(options: Mapping[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
     return o, c
 
 
+def _ascii_stl(path: str) -> bool:
+    """Whether an ``.stl`` file is ASCII (its size is not a binary STL's 84 + 50 x its triangle count), which
+    MuJoCo does not read (simple_humanoid's ``box.stl``)."""
+    file = Path(path)
+    if file.suffix.lower() != ".stl" or not file.is_file():
+        return False
+    with file.open("rb") as f:
+        head = f.read(84)
+    return len(head) < 84 or file.stat().st_size != 84 + 50 * int.from_bytes(head[80:84], "little")
+
+
 def _unreadable(g: Any) -> bool:
-    """Whether a geometry object is a mesh in a format MuJoCo does not read (``.dae``)."""
-    return bool(g.meshPath) and type(g.geometry).__name__.startswith("BVH") and not g.meshPath.lower().endswith(
-        _MESH_EXTENSIONS)
+    """Whether a geometry object is a mesh MuJoCo does not read (``.dae``, ASCII ``.stl``)."""
+    return bool(g.meshPath) and type(g.geometry).__name__.startswith(("BVH", "Convex")) and (
+        not g.meshPath.lower().endswith(_MESH_EXTENSIONS) or _ascii_stl(g.meshPath))
 
 
 def _readable(model: pin.GeometryModel) -> pin.GeometryModel:
@@ -85,11 +95,12 @@ def _visual_robot(robot: "Robot") -> "Robot":
 
 
 def _floating(robot_or_name: "Robot | str") -> "Robot":
-    """The robot, loaded floating when given by name."""
+    """The robot, loaded floating when given by name (fixed when its registry spec is: the hybrid leg)."""
     if isinstance(robot_or_name, str):
+        from .._registry import get_spec
         from ..robot import load
 
-        return load(robot_or_name, floating=True)
+        return load(robot_or_name, floating=get_spec(robot_or_name).floating)
     return _robot(robot_or_name, {})
 
 
@@ -129,7 +140,9 @@ def _add_geoms(root: ET.Element, robot: "Robot", ground: GroundModel) -> int:
 
 
 def _floor_and_key(root: ET.Element, robot: "Robot", ground: GroundModel, c: Mapping[str, Any]) -> float:
-    """The floor at z = 0 made to collide; keyframe 0 standing on it; returns the standing height (m)."""
+    """The floor at z = 0 made to collide, keyframe 0 standing on it; returns the standing height (m). A fixed
+    base: the floor at the lowest predicted contact of the reference pose instead, the keyframes as they are;
+    returns the floor's height (m)."""
     asset = root.find("asset")
     assert asset is not None
     ET.SubElement(asset, "texture", name="sky", type="skybox", builtin="gradient", rgb1="0.75 0.82 0.9",
@@ -138,12 +151,18 @@ def _floor_and_key(root: ET.Element, robot: "Robot", ground: GroundModel, c: Map
     floor.attrib.update(pos="0 0 0", contype="0", conaffinity="1", condim=str(c["condim"]),
                         friction=_vec(c["friction"]), solref=_vec(c["contact_solref"]),
                         solimp=_vec(c["contact_solimp"]))
+    if ground.fixed_base:
+        floor.set("pos", _vec([0.0, 0.0, -ground.standing_height(robot.q0)]))
+        return -ground.standing_height(robot.q0)
     poses = {**robot.poses, robot.spec.reference_pose: robot.q0}
+    joints = [None] + [_joint(robot.model, i) for i in range(1, robot.model.njoints)]
     for key in root.iter("key"):
-        qpos = np.array(key.get("qpos", "").split(), dtype=float)
-        qpos[2] = ground.standing_height(poses[key.get("name")])
+        q = ground.pose(poses[key.get("name")])
+        qpos = _qpos(joints, q)
+        qpos[2] = ground.standing_height(q)
         key.set("qpos", _vec(qpos))
-    return ground.standing_height(robot.q0)
+        key.set("ctrl", _vec(q[robot.idx_q(a)] for a in robot.actuated_joints))
+    return ground.standing_height(ground.pose(robot.q0))
 
 
 def to_ground_mjcf(robot_or_name: "Robot | str", *, ground: GroundModel | None = None, **options: Any) -> str:
@@ -166,16 +185,21 @@ def to_ground_mjcf(robot_or_name: "Robot | str", *, ground: GroundModel | None =
         InvalidParameterError: an unknown or bad option, a model without a ground model.
     """
     robot = _floating(robot_or_name)
-    o, c = _split(options)
     ground = ground_model(robot) if ground is None else ground
+    o, c = _split({"timestep": ground.timestep or GROUND_DEFAULTS["timestep"], **options})
     root = ET.fromstring(_build_xml(_visual_robot(robot), {**o, "floor": True}))
     _contact_class(root, c)
     n = _add_geoms(root, robot, ground)
+    gains = {} if "kp" in options else ground.stiffness()  # the ground model's smallest gains (flat feet)
+    for act in root.iter("position"):
+        kp = gains.get(str(act.get("joint")), 0.0)
+        if kp > float(act.get("kp", "0")):
+            act.set("kp", f"{kp:.3g}")
     height = _floor_and_key(root, robot, ground, c)
-    root.insert(1, ET.Comment(
-        f" ground export: {n} contact geoms (class contact), floor at z = 0, keyframe 0 standing at base height "
-        f"{height:.6f} m (legkin's prediction) "
-    ))
+    where = (f"fixed base, floor at z = {height:.6f} m under the lowest contact (legkin's prediction)"
+             if ground.fixed_base else
+             f"floor at z = 0, keyframe 0 standing at base height {height:.6f} m (legkin's prediction)")
+    root.insert(1, ET.Comment(f" ground export: {n} contact geoms (class contact), {where} "))
     ET.indent(root, space="  ")
     return ET.tostring(root, encoding="unicode") + "\n"
 
@@ -206,7 +230,7 @@ def load_ground(robot_or_name: "Robot | str", *, ground: GroundModel | None = No
     out = GroundMechanism.__new__(GroundMechanism)
     out.__dict__.update(mech.__dict__)
     out.ground = ground
-    out.height = out.ground.standing_height(robot.q0)
+    out.height = out.ground.standing_height(ground.pose(robot.q0))
     return out
 
 

@@ -63,6 +63,10 @@ class GroundModel(ABC):
         line_half_width: half the length (m) of a line contact across the base's y axis (a tyre lying flat: its
             centre of pressure anywhere on it is legkin's contact); 0 for point contacts.
         rolls_sideways: whether a contact rolls about the base x axis too (a sphere) or only about y (a tyre).
+        timestep: the export's time step (s) for this mechanism, or None (the ground default, 1 ms).
+        no_squat: why the ``squat`` scenario cannot run on this robot, or None.
+        fixed_base: a fixed mechanism (its registry spec not floating: the hybrid leg), whose floor is put under its
+            contacts and whose scenario is ``press``.
     """
 
     robot: "Robot"
@@ -73,6 +77,9 @@ class GroundModel(ABC):
     stand_angle: float = 0.0
     line_half_width: float = 0.0
     rolls_sideways: bool = True
+    timestep: float | None = None
+    no_squat: str | None = None
+    fixed_base: bool = False
 
     @abstractmethod
     def geoms(self) -> list[ContactGeom]:
@@ -136,6 +143,16 @@ class GroundModel(ABC):
         """``q`` with every wheel turned forward by ``angle`` (rad): only for mechanisms with wheels."""
         raise InvalidParameterError(f"{self.robot.name} has no wheels to roll")
 
+    def pose(self, q: np.ndarray) -> np.ndarray:
+        """The configuration the scenarios and the keyframes use for the pose ``q`` (default ``q`` itself; flat
+        feet: levelled, :meth:`FootGround.pose`)."""
+        return q
+
+    def stiffness(self) -> dict[str, float]:
+        """The smallest position gain (N m / rad) of some actuated joints in the ground export (default none; flat
+        feet: :meth:`FootGround.stiffness`)."""
+        return {}
+
     def standing_height(self, q: np.ndarray) -> float:
         """Base height (m) that puts the lowest predicted contact on the floor z = 0 (level base)."""
         return float(-np.min(self.contacts(q)[:, 2]))
@@ -143,51 +160,78 @@ class GroundModel(ABC):
 
 @dataclass(frozen=True)
 class Foot:
-    """A foot: a sphere of ``radius`` (m) centred on ``frame``, moved by the three joints ``idx_q`` of ``leg``."""
+    """A contact sphere of ``radius`` (m) centred at ``offset`` (m) in ``frame``, moved by the joints ``idx_q`` of
+    ``leg``: a point foot (one per leg, at the foot frame) or one corner of a flat foot's sole (several per leg,
+    :func:`legkin.legs.sim.sole_spheres`). Its geom is ``<leg>_<label>_contact``."""
 
     leg: str
     frame: str
     radius: float
     idx_q: tuple[int, ...]
+    offset: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    label: str = "foot"
+
+
+#: Smallest position gain of a flat-footed leg's joints, in units of the robot's toppling stiffness m g h
+#: (:meth:`FootGround.stiffness`).
+STIFFNESS = 2.0
+#: A flat foot within this (|R - R_level|, max entry) of level is left as it is (:meth:`FootGround.pose`): 1e-9
+#: tilts a 0.2 m sole by 2e-10 m.
+_LEVEL_TOL = 1e-9
+
+
+def _level(rotation: np.ndarray) -> np.ndarray:
+    """The rotation about z nearest ``rotation`` in yaw (its x axis projected on the floor)."""
+    yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
+    return np.array(pin.rpy.rpyToMatrix(0.0, 0.0, yaw))
 
 
 class FootGround(GroundModel):
-    """Feet as spheres at the foot frames; legkin's leg ``fk(leg, q_leg)`` and ``ik(leg, p, q_near)`` (base frame).
+    """Feet as contact spheres (:class:`Foot`); legkin's leg ``fk(leg, q_leg)`` (the foot frame's 4x4 pose) and
+    ``ik(leg, pose, q_near)`` (base frame). A leg with several spheres has a flat foot: its sole is held level.
 
-    The predicted contact of a foot is its centre minus ``radius`` along z; :meth:`hold` runs the leg IK on the
-    foot centres ``target + radius z``.
+    The predicted contact of a sphere is its centre minus ``radius`` along z; :meth:`hold` runs the leg IK on the
+    foot pose that puts the sphere centres on ``target + radius z`` (a flat foot keeping its orientation).
     """
 
     def __init__(self, robot: "Robot", feet: Sequence[Foot], fk: Callable[[str, np.ndarray], np.ndarray],
                  ik: Callable[[str, np.ndarray, np.ndarray], np.ndarray]) -> None:
         self.robot, self.feet, self._fk, self._ik = robot, list(feet), fk, ik
-        self.collision_skip = frozenset(
+        self.legs = {f.leg: [g for g in self.feet if g.leg == f.leg] for f in self.feet}
+        model = robot.model
+        flat = {model.frames[model.getFrameId(f[0].frame)].parentJoint for f in self.legs.values() if len(f) > 1}
+        self.collision_skip = frozenset(  # the foot frames' shapes, and every shape of a flat foot's body
             g.name for g in robot.collision_model.geometryObjects
-            if robot.model.frames[g.parentFrame].name in {f.frame for f in self.feet}
+            if model.frames[g.parentFrame].name in {f.frame for f in self.feet} or g.parentJoint in flat
         )
 
     def geoms(self) -> list[ContactGeom]:
-        """One sphere per foot, at its frame."""
+        """One sphere per :class:`Foot`, at its offset in its frame."""
         model = self.robot.model
         out = []
         for f in self.feet:
             frame = model.frames[model.getFrameId(f.frame)]
-            out.append(ContactGeom(f"{f.leg}_foot_contact", frame.parentJoint, "sphere", (f.radius,), frame.placement))
+            out.append(ContactGeom(f"{f.leg}_{f.label}_contact", frame.parentJoint, "sphere", (f.radius,),
+                                   frame.placement * pin.SE3(np.eye(3), np.array(f.offset))))
         return out
 
+    def _points(self, q: np.ndarray) -> np.ndarray:
+        """(k, 3) the sphere centres (legkin's leg FK), base frame."""
+        poses = {leg: self._fk(leg, q[list(f[0].idx_q)]) for leg, f in self.legs.items()}
+        return np.array([poses[f.leg][:3, :3] @ np.array(f.offset) + poses[f.leg][:3, 3] for f in self.feet])
+
     def contacts(self, q: np.ndarray) -> np.ndarray:
-        """The lowest point of each foot sphere (legkin's leg FK), base frame."""
-        down = np.array([0.0, 0.0, 1.0])
-        return np.array([self._fk(f.leg, q[list(f.idx_q)]) - f.radius * down for f in self.feet])
+        """The lowest point of each contact sphere (legkin's leg FK), base frame."""
+        return self._points(q) - np.array([[0.0, 0.0, f.radius] for f in self.feet])
 
     def contact_frames(self, q: np.ndarray) -> list[tuple[tuple[str, ...], float]]:
-        """Each foot frame and sphere radius."""
+        """Each sphere's frame and radius."""
         return [((f.frame,), f.radius) for f in self.feet]
 
     def static_torques(self, q: np.ndarray) -> np.ndarray:
-        """``g(q) - sum_k J_k^T f_k``: gravity and vertical foot forces ``f_k`` carrying the weight with no moment
-        about the centre of mass (the least-norm solution of the three balance equations; Pinocchio, level
-        base); the base rows are not used."""
+        """``g(q) - sum_k J_k^T f_k``: gravity and vertical forces ``f_k`` at the sphere centres carrying the weight
+        with no moment about the centre of mass (the least-norm solution of the three balance equations;
+        Pinocchio, level base); the base rows are not used."""
         model = self.robot.model
         data = model.createData()
         tau = np.array(pin.computeGeneralizedGravity(model, data, q))
@@ -196,20 +240,57 @@ class FootGround(GroundModel):
         pin.updateFramePlacements(model, data)
         weight = -float(model.gravity.linear[2]) * sum(i.mass for i in model.inertias)
         fids = [model.getFrameId(f.frame) for f in self.feet]
-        xy = np.array([data.oMf[i].translation[:2] for i in fids])
+        arms = [data.oMf[i].rotation @ np.array(f.offset) for i, f in zip(fids, self.feet)]
+        xy = np.array([data.oMf[i].translation[:2] + a[:2] for i, a in zip(fids, arms)])
         balance = np.vstack([np.ones(len(fids)), xy.T])
         forces = np.linalg.lstsq(balance, weight * np.array([1.0, com[0], com[1]]), rcond=None)[0]
-        for fid, fz in zip(fids, forces):
-            jac = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)[:3]
-            tau -= jac.T @ np.array([0.0, 0.0, fz])
+        for fid, arm, fz in zip(fids, arms, forces):
+            jac = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
+            point = jac[:3] - pin.skew(arm) @ jac[3:]  # the velocity of the sphere centre
+            tau -= point.T @ np.array([0.0, 0.0, fz])
         return tau
 
-    def hold(self, q: np.ndarray, targets: np.ndarray) -> np.ndarray:
-        """Leg IK (nearest to ``q``) putting each foot's lowest point on its target."""
+    def _solve(self, q: np.ndarray, leg: str, rotation: np.ndarray, position: np.ndarray) -> np.ndarray:
+        """``q`` with ``leg``'s joints from its IK (nearest ``q``) putting its foot frame at (rotation, position)."""
+        idx = list(self.legs[leg][0].idx_q)
+        pose = np.eye(4)
+        pose[:3, :3], pose[:3, 3] = rotation, position
         out = np.array(q, dtype=float)
-        for f, t in zip(self.feet, np.asarray(targets, dtype=float)):
-            idx = list(f.idx_q)
-            out[idx] = self._ik(f.leg, t + np.array([0.0, 0.0, f.radius]), out[idx])
+        out[idx] = self._ik(leg, pose, out[idx])
+        return out
+
+    def hold(self, q: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """Leg IK (nearest to ``q``) putting each sphere's lowest point on its target, a flat foot keeping its
+        orientation (the foot frame's position: the mean over its spheres, exact when they move rigidly)."""
+        out = np.array(q, dtype=float)
+        centres = np.asarray(targets, dtype=float) + np.array([[0.0, 0.0, f.radius] for f in self.feet])
+        for leg, feet in self.legs.items():
+            rotation = self._fk(leg, q[list(feet[0].idx_q)])[:3, :3]
+            rows = [k for k, f in enumerate(self.feet) if f.leg == leg]
+            position = np.mean([centres[k] - rotation @ np.array(self.feet[k].offset) for k in rows], axis=0)
+            out = self._solve(out, leg, rotation, position)
+        return out
+
+    def stiffness(self) -> dict[str, float]:
+        """:data:`STIFFNESS` ``m g h`` for every joint of a leg on a flat foot: ``m`` the robot's mass, ``h`` its
+        centre of mass's height above the soles in the reference pose. The robot standing on its soles is an
+        inverted pendulum that an ankle softer than ``m g h`` lets topple (g1's 98.7 N m / rad from its foot's
+        inertia, for m g h = 230 N m / rad: it fell forwards 0.04 rad in 2 s)."""
+        model, q = self.robot.model, self.pose(self.robot.q0)
+        data = model.createData()
+        height = float(pin.centerOfMass(model, data, q)[2]) + self.standing_height(q)
+        weight = -float(model.gravity.linear[2]) * sum(i.mass for i in model.inertias)
+        joints = [model.idx_qs.tolist().index(i) for f in self.legs.values() if len(f) > 1 for i in f[0].idx_q]
+        return {model.names[j]: STIFFNESS * weight * height for j in joints}
+
+    def pose(self, q: np.ndarray) -> np.ndarray:
+        """``q`` with every flat foot levelled (its yaw and position kept; leg IK nearest ``q``): an SRDF pose whose
+        soles are not level with the base (icub's half_sitting: pitched 0.063 rad) would land on an edge."""
+        out = np.array(q, dtype=float)
+        for leg, feet in self.legs.items():
+            pose = self._fk(leg, q[list(feet[0].idx_q)])
+            if len(feet) > 1 and np.abs(pose[:3, :3] - _level(pose[:3, :3])).max() > _LEVEL_TOL:
+                out = self._solve(out, leg, _level(pose[:3, :3]), pose[:3, 3])
         return out
 
 
@@ -251,13 +332,15 @@ def has_ground_model(robot: "Robot | str") -> bool:
 
 
 def ground_model(robot: "Robot") -> GroundModel:
-    """The :class:`GroundModel` of a floating robot, from its package's ``sim`` module.
+    """The :class:`GroundModel` of a floating robot (or a fixed mechanism), from its package's ``sim`` module.
 
     Raises:
-        InvalidParameterError: the robot is not floating, or its package has no ground model.
+        InvalidParameterError: the robot is not loaded as its registry spec says (floating; fixed for a fixed
+            mechanism, the hybrid leg), or its package has no ground model.
     """
-    if not robot.floating:
-        raise InvalidParameterError(f"{robot.name}: the ground simulation needs legkin.load(name, floating=True)")
+    if robot.floating != robot.spec.floating:  # a fixed mechanism (the hybrid leg) presses on the floor fixed
+        raise InvalidParameterError(
+            f"{robot.name}: the ground simulation needs legkin.load(name, floating={robot.spec.floating})")
     if not has_ground_model(robot):
         raise InvalidParameterError(f"{robot.name} has no ground model ({robot.spec.package}.sim)")
     module = importlib.import_module(f"{robot.spec.package}.sim")

@@ -1,4 +1,5 @@
-"""Ground scenarios of a floating mechanism in MuJoCo, measured against legkin (:func:`run_scenario`).
+"""Ground scenarios of a floating mechanism (or a fixed one pressing) in MuJoCo, measured against legkin
+(:func:`run_scenario`).
 
 * ``stand``: dropped from ``drop`` (1 cm) above its standing height in a pose, after ``seconds`` (2 s): the base
   height against legkin's prediction (:meth:`~legkin.mjcf.ground.GroundModel.standing_height`), each centre of
@@ -8,6 +9,9 @@
 * ``squat``: after 0.5 s standing, the base lowered by ``depth`` (5 cm) and raised back (a cosine), the joints
   from legkin's IK holding the contacts on their ground points (:meth:`~legkin.mjcf.ground.GroundModel.hold`);
   the slip (largest horizontal drift of a centre of pressure) and the base height against the commanded one.
+* ``press`` (a fixed mechanism only, :attr:`~legkin.mjcf.ground.GroundModel.fixed_base`: the hybrid leg): the
+  foot on the floor under it, its IK target moved 5 mm into the floor; the centre of pressure against legkin's
+  contact at MuJoCo's configuration, and the deepest penetration (no feedforward, no integral term).
 
 The controller is the export's position actuators with an offset holding the weight: where the ground model
 knows the static joint torques (:meth:`~legkin.mjcf.ground.GroundModel.static_torques`: legs), ``tau / kp`` is
@@ -36,7 +40,7 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["SCENARIOS", "ScenarioResult", "run_scenario", "TOL_HEIGHT", "TOL_CONTACT", "TOL_PENETRATION",
            "TOL_ROLL", "TOL_SLIP"]
 
-SCENARIOS = ("stand", "roll", "squat")
+SCENARIOS = ("stand", "roll", "squat", "press")
 TOL_HEIGHT = 2e-3
 TOL_CONTACT = 2e-3
 TOL_PENETRATION = 1e-3
@@ -116,7 +120,8 @@ class _Runner:
         tau = self.mech.ground.static_torques(self.mech.q(d.qpos))
         if tau is not None:  # a fixed offset holding the weight (feedforward) instead of the integral term
             vadr = m.jnt_dofadr[m.actuator_trnid[:, 0]]
-            self.feedforward = tau[vadr] / m.actuator_gainprm[:, 0]
+            gain = m.actuator_gainprm[:, 0]  # 0 for a joint carrying no inertia (romeo's fingers): no offset
+            self.feedforward = np.divide(tau[vadr], gain, out=np.zeros(m.nu), where=gain > 0.0)
             self.integrate = False
         self.mujoco.mj_forward(m, d)
 
@@ -211,6 +216,8 @@ class _Runner:
         """legkin's contact points at MuJoCo's configuration, in the world (MuJoCo's base pose)."""
         d = self.mech.data
         q = self.mech.q(d.qpos)
+        if self.mech.ground.fixed_base:  # the base frame is the world's
+            return self.mech.ground.contacts(q)
         rot = d.xmat[self.mech.body_ids[1]].reshape(3, 3)
         return self.mech.ground.contacts(q) @ rot.T + d.qpos[:3]
 
@@ -233,10 +240,10 @@ def _key(mech: GroundMechanism, pose: str | None) -> tuple[int, np.ndarray]:
     mujoco = _mujoco()
     robot = mech.robot
     pose = robot.spec.reference_pose if pose is None else pose
-    key = mujoco.mj_name2id(mech.model, mujoco.mjtObj.mjOBJ_KEY, pose)
+    key = mujoco.mj_name2id(mech.model, mujoco.mjtObj.mjOBJ_KEY, pose) if pose else 0  # g1: no SRDF, key 0 is q0
     if key < 0:
         raise InvalidParameterError(f"{robot.name} has no pose {pose!r}; poses: {', '.join(robot.poses)}")
-    return key, {**robot.poses, robot.spec.reference_pose: robot.q0}[pose]
+    return key, mech.ground.pose({**robot.poses, robot.spec.reference_pose: robot.q0}[pose])
 
 
 def _stand(run: _Runner, pose: str | None, seconds: float, drop: float) -> list["CheckResult"]:
@@ -303,12 +310,9 @@ def _squat(run: _Runner, pose: str | None, seconds: float, depth: float) -> list
         return 0.5 * depth * (1.0 - np.cos(2.0 * np.pi * min(1.0, (t - t0) / seconds)))
 
     ticks = np.linspace(0.0, seconds, 201)  # legkin's IK every 10 ms of a 2 s squat, interpolated between
-    ctrl = np.array([mech.ctrl(mech.ground.hold_rolling(q, ground + np.array([0.0, 0.0, lowered(t0 + t)])))
-                     for t in ticks])
+    target = _interpolator(t0, ticks, [mech.ctrl(mech.ground.hold_rolling(
+        q, ground + np.array([0.0, 0.0, lowered(t0 + t)]))) for t in ticks])
     run.track_slip(run.predicted())
-
-    def target(t: float) -> np.ndarray:
-        return np.array([np.interp(t - t0, ticks, c) for c in ctrl.T])
 
     for _ in range(20):
         run.run(seconds / 20, target)
@@ -320,6 +324,27 @@ def _squat(run: _Runner, pose: str | None, seconds: float, depth: float) -> list
                 np.array(slip), TOL_SLIP),
         compare(f"{name} squat: base height {_SETTLE_AFTER:g} s after - before (m)",
                 np.array([mech.data.qpos[2] - base0[2]]), TOL_HEIGHT),
+    ]
+
+
+def _press(run: _Runner, pose: str | None, seconds: float, depth: float) -> list["CheckResult"]:
+    """A fixed mechanism's foot on the floor under it (the reference pose), its IK target moved ``depth`` below the
+    floor over 0.2 s and held: where it presses against legkin's contact, and the penetration."""
+    from .._checkkit import compare
+
+    mech = run.mech
+    key, q = _key(mech, pose)
+    run.start(key, 0.0)
+    run.integrate = False  # an integral term would wind up against the floor
+    run.run(_SETTLE)
+    pressed = mech.ctrl(mech.ground.hold(q, mech.ground.contacts(q) - np.array([0.0, 0.0, depth])))
+    run.run(seconds, _interpolator(run.time, np.array([0.0, 0.2]), [mech.ctrl(q), pressed]))
+    pred = run.predicted()
+    name = mech.robot.name
+    return [
+        compare(f"{name} press: foot commanded {depth:g} m into the floor, centre of pressure - legkin's contact at "
+                "MuJoCo's motor angles (m)", np.linalg.norm(run.pressure(pred) - pred, axis=1), TOL_CONTACT),
+        compare(f"{name} press: deepest penetration over the run (m)", np.array([run.penetration]), TOL_PENETRATION),
     ]
 
 
@@ -344,6 +369,11 @@ def run_scenario(model: "str | GroundMechanism", scenario: str, *, seconds: floa
     if scenario not in SCENARIOS:
         raise InvalidParameterError(f"unknown scenario {scenario!r}; scenarios: {', '.join(SCENARIOS)}")
     mech = load_ground(model, **options) if isinstance(model, str) else model
+    if (scenario == "press") != mech.ground.fixed_base:
+        raise InvalidParameterError(f"{mech.robot.name}: scenario {scenario!r} is for "
+                                    f"{'a fixed mechanism' if scenario == 'press' else 'a floating robot'}")
+    if scenario == "squat" and mech.ground.no_squat:
+        raise InvalidParameterError(f"{mech.robot.name} does not squat: {mech.ground.no_squat}")
     if scenario == "squat" and pose is None:
         pose = mech.ground.squat_pose
     run = _Runner(mech, fps)
@@ -351,6 +381,8 @@ def run_scenario(model: "str | GroundMechanism", scenario: str, *, seconds: floa
         rows = _stand(run, pose, seconds, 0.01)
     elif scenario == "roll":
         rows = _roll(run, pose, seconds, 2.0 * np.pi)
+    elif scenario == "press":
+        rows = _press(run, pose, seconds, 0.005)
     else:
         rows = _squat(run, pose, seconds, 0.05)
     return ScenarioResult(scenario, mech.robot.name, rows, run.time, run.wall, run.time / max(run.wall, 1e-9),
@@ -359,16 +391,19 @@ def run_scenario(model: "str | GroundMechanism", scenario: str, *, seconds: floa
 
 def ground_rows(name: str) -> list["CheckResult"]:
     """The ``legkin check`` rows of the ground scenarios of ``name``: ``stand``, ``roll`` (wheels) and ``squat``
-    (none for a model without a ground model)."""
-    from ..robot import load
+    (unless the ground model says why not); ``press`` for a fixed mechanism (the hybrid leg); none for a model
+    without a ground model."""
     from .ground import has_ground_model
 
     if not has_ground_model(name):
         return []
-    mech = load_ground(load(name, floating=True))
+    mech = load_ground(name)
+    if mech.ground.fixed_base:
+        return run_scenario(mech, "press").rows
     rows: list["CheckResult"] = []
-    for scenario in SCENARIOS:
-        if scenario == "roll" and mech.ground.rolling_radius is None:
+    for scenario in SCENARIOS[:3]:
+        no_wheels = scenario == "roll" and mech.ground.rolling_radius is None
+        if no_wheels or (scenario == "squat" and mech.ground.no_squat):
             continue
         rows += run_scenario(mech, scenario).rows
     return rows

@@ -1,4 +1,4 @@
-"""``legkin sim MODEL --scenario stand|roll|squat [--video out.mp4 | --html out.html]``: run a ground scenario
+"""``legkin sim MODEL --scenario stand|roll|squat|press [--video out.mp4 | --html out.html]``: run a ground scenario
 (:func:`legkin.mjcf.scenarios.run_scenario`), print its figures and real-time factor, optionally record it."""
 
 from __future__ import annotations
@@ -25,7 +25,8 @@ _FPS = 30.0
 
 def render_frames(mech: GroundMechanism, frames: Sequence[np.ndarray], *, width: int = 640, height: int = 480,
                   azimuth: float = 135.0, elevation: float = -15.0, distance: float = 1.6) -> list[np.ndarray]:
-    """RGB images (height, width, 3) of ``qpos`` frames, the camera following the base (``MUJOCO_GL=egl``)."""
+    """RGB images (height, width, 3) of ``qpos`` frames, the camera following the base, half way down to the floor
+    (a fixed mechanism: at its base) (``MUJOCO_GL=egl``)."""
     mujoco = _mujoco()
     try:
         renderer = mujoco.Renderer(mech.model, height, width)
@@ -38,7 +39,8 @@ def render_frames(mech: GroundMechanism, frames: Sequence[np.ndarray], *, width:
         for qpos in frames:
             mech.data.qpos[:] = qpos
             mujoco.mj_forward(mech.model, mech.data)
-            cam.lookat[:] = [qpos[0], qpos[1], 0.5 * qpos[2]]
+            base = mech.data.xpos[mech.body_ids[1]]  # a fixed mechanism's qpos starts with joint angles
+            cam.lookat[:] = [base[0], base[1], 0.5 * base[2]] if not mech.ground.fixed_base else base
             renderer.update_scene(mech.data, camera=cam)
             out.append(renderer.render().copy())
     finally:
@@ -83,9 +85,10 @@ def write_html(images: Sequence[np.ndarray], path: str | Path, title: str, fps: 
 
 def add_sim_command(subparsers: "argparse._SubParsersAction") -> "argparse.ArgumentParser":
     """Add ``legkin sim`` to ``legkin``'s parser."""
-    p = subparsers.add_parser("sim", help="run a MuJoCo ground scenario (stand, roll, squat) and measure it")
+    p = subparsers.add_parser("sim", help="run a MuJoCo ground scenario (stand, roll, squat, press) and measure it")
     p.add_argument("model")
-    p.add_argument("--scenario", choices=SCENARIOS, default="stand")
+    p.add_argument("--scenario", choices=SCENARIOS, default=None,
+                   help="default: stand (press for a fixed mechanism, the hybrid leg)")
     p.add_argument("--seconds", type=float, default=2.0, help="scenario length, s (default %(default)g)")
     out = p.add_mutually_exclusive_group()
     out.add_argument("--video", metavar="PATH", help="record an MP4 (MUJOCO_GL=egl headless)")
@@ -103,7 +106,8 @@ def run_sim(args: "argparse.Namespace") -> int:
     from .floating import load_ground
 
     mech = load_ground(args.model)
-    res = run_scenario(mech, args.scenario, seconds=args.seconds, fps=_FPS if record else None)
+    scenario = args.scenario or ("press" if mech.ground.fixed_base else "stand")
+    res = run_scenario(mech, scenario, seconds=args.seconds, fps=_FPS if record else None)
     width = max(len(r.name) for r in res.rows)
     for r in res.rows:
         print(f"{r.name:<{width}}  {r.max_error:10.3e}  tol {r.tolerance:7.0e}  {'pass' if r.passed else 'FAIL'}")
@@ -112,6 +116,6 @@ def run_sim(args: "argparse.Namespace") -> int:
         images = render_frames(mech, res.frames)
         kw: dict[str, Any] = {}
         path = write_video(images, args.video, **kw) if args.video else write_html(
-            images, args.html, f"legkin {args.model}: {args.scenario}")
+            images, args.html, f"legkin {args.model}: {scenario}")
         print(f"wrote {path}")
     return 0 if all(r.passed for r in res.rows) else 1

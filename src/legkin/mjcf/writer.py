@@ -69,6 +69,10 @@ def _inertial(inertia: pin.Inertia, moving: bool, o: Mapping[str, Any]) -> tuple
         if inertia.mass == 0.0:
             com = np.zeros(3)
     eig = np.linalg.eigvalsh(0.5 * (mat + mat.T))
+    if moving and eig[-1] < 1e-12 * mass * o["min_radius"] ** 2:  # a point mass (icub's hips: 0 or 1e-18)
+        note = f"rotational inertia {eig[-1]:.1e}: a solid sphere of {mass:g} kg, radius {o['min_radius']:g} m"
+        mat = 0.4 * mass * o["min_radius"] ** 2 * np.eye(3)
+        eig = np.linalg.eigvalsh(mat)
     if eig[0] < -1e-12 * max(eig[-1], 1e-300) or eig[0] + eig[1] < eig[2] * (1 - 1e-9):
         raise LegkinError(
             f"inertia with principal moments {eig} is not physically consistent (negative, or triangle "

@@ -2,7 +2,8 @@
 
 Contact geometry: the tyre (:mod:`.tyre`: the pitch curve swept by a disk of radius ``r`` = 0.0345 m, extruded over
 the width T) as cylinders of radius ``r`` and length T whose axes are the leg-plane normal, centred on the pitch
-arcs of the four rim links (:data:`.tyre.PIECE_LINKS`) at most ``step`` apart, both ends of every arc included.
+arcs of the four rim links (:data:`.tyre.PIECE_LINKS`) at most ``step`` apart, both ends of every arc included
+(once where two arcs meet: :data:`_ARCS`).
 The union of these cylinders is the swept tyre sampled along the pitch curve: it is exact at the samples, the
 caps at the tips and the fillets at the hinges (those are the end cylinders), and between two samples it lies
 inside the true surface by at most ``R (1 - cos(phi/2))``, phi the angle between two neighbours on the pitch circle
@@ -29,16 +30,24 @@ from .linkage import theta_beta
 from .stance import stance_ik, stance_ik_all
 from .tyre import PIECE_LINKS, tyre_pieces
 
-__all__ = ["ground_model", "WheelGround", "TYRE_STEP"]
+__all__ = ["ground_model", "WheelGround", "TYRE_STEP", "TIMESTEP"]
 
 #: Largest distance (m) between two tyre cylinders along the pitch curve (module docstring): 4 mm keeps MuJoCo's
 #: lowest point within 2 mm (half the spacing) of legkin's along the ground and 2e-5 m in height
 #: (scripts/mujoco_tyre_fit.py; 8 mm: 3.96e-3 m and 7.8e-5 m, and a loaded centre of pressure 3.1e-3 m off).
 TYRE_STEP = 0.004
+#: The export's time step (s): the squat's real-time factor 9.0 at 1 ms, 11.8 at 1.5 ms, 15.6 at 2 ms (one core,
+#: CPU time), every row within its tolerance at each (deepest penetration 1.3e-4, 2.4e-4, 8.1e-4 m of the 1e-3 m
+#: allowed; roll 3.6e-3, 3.4e-3, 3.3e-3 of 0.02; squat slip 3.4e-4, 3.5e-4, 4.5e-4 m of 2e-3): 1.5 ms keeps
+#: the penetration a quarter of its tolerance.
+TIMESTEP = 1.5e-3
 #: |gamma| (rad) under which a tyre counts as flat across its width (:meth:`WheelGround.contacts`).
 _LEVEL = 1e-3
 #: The pitch arcs of a leg: (rim link, centre frame, first end, second end), ``<leg>_`` omitted; the lower rims'
-#: hinge end F is their link frame.
+#: hinge end F is their link frame. Where two arcs meet (the hinges F_L, F_R; the toe G = G_cut) one cylinder is
+#: exported, on the first arc: the coincident pair doubled those contacts (16 in the squat, 12 without) and
+#: measured (scripts/mujoco_tyre_fit.py rows unchanged; 1.5 ms step) squat 13.6 -> 15.9 x real time, stand
+#: centre of pressure 6.4e-4 -> 5.9e-5 m from legkin's, squat slip 3.5e-4 -> 6.6e-4 m, roll 3.4e-3 -> 3.1e-3.
 _ARCS = (
     ("rim_upper_L", "U_L", "H_L", "F_L"),
     ("rim_lower_L", "L_L", "rim_lower_L", "G"),
@@ -69,6 +78,7 @@ class WheelGround(GroundModel):
         self.rolling_radius = self.geometry.R + TYRE_THICKNESS
         self.line_half_width = 0.5 * self.geometry.T
         self.rolls_sideways = False
+        self.timestep = TIMESTEP
         self.stand_angle = 0.0
         self.geoms()  # sets stand_angle
         self.squat_pose = "leg"  # theta = 160 deg: the reference pose ("wheel") cannot go 5 cm lower
@@ -114,7 +124,8 @@ class WheelGround(GroundModel):
                 n = max(1, int(np.ceil(span * radius / self.step)))
                 if link == "rim_lower_L":
                     self.stand_angle = 0.5 * span / n  # the contact between two cylinders: the worst case
-                for i in range(n + 1):
+                first, last = (1, n - 1) if link == "rim_lower_R" else (1, n) if link == "rim_lower_L" else (0, n)
+                for i in range(first, last + 1):  # a hinge's or the toe's cylinder once (_ARCS)
                     p = c + pin.AngleAxis(span * i / n, normal / np.linalg.norm(normal)).matrix() @ u
                     out.append(ContactGeom(f"{leg}_{link}_tyre{i}", joint, "cylinder", (TYRE_THICKNESS, half),
                                            pin.SE3(rot, p)))

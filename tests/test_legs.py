@@ -754,15 +754,15 @@ def test_haa_arc_test_drops_only_angles_off_the_limits():
 
 
 @pytest.mark.parametrize("robot", ["quadruped", "go2", "solo12"])
-def test_out_of_reach_exit_gives_the_complete_paths_verdict(robot):
-    """``Leg.ik`` decides a target out of reach beyond doubt without its complete path (``_out_of_reach_k``: the
-    workspace study's common case). Its status and data must be those of the complete path (``_ik_all_core``, whose
+def test_no_candidate_exit_gives_the_complete_paths_verdict(robot):
+    """``Leg.ik`` decides a target with no candidate branch without its complete path when the verdict is beyond
+    doubt (``_no_candidate_k``: the workspace study's common case). Its status and data must be those of the complete path (``_ik_all_core``, whose
     ``UNREACHABLE`` they copy): on targets in a box around each leg's hip (most out of reach), every row that
     ``ik_all`` finds out of reach is out of reach for ``ik`` with the same miss and reason, and every row ``ik``
     finds out of reach is one that ``ik_all`` does."""
     import legkin
     from legkin.legs._ik_kernels import _ik_all_batch, _ik_batch
-    from legkin.legs._layout import _UNREACHABLE, IK_TOL
+    from legkin.legs._layout import _JOINT_LIMIT, _UNREACHABLE, IK_TOL
 
     found = legkin.quadruped.legs() if robot == "quadruped" else legs.from_model(legkin.load(robot).model)
     rng = np.random.default_rng(11)
@@ -778,3 +778,14 @@ def test_out_of_reach_exit_gives_the_complete_paths_verdict(robot):
         assert out.sum() > n // 4  # the box is mostly out of reach: the exit is exercised
         np.testing.assert_array_equal(st == _UNREACHABLE, out)
         np.testing.assert_array_equal(info[out], info_all[out])
+        # reachable only outside the limits (decided without the complete path when well-conditioned): every
+        # branch of ik_all is outside the limits, and the single call's error measures by how much
+        limit = np.flatnonzero(st == _JOINT_LIMIT)
+        assert len(limit) > n // 20 or robot != "quadruped"  # POPI's limits: ~40 % of its box
+        for i in limit[:: max(1, len(limit) // 200)]:
+            branches = leg.ik_all(p[i])
+            by = leg._least_violation(branches)[3]
+            assert by > 0.0
+            with pytest.raises(errors.JointLimitError) as raised:
+                leg.ik(p[i])
+            assert raised.value.distance == by and math.isfinite(by)

@@ -393,24 +393,36 @@ def _ik_every_k(p, g, ref, tol, out):
 
 
 @kernel
-def _out_of_reach_k(g, x, t, cyl, tol, slack):
-    """Whether the target is out of reach beyond doubt: inside the abduction cylinder, or beyond the knee's reach
-    on both abduction branches, each by more than ``slack`` (the cases :func:`_ik_all_core` skips without a polish).
-    Returns ``(_UNREACHABLE, miss, reason)`` with the data :func:`_ik_all_core` gives (the least miss, m, and its
-    reason), or ``(OK, 0, 0)`` when it is not that clear (the complete path decides). A cheap exit for the
-    targets of a workspace study, most of them out of reach."""
+def _no_candidate_k(g, x, t, cyl, tol, slack, clean_a):
+    """The verdict on a target none of whose branches is a candidate of the limits-first :func:`_ik_core`, when it
+    is beyond doubt (a workspace study's common case; otherwise ``(OK, 0, 0)``: the complete path decides):
+
+    * out of reach: inside the abduction cylinder, or beyond the knee's reach on both abduction branches, each by
+      more than ``slack`` (the cases :func:`_ik_all_core` skips without a polish). Returns ``(_UNREACHABLE, miss,
+      reason)`` with :func:`_ik_all_core`'s data (the least miss, m, and its reason);
+    * reachable only outside the limits: on the exact ideal structure, away from the singular sets
+      (:data:`WELL_CONDITIONED`: the closed form is the answer, no polish moves it) and inside the reach by ``tol``,
+      every branch was dropped for a joint more than :data:`CANDIDATE_SLACK` (> :data:`LIMIT_SLACK`) outside its
+      limits, which :func:`_accept_k` rejects too. Returns ``(_JOINT_LIMIT, nan, 4)`` (the least violation is
+      measured by the single call's error, from :meth:`Leg.ik_all`)."""
     if cyl > slack:
         return _UNREACHABLE, cyl, _IN_CYLINDER
     best, why = math.inf, 0.0
     if cyl > tol:
         best, why = cyl, _IN_CYLINDER
+    clean = clean_a and cyl <= tol
     for ia in range(1 if g[_H] == 0.0 else 2):  # h_X = 0: the knee's miss is the same on both abduction branches
-        _wx, _wy, miss, far, _c, _acb, _clean = _pitch_k(g, x, t if ia == 1 else -t)
+        _wx, _wy, miss, far, _c, _acb, clean_w = _pitch_k(g, x, t if ia == 1 else -t)
+        clean = clean and clean_w and miss <= tol
         if not miss > slack:
-            return OK, 0.0, 0.0
-        if miss < best:
+            best = -1.0  # this branch is within the reach: not out of reach
+        elif miss < best:
             best, why = miss, (_TOO_FAR if far else _TOO_NEAR)
-    return _UNREACHABLE, best, why
+    if best >= 0.0:
+        return _UNREACHABLE, best, why
+    if clean:
+        return _JOINT_LIMIT, _NAN, 4.0
+    return OK, 0.0, 0.0
 
 
 @kernel
@@ -466,9 +478,9 @@ def _ik_core(p, g, ref, tol, out):
     if clean and inside:  # well-conditioned, strictly inside the limits: the representatives found are the answer
         out[0], out[1], out[2] = y0, y1, y2
         return OK, 0.0, 0.0
-    if best == math.inf:  # no candidate: out of reach (decided here when it is clear), else the complete path
-        status, i0, i1 = _out_of_reach_k(g, x, t, cyl, tol, slack)
-        if status == _UNREACHABLE:
+    if best == math.inf:  # no candidate: decided here when it is clear (_no_candidate_k), else the complete path
+        status, i0, i1 = _no_candidate_k(g, x, t, cyl, tol, slack, clean_a)
+        if status != OK:
             return status, i0, i1
     else:
         j1, j2, j3, res = _settle_k(p, g, c1, c2, c3, clean)

@@ -505,13 +505,13 @@ class Leg:
                                     target=p, distance=miss)
         if status == _JOINT_LIMIT:
             branches = self.ik_all(p, tol=tol)
-            j, value, closest = self._least_violation(branches)
+            j, value, closest, by = self._least_violation(branches)
             return JointLimitError(
                 f"target {tgt} of leg {self.name} is reachable only outside the joint limits "
-                f"[{self.lower.tolist()}, {self.upper.tolist()}] (by {float(info[0]):.6g} rad at least: joint "
+                f"[{self.lower.tolist()}, {self.upper.tolist()}] (by {by:.6g} rad at least: joint "
                 f"{self.joint_names[j]} = {value:.6g} rad in the closest branch); "
                 f"branches {np.round(branches, 6).tolist()}",
-                target=p, closest=closest, distance=float(info[0]), joint=self.joint_names[j], value=value,
+                target=p, closest=closest, distance=by, joint=self.joint_names[j], value=value,
                 lower=float(self.lower[j]), upper=float(self.upper[j]),
             )
         return InvalidInputError(f"p must be finite, got {tgt}")  # pragma: no cover - as_input caught it
@@ -525,9 +525,10 @@ class Leg:
         batch_loop(rows, self.params, ref1, IK_TOL, np.empty((1,) + width), status, info)
         return self._error(int(status[0]), info[0], rows[0])
 
-    def _least_violation(self, branches: np.ndarray) -> tuple[int, float, np.ndarray]:
+    def _least_violation(self, branches: np.ndarray) -> tuple[int, float, np.ndarray, float]:
         """The branch least outside the limits (each angle's 2 pi representative nearest them): the index of its
-        joint farthest outside, that joint's value (rad) and the branch (error path only)."""
+        joint farthest outside, that joint's value (rad), the branch and by how much that joint is outside (rad)
+        (error path only)."""
         best: tuple[float, int, float, np.ndarray] = (math.inf, 0, math.nan, branches[0])
         mid = 0.5 * (np.clip(self.lower, -1e9, 1e9) + np.clip(self.upper, -1e9, 1e9))
         for q in branches[np.isfinite(branches[:, 0])]:
@@ -536,7 +537,7 @@ class Leg:
             j = int(np.argmax(out_by))
             if out_by[j] < best[0]:
                 best = (float(out_by[j]), j, float(x[j]), x)
-        return best[1], best[2], best[3]
+        return best[1], best[2], best[3], best[0]
 
     @overload
     def ik_all(self, target: ArrayLike, *, q_near: ArrayLike | None = ..., tol: float = ...,

@@ -68,6 +68,7 @@ def _from_lwa(jac: np.ndarray, placement: np.ndarray, reference) -> np.ndarray:
 
 
 _SOLVER: list[Any] = []
+_NO_MOTORS = np.zeros(0)
 
 
 def _solver() -> Any:
@@ -77,6 +78,11 @@ def _solver() -> Any:
 
         _SOLVER.append(solve_passive)
     return _SOLVER[0]
+
+
+def _vector(x: Any, n: int) -> bool:
+    """``x`` is a float64 vector of length ``n`` (what the kernel takes as is)."""
+    return type(x) is np.ndarray and x.dtype == np.float64 and x.shape == (n,)
 
 
 def _joint_kind(joint) -> tuple[int, tuple[float, ...]] | None:
@@ -168,17 +174,30 @@ class ClosedLoopMixin:
             self.__dict__["_closed_cache"] = cache
         return cache
 
+    def _kernel_args(self) -> tuple[Any, ...]:
+        """The arguments of :func:`legkin._tree_kernels.solve_passive` after ``q`` and ``motors`` up to ``passive``
+        (the motors' q indices, the tree's arrays), cached; needs :meth:`_tree`."""
+        args = self.__dict__.get("_kernel_args_cache")
+        if args is None:
+            t, iq = self._compiled()[:2]
+            assert t is not None
+            args = (iq.astype(np.int64), t.parent, t.kind, t.axis, t.place_r, t.place_t, t.idx_q, t.idx_v, t.loop_j,
+                    t.loop_r, t.loop_t, t.loop_six)
+            self.__dict__["_kernel_args_cache"] = args
+        return args
+
     def _tree_solve(
-        self, q: np.ndarray, passive: np.ndarray, max_iter: int = _MAX_ITER
+        self, q: np.ndarray, passive: np.ndarray, max_iter: int = _MAX_ITER, motors: np.ndarray | None = None
     ) -> tuple[np.ndarray, bool, int, float]:
         """The compiled solve (:func:`legkin._tree_kernels.solve_passive`: minimum-norm Gauss-Newton, its test the
-        frames' own error) moving the velocity coordinates ``passive``; returns the configuration, whether it
-        closed, the iterations and the worst frame error (m or rad). Needs :meth:`_tree`."""
-        t = self._tree()
-        assert t is not None
-        out, info = np.empty_like(q), np.zeros(2)
-        status = _solver()(q, t.parent, t.kind, t.axis, t.place_r, t.place_t, t.idx_q, t.idx_v, t.loop_j,
-                           t.loop_r, t.loop_t, t.loop_six, passive, CLOSED_TOL, max_iter, out, info)
+        frames' own error) from ``q`` with the motors set to ``motors`` (None: as in ``q``), moving the velocity
+        coordinates ``passive``; returns the configuration, whether it closed, the iterations and the worst frame
+        error (m or rad). Needs :meth:`_tree`."""
+        args = self._kernel_args()
+        out, info = np.empty_like(q), np.zeros(3)
+        if motors is None:
+            motors, args = _NO_MOTORS, (_NO_MOTORS.astype(np.int64),) + args[1:]
+        status = _solver()(q, motors, *args, passive, CLOSED_TOL, max_iter, out, info)
         return out, status == 0, int(info[0]), float(info[1])  # 0: legkin._kernels.OK
 
     def _fk_step(self, motors: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, bool]:
@@ -189,7 +208,7 @@ class ClosedLoopMixin:
         q = q.copy()
         q[iq] = motors
         if tree is not None:
-            qt, ok, _, worst = self._tree_solve(q, passive)
+            qt, ok, _, worst = self._tree_solve(q, passive, motors=motors)
             if ok:
                 return qt, True
             # stalled near closure (measured: robot_delta, 2 of 200 samples at ~3e-10): Pinocchio's damped LM
@@ -215,6 +234,19 @@ class ClosedLoopMixin:
             if ok:
                 return qk
         return None
+
+    def _fk_lean(self, motors: Any, q_near: Any) -> np.ndarray | None:
+        """The single call's lean path: float64 vectors of the right lengths go straight to the compiled solve (which
+        checks their finiteness); None when the inputs are of another form or the solve does not close (the full
+        path then checks them, continues from ``q_near`` or says why)."""
+        tree, iq, _, passive = self._compiled()
+        nq = self.model.nq
+        if tree is None or not _vector(motors, len(iq)) or not (q_near is None or _vector(q_near, nq)):
+            return None
+        out = np.empty(nq)
+        status = _solver()(self.q0 if q_near is None else q_near, motors, *self._kernel_args(), passive, CLOSED_TOL,
+                           _MAX_ITER, out, np.empty(3))
+        return out if status == 0 else None  # 0: legkin._kernels.OK
 
     def _fk_error(self, m: np.ndarray, q: np.ndarray) -> LoopClosureError:
         errs = loop_errors(self.model, self._loopset.data, self._loopset.loops, self._fk_step(m, q)[0])
@@ -249,6 +281,10 @@ class ClosedLoopMixin:
             LoopClosureError: (single call) the loops do not close with these motor values (out of the workspace,
                 or across a singularity from ``q_near``).
         """
+        if return_mask is False:
+            lean = self._fk_lean(motors, q_near)
+            if lean is not None:
+                return lean
         iq = self._compiled()[1]
         m = as_input(motors, "motors", (len(iq),))
         return_mask = check_flag(return_mask, "return_mask")

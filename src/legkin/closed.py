@@ -187,16 +187,22 @@ class ClosedLoopMixin:
         return args
 
     def _tree_solve(
-        self, q: np.ndarray, passive: np.ndarray, max_iter: int = _MAX_ITER, motors: np.ndarray | None = None
+        self, q: np.ndarray, passive: np.ndarray, max_iter: int = _MAX_ITER, motors: np.ndarray | None = None,
+        loops: Any = None, point: bool = False,
     ) -> tuple[np.ndarray, bool, int, float]:
         """The compiled solve (:func:`legkin._tree_kernels.solve_passive`: minimum-norm Gauss-Newton, its test the
         frames' own error) from ``q`` with the motors set to ``motors`` (None: as in ``q``), moving the velocity
-        coordinates ``passive``; returns the configuration, whether it closed, the iterations and the worst frame
-        error (m or rad). Needs :meth:`_tree`."""
+        coordinates ``passive``, closing the loops of indices ``loops`` (None: all), as point loops if ``point``;
+        returns the configuration, whether it closed, the iterations and the worst frame error (m or rad). Needs
+        :meth:`_tree`."""
         args = self._kernel_args()
         out, info = np.empty_like(q), np.zeros(3)
         if motors is None:
             motors, args = _NO_MOTORS, (_NO_MOTORS.astype(np.int64),) + args[1:]
+        if loops is not None or point:
+            k = np.arange(len(args[8])) if loops is None else np.asarray(loops, dtype=np.int64)
+            six = np.zeros(len(k), dtype=np.bool_) if point else args[11][k]
+            args = args[:8] + (args[8][k], args[9][k], args[10][k], six)
         status = _solver()(q, motors, *args, passive, CLOSED_TOL, max_iter, out, info)
         return out, status == 0, int(info[0]), float(info[1])  # 0: legkin._kernels.OK
 

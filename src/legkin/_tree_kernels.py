@@ -333,22 +333,36 @@ def _step(jac, res, loop_six, touch, lists, counts, row0, first, a, ld, d, y, dv
             dv[v] -= x
 
 
-@kernel(entry=True)
-def solve_passive(q, motors, motor_q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t,
-                  loop_six, passive, tol, max_iter, q_out, info):
-    """Close the loops from ``q`` with ``q[motor_q] = motors`` (none: empty arrays) moving the ``passive`` velocity
-    coordinates only; ``q_out`` the result, ``info`` the Gauss-Newton iterations, the frames' worst error (m or
-    rad) and the residual evaluations.
+@kernel(inline=True)
+def _unpack(ints, floats, flags):
+    """The tree's arrays, views of the three that :func:`legkin.closed.pack` makes (one argument each instead of
+    thirteen: numba's dispatch of a call costs about 60 ns an argument): ``ints`` = ``[nj, nl, nm]``, ``parent``,
+    ``kind``, ``idx_q``, ``idx_v`` (nj each), ``loop_j`` (nl x 2), ``motor_q`` (nm); ``floats`` = ``axis``
+    (nj x 3), ``place_r`` (nj x 3 x 3), ``place_t`` (nj x 3), ``loop_r`` (nl x 2 x 3 x 3), ``loop_t`` (nl x 2 x 3);
+    ``flags`` = ``passive`` (nv), ``loop_six`` (nl)."""
+    nj, nl, nm = ints[0], ints[1], ints[2]
+    o = 3 + 4 * nj + 2 * nl
+    nv = flags.shape[0] - nl
+    return (ints[3:3 + nj], ints[3 + nj:3 + 2 * nj], floats[:3 * nj].reshape((nj, 3)),
+            floats[3 * nj:12 * nj].reshape((nj, 3, 3)), floats[12 * nj:15 * nj].reshape((nj, 3)),
+            ints[3 + 2 * nj:3 + 3 * nj], ints[3 + 3 * nj:3 + 4 * nj], ints[3 + 4 * nj:o].reshape((nl, 2)),
+            floats[15 * nj:15 * nj + 18 * nl].reshape((nl, 2, 3, 3)),
+            floats[15 * nj + 18 * nl:15 * nj + 24 * nl].reshape((nl, 2, 3)), flags[nv:], flags[:nv], ints[o:o + nm])
 
-    Minimum-norm Gauss-Newton steps, halved while the residual grows (not once the loops are within ``tol``: a
-    step that no longer reduces the error is round-off); the Jacobian is assembled only where the iteration goes
-    on. It stops at :data:`FINE` (quadratic convergence: the next step would change ``q`` by about the error),
-    or when no step reduces the residual.
+
+@kernel(entry=True)
+def solve_passive(q, motors, ints, floats, flags, tol, max_iter, q_out, info):
+    """Close the loops from ``q`` with the motors (``q[motor_q]``) set to ``motors`` (none: empty arrays) moving the
+    ``passive`` velocity coordinates only (the tree packed by :func:`legkin.closed.pack`, see :func:`_unpack`);
+    ``q_out`` the result, ``info`` the Gauss-Newton iterations, the frames' worst error (m or rad) and the residual
+    evaluations (:func:`_solve`).
 
     Returns:
         :data:`legkin._kernels.OK` when every loop's frames end within ``tol`` (m and rad), :data:`OPEN` if not,
         :data:`BAD` for a non-finite ``q`` or ``motors`` (nothing solved).
     """
+    parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t, loop_six, passive, motor_q = _unpack(
+        ints, floats, flags)
     for i in range(q.shape[0]):
         q_out[i] = q[i]
     for i in range(motors.shape[0]):
@@ -356,12 +370,25 @@ def solve_passive(q, motors, motor_q, parent, kind, axis, place_r, place_t, idx_
     for i in range(q.shape[0]):
         if not np.isfinite(q_out[i]):
             return BAD
+    worst = _solve(q_out, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t, loop_six,
+                   passive, tol, max_iter, info)
+    return OK if worst <= tol else OPEN
+
+
+@kernel
+def _solve(q_out, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t, loop_six, passive,
+           tol, max_iter, info):
+    """Minimum-norm Gauss-Newton on the ``passive`` coordinates from ``q_out``, in place; returns the frames' worst
+    error (m or rad). Steps are halved while the residual grows (not once the loops are within ``tol``: a step that
+    no longer reduces the error is round-off); the Jacobian is assembled only where the iteration goes on. It
+    stops at :data:`FINE` (quadratic convergence: the next step would change ``q`` by about the error), or when no
+    step reduces the residual."""
     nj, nl, nv = parent.shape[0], loop_j.shape[0], passive.shape[0]
     touch, lists, counts, row0, first, rows = _sparsity(loop_j, loop_six, parent, kind, idx_v, passive)
     o_r, o_t, pts, res = np.empty((2, nj, 3, 3)), np.zeros((2, nj, 3)), np.empty((2, nl, 2, 3)), np.empty((2, rows))
     o_r[:, 0] = np.eye(3)
     jac, a, ld, dy = np.empty((rows, nv)), np.empty((rows, rows)), np.empty((rows, rows)), np.empty((2, rows))
-    dv, trial, mats, vecs = np.empty(nv), np.empty_like(q), np.empty((5, 3, 3)), np.empty((4, 3))
+    dv, trial, mats, vecs = np.empty(nv), np.empty_like(q_out), np.empty((5, 3, 3)), np.empty((4, 3))
     s = 0  # the state of q_out: o_r[s], o_t[s], pts[s], res[s]; 1 - s: the trial's
     worst = _residual(q_out, parent, kind, axis, place_r, place_t, idx_q, loop_j, loop_r, loop_t, loop_six, o_r[s],
                       o_t[s], pts[s], res[s], mats, vecs)
@@ -386,7 +413,7 @@ def solve_passive(q, motors, motor_q, parent, kind, axis, place_r, place_t, idx_
         q_out[:] = trial
         s, worst = 1 - s, w2
         info[0], info[1] = it + 1.0, worst
-    return OK if worst <= tol else OPEN
+    return worst
 
 
 @kernel(entry=True)

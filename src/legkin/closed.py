@@ -31,7 +31,7 @@ from .closing import CLOSED_TOL, loop_errors
 from .errors import InvalidInputError, LoopClosureError, UnreachableError
 from .loops import levenberg_marquardt
 
-__all__ = ["ClosedLoopMixin", "Tree", "tree_of"]
+__all__ = ["ClosedLoopMixin", "Tree", "tree_of", "pack"]
 
 _STEPS = (1, 2, 4, 8, 16, 32, 64)
 _MAX_ITER = 50
@@ -69,6 +69,7 @@ def _from_lwa(jac: np.ndarray, placement: np.ndarray, reference) -> np.ndarray:
 
 _SOLVER: list[Any] = []
 _NO_MOTORS = np.zeros(0)
+_F64 = np.dtype(np.float64)
 
 
 def _solver() -> Any:
@@ -78,11 +79,6 @@ def _solver() -> Any:
 
         _SOLVER.append(solve_passive)
     return _SOLVER[0]
-
-
-def _vector(x: Any, n: int) -> bool:
-    """``x`` is a float64 vector of length ``n`` (what the kernel takes as is)."""
-    return type(x) is np.ndarray and x.dtype == np.float64 and x.shape == (n,)
 
 
 def _joint_kind(joint) -> tuple[int, tuple[float, ...]] | None:
@@ -116,6 +112,21 @@ def tree_of(model: pin.Model, loops) -> Tree | None:
         np.array([[f.placement.translation for f in pair] for pair in frames]).reshape(-1, 2, 3),
         np.array([lp.type == "frame" for lp in loops], dtype=np.bool_),
     )
+
+
+def pack(tree: Tree, motor_q: np.ndarray, passive: np.ndarray, loops: Any = None,
+         point: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``tree`` as the three arrays :func:`legkin._tree_kernels.solve_passive` takes (layout: its ``_unpack``), with
+    the motors' q indices ``motor_q``, the ``passive`` mask (over the velocity coordinates), the loops of indices
+    ``loops`` only (None: all), as point loops if ``point``."""
+    k = np.arange(len(tree.loop_j)) if loops is None else np.asarray(loops, dtype=np.int64)
+    six = np.zeros(len(k), dtype=np.bool_) if point else tree.loop_six[k]
+    nj = len(tree.parent)
+    ints = np.concatenate([[nj, len(k), len(motor_q)], tree.parent, tree.kind, tree.idx_q, tree.idx_v,
+                           tree.loop_j[k].ravel(), motor_q]).astype(np.int64)
+    floats = np.concatenate([tree.axis.ravel(), tree.place_r.ravel(), tree.place_t.ravel(), tree.loop_r[k].ravel(),
+                             tree.loop_t[k].ravel()])
+    return ints, floats, np.concatenate([np.asarray(passive, dtype=np.bool_), six])
 
 
 class ClosedLoopMixin:
@@ -174,15 +185,14 @@ class ClosedLoopMixin:
             self.__dict__["_closed_cache"] = cache
         return cache
 
-    def _kernel_args(self) -> tuple[Any, ...]:
-        """The arguments of :func:`legkin._tree_kernels.solve_passive` after ``q`` and ``motors`` up to ``passive``
-        (the motors' q indices, the tree's arrays), cached; needs :meth:`_tree`."""
+    def _kernel_args(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:func:`legkin._tree_kernels.solve_passive`'s tree arguments for ``closed_fk`` (the motors' q indices, the
+        passive mask), cached; needs :meth:`_tree`."""
         args = self.__dict__.get("_kernel_args_cache")
         if args is None:
-            t, iq = self._compiled()[:2]
+            t, iq, _, passive = self._compiled()
             assert t is not None
-            args = (iq.astype(np.int64), t.parent, t.kind, t.axis, t.place_r, t.place_t, t.idx_q, t.idx_v, t.loop_j,
-                    t.loop_r, t.loop_t, t.loop_six)
+            args = pack(t, iq, passive)
             self.__dict__["_kernel_args_cache"] = args
         return args
 
@@ -195,15 +205,12 @@ class ClosedLoopMixin:
         coordinates ``passive``, closing the loops of indices ``loops`` (None: all), as point loops if ``point``;
         returns the configuration, whether it closed, the iterations and the worst frame error (m or rad). Needs
         :meth:`_tree`."""
-        args = self._kernel_args()
+        t, iq = self._compiled()[:2]
+        assert t is not None
         out, info = np.empty_like(q), np.zeros(3)
         if motors is None:
-            motors, args = _NO_MOTORS, (_NO_MOTORS.astype(np.int64),) + args[1:]
-        if loops is not None or point:
-            k = np.arange(len(args[8])) if loops is None else np.asarray(loops, dtype=np.int64)
-            six = np.zeros(len(k), dtype=np.bool_) if point else args[11][k]
-            args = args[:8] + (args[8][k], args[9][k], args[10][k], six)
-        status = _solver()(q, motors, *args, passive, CLOSED_TOL, max_iter, out, info)
+            motors, iq = _NO_MOTORS, _NO_MOTORS.astype(np.int64)
+        status = _solver()(q, motors, *pack(t, iq, passive, loops, point), CLOSED_TOL, max_iter, out, info)
         return out, status == 0, int(info[0]), float(info[1])  # 0: legkin._kernels.OK
 
     def _fk_step(self, motors: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, bool]:
@@ -245,14 +252,20 @@ class ClosedLoopMixin:
         """The single call's lean path: float64 vectors of the right lengths go straight to the compiled solve (which
         checks their finiteness); None when the inputs are of another form or the solve does not close (the full
         path then checks them, continues from ``q_near`` or says why)."""
-        tree, iq, _, passive = self._compiled()
-        nq = self.model.nq
-        if tree is None or not _vector(motors, len(iq)) or not (q_near is None or _vector(q_near, nq)):
+        lean = self.__dict__.get("_lean_cache")
+        if lean is None:
+            tree, iq, _, passive = self._compiled()
+            lean = None if tree is None else (_solver(), (len(iq),), (self.model.nq,),
+                                              (*self._kernel_args(), CLOSED_TOL, _MAX_ITER), np.empty(3))
+            self.__dict__["_lean_cache"] = lean or ()
+        if not lean or type(motors) is not np.ndarray or motors.dtype is not _F64 or motors.shape != lean[1]:
             return None
-        out = np.empty(nq)
-        status = _solver()(self.q0 if q_near is None else q_near, motors, *self._kernel_args(), passive, CLOSED_TOL,
-                           _MAX_ITER, out, np.empty(3))
-        return out if status == 0 else None  # 0: legkin._kernels.OK
+        if q_near is None:
+            q_near = self.q0
+        elif type(q_near) is not np.ndarray or q_near.dtype is not _F64 or q_near.shape != lean[2]:
+            return None
+        out = np.empty(lean[2])
+        return out if lean[0](q_near, motors, *lean[3], out, lean[4]) == 0 else None  # 0: legkin._kernels.OK
 
     def _fk_error(self, m: np.ndarray, q: np.ndarray) -> LoopClosureError:
         errs = loop_errors(self.model, self._loopset.data, self._loopset.loops, self._fk_step(m, q)[0])

@@ -62,6 +62,8 @@ def test_closed_fk_jacobian_ik(robot):
     target = robot.frame_placement(qs[1], frame)
     qi = robot.closed_ik(frame, target)
     assert _worst(robot, qi) <= CLOSED_TOL
+    # the compiled solve reaches it (the target as one more loop), not only the Levenberg-Marquardt fallback
+    assert robot._ik_compiled(robot.frame_id(frame), target, target.translation, robot.q0) is not None
     assert np.linalg.norm(pin.log6(target.actInv(robot.frame_placement(qi, frame))).vector) <= CLOSED_TOL
 
 

@@ -378,23 +378,43 @@ class ClosedLoopMixin:
             return None, x
         return pin.SE3(x), x[:3, 3]
 
+    def _ik_compiled(self, fid: int, target: pin.SE3 | None, position: np.ndarray, q0: np.ndarray) -> np.ndarray | None:
+        """The compiled solve of ``closed_ik``: the target as one more loop, from the frame to the world (joint 0) at
+        the target (a point loop for a position), every joint free; the configuration if every loop and the target
+        are met to :data:`CLOSED_TOL`, else None (no kernel for these joints, or a stall)."""
+        t = self._tree()
+        if t is None:
+            return None
+        f = self.model.frames[fid]
+        rot = np.eye(3) if target is None else target.rotation
+        ik = Tree(**{**t.__dict__, "loop_j": np.vstack([t.loop_j, [[f.parentJoint, 0]]]),
+                     "loop_r": np.concatenate([t.loop_r, [[f.placement.rotation, rot]]]),
+                     "loop_t": np.concatenate([t.loop_t, [[f.placement.translation, position]]]),
+                     "loop_six": np.append(t.loop_six, target is not None)})
+        out, info = np.empty_like(q0), np.zeros(3)
+        status = _solver()(q0, _NO_MOTORS, *pack(ik, _NO_MOTORS.astype(np.int64), np.ones(self.model.nv, dtype=bool)),
+                           CLOSED_TOL, 4 * _MAX_ITER, out, info)
+        return out if status == 0 else None  # 0: legkin._kernels.OK
+
     def _ik_one(self, fid: int, pose, q0: np.ndarray) -> tuple[np.ndarray, float, float]:
-        """Gauss-Newton from ``q0`` on the loops and the frame's error; returns q, distance (m), angle (rad)."""
+        """The compiled Gauss-Newton (:meth:`_ik_compiled`), else Levenberg-Marquardt over Pinocchio, from ``q0`` on
+        the loops and the frame's error; returns q, distance (m), angle (rad)."""
         target, position = self._pose_target(pose)
         model, data = self.model, self._loopset.data
-        free = np.ones(model.nv, dtype=bool)
+        q = self._ik_compiled(fid, target, position, q0)
+        if q is None:
+            def fun(q):
+                r, jc = self._loopset.residual_and_jacobian(q)
+                pin.updateFramePlacements(model, data)
+                om = data.oMf[fid]
+                ref = pin.LOCAL if target is not None else pin.LOCAL_WORLD_ALIGNED
+                jf = pin.getFrameJacobian(model, data, fid, ref)
+                if target is None:
+                    return np.concatenate([r, om.translation - position]), np.vstack([jc, jf[:3]])
+                err = pin.log6(target.actInv(om)).vector
+                return np.concatenate([r, err]), np.vstack([jc, pin.Jlog6(target.actInv(om)) @ jf])
 
-        def fun(q):
-            r, jc = self._loopset.residual_and_jacobian(q)
-            pin.updateFramePlacements(model, data)
-            om = data.oMf[fid]
-            jf = pin.getFrameJacobian(model, data, fid, pin.LOCAL if target is not None else pin.LOCAL_WORLD_ALIGNED)
-            if target is None:
-                return np.concatenate([r, om.translation - position]), np.vstack([jc, jf[:3]])
-            err = pin.log6(target.actInv(om)).vector
-            return np.concatenate([r, err]), np.vstack([jc, pin.Jlog6(target.actInv(om)) @ jf])
-
-        q, _, _, _, _ = levenberg_marquardt(model, fun, q0, free, 1e-14, 4 * _MAX_ITER)
+            q = levenberg_marquardt(model, fun, q0, np.ones(model.nv, dtype=bool), 1e-14, 4 * _MAX_ITER)[0]
         pin.framesForwardKinematics(model, data, q)
         om = data.oMf[fid]
         dist = float(np.linalg.norm(om.translation - position))

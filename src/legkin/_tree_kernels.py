@@ -15,11 +15,12 @@ are the norms of its parts, so the solver's stopping test is the frames' own err
 
 Gauss-Newton on the passive coordinates, minimum-norm steps ``dv = -J^T y``, ``J J^T y = r`` solved by an
 ``LDL^T`` factorisation that skips the zero pivots (the redundant rows of planar loops make ``J J^T`` singular),
-halved while the residual grows. ``J J^T`` is sparse: a loop's rows only meet the columns of the joints that move
-its two frames, so its blocks are summed over the columns two loops share, and loops that share none (two legs)
-leave zero blocks that its factor keeps outside its envelope (:func:`_structure`). The Jacobian is assembled only
-at the configurations the iteration steps from (the residual alone decides a trial step). No LAPACK: numba's
-``np.linalg`` needs SciPy, which legkin does not require.
+damped (``J J^T + mu I``, ``mu`` growing) while the residual grows. ``J J^T`` is sparse: a loop's rows only
+meet the columns of the joints that move its two frames, so its blocks are summed over the columns two loops
+share, and loops that share none (two legs) leave zero blocks that its factor keeps outside its envelope
+(:func:`_structure`). The Jacobian is assembled only at the configurations the iteration steps from (the
+residual alone decides a trial step). No LAPACK: numba's ``np.linalg`` needs SciPy, which legkin does not
+require.
 """
 
 from __future__ import annotations
@@ -319,10 +320,18 @@ def _solve_psd(a, b, first, d, ld, out):
 
 
 @kernel
-def _step(jac, res, loop_six, touch, lists, counts, row0, first, a, ld, d, y, dv):
-    """Minimum-norm Gauss-Newton step on the passive columns: ``dv = -J_p^T y`` with ``J_p J_p^T y = r`` (the
-    structure from :func:`_structure`; ``a``, ``ld`` (rows x rows), ``d``, ``y`` (rows,): work arrays)."""
+def _step(jac, res, loop_six, touch, lists, counts, row0, first, mu, a, ld, d, y, dv):
+    """Minimum-norm Gauss-Newton step on the passive columns: ``dv = -J_p^T y`` with ``(J_p J_p^T + mu m I) y = r``
+    (``m`` the largest diagonal entry of ``J_p J_p^T``; ``mu`` = 0: Gauss-Newton, ``mu`` > 0: a damped step, a
+    descent direction even where ``J_p`` is rank-deficient and ``r`` outside its range); the structure from
+    :func:`_structure`; ``a``, ``ld`` (rows x rows), ``d``, ``y`` (rows,): work arrays."""
     _gram(jac, loop_six, touch, lists, counts, row0, a)
+    if mu > 0.0:
+        m = 0.0
+        for i in range(a.shape[0]):
+            m = max(m, a[i, i])
+        for i in range(a.shape[0]):
+            a[i, i] += mu * m
     _solve_psd(a, res, first, d, ld, y)
     dv[:] = 0.0
     for k in range(row0.shape[0]):
@@ -379,10 +388,10 @@ def solve_passive(q, motors, ints, floats, flags, tol, max_iter, q_out, info):
 def _solve(q_out, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t, loop_six, passive,
            tol, max_iter, info):
     """Minimum-norm Gauss-Newton on the ``passive`` coordinates from ``q_out``, in place; returns the frames' worst
-    error (m or rad). Steps are halved while the residual grows (not once the loops are within ``tol``: a step that
-    no longer reduces the error is round-off); the Jacobian is assembled only where the iteration goes on. It
-    stops at :data:`FINE` (quadratic convergence: the next step would change ``q`` by about the error), or when no
-    step reduces the residual."""
+    error (m or rad). A step that does not reduce the residual is damped (:func:`_step`), more and more, until one
+    does (not once the loops are within ``tol``: a step that no longer reduces the error is round-off); the
+    Jacobian is assembled only where the iteration goes on. It stops at :data:`FINE` (quadratic convergence: the
+    next step would change ``q`` by about the error), or when no step reduces the residual."""
     nj, nl, nv = parent.shape[0], loop_j.shape[0], passive.shape[0]
     touch, lists, counts, row0, first, rows = _sparsity(loop_j, loop_six, parent, kind, idx_v, passive)
     o_r, o_t, pts, res = np.empty((2, nj, 3, 3)), np.zeros((2, nj, 3)), np.empty((2, nl, 2, 3)), np.empty((2, rows))
@@ -397,9 +406,10 @@ def _solve(q_out, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, lo
         if worst <= FINE:
             break
         _jacobian(parent, kind, axis, idx_v, loop_j, loop_six, o_r[s], o_t[s], pts[s], jac, vecs[3])
-        _step(jac, res[s], loop_six, touch, lists, counts, row0, first, a, ld, dy[0], dy[1], dv)
         norm, reduced, w2 = np.sqrt(np.sum(res[s] ** 2)), False, worst
-        for _half in range(12):
+        for k in range(12):  # Gauss-Newton, then damped steps, damping 1e-9 to 10 (relative)
+            _step(jac, res[s], loop_six, touch, lists, counts, row0, first, 0.0 if k == 0 else 10.0 ** (k - 10), a,
+                  ld, dy[0], dy[1], dv)
             _integrate(q_out, dv, kind, idx_q, idx_v, trial)
             w2 = _residual(trial, parent, kind, axis, place_r, place_t, idx_q, loop_j, loop_r, loop_t, loop_six,
                            o_r[1 - s], o_t[1 - s], pts[1 - s], res[1 - s], mats, vecs)
@@ -407,7 +417,6 @@ def _solve(q_out, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, lo
             reduced = np.sqrt(np.sum(res[1 - s] ** 2)) < norm
             if reduced or worst <= tol:
                 break
-            dv *= 0.5
         if not reduced:
             break  # round-off level (or a local minimum): the tolerance decides
         q_out[:] = trial
@@ -455,7 +464,7 @@ def closed_jacobian_k(q, parent, kind, axis, place_r, place_t, idx_q, idx_v, loo
                     if passive[c]:
                         x += jac[i, c] * dv[c]
                 res[i] = x
-            _step(jac, res, loop_six, touch, lists, counts, row0, first, a2, ld, d, y, ddv)
+            _step(jac, res, loop_six, touch, lists, counts, row0, first, 0.0, a2, ld, d, y, ddv)
             dv += ddv
         for r in range(6):
             x = jf[r, motor_v[m]]

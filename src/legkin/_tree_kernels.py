@@ -15,10 +15,10 @@ are the norms of its parts, so the solver's stopping test is the frames' own err
 
 Gauss-Newton on the passive coordinates, minimum-norm steps ``dv = -J^T y``, ``J J^T y = r`` solved by an
 ``LDL^T`` factorisation that skips the zero pivots (the redundant rows of planar loops make ``J J^T`` singular),
-damped (``J J^T + mu I``, ``mu`` growing) while the residual grows. ``J J^T`` is sparse: a loop's rows only
-meet the columns of the joints that move its two frames, so its blocks are summed over the columns two loops
-share, and loops that share none (two legs) leave zero blocks that its factor keeps outside its envelope
-(:func:`_structure`). The Jacobian is assembled only at the configurations the iteration steps from (the
+halved, then damped (``J J^T + mu I``, ``mu`` growing), while the residual grows. ``J J^T`` is sparse: a
+loop's rows only meet the columns of the joints that move its two frames, so its blocks are summed over the
+columns two loops share, and loops that share none (two legs) leave zero blocks that its factor keeps outside its
+envelope (:func:`_structure`). The Jacobian is assembled only at the configurations the iteration steps from (the
 residual alone decides a trial step). No LAPACK: numba's ``np.linalg`` needs SciPy, which legkin does not
 require.
 """
@@ -388,8 +388,9 @@ def solve_passive(q, motors, ints, floats, flags, tol, max_iter, q_out, info):
 def _solve(q_out, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t, loop_six, passive,
            tol, max_iter, info):
     """Minimum-norm Gauss-Newton on the ``passive`` coordinates from ``q_out``, in place; returns the frames' worst
-    error (m or rad). A step that does not reduce the residual is damped (:func:`_step`), more and more, until one
-    does (not once the loops are within ``tol``: a step that no longer reduces the error is round-off); the
+    error (m or rad). A step that does not reduce the residual is halved, up to 5 times (near a singularity the
+    Gauss-Newton direction is still the one to follow), then damped (:func:`_step`), more and more, until one does
+    (not once the loops are within ``tol``: a step that no longer reduces the error is round-off); the
     Jacobian is assembled only where the iteration goes on. It stops at :data:`FINE` (quadratic convergence: the
     next step would change ``q`` by about the error), or when no step reduces the residual."""
     nj, nl, nv = parent.shape[0], loop_j.shape[0], passive.shape[0]
@@ -407,9 +408,12 @@ def _solve(q_out, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, lo
             break
         _jacobian(parent, kind, axis, idx_v, loop_j, loop_six, o_r[s], o_t[s], pts[s], jac, vecs[3])
         norm, reduced, w2 = np.sqrt(np.sum(res[s] ** 2)), False, worst
-        for k in range(12):  # Gauss-Newton, then damped steps, damping 1e-9 to 10 (relative)
-            _step(jac, res[s], loop_six, touch, lists, counts, row0, first, 0.0 if k == 0 else 10.0 ** (k - 10), a,
-                  ld, dy[0], dy[1], dv)
+        for k in range(16):  # Gauss-Newton, halved 5 times, then damped steps (damping 1e-9 to 10, relative)
+            if k == 0 or k > 5:
+                _step(jac, res[s], loop_six, touch, lists, counts, row0, first, 0.0 if k == 0 else 10.0 ** (k - 15),
+                      a, ld, dy[0], dy[1], dv)
+            else:
+                dv *= 0.5
             _integrate(q_out, dv, kind, idx_q, idx_v, trial)
             w2 = _residual(trial, parent, kind, axis, place_r, place_t, idx_q, loop_j, loop_r, loop_t, loop_six,
                            o_r[1 - s], o_t[1 - s], pts[1 - s], res[1 - s], mats, vecs)

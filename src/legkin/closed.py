@@ -116,9 +116,18 @@ def tree_of(model: pin.Model, loops) -> Tree | None:
 
 def pack(tree: Tree, motor_q: np.ndarray, passive: np.ndarray, loops: Any = None,
          point: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``tree`` as the three arrays :func:`legkin._tree_kernels.solve_passive` takes (layout: its ``_unpack``), with
-    the motors' q indices ``motor_q``, the ``passive`` mask (over the velocity coordinates), the loops of indices
-    ``loops`` only (None: all), as point loops if ``point``."""
+    """``tree`` as the three arrays :func:`legkin._tree_kernels.solve_passive` takes (layout: its ``_unpack``).
+
+    Args:
+        tree: the model's arrays (:func:`tree_of`).
+        motor_q: the motors' indices in ``q`` (int64; empty: no motor set).
+        passive: boolean mask over the velocity coordinates the solve moves.
+        loops: the indices of the loops to close (None: all).
+        point: close them as point loops (origins only).
+
+    Returns:
+        ``(ints, floats, flags)``: int64, float64 (rad, m) and boolean vectors.
+    """
     k = np.arange(len(tree.loop_j)) if loops is None else np.asarray(loops, dtype=np.int64)
     six = np.zeros(len(k), dtype=np.bool_) if point else tree.loop_six[k]
     nj = len(tree.parent)

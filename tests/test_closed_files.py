@@ -181,6 +181,13 @@ def test_single_and_batch_rule():
         robot.closed_fk(far)
     with pytest.raises(InvalidInputError):
         robot.closed_fk(motors[0][:-1])
+    for i in (0, robot._motor_index()[0][0]):  # a passive and a motor coordinate of q_near: refused, not overwritten
+        near = robot.q0.copy()
+        near[i] = np.inf
+        with pytest.raises(InvalidInputError, match="q_near"):
+            robot.closed_fk(motors[0], near)
+    with pytest.raises(InvalidInputError, match="motors must be finite"):
+        robot.closed_fk(np.r_[np.nan, motors[0][1:]])
     jac, ok = robot.closed_jacobian(qs[:2], "closedloop2_B", return_mask=True)
     assert jac.shape == (2, 6, len(robot.actuated)) and ok.all()
     assert np.allclose(jac[1], robot.closed_jacobian(qs[1], "closedloop2_B"))

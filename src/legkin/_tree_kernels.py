@@ -373,12 +373,13 @@ def solve_passive(q, motors, ints, floats, flags, tol, max_iter, q_out, info):
     parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t, loop_six, passive, motor_q = _unpack(
         ints, floats, flags)
     for i in range(q.shape[0]):
+        if not np.isfinite(q[i]):
+            return BAD
         q_out[i] = q[i]
     for i in range(motors.shape[0]):
-        q_out[motor_q[i]] = motors[i]
-    for i in range(q.shape[0]):
-        if not np.isfinite(q_out[i]):
+        if not np.isfinite(motors[i]):
             return BAD
+        q_out[motor_q[i]] = motors[i]
     worst = _solve(q_out, parent, kind, axis, place_r, place_t, idx_q, idx_v, loop_j, loop_r, loop_t, loop_six,
                    passive, tol, max_iter, info)
     return OK if worst <= tol else OPEN

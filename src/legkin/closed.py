@@ -31,7 +31,7 @@ from .closing import CLOSED_TOL, loop_errors
 from .errors import InvalidInputError, LoopClosureError, UnreachableError
 from .loops import levenberg_marquardt
 
-__all__ = ["ClosedLoopMixin", "Tree", "tree_of"]
+__all__ = ["ClosedLoopMixin", "Tree", "tree_of", "pack"]
 
 _STEPS = (1, 2, 4, 8, 16, 32, 64)
 _MAX_ITER = 50
@@ -68,6 +68,8 @@ def _from_lwa(jac: np.ndarray, placement: np.ndarray, reference) -> np.ndarray:
 
 
 _SOLVER: list[Any] = []
+_NO_MOTORS = np.zeros(0)
+_F64 = np.dtype(np.float64)
 
 
 def _solver() -> Any:
@@ -110,6 +112,30 @@ def tree_of(model: pin.Model, loops) -> Tree | None:
         np.array([[f.placement.translation for f in pair] for pair in frames]).reshape(-1, 2, 3),
         np.array([lp.type == "frame" for lp in loops], dtype=np.bool_),
     )
+
+
+def pack(tree: Tree, motor_q: np.ndarray, passive: np.ndarray, loops: Any = None,
+         point: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``tree`` as the three arrays :func:`legkin._tree_kernels.solve_passive` takes (layout: its ``_unpack``).
+
+    Args:
+        tree: the model's arrays (:func:`tree_of`).
+        motor_q: the motors' indices in ``q`` (int64; empty: no motor set).
+        passive: boolean mask over the velocity coordinates the solve moves.
+        loops: the indices of the loops to close (None: all).
+        point: close them as point loops (origins only).
+
+    Returns:
+        ``(ints, floats, flags)``: int64, float64 (rad, m) and boolean vectors.
+    """
+    k = np.arange(len(tree.loop_j)) if loops is None else np.asarray(loops, dtype=np.int64)
+    six = np.zeros(len(k), dtype=np.bool_) if point else tree.loop_six[k]
+    nj = len(tree.parent)
+    ints = np.concatenate([[nj, len(k), len(motor_q)], tree.parent, tree.kind, tree.idx_q, tree.idx_v,
+                           tree.loop_j[k].ravel(), motor_q]).astype(np.int64)
+    floats = np.concatenate([tree.axis.ravel(), tree.place_r.ravel(), tree.place_t.ravel(), tree.loop_r[k].ravel(),
+                             tree.loop_t[k].ravel()])
+    return ints, floats, np.concatenate([np.asarray(passive, dtype=np.bool_), six])
 
 
 class ClosedLoopMixin:
@@ -168,17 +194,32 @@ class ClosedLoopMixin:
             self.__dict__["_closed_cache"] = cache
         return cache
 
+    def _kernel_args(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """:func:`legkin._tree_kernels.solve_passive`'s tree arguments for ``closed_fk`` (the motors' q indices, the
+        passive mask), cached; needs :meth:`_tree`."""
+        args = self.__dict__.get("_kernel_args_cache")
+        if args is None:
+            t, iq, _, passive = self._compiled()
+            assert t is not None
+            args = pack(t, iq, passive)
+            self.__dict__["_kernel_args_cache"] = args
+        return args
+
     def _tree_solve(
-        self, q: np.ndarray, passive: np.ndarray, max_iter: int = _MAX_ITER
+        self, q: np.ndarray, passive: np.ndarray, max_iter: int = _MAX_ITER, motors: np.ndarray | None = None,
+        loops: Any = None, point: bool = False,
     ) -> tuple[np.ndarray, bool, int, float]:
         """The compiled solve (:func:`legkin._tree_kernels.solve_passive`: minimum-norm Gauss-Newton, its test the
-        frames' own error) moving the velocity coordinates ``passive``; returns the configuration, whether it
-        closed, the iterations and the worst frame error (m or rad). Needs :meth:`_tree`."""
-        t = self._tree()
+        frames' own error) from ``q`` with the motors set to ``motors`` (None: as in ``q``), moving the velocity
+        coordinates ``passive``, closing the loops of indices ``loops`` (None: all), as point loops if ``point``;
+        returns the configuration, whether it closed, the iterations and the worst frame error (m or rad). Needs
+        :meth:`_tree`."""
+        t, iq = self._compiled()[:2]
         assert t is not None
-        out, info = np.empty_like(q), np.zeros(2)
-        status = _solver()(q, t.parent, t.kind, t.axis, t.place_r, t.place_t, t.idx_q, t.idx_v, t.loop_j,
-                           t.loop_r, t.loop_t, t.loop_six, passive, CLOSED_TOL, max_iter, out, info)
+        out, info = np.empty_like(q), np.zeros(3)
+        if motors is None:
+            motors, iq = _NO_MOTORS, _NO_MOTORS.astype(np.int64)
+        status = _solver()(q, motors, *pack(t, iq, passive, loops, point), CLOSED_TOL, max_iter, out, info)
         return out, status == 0, int(info[0]), float(info[1])  # 0: legkin._kernels.OK
 
     def _fk_step(self, motors: np.ndarray, q: np.ndarray) -> tuple[np.ndarray, bool]:
@@ -189,7 +230,7 @@ class ClosedLoopMixin:
         q = q.copy()
         q[iq] = motors
         if tree is not None:
-            qt, ok, _, worst = self._tree_solve(q, passive)
+            qt, ok, _, worst = self._tree_solve(q, passive, motors=motors)
             if ok:
                 return qt, True
             # stalled near closure (measured: robot_delta, 2 of 200 samples at ~3e-10): Pinocchio's damped LM
@@ -215,6 +256,25 @@ class ClosedLoopMixin:
             if ok:
                 return qk
         return None
+
+    def _fk_lean(self, motors: Any, q_near: Any) -> np.ndarray | None:
+        """The single call's lean path: float64 vectors of the right lengths go straight to the compiled solve (which
+        checks their finiteness); None when the inputs are of another form or the solve does not close (the full
+        path then checks them, continues from ``q_near`` or says why)."""
+        lean = self.__dict__.get("_lean_cache")
+        if lean is None:
+            tree, iq, _, passive = self._compiled()
+            lean = None if tree is None else (_solver(), (len(iq),), (self.model.nq,),
+                                              (*self._kernel_args(), CLOSED_TOL, _MAX_ITER), np.empty(3))
+            self.__dict__["_lean_cache"] = lean or ()
+        if not lean or type(motors) is not np.ndarray or motors.dtype is not _F64 or motors.shape != lean[1]:
+            return None
+        if q_near is None:
+            q_near = self.q0
+        elif type(q_near) is not np.ndarray or q_near.dtype is not _F64 or q_near.shape != lean[2]:
+            return None
+        out = np.empty(lean[2])
+        return out if lean[0](q_near, motors, *lean[3], out, lean[4]) == 0 else None  # 0: legkin._kernels.OK
 
     def _fk_error(self, m: np.ndarray, q: np.ndarray) -> LoopClosureError:
         errs = loop_errors(self.model, self._loopset.data, self._loopset.loops, self._fk_step(m, q)[0])
@@ -249,6 +309,10 @@ class ClosedLoopMixin:
             LoopClosureError: (single call) the loops do not close with these motor values (out of the workspace,
                 or across a singularity from ``q_near``).
         """
+        if return_mask is False:
+            lean = self._fk_lean(motors, q_near)
+            if lean is not None:
+                return lean
         iq = self._compiled()[1]
         m = as_input(motors, "motors", (len(iq),))
         return_mask = check_flag(return_mask, "return_mask")
@@ -323,23 +387,43 @@ class ClosedLoopMixin:
             return None, x
         return pin.SE3(x), x[:3, 3]
 
+    def _ik_compiled(self, fid: int, target: pin.SE3 | None, position: np.ndarray, q0: np.ndarray) -> np.ndarray | None:
+        """The compiled solve of ``closed_ik``: the target as one more loop, from the frame to the world (joint 0) at
+        the target (a point loop for a position), every joint free; the configuration if every loop and the target
+        are met to :data:`CLOSED_TOL`, else None (no kernel for these joints, or a stall)."""
+        t = self._tree()
+        if t is None:
+            return None
+        f = self.model.frames[fid]
+        rot = np.eye(3) if target is None else target.rotation
+        ik = Tree(**{**t.__dict__, "loop_j": np.vstack([t.loop_j, [[f.parentJoint, 0]]]),
+                     "loop_r": np.concatenate([t.loop_r, [[f.placement.rotation, rot]]]),
+                     "loop_t": np.concatenate([t.loop_t, [[f.placement.translation, position]]]),
+                     "loop_six": np.append(t.loop_six, target is not None)})
+        out, info = np.empty_like(q0), np.zeros(3)
+        status = _solver()(q0, _NO_MOTORS, *pack(ik, _NO_MOTORS.astype(np.int64), np.ones(self.model.nv, dtype=bool)),
+                           CLOSED_TOL, 4 * _MAX_ITER, out, info)
+        return out if status == 0 else None  # 0: legkin._kernels.OK
+
     def _ik_one(self, fid: int, pose, q0: np.ndarray) -> tuple[np.ndarray, float, float]:
-        """Gauss-Newton from ``q0`` on the loops and the frame's error; returns q, distance (m), angle (rad)."""
+        """The compiled Gauss-Newton (:meth:`_ik_compiled`), else Levenberg-Marquardt over Pinocchio, from ``q0`` on
+        the loops and the frame's error; returns q, distance (m), angle (rad)."""
         target, position = self._pose_target(pose)
         model, data = self.model, self._loopset.data
-        free = np.ones(model.nv, dtype=bool)
+        q = self._ik_compiled(fid, target, position, q0)
+        if q is None:
+            def fun(q):
+                r, jc = self._loopset.residual_and_jacobian(q)
+                pin.updateFramePlacements(model, data)
+                om = data.oMf[fid]
+                ref = pin.LOCAL if target is not None else pin.LOCAL_WORLD_ALIGNED
+                jf = pin.getFrameJacobian(model, data, fid, ref)
+                if target is None:
+                    return np.concatenate([r, om.translation - position]), np.vstack([jc, jf[:3]])
+                err = pin.log6(target.actInv(om)).vector
+                return np.concatenate([r, err]), np.vstack([jc, pin.Jlog6(target.actInv(om)) @ jf])
 
-        def fun(q):
-            r, jc = self._loopset.residual_and_jacobian(q)
-            pin.updateFramePlacements(model, data)
-            om = data.oMf[fid]
-            jf = pin.getFrameJacobian(model, data, fid, pin.LOCAL if target is not None else pin.LOCAL_WORLD_ALIGNED)
-            if target is None:
-                return np.concatenate([r, om.translation - position]), np.vstack([jc, jf[:3]])
-            err = pin.log6(target.actInv(om)).vector
-            return np.concatenate([r, err]), np.vstack([jc, pin.Jlog6(target.actInv(om)) @ jf])
-
-        q, _, _, _, _ = levenberg_marquardt(model, fun, q0, free, 1e-14, 4 * _MAX_ITER)
+            q = levenberg_marquardt(model, fun, q0, np.ones(model.nv, dtype=bool), 1e-14, 4 * _MAX_ITER)[0]
         pin.framesForwardKinematics(model, data, q)
         om = data.oMf[fid]
         dist = float(np.linalg.norm(om.translation - position))

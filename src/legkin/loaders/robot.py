@@ -126,8 +126,9 @@ class FileRobot(Robot):
         if self._tree() is None:
             return None, True
 
-        def fast(q, free):
-            q, _, iterations, _ = self._tree_solve(q, np.asarray(free, dtype=np.bool_), _LOAD_ITER)
+        def fast(q, free, loops=None, point=False):
+            q, _, iterations, _ = self._tree_solve(q, np.asarray(free, dtype=np.bool_), _LOAD_ITER, loops=loops,
+                                                   point=point)
             return q, iterations
 
         return fast, False

@@ -176,9 +176,10 @@ def _legkin_pool_threads() -> list[str]:
 
 
 def test_dask_task_uses_one_core(cluster):
-    """A study task runs its batches on the task's thread alone, whatever numba's thread count in the worker (here
-    the machine's CPU count: the environment of a dask worker is applied after its process imported numba, when
-    the parent's __main__ imports it), and the worker has dask's profiler off (legkin.study.cluster.QUIET)."""
+    """A study task runs its batches on the task's thread alone (no legkin batch-pool thread started), whatever
+    numba's thread count in the worker (here the machine's CPU count; an env= of the cluster would not do: dask
+    applies it after the worker process has imported the parent's __main__, and with it, often, numba), and
+    local_cluster's workers have dask's profiler off (legkin.study.cluster.QUIET)."""
     import dask
     import numba
 

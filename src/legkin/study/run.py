@@ -195,7 +195,9 @@ def study(model: str, params: Mapping[str, Any], samples: int = 10**6, metrics: 
             "rim_contact" for the wheel-leg).
         seed: root seed; block (point i, block b) uses ``SeedSequence(seed, spawn_key=(i, b))``.
         client: None: in-process (the compiled batches on every numba thread); a ``dask.distributed.Client``: one
-            task per chunk on its workers. The table is identical bit for bit either way.
+            task per chunk on its workers, each on one numba thread (one core a worker thread;
+            :func:`~legkin.study.cluster.local_cluster` starts such a cluster here). The table is identical bit for
+            bit either way.
         block_size: samples per block (the unit of seeding: changing it changes the samples).
         chunk_blocks: blocks per dask task (default :data:`CHUNK_BLOCKS`); does not change the result.
         singular_threshold: eps, dimensionless, in (0, 1).

@@ -1,11 +1,11 @@
-"""A dask ``LocalCluster`` whose workers each use one core: one worker process = one task thread = one numba thread.
+"""A dask ``LocalCluster`` whose workers each use one core: one worker process = one task thread, and a study task
+runs its batches on that thread alone (:func:`legkin.study.run.run_chunk`, ``threads=1``).
 
-What else a dask process runs beside its tasks, measured on a 2-CPU machine (scripts/bench_study.py): with dask's
-defaults an idle worker process spends 2.3 % of a core (its event loop ticks every 20 ms, its memory monitor every
-100 ms) and, while a task runs, 8-10 % more CPU than the task's own thread (the statistical profiler samples the
-task thread's stack every 10 ms); the scheduler and nannies in the client's process spend 3 % of a core. On 2 cores
-with 2 workers that is ~8 % of a core taken from the workers. :data:`QUIET` turns the profiler off and slows the
-periodic callbacks (+1 % a worker, 0.6 % of a core in the client's process).
+What a dask process runs beside its tasks, measured on a 2-CPU machine (process CPU time over 5-10 s, idle and
+while a task ran): with dask's defaults a worker process spends 2.3-2.8 % of a core beyond its task's thread (its
+statistical profiler samples the task's stack every 10 ms, its event loop ticks every 20 ms, its memory monitor
+runs every 100 ms) and the client's process (scheduler and nannies) 3 %: on 2 cores with 2 workers, ~8 % of a core
+taken from the workers. With :data:`QUIET`: 0.3 % a worker, 0.6-0.8 % in the client's process.
 """
 
 from __future__ import annotations

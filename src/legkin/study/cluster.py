@@ -27,13 +27,14 @@ QUIET: dict[str, Any] = {
     "distributed.admin.system-monitor.interval": "2s",
 }
 
+
 @contextlib.contextmanager
 def local_cluster(workers: int = 2) -> Iterator[Any]:
     """A ``LocalCluster`` of ``workers`` processes on this machine and a client connected to it, closed on exit.
 
-    Each worker process runs one task at a time (``threads_per_worker=1``) with one numba thread
-    (:data:`WORKER_ENV`) and dask's background work reduced (:data:`QUIET`), so k workers use k cores. The
-    dashboard takes a free port. (``legkin study --scheduler local:K`` uses it.)
+    Each worker process runs one task at a time (``threads_per_worker=1``), a study task on one numba thread (on
+    any cluster), with dask's background work reduced (:data:`QUIET`), so k workers use k cores. The dashboard
+    takes a free port. (``legkin study --scheduler local:K`` uses it.)
 
     Args:
         workers: the number of worker processes (>= 1).

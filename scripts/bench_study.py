@@ -65,6 +65,18 @@ def _task_overhead(client: Any, k: int = 400) -> float:
     return (time.perf_counter() - t0) / k
 
 
+def _autogroup() -> str:
+    """Linux's autogroup scheduling: the processes of one session (this script, its scheduler, its workers) share
+    one fair share of the CPUs against the other sessions, so on a busy machine k workers get the cores of one."""
+    try:
+        with open("/proc/sys/kernel/sched_autogroup_enabled") as f:
+            on = f.read().strip() == "1"
+    except OSError:
+        return ""
+    return ("; autogroup scheduling on: this session's processes share one CPU share with other sessions busy"
+            if on else "")
+
+
 def _worker_conditions() -> str:
     """What a worker process ran on: numba's thread count (a study task runs on 1), the thread env vars, its OS
     threads, legkin's batch-pool threads (started only by a batch split over numba threads) and dask's profiler."""
@@ -173,7 +185,7 @@ def main() -> None:
     start = time.perf_counter()
     print(f"conditions: {os.cpu_count()} CPUs, load average {os.getloadavg()[0]:.2f} (1 min, lags) at start, numba "
           f"threads {numba.get_num_threads()} in-process; model {a.model}, {a.param}={a.value}, metrics "
-          f"{'+'.join(DEFAULT_METRICS)}")
+          f"{'+'.join(DEFAULT_METRICS)}{_autogroup()}")
     rows = _in_process(a)
     grid = {a.param: [a.value] * 4}  # 4 points: chunks for both workers from the start
     runs = {k: _cluster_run(k, a.model, grid, a.cluster_n, k == 1) for k in ((1, 2) if a.cluster_n else ())}

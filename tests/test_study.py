@@ -164,11 +164,32 @@ def test_cli_writes_the_table_and_the_plot(tmp_path, capsys):
 @pytest.fixture(scope="module")
 def cluster():
     pytest.importorskip("distributed")  # the study extra; the tests above run without it
-    from distributed import Client, LocalCluster
+    from legkin.study import local_cluster
 
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as lc:
-        with Client(lc) as client:
-            yield lc, client
+    with local_cluster(2) as client:
+        yield client.cluster, client
+
+
+def _legkin_pool_threads() -> list[str]:
+    """The threads of legkin's batch pool in this process: started by the first batch split over numba threads."""
+    return [t.name for t in threading.enumerate() if t.name.startswith("legkin")]
+
+
+def test_dask_task_uses_one_core(cluster):
+    """A study task runs its batches on the task's thread alone (no legkin batch-pool thread started), whatever
+    numba's thread count in the worker (here the machine's CPU count; an env= of the cluster would not do: dask
+    applies it after the worker process has imported the parent's __main__, and with it, often, numba), and
+    local_cluster's workers have dask's profiler off (legkin.study.cluster.QUIET)."""
+    import dask
+    import numba
+
+    lc, client = cluster
+    worker_threads = client.run(numba.get_num_threads)
+    if min(worker_threads.values()) < 2:
+        pytest.skip("one CPU: a batch never splits over numba threads here")
+    study("planar_2link", {"l1": [0.25, 0.3]}, samples=200_000, client=client)  # blocks of 65536 >= min_parallel
+    assert client.run(_legkin_pool_threads) == {w: [] for w in worker_threads}
+    assert set(client.run(dask.config.get, "distributed.worker.profile.enabled").values()) == {False}
 
 
 TRIPOD = ("tripod", {"alpha": [0.7, 1.1]}, 300_000)

@@ -9,17 +9,18 @@ import importlib
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from .cluster import local_cluster
     from .run import BLOCK_SIZE, CHUNK_BLOCKS, DEFAULT_METRICS, Plan, plan, study
     from .targets import TARGETS, StudyTarget, get_target
 
 #: Public name -> the submodule defining it.
 _WHERE = {
     "study": "run", "plan": "run", "Plan": "run", "BLOCK_SIZE": "run", "CHUNK_BLOCKS": "run", "DEFAULT_METRICS": "run",
-    "TARGETS": "targets", "StudyTarget": "targets", "get_target": "targets",
+    "local_cluster": "cluster", "TARGETS": "targets", "StudyTarget": "targets", "get_target": "targets",
 }
 
-__all__ = ["study", "plan", "Plan", "TARGETS", "StudyTarget", "get_target", "BLOCK_SIZE", "CHUNK_BLOCKS",
-           "DEFAULT_METRICS"]
+__all__ = ["study", "plan", "Plan", "local_cluster", "TARGETS", "StudyTarget", "get_target", "BLOCK_SIZE",
+           "CHUNK_BLOCKS", "DEFAULT_METRICS"]
 
 
 def __getattr__(name: str) -> Any:

@@ -53,8 +53,8 @@ def _need(modules: tuple[str, ...], what: str) -> None:
 
 @contextlib.contextmanager
 def scheduler_client(spec: str | None) -> Iterator[Any]:
-    """None (in-process), a LocalCluster (``local`` or ``local:K``: K worker processes, one thread and one numba
-    thread each) or a connection to a running scheduler (its address).
+    """None (in-process), a LocalCluster (``local`` or ``local:K``: :func:`~legkin.study.cluster.local_cluster`, K
+    worker processes of one core each) or a connection to a running scheduler (its address).
 
     Args:
         spec: the ``--scheduler`` value.
@@ -66,16 +66,17 @@ def scheduler_client(spec: str | None) -> Iterator[Any]:
         yield None
         return
     _need(("distributed",), "--scheduler")
-    from distributed import Client, LocalCluster
-
     if spec == "local" or spec.startswith("local:"):
         k = spec.partition(":")[2] or "2"
         if not k.isdigit() or int(k) < 1:
             raise LegkinError(f"--scheduler local:K needs K >= 1 workers, got {spec!r}")
-        with LocalCluster(n_workers=int(k), threads_per_worker=1, processes=True, dashboard_address=":0",
-                          env={"NUMBA_NUM_THREADS": "1"}) as cluster, Client(cluster) as client:
+        from .cluster import local_cluster
+
+        with local_cluster(int(k)) as client:
             yield client
         return
+    from distributed import Client
+
     with Client(spec) as client:
         yield client
 

@@ -9,10 +9,11 @@ in-process, on one worker or on many, whatever ``chunk_blocks``.
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import uuid
 from dataclasses import dataclass
-from typing import Any, Mapping, Sequence
+from typing import Any, Iterator, Mapping, Sequence
 
 import numpy as np
 
@@ -110,14 +111,32 @@ def plan(model: str, params: Mapping[str, Any], samples: int, metrics: Sequence[
                 seed)
 
 
+@contextlib.contextmanager
+def _numba_threads(k: int | None) -> Iterator[None]:
+    """The batches called inside run on at most k numba threads (numba's setting is per calling thread); None: as
+    set."""
+    if k is None:
+        yield
+        return
+    import numba
+
+    before = numba.get_num_threads()
+    numba.set_num_threads(max(1, min(k, before)))
+    try:
+        yield
+    finally:
+        numba.set_num_threads(before)
+
+
 def run_chunk(model: str, params: Mapping[str, Any], point: int, sizes: Sequence[int], first: int, seed: int,
-              metrics: tuple[str, ...], threshold: float) -> list[dict[str, Any]]:
+              metrics: tuple[str, ...], threshold: float, threads: int | None = None) -> list[dict[str, Any]]:
     """The statistics of blocks ``first, first + 1, ...`` (sizes ``sizes``) of one point: one dask task.
 
     Args:
         model: the target's name. params: the point's resolved parameters. point: its index (seeding).
         sizes: the blocks' sample counts. first: the first block's index. seed: the root seed.
         metrics: the metric groups. threshold: the singularity threshold eps.
+        threads: numba threads of the batches (None: numba's setting; a dask task: 1, its worker thread's core).
 
     Returns:
         One :func:`~legkin.study.stats.block_stats` dict per block.
@@ -125,10 +144,11 @@ def run_chunk(model: str, params: Mapping[str, Any], point: int, sizes: Sequence
     target = get_target(model)
     extras = tuple(m for m in metrics if m in target.extras)
     out = []
-    for j, n in enumerate(sizes):
-        rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(point, first + j)))
-        solved = target.solve(target.sample(rng, n, params), params, extras)
-        out.append(block_stats(solved, n, threshold, extras))
+    with _numba_threads(threads):
+        for j, n in enumerate(sizes):
+            rng = np.random.default_rng(np.random.SeedSequence(seed, spawn_key=(point, first + j)))
+            solved = target.solve(target.sample(rng, n, params), params, extras)
+            out.append(block_stats(solved, n, threshold, extras))
     return out
 
 
@@ -147,11 +167,13 @@ def _run_local(p: Plan, show: bool) -> list[list[dict[str, Any]]]:
 
 
 def _run_dask(p: Plan, client: Any, show: bool) -> list[list[dict[str, Any]]]:
-    """One task per chunk (keys unique to this run); dask re-runs a task whose worker is lost."""
+    """One task per chunk (keys unique to this run), on one numba thread: the parallelism is dask's workers and
+    their threads, one core each (a worker's ``NUMBA_NUM_THREADS`` is the machine's CPU count whenever its process
+    imported numba before dask applied its environment). dask re-runs a task whose worker is lost."""
     from distributed import progress
 
     run = uuid.uuid4().hex[:12]
-    futures = [client.submit(run_chunk, *_args(p, c), key=f"legkin-study-{run}-{k}", retries=2)
+    futures = [client.submit(run_chunk, *_args(p, c), threads=1, key=f"legkin-study-{run}-{k}", retries=2)
                for k, c in enumerate(p.chunks)]
     if show:
         progress(futures)
@@ -173,7 +195,9 @@ def study(model: str, params: Mapping[str, Any], samples: int = 10**6, metrics: 
             "rim_contact" for the wheel-leg).
         seed: root seed; block (point i, block b) uses ``SeedSequence(seed, spawn_key=(i, b))``.
         client: None: in-process (the compiled batches on every numba thread); a ``dask.distributed.Client``: one
-            task per chunk on its workers. The table is identical bit for bit either way.
+            task per chunk on its workers, each on one numba thread (one core a worker thread;
+            :func:`~legkin.study.cluster.local_cluster` starts such a cluster here). The table is identical bit for
+            bit either way.
         block_size: samples per block (the unit of seeding: changing it changes the samples).
         chunk_blocks: blocks per dask task (default :data:`CHUNK_BLOCKS`); does not change the result.
         singular_threshold: eps, dimensionless, in (0, 1).

@@ -4,7 +4,7 @@ kinematics from the three motors (:func:`fk`, through the closed sub-chain's FK 
 from __future__ import annotations
 
 import math
-from typing import Literal, Sequence, overload
+from typing import Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -12,24 +12,13 @@ from numpy.typing import ArrayLike
 from .._batch import as_angles, dispatch
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import ConvergenceError, SingularityError
-from ._options import (
-    SCALARS,
-    ST_ASSEMBLE,
-    ST_BAND,
-    ST_INPUT,
-    ST_SINGULAR,
-    flat,
-    mode_args,
-    resolve,
-)
+from ._options import SCALARS, ST_ASSEMBLE, ST_BAND, ST_INPUT, ST_SINGULAR, Branch, flat, mode_args, resolve
 from .chains import CX, CY, CZ, OX, OZ, rod_rates_k, tips_k
 from .extension import ll_k
 from .forward import fk_failure, fk_select_k
 from .geometry import FK_GAIN_MAX, FOOT_X, RATIO, Geometry
 
 __all__ = ["foot_position_from_platform", "fk", "jacobian"]
-
-Branch = Sequence[int]
 
 
 @kernel(entry=True)

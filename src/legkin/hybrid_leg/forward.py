@@ -4,7 +4,7 @@ in the assembly mode asked for (seed 003, eqs 1-16; the poses of :mod:`.polynomi
 from __future__ import annotations
 
 import math
-from typing import Literal, NamedTuple, Sequence, overload
+from typing import Literal, NamedTuple, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -17,6 +17,7 @@ from ._options import (
     SCALARS,
     ST_ASSEMBLE,
     ST_INPUT,
+    Branch,
     check_assembly,
     check_branch,
     fast_branch,
@@ -30,8 +31,6 @@ from .geometry import K_TOL, Geometry
 from .polynomial import MAX_SOL, rod_newton_k, solutions_k
 
 __all__ = ["platform_orientation", "platform_poses", "PlatformPoses"]
-
-Branch = Sequence[int]
 
 
 @kernel(entry=True)

@@ -10,7 +10,7 @@ boolean mask of successes.
 from __future__ import annotations
 
 import math
-from typing import Literal, Sequence, overload
+from typing import Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -18,38 +18,11 @@ from numpy.typing import ArrayLike
 from .._batch import as_angles, check_flag, finish
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import SingularityError
-from ._options import (
-    SCALARS,
-    ST_REACH,
-    ST_SINGULAR,
-    check_branch,
-    fast_branch,
-    flat,
-    resolve,
-    unreachable,
-)
-from .chains import (
-    AX0,
-    AX1,
-    AY0,
-    AY1,
-    AZ0,
-    AZ1,
-    CX,
-    CY,
-    CZ,
-    motor_angles_k,
-    ref_of,
-    rod_rates_k,
-    rot_k,
-    sgn_k,
-    tips_k,
-)
+from ._options import SCALARS, ST_REACH, ST_SINGULAR, Branch, check_branch, fast_branch, flat, resolve, unreachable
+from .chains import AX0, AX1, AY0, AY1, AZ0, AZ1, CX, CY, CZ, motor_angles_k, ref_of, rod_rates_k, rot_k, sgn_k, tips_k
 from .geometry import Geometry
 
 __all__ = ["platform_rotation", "rod_spans", "motor_angles", "motor_jacobian", "assembly_mode"]
-
-Branch = Sequence[int]
 
 
 # ----------------------------------------------------------------------------- kernels

@@ -9,7 +9,7 @@ raises InvalidInputError.
 from __future__ import annotations
 
 import math
-from typing import Callable, Literal, Sequence, overload
+from typing import Callable, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -17,13 +17,11 @@ from numpy.typing import ArrayLike
 from .._batch import as_input, check_flag, finish
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import InvalidInputError
-from ._options import ST_INPUT, check_branch, fast_branch, resolve, unreachable
+from ._options import ST_INPUT, Branch, check_branch, fast_branch, resolve, unreachable
 from .chains import AX0, AX1, AY0, AY1, AZ0, AZ1, CX, CY, CZ, L, chains_k, is_rotation_k, rotation_error_k, tips_k
 from .geometry import BETA, K_TOL, Geometry
 
 __all__ = ["motor_angles_from_rotation", "sphere_joint_angles", "spherical_free_axis"]
-
-Branch = Sequence[int]
 
 
 @kernel(entry=True)

@@ -26,7 +26,7 @@ from ._options import (
     mode_text,
     resolve,
 )
-from .chains import chains_k, ref_of, rot_k, tips_k
+from .chains import chains_k, lever_tips_k, ref_of, rot_k
 from .geometry import K_TOL, Geometry
 from .polynomial import MAX_SOL, rod_newton_k, solutions_k
 
@@ -111,9 +111,7 @@ def _poses_b(t1, t2, tol, max_iter, x, br, asm):
 def fk_guess_k(t1, t2, g0, g1, b1, b2, tol, max_iter, x):
     """:func:`platform_orientation` from a guess: plain Newton from (g0, g1), then the pose must close both rods
     within tol and give back the motors (t1, t2) on branch (b1, b2). Returns _OK or ST_ASSEMBLE (x NaN)."""
-    tip = np.empty((2, 3))
-    dtip = np.empty((2, 3))
-    tips_k(t1, t2, tip, dtip)
+    tip, dtip = lever_tips_k(t1, t2)
     x[0], x[1] = g0, g1
     err = rod_newton_k(x, tip, max_iter, False)
     x[0], x[1] = wrap_k(x[0]), wrap_k(x[1])

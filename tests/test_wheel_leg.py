@@ -433,6 +433,9 @@ def test_ik_unreachable():
         lambda: wl.ik([0.1, [0.2]], "FL"),
         lambda: wl.ik([0.1, 0.1, -0.2], "FL", q_start=[1.0, 0.0, 0.0], method="damped", alpha=np.zeros(2),
                       w=np.zeros(3)),
+        # a float64 target and q_near / q_start (the fast path) with a NaN / inf entry beyond theta
+        lambda: wl.ik(wl.fk([1.0, 0.2, 0.1], "FL"), "FL", q_near=np.array([1.0, np.nan, 0.0])),
+        lambda: wl.ik(wl.fk([1.0, 0.2, 0.1], "FL"), "FL", q_start=np.array([1.0, 0.0, np.inf]), method="damped"),
     ],
 )
 def test_invalid_inputs(call):

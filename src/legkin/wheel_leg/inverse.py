@@ -257,8 +257,8 @@ def _rows(rows: np.ndarray, a, b, near, start, ctx: _IKCtx):
     _check_w(w, ctx.base.geo)
     out = [alpha, w]
     for x, name in ((near, "q_near"), (start, "q_start")):
-        if x is not None:
-            x = np.ascontiguousarray(np.broadcast_to(x, (n, 3)))
+        if x is not None:  # finite (InvalidInputError), theta in range
+            x = np.ascontiguousarray(np.broadcast_to(as_input(x, name, (3,)), (n, 3)))
             _check_theta(x[:, 0], f"theta ({name}[..., 0])")
         out.append(x)
     return out

@@ -601,6 +601,25 @@ def test_ik_contract_property(theta, beta, gamma, alpha, w, leg, rim, offset, ax
         assert np.linalg.norm(wl.fk(q, leg, alpha=alpha, w=w, rim=rim) - target) <= 1e-12
 
 
+def test_ik_context_is_built_once_per_keyword_set(monkeypatch):
+    """ik and ik_all build their context (the keywords checked, the kernels' constants and tables) once per keyword
+    set, whatever the path (fast, batch, info, ik_all, the failure path)."""
+    from legkin.wheel_leg import inverse
+
+    calls = []
+    build = inverse._context
+    monkeypatch.setattr(inverse, "_context", lambda *a: calls.append(a) or build(*a))
+    inverse._ik_ctx_cached.cache_clear()
+    target = wl.fk([1.0, 0.2, 0.1], "RL", alpha=0.2)
+    for _ in range(2):
+        wl.ik(target, "RL", alpha=0.2)
+        wl.ik(np.stack([target, target]), "RL", alpha=[0.2, 0.2], return_info=True)
+        wl.ik_all(target.tolist(), "RL", alpha=0.2)
+        with pytest.raises(legkin.UnreachableError):
+            wl.ik(target + 1.0, "RL", alpha=0.2)
+    assert len(calls) == 1
+
+
 def test_ik_info_counts_evaluations():
     q = np.array([[1.0, 0.2, 0.1], [1.5, -0.3, -0.2]])
     target = wl.fk(q, "FL", alpha=0.3, w=0.01)

@@ -433,6 +433,9 @@ def test_ik_unreachable():
         lambda: wl.ik([0.1, [0.2]], "FL"),
         lambda: wl.ik([0.1, 0.1, -0.2], "FL", q_start=[1.0, 0.0, 0.0], method="damped", alpha=np.zeros(2),
                       w=np.zeros(3)),
+        # a float64 target and q_near / q_start (the fast path) with a NaN / inf entry beyond theta
+        lambda: wl.ik(wl.fk([1.0, 0.2, 0.1], "FL"), "FL", q_near=np.array([1.0, np.nan, 0.0])),
+        lambda: wl.ik(wl.fk([1.0, 0.2, 0.1], "FL"), "FL", q_start=np.array([1.0, 0.0, np.inf]), method="damped"),
     ],
 )
 def test_invalid_inputs(call):
@@ -596,6 +599,25 @@ def test_ik_contract_property(theta, beta, gamma, alpha, w, leg, rim, offset, ax
             continue
         assert abs(q[2]) <= wl.ABAD_LIMIT and wl.THETA_MIN <= q[0] <= wl.THETA_MAX
         assert np.linalg.norm(wl.fk(q, leg, alpha=alpha, w=w, rim=rim) - target) <= 1e-12
+
+
+def test_ik_context_is_built_once_per_keyword_set(monkeypatch):
+    """ik and ik_all build their context (the keywords checked, the kernels' constants and tables) once per keyword
+    set, whatever the path (fast, batch, info, ik_all, the failure path)."""
+    from legkin.wheel_leg import inverse
+
+    calls = []
+    build = inverse._context
+    monkeypatch.setattr(inverse, "_context", lambda *a: calls.append(a) or build(*a))
+    inverse._ik_ctx_cached.cache_clear()
+    target = wl.fk([1.0, 0.2, 0.1], "RL", alpha=0.2)
+    for _ in range(2):
+        wl.ik(target, "RL", alpha=0.2)
+        wl.ik(np.stack([target, target]), "RL", alpha=[0.2, 0.2], return_info=True)
+        wl.ik_all(target.tolist(), "RL", alpha=0.2)
+        with pytest.raises(legkin.UnreachableError):
+            wl.ik(target + 1.0, "RL", alpha=0.2)
+    assert len(calls) == 1
 
 
 def test_ik_info_counts_evaluations():

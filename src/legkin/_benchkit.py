@@ -6,8 +6,8 @@ import contextlib
 import importlib.util
 import os
 import sys
-from dataclasses import dataclass, field
-from typing import Any, Callable, Iterable
+from dataclasses import dataclass, field, fields
+from typing import Any, Callable, Iterable, Mapping
 
 import numpy as np
 
@@ -241,25 +241,27 @@ class MethodResult:
     note: str = ""
 
     def as_dict(self) -> dict:
-        d = {
-            "name": self.name,
-            "targets": self.targets,
-            "solved": self.solved,
-            "median_error": self.median_error,
-            "max_error": self.max_error,
-            "time_per_target_s": self.time_per_target_s,
-            "group": self.group,
-            "error_unit": self.unit,
-            "solved_count": self.solved_count,
-            "repeats": self.repeats,
-            "ratio_to_fastest": self.ratio,
-        }
-        for key in ("reached", "iterations_median", "fk_evals_mean", "bytes_per_target"):
-            if getattr(self, key) is not None:
-                d[key] = getattr(self, key)
-        if self.median_orientation_error is not None:
-            d["median_secondary_error"] = self.median_orientation_error
-            d["max_secondary_error"] = self.max_orientation_error
-        if self.note:
-            d["note"] = self.note
-        return d
+        """The JSON row (docs/bench.json), :func:`record`."""
+        return record(self, {"unit": "error_unit", "ratio": "ratio_to_fastest",
+                             "median_orientation_error": "median_secondary_error",
+                             "max_orientation_error": "max_secondary_error"})
+
+
+def record(result: Any, renamed: Mapping[str, str], extra: Mapping[str, Any] | None = None) -> dict:
+    """A result dataclass as a JSON record: its fields in order (named as ``renamed`` says), an optional field (one
+    whose default is None or "") left out while it has that default, then ``extra``.
+
+    Args:
+        result: the dataclass instance.
+        renamed: field name -> key in the record.
+        extra: more keys (computed properties).
+
+    Returns:
+        the record, a new dict.
+    """
+    d = {}
+    for f in fields(result):
+        value = getattr(result, f.name)
+        if not (f.default in (None, "") and value == f.default):
+            d[renamed.get(f.name, f.name)] = value
+    return {**d, **(extra or {})}

@@ -18,6 +18,8 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ._benchkit import record
+
 __all__ = [
     "SingleCall",
     "YARDSTICKS",
@@ -80,19 +82,8 @@ class SingleCallResult:
         return self.time_per_call_s / self.yardstick_time_s
 
     def as_dict(self) -> dict:
-        d = {
-            "name": self.name,
-            "yardstick": self.yardstick,
-            "time_per_call_s": self.time_per_call_s,
-            "yardstick_time_per_call_s": self.yardstick_time_s,
-            "ratio": self.ratio,
-            "number": self.number,
-            "repeats": self.repeats,
-            "iterative": self.iterative,
-        }
-        if self.error:
-            d["error"] = self.error
-        return d
+        """The JSON row (docs/bench.json), :func:`legkin._benchkit.record`."""
+        return record(self, {"yardstick_time_s": "yardstick_time_per_call_s"}, {"ratio": self.ratio})
 
 
 def time_call(call: Callable[[], object], repeats: int, min_time: float) -> tuple[float, int]:

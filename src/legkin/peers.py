@@ -27,6 +27,8 @@ PEER_TOL = 1e-10
 PEER_MAX_ITER = 200
 #: The damping given to mink and pink (their QP's Levenberg-Marquardt term), as CLIK's.
 PEER_DAMPING = 1e-12
+#: mink's and pink's integration step (s): a full step of the QP's velocity.
+PEER_DT = 1.0
 
 
 def _reference(bench):
@@ -75,37 +77,47 @@ def _rtb():
 
 
 # ------------------------------------------------------------------------------------------- mink
-def _differential_ik(p: np.ndarray, iq: int, dt: float, start: Callable[[np.ndarray], Any],
-                     foot: Callable[[Any], np.ndarray], velocity: Callable[[Any], np.ndarray]
-                     ) -> tuple[np.ndarray, np.ndarray]:
-    """mink's and pink's loop: per target, ``conf = start(target)``, then ``conf.integrate_inplace(velocity(conf),
-    dt)`` until ``|foot(conf) - target| < PEER_TOL`` (m) or PEER_MAX_ITER steps.
+def _differential_peer(setup: str, limits: str, iq: int, start: Callable[[], Any], task: Any,
+                       pose: Callable[[np.ndarray], Any], foot: Callable[[Any], np.ndarray],
+                       velocity: Callable[[Any], np.ndarray]) -> tuple[Callable[[np.ndarray], Any], str]:
+    """mink's and pink's method: per target, ``conf = start()``, ``task.set_target(pose(target))``, then
+    ``conf.integrate_inplace(velocity(conf), PEER_DT)`` until ``|foot(conf) - target| < PEER_TOL`` (m) or
+    PEER_MAX_ITER steps.
 
     Args:
-        p: (n, 3) foot targets (m).
+        setup: the note's first part (the peer, its model and task).
+        limits: the limits its ``solve_ik`` takes, for the note.
         iq: the leg's first joint in the configuration ``conf.q``.
-        dt: the integration step (s).
-        start: the configuration at the start of one target's solve (the target set in its task).
+        start: the configuration at the start of one target's solve (q0).
+        task: the peer's foot task.
+        pose: the task's target pose (an SE3 of the peer's) of a foot target (m).
         foot: the foot position (3,) of a configuration (m).
         velocity: the joint velocity (rad/s) the peer's QP asks of a configuration.
 
     Returns:
-        ``(q (n, 3) the leg's joints (rad), iterations (n,))``.
+        ``(run, note)``: ``run(p)`` of (n, 3) foot targets (m) returns ``(q (n, 3) the leg's joints (rad),
+        iterations (n,))``.
     """
-    out = np.full((len(p), 3), np.nan)
-    iters = np.zeros(len(p))
-    for k, target in enumerate(p):
-        conf = start(target)
-        i = 0
-        while True:
-            err = foot(conf) - target
-            if np.linalg.norm(err) < PEER_TOL or i >= PEER_MAX_ITER:
-                break
-            conf.integrate_inplace(velocity(conf), dt)
-            i += 1
-        out[k] = conf.q[iq : iq + 3]
-        iters[k] = i
-    return out, iters
+    def run(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        out = np.full((len(p), 3), np.nan)
+        iters = np.zeros(len(p))
+        for k, target in enumerate(p):
+            conf = start()
+            task.set_target(pose(target))
+            i = 0
+            while True:
+                err = foot(conf) - target
+                if np.linalg.norm(err) < PEER_TOL or i >= PEER_MAX_ITER:
+                    break
+                conf.integrate_inplace(velocity(conf), PEER_DT)
+                i += 1
+            out[k] = conf.q[iq : iq + 3]
+            iters[k] = i
+        return out, iters
+
+    note = (f"{setup}, loop solve_ik(daqp, damping {PEER_DAMPING:g}, {limits}) + integrate_inplace with dt = "
+            f"{PEER_DT:g} (a full step), until |e| < {PEER_TOL:g} m or {PEER_MAX_ITER} iterations")
+    return run, note
 
 
 def _mink():
@@ -127,22 +139,16 @@ def _mink():
     conf = mink.Configuration(model, q0)
     task = mink.FrameTask(f"{LEG}_FOOT", "body", position_cost=1.0, orientation_cost=0.0)
     limits = [mink.ConfigurationLimit(model)]
-    dt = 1.0
 
-    def start(target):
+    def start():
         conf.update(q0)
-        task.set_target(mink.SE3.from_translation(target))
         return conf
 
-    def run(p):
-        return _differential_ik(
-            p, iq, dt, start, lambda c: c.get_transform_frame_to_world(f"{LEG}_FOOT", "body").translation(),
-            lambda c: mink.solve_ik(c, [task], dt, "daqp", damping=PEER_DAMPING, limits=limits))
-
-    note = (f"mink: the URDF in MuJoCo (fusestatic off), FrameTask({LEG}_FOOT, position_cost 1, orientation_cost "
-            f"0), loop solve_ik(daqp, damping {PEER_DAMPING:g}, ConfigurationLimit) + integrate_inplace with dt = 1 "
-            f"(a full step), from q0, until |e| < {PEER_TOL:g} m or {PEER_MAX_ITER} iterations")
-    return run, note
+    return _differential_peer(
+        f"mink: the URDF in MuJoCo (fusestatic off), from q0, FrameTask({LEG}_FOOT, position_cost 1, "
+        "orientation_cost 0)", "ConfigurationLimit", iq, start, task, mink.SE3.from_translation,
+        lambda c: c.get_transform_frame_to_world(f"{LEG}_FOOT", "body").translation(),
+        lambda c: mink.solve_ik(c, [task], PEER_DT, "daqp", damping=PEER_DAMPING, limits=limits))
 
 
 # ------------------------------------------------------------------------------------------- pink
@@ -156,23 +162,12 @@ def _pink():
     data = model.createData()
     q0 = robot.q0.copy()
     task = FrameTask(f"{LEG}_FOOT", position_cost=1.0, orientation_cost=0.0)
-    dt = 1.0
     eye = np.eye(3)
-
-    def start(target):
-        conf = pink.Configuration(model, data, q0)
-        task.set_target(pin.SE3(eye, target))
-        return conf
-
-    def run(p):
-        return _differential_ik(
-            p, iq, dt, start, lambda c: c.get_transform_frame_to_world(f"{LEG}_FOOT").translation,
-            lambda c: pink.solve_ik(c, [task], dt, solver="daqp", damping=PEER_DAMPING, safety_break=False))
-
-    note = (f"pink: Configuration(model, data, q0), FrameTask({LEG}_FOOT, position_cost 1, orientation_cost 0), "
-            f"loop solve_ik(daqp, damping {PEER_DAMPING:g}, its default configuration and velocity limits) + "
-            f"integrate_inplace with dt = 1 (a full step), until |e| < {PEER_TOL:g} m or {PEER_MAX_ITER} iterations")
-    return run, note
+    return _differential_peer(
+        f"pink: Configuration(model, data, q0), FrameTask({LEG}_FOOT, position_cost 1, orientation_cost 0)",
+        "its default configuration and velocity limits", iq, lambda: pink.Configuration(model, data, q0), task,
+        lambda t: pin.SE3(eye, t), lambda c: c.get_transform_frame_to_world(f"{LEG}_FOOT").translation,
+        lambda c: pink.solve_ik(c, [task], PEER_DT, solver="daqp", damping=PEER_DAMPING, safety_break=False))
 
 
 # ------------------------------------------------------------------------------------------- pytorch-kinematics

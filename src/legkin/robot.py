@@ -338,29 +338,13 @@ class Robot(ClosedLoopMixin):
         return self._loopset.mobility(q, free, check_number(tol, "tol", 0.0, 1.0, high_open=True))
 
     @overload
-    def solve_loops(
-        self,
-        q_init: Any = ...,
-        fixed: Mapping[str, float] | Iterable[str] | None = ...,
-        *,
-        tol: float = ...,
-        max_iter: int = ...,
-        damping: float = ...,
-        return_info: Literal[False] = ...,
-    ) -> np.ndarray: ...
-
+    def solve_loops(self, q_init: Any = ..., fixed: Mapping[str, float] | Iterable[str] | None = ..., *,
+                    tol: float = ..., max_iter: int = ..., damping: float = ...,
+                    return_info: Literal[False] = ...) -> np.ndarray: ...
     @overload
-    def solve_loops(
-        self,
-        q_init: Any = ...,
-        fixed: Mapping[str, float] | Iterable[str] | None = ...,
-        *,
-        tol: float = ...,
-        max_iter: int = ...,
-        damping: float = ...,
-        return_info: Literal[True],
-    ) -> tuple[np.ndarray, LoopSolveInfo]: ...
-
+    def solve_loops(self, q_init: Any = ..., fixed: Mapping[str, float] | Iterable[str] | None = ..., *,
+                    tol: float = ..., max_iter: int = ..., damping: float = ...,
+                    return_info: Literal[True]) -> tuple[np.ndarray, LoopSolveInfo]: ...
     def solve_loops(
         self,
         q_init: Any = None,

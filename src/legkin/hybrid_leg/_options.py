@@ -6,7 +6,7 @@ InvalidInputError, hence a ValueError) naming the option and the value given.
 
 from __future__ import annotations
 
-from typing import Final
+from typing import Final, Sequence
 
 import numpy as np
 
@@ -20,6 +20,9 @@ ST_REACH: Final = 2  # a chain out of the motors' reach (|k| > 1 + tol)
 ST_ASSEMBLE: Final = 3  # the closed sub-chain does not assemble in the mode asked for
 ST_BAND: Final = 4  # the forward-singularity band (foot gain >= FK_GAIN_MAX)
 ST_SINGULAR: Final = 5  # N singular / reach boundary
+
+#: A motor branch pair (b1, b2), each +1 or -1 (:func:`check_branch`).
+Branch = Sequence[int]
 
 #: Scalar types a single-call fast path passes straight to a kernel (anything else takes the checked path).
 SCALARS = (float, np.float64)

@@ -193,11 +193,6 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         Method("pinocchio closed-loop IK (LM on loops + foot, start q0)", targets, _pinocchio_ik(robot),
                _pinocchio_score(robot), max_targets=n_iter, repeats=3),
     ]
-    return ModelBench(
-        methods=methods,
-        units={"ik": "m"},
-        tolerance=f"foot error <= {SOLVE_TOL:g} m (and loop |r| <= {SOLVE_TOL:g} for Pinocchio's configuration)",
-        notes=_notes(n_batch, n_scalar, n_iter),
-        summary=_summary,
-        secondary="loop |r|",
-    )
+    tolerance = f"foot error <= {SOLVE_TOL:g} m (and loop |r| <= {SOLVE_TOL:g} for Pinocchio's configuration)"
+    return ModelBench(methods=methods, units={"ik": "m"}, tolerance=tolerance, notes=_notes(n_batch, n_scalar, n_iter),
+                      summary=_summary, secondary="loop |r|")

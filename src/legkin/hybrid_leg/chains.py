@@ -64,6 +64,17 @@ def is_rotation_k(m):
 
 
 @kernel
+def arm_k(m, i):
+    """``m a_i``: chain i's platform point relative to the centre (eqs 9, 16), rotated by m (3, 3) (three numbers)."""
+    if i == 0:
+        ax, ay, az = AX0, AY0, AZ0
+    else:
+        ax, ay, az = AX1, AY1, AZ1
+    return (m[0, 0] * ax + m[0, 1] * ay + m[0, 2] * az, m[1, 0] * ax + m[1, 1] * ay + m[1, 2] * az,
+            m[2, 0] * ax + m[2, 1] * ay + m[2, 2] * az)
+
+
+@kernel
 def chain_k(m, i, bi, tol, theta, kout):
     """Chain i's rod-length equation (seed eqs 3-9, 10-16) for the platform rotation m (3, 3), branch bi.
 
@@ -72,12 +83,11 @@ def chain_k(m, i, bi, tol, theta, kout):
     ``k = C / sqrt(A^2 + B^2)``. Writes theta[i] (wrapped; NaN when unreachable) and kout[i]; returns reachable.
     """
     if i == 0:
-        ax, ay, az, px, py, pz, sg, yaw = AX0, AY0, AZ0, PX0, PY0, PZ0, 1.0, BETA
+        px, py, pz, sg, yaw = PX0, PY0, PZ0, 1.0, BETA
     else:
-        ax, ay, az, px, py, pz, sg, yaw = AX1, AY1, AZ1, PX1, PY1, PZ1, -1.0, -BETA
-    wx = px - (CX + (m[0, 0] * ax + m[0, 1] * ay + m[0, 2] * az))
-    wy = py - (CY + (m[1, 0] * ax + m[1, 1] * ay + m[1, 2] * az))
-    wz = pz - (CZ + (m[2, 0] * ax + m[2, 1] * ay + m[2, 2] * az))
+        px, py, pz, sg, yaw = PX1, PY1, PZ1, -1.0, -BETA
+    rx, ry, rz = arm_k(m, i)
+    wx, wy, wz = px - (CX + rx), py - (CY + ry), pz - (CZ + rz)
     a = LX * wx
     b = LX * wy
     c = 0.5 * (L * L - (wx * wx + wy * wy + wz * wz) - LX * LX - LZ * LZ - 2.0 * LZ * wz)
@@ -130,6 +140,15 @@ def tips_k(t1, t2, tip, dtip):
         dtip[i, 0] = -LX * s
         dtip[i, 1] = LX * c
         dtip[i, 2] = 0.0
+
+
+@kernel(inline=True)
+def lever_tips_k(t1, t2):
+    """:func:`tips_k` into new arrays: (tip (2, 3), dtip (2, 3))."""
+    tip = np.empty((2, 3))
+    dtip = np.empty((2, 3))
+    tips_k(t1, t2, tip, dtip)
+    return tip, dtip
 
 
 @kernel
@@ -210,9 +229,7 @@ def ref_sign_k(b1, b2):
     th = np.empty(2)
     kk = np.empty(2)
     chains_k(rot, b1, b2, K_TOL, th, kk)
-    tip = np.empty((2, 3))
-    dtip = np.empty((2, 3))
-    tips_k(th[0], th[1], tip, dtip)
+    tip, dtip = lever_tips_k(th[0], th[1])
     g = np.empty(2)
     nm = np.empty((2, 2))
     rod_system_k(0.0, 0.0, tip, g, nm)

@@ -4,7 +4,7 @@ kinematics from the three motors (:func:`fk`, through the closed sub-chain's FK 
 from __future__ import annotations
 
 import math
-from typing import Literal, Sequence, overload
+from typing import Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -12,24 +12,13 @@ from numpy.typing import ArrayLike
 from .._batch import as_angles, dispatch
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import ConvergenceError, SingularityError
-from ._options import (
-    SCALARS,
-    ST_ASSEMBLE,
-    ST_BAND,
-    ST_INPUT,
-    ST_SINGULAR,
-    flat,
-    mode_args,
-    resolve,
-)
-from .chains import CX, CY, CZ, OX, OZ, rod_rates_k, tips_k
+from ._options import SCALARS, ST_ASSEMBLE, ST_BAND, ST_INPUT, ST_SINGULAR, Branch, flat, mode_args, resolve
+from .chains import CX, CY, CZ, OX, OZ, lever_tips_k, rod_rates_k
 from .extension import ll_k
 from .forward import fk_failure, fk_select_k
 from .geometry import FK_GAIN_MAX, FOOT_X, RATIO, Geometry
 
 __all__ = ["foot_position_from_platform", "fk", "jacobian"]
-
-Branch = Sequence[int]
 
 
 @kernel(entry=True)
@@ -111,9 +100,7 @@ def foot_position_k(t1, t2, t0, sv, b1, b2, s, out, aux):
     if st != OK:
         return st
     tll = ll_k(t0, sv)
-    tip = np.empty((2, 3))
-    dtip = np.empty((2, 3))
-    tips_k(t1, t2, tip, dtip)
+    tip, dtip = lever_tips_k(t1, t2)
     aux[2] = gain_k(x[0], x[1], tll, tip, dtip)
     if not (aux[2] < FK_GAIN_MAX):
         return ST_BAND
@@ -141,9 +128,7 @@ def foot_jacobian_k(t1, t2, t0, sv, b1, b2, s, jac):
     if st != OK:
         return st
     r, p = x[0], x[1]
-    tip = np.empty((2, 3))
-    dtip = np.empty((2, 3))
-    tips_k(t1, t2, tip, dtip)
+    tip, dtip = lever_tips_k(t1, t2)
     nm = np.empty((2, 2))
     dd = np.empty(2)
     rod_rates_k(r, p, tip, dtip, nm, dd)

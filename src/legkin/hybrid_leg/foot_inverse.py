@@ -11,27 +11,13 @@ from numpy.typing import ArrayLike
 from .._batch import as_input, check_flag, dispatch, finish
 from ..errors import InvalidInputError, UnreachableError
 from ._ik_errors import arc_error, axis_error, ik_error, platform_pose
-from ._ik_kernels import (
-    foot_ik_b,
-    ik_all_b,
-    ik_all_out_k,
-    platform_pose_b,
-)
-from ._options import (
-    check_assembly,
-    check_branch,
-    check_sign,
-    fast_geometry,
-    fmt,
-    mode_args,
-    resolve,
-)
+from ._ik_kernels import foot_ik_b, ik_all_b, ik_all_out_k, platform_pose_b
+from ._options import Branch, check_assembly, check_branch, check_sign, fast_geometry, fmt, mode_args, resolve
 from .chains import CX, CY, CZ
 from .geometry import CENTER, FOOT_IK_ORDER, Geometry
 
 __all__ = ["foot_platform_ik", "ik", "ik_all", "ik_branches", "FootIKSolutions"]
 
-Branch = Sequence[int]
 _COMBOS = np.array(FOOT_IK_ORDER, dtype=np.float64)
 _NO_NEAR = np.full((1, 3), np.nan)  # the near row of a single call (none)
 _NO_BRANCH = bytes(16)  # the bytes of a mask (16,) without any branch (10x cheaper to compare than .any())

@@ -4,7 +4,7 @@ in the assembly mode asked for (seed 003, eqs 1-16; the poses of :mod:`.polynomi
 from __future__ import annotations
 
 import math
-from typing import Literal, NamedTuple, Sequence, overload
+from typing import Literal, NamedTuple, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -17,6 +17,7 @@ from ._options import (
     SCALARS,
     ST_ASSEMBLE,
     ST_INPUT,
+    Branch,
     check_assembly,
     check_branch,
     fast_branch,
@@ -25,13 +26,11 @@ from ._options import (
     mode_text,
     resolve,
 )
-from .chains import chains_k, ref_of, rot_k, tips_k
+from .chains import chains_k, lever_tips_k, ref_of, rot_k
 from .geometry import K_TOL, Geometry
 from .polynomial import MAX_SOL, rod_newton_k, solutions_k
 
 __all__ = ["platform_orientation", "platform_poses", "PlatformPoses"]
-
-Branch = Sequence[int]
 
 
 @kernel(entry=True)
@@ -112,9 +111,7 @@ def _poses_b(t1, t2, tol, max_iter, x, br, asm):
 def fk_guess_k(t1, t2, g0, g1, b1, b2, tol, max_iter, x):
     """:func:`platform_orientation` from a guess: plain Newton from (g0, g1), then the pose must close both rods
     within tol and give back the motors (t1, t2) on branch (b1, b2). Returns _OK or ST_ASSEMBLE (x NaN)."""
-    tip = np.empty((2, 3))
-    dtip = np.empty((2, 3))
-    tips_k(t1, t2, tip, dtip)
+    tip, dtip = lever_tips_k(t1, t2)
     x[0], x[1] = g0, g1
     err = rod_newton_k(x, tip, max_iter, False)
     x[0], x[1] = wrap_k(x[0]), wrap_k(x[1])

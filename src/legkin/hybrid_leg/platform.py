@@ -10,7 +10,7 @@ boolean mask of successes.
 from __future__ import annotations
 
 import math
-from typing import Literal, Sequence, overload
+from typing import Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -18,38 +18,11 @@ from numpy.typing import ArrayLike
 from .._batch import as_angles, check_flag, finish
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import SingularityError
-from ._options import (
-    SCALARS,
-    ST_REACH,
-    ST_SINGULAR,
-    check_branch,
-    fast_branch,
-    flat,
-    resolve,
-    unreachable,
-)
-from .chains import (
-    AX0,
-    AX1,
-    AY0,
-    AY1,
-    AZ0,
-    AZ1,
-    CX,
-    CY,
-    CZ,
-    motor_angles_k,
-    ref_of,
-    rod_rates_k,
-    rot_k,
-    sgn_k,
-    tips_k,
-)
+from ._options import SCALARS, ST_REACH, ST_SINGULAR, Branch, check_branch, fast_branch, flat, resolve, unreachable
+from .chains import CX, CY, CZ, arm_k, lever_tips_k, motor_angles_k, ref_of, rod_rates_k, rot_k, sgn_k
 from .geometry import Geometry
 
 __all__ = ["platform_rotation", "rod_spans", "motor_angles", "motor_jacobian", "assembly_mode"]
-
-Branch = Sequence[int]
 
 
 # ----------------------------------------------------------------------------- kernels
@@ -62,16 +35,12 @@ def _rot_b(r, p, out):
 @kernel(entry=True)
 def spans_k(t1, t2, r, p, out):
     """|A_i - S_i| (2,): lever tips of eqs 7, 14 to the platform points of eqs 9, 16 at R_P = Rx(r) Ry(p)."""
-    tip = np.empty((2, 3))
-    dtip = np.empty((2, 3))
-    tips_k(t1, t2, tip, dtip)
+    tip, dtip = lever_tips_k(t1, t2)
     m = np.empty((3, 3))
     rot_k(r, p, m)
     for i in range(2):
-        ax, ay, az = (AX0, AY0, AZ0) if i == 0 else (AX1, AY1, AZ1)
-        dx = CX + (m[0, 0] * ax + m[0, 1] * ay + m[0, 2] * az) - tip[i, 0]
-        dy = CY + (m[1, 0] * ax + m[1, 1] * ay + m[1, 2] * az) - tip[i, 1]
-        dz = CZ + (m[2, 0] * ax + m[2, 1] * ay + m[2, 2] * az) - tip[i, 2]
+        rx, ry, rz = arm_k(m, i)
+        dx, dy, dz = CX + rx - tip[i, 0], CY + ry - tip[i, 1], CZ + rz - tip[i, 2]
         out[i] = math.sqrt(dx * dx + dy * dy + dz * dz)
 
 
@@ -98,9 +67,7 @@ def motor_jacobian_k(r, p, b1, b2, jac, kout, mode):
     st = motor_angles_k(r, p, b1, b2, th, kout)
     if st != OK:
         return st
-    tip = np.empty((2, 3))
-    dtip = np.empty((2, 3))
-    tips_k(th[0], th[1], tip, dtip)
+    tip, dtip = lever_tips_k(th[0], th[1])
     nm = np.empty((2, 2))
     dd = np.empty(2)
     rod_rates_k(r, p, tip, dtip, nm, dd)
@@ -195,10 +162,8 @@ def motor_angles(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *, 
     solved in closed form; ``branch = (b1, b2)`` picks one of its two solutions per chain.
 
     Args:
-        roll, pitch: platform angles (rad), broadcast together.
-        branch: the motor branch pair (b1, b2), each +1 or -1.
-        geometry: the geometry (universal centre); None = the default.
-        return_mask: also return the mask of successes.
+        roll, pitch: platform angles (rad), broadcast together; branch, geometry (universal centre), return_mask:
+            as :func:`motor_angles_from_rotation`.
 
     Returns:
         (..., 2) (theta1, theta2) (rad), NaN where out of reach; then the mask, if asked.

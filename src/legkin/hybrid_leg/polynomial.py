@@ -24,7 +24,24 @@ import numpy as np
 
 from .._kernels import kernel
 from .._rotations import wrap_k
-from .chains import AX0, AX1, AY0, AY1, AZ0, AZ1, CX, CY, CZ, L, chain_k, rod_rate_k, rod_system_k, rot_k, sgn_k, tips_k
+from .chains import (
+    AX0,
+    AX1,
+    AY0,
+    AY1,
+    AZ0,
+    AZ1,
+    CX,
+    CY,
+    CZ,
+    L,
+    chain_k,
+    lever_tips_k,
+    rod_rate_k,
+    rod_system_k,
+    rot_k,
+    sgn_k,
+)
 from .geometry import BOUNDARY_TOL, K_TOL, LIMIT_TOL, PLATFORM_LIMIT
 
 _TWO_PI = 2.0 * math.pi
@@ -415,9 +432,7 @@ def solutions_k(t1, t2, tol, max_iter, xs, bl, sdet):
     their pitch from the two rod equations (linear in cos, sin pitch), each polished by Newton; near the forward
     singularity, extra Newton runs from both sides of each near-singular solution with the det N barrier.
     """
-    tip = np.empty((2, 3))
-    dtip = np.empty((2, 3))
-    tips_k(t1, t2, tip, dtip)
+    tip, dtip = lever_tips_k(t1, t2)
     x0 = np.empty((MAX_SOL, 2))
     imag = np.empty(MAX_SOL)
     nseed = seeds_k(tip, x0, imag)

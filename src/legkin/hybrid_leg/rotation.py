@@ -9,7 +9,7 @@ raises InvalidInputError.
 from __future__ import annotations
 
 import math
-from typing import Callable, Literal, Sequence, overload
+from typing import Callable, Literal, overload
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -17,13 +17,11 @@ from numpy.typing import ArrayLike
 from .._batch import as_input, check_flag, finish
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import InvalidInputError
-from ._options import ST_INPUT, check_branch, fast_branch, resolve, unreachable
-from .chains import AX0, AX1, AY0, AY1, AZ0, AZ1, CX, CY, CZ, L, chains_k, is_rotation_k, rotation_error_k, tips_k
+from ._options import ST_INPUT, Branch, check_branch, fast_branch, resolve, unreachable
+from .chains import CX, CY, CZ, L, arm_k, chains_k, is_rotation_k, lever_tips_k, rotation_error_k
 from .geometry import BETA, K_TOL, Geometry
 
 __all__ = ["motor_angles_from_rotation", "sphere_joint_angles", "spherical_free_axis"]
-
-Branch = Sequence[int]
 
 
 @kernel(entry=True)
@@ -44,15 +42,11 @@ def sphere_k(m, b1, b2, out, kout):
     out[:, :] = math.nan
     if st != OK:
         return st
-    tip = np.empty((2, 3))
-    dtip = np.empty((2, 3))
-    tips_k(th[0], th[1], tip, dtip)
+    tip, dtip = lever_tips_k(th[0], th[1])
     for i in range(2):
-        ax, ay, az = (AX0, AY0, AZ0) if i == 0 else (AX1, AY1, AZ1)
         phi = th[i] + (BETA if i == 0 else -BETA)
-        dx = CX + (m[0, 0] * ax + m[0, 1] * ay + m[0, 2] * az) - tip[i, 0]
-        dy = CY + (m[1, 0] * ax + m[1, 1] * ay + m[1, 2] * az) - tip[i, 1]
-        dz = CZ + (m[2, 0] * ax + m[2, 1] * ay + m[2, 2] * az) - tip[i, 2]
+        rx, ry, rz = arm_k(m, i)
+        dx, dy, dz = CX + rx - tip[i, 0], CY + ry - tip[i, 1], CZ + rz - tip[i, 2]
         c, s = math.cos(phi), math.sin(phi)
         ux, uy, uz = (c * dx + s * dy) / L, (-s * dx + c * dy) / L, dz / L
         out[i, 0] = math.atan2(uy, ux)
@@ -70,15 +64,10 @@ def free_axis_k(m, b1, b2, out, kout):
     out[:] = math.nan
     if st != OK:
         return st
-    tip = np.empty((2, 3))
-    dtip = np.empty((2, 3))
-    tips_k(th[0], th[1], tip, dtip)
+    tip, dtip = lever_tips_k(th[0], th[1])
     g = np.empty((2, 3))
     for i in range(2):
-        ax, ay, az = (AX0, AY0, AZ0) if i == 0 else (AX1, AY1, AZ1)
-        rx = m[0, 0] * ax + m[0, 1] * ay + m[0, 2] * az
-        ry = m[1, 0] * ax + m[1, 1] * ay + m[1, 2] * az
-        rz = m[2, 0] * ax + m[2, 1] * ay + m[2, 2] * az
+        rx, ry, rz = arm_k(m, i)
         dx, dy, dz = CX + rx - tip[i, 0], CY + ry - tip[i, 1], CZ + rz - tip[i, 2]
         g[i, 0], g[i, 1], g[i, 2] = ry * dz - rz * dy, rz * dx - rx * dz, rx * dy - ry * dx
     a0 = g[0, 1] * g[1, 2] - g[0, 2] * g[1, 1]
@@ -108,11 +97,19 @@ def _free_axis_b(m, b1, b2, out, kout, st):
         st[j] = free_axis_k(m[j], b1, b2, out[j], kout[j])
 
 
-def _rotation_call(kernels: Callable[..., object], core: tuple[int, ...],
+def _rotation_call(single: Callable[..., int], kernels: Callable[..., object], core: tuple[int, ...],
                    rotation: ArrayLike, branch: Branch, return_mask: bool, geometry: Geometry | None
                    ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
-    """The three functions of a platform rotation (motor angles, sphere joint angles, free axis) on their batch
-    loop: rotations checked (InvalidInputError unless orthonormal with det +1 within 1e-9)."""
+    """The three functions of a platform rotation (motor angles, sphere joint angles, free axis): one float64
+    rotation with the default keywords straight to its kernel ``single``, else the batch loop ``kernels`` on the
+    rotations checked (InvalidInputError unless orthonormal with det +1 within 1e-9)."""
+    if (return_mask is False and geometry is None and type(rotation) is np.ndarray and rotation.shape == (3, 3)
+            and rotation.dtype == np.float64):
+        fb = fast_branch(branch)
+        if fb is not None:
+            out1, k1 = np.empty(core), np.empty(2)
+            if single(rotation, fb[0], fb[1], out1, k1) == OK:
+                return out1
     resolve(geometry)
     rot = as_input(rotation, "rotation", (3, 3))
     b = check_branch(branch)
@@ -129,13 +126,6 @@ def _rotation_call(kernels: Callable[..., object], core: tuple[int, ...],
     ok = (st == OK).reshape(shape)
     return finish(out.reshape(shape + core), ok, rot.ndim == 2, return_mask,
                   lambda: unreachable("the platform rotation", k[0]))
-
-
-def _fast_rotation(rotation: object, branch: Branch, return_mask: bool, geometry: object) -> tuple[float, float] | None:
-    if (return_mask is False and geometry is None and type(rotation) is np.ndarray and rotation.shape == (3, 3)
-            and rotation.dtype == np.float64):
-        return fast_branch(branch)
-    return None
 
 
 @overload
@@ -169,12 +159,7 @@ def motor_angles_from_rotation(rotation: ArrayLike, branch: Branch = (1, 1), *, 
     Raises:
         UnreachableError: single rotation out of reach.
     """
-    fb = _fast_rotation(rotation, branch, return_mask, geometry)
-    if fb is not None:
-        theta, k = np.empty(2), np.empty(2)
-        if rot_angles_k(rotation, fb[0], fb[1], theta, k) == OK:
-            return theta
-    return _rotation_call(_rot_angles_b, (2,), rotation, branch, return_mask, geometry)  # type: ignore[no-any-return]
+    return _rotation_call(rot_angles_k, _rot_angles_b, (2,), rotation, branch, return_mask, geometry)
 
 
 @overload
@@ -205,12 +190,7 @@ def sphere_joint_angles(rotation: ArrayLike, branch: Branch = (1, 1), *, geometr
     Raises:
         UnreachableError: single rotation out of reach.
     """
-    fb = _fast_rotation(rotation, branch, return_mask, geometry)
-    if fb is not None:
-        out, k = np.empty((2, 3)), np.empty(2)
-        if sphere_k(rotation, fb[0], fb[1], out, k) == OK:
-            return out
-    return _rotation_call(_sphere_b, (2, 3), rotation, branch, return_mask, geometry)  # type: ignore[no-any-return]
+    return _rotation_call(sphere_k, _sphere_b, (2, 3), rotation, branch, return_mask, geometry)
 
 
 @overload
@@ -229,10 +209,8 @@ def spherical_free_axis(rotation: ArrayLike, branch: Branch = (1, 1), *, geometr
     At R_P = I on the neutral branch it is ~(-0.39, 0, 0.92) through the LCS centre.
 
     Args:
-        rotation: (..., 3, 3) platform rotation matrices.
-        branch: the motor branch pair (b1, b2), each +1 or -1.
-        geometry: the geometry; None = the default.
-        return_mask: also return the mask of successes.
+        rotation: (..., 3, 3) platform rotation matrices; branch, geometry, return_mask: as
+            :func:`motor_angles_from_rotation`.
 
     Returns:
         (..., 3) unit axes of the free rotation (CCS); then the mask, if asked.
@@ -240,9 +218,4 @@ def spherical_free_axis(rotation: ArrayLike, branch: Branch = (1, 1), *, geometr
     Raises:
         UnreachableError: single rotation out of reach.
     """
-    fb = _fast_rotation(rotation, branch, return_mask, geometry)
-    if fb is not None:
-        out, k = np.empty(3), np.empty(2)
-        if free_axis_k(rotation, fb[0], fb[1], out, k) == OK:
-            return out
-    return _rotation_call(_free_axis_b, (3,), rotation, branch, return_mask, geometry)  # type: ignore[no-any-return]
+    return _rotation_call(free_axis_k, _free_axis_b, (3,), rotation, branch, return_mask, geometry)

@@ -197,14 +197,9 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
     methods = _fk_methods(robot, motors, r_true, n_batch, n_scalar, n_iter) + _ik_methods(
         robot, orient, r_true, n_batch, n_scalar, n_iter
     )
-    return ModelBench(
-        methods=methods,
-        units={"fk": "rad", "ik": "rad"},
-        tolerance=f"rotation error <= {SOLVE_TOL:g} rad (and loop |r| <= {SOLVE_TOL:g} for joint answers)",
-        notes=_notes(n_batch, n_scalar, n_iter),
-        summary=_summary,
-        secondary="loop |r|",
-    )
+    tolerance = f"rotation error <= {SOLVE_TOL:g} rad (and loop |r| <= {SOLVE_TOL:g} for joint answers)"
+    return ModelBench(methods=methods, units={"fk": "rad", "ik": "rad"}, tolerance=tolerance,
+                      notes=_notes(n_batch, n_scalar, n_iter), summary=_summary, secondary="loop |r|")
 
 
 def single_calls() -> list:

@@ -93,21 +93,30 @@ def _k_rank1(a1, a2, r, f):  # type: ignore[no-untyped-def]
     return u0, u1, fs
 
 
-@kernel
-def _k_gn_step(a1, a2, r):  # type: ignore[no-untyped-def]
-    """``-pinv([a1 a2]) r`` in closed form (the module docstring, "Step") for (3,) columns: (s0, s1)."""
-    nn = 0.0
-    t0 = 0.0
-    t1 = 0.0
+@kernel(inline=True)
+def _k_cross(u, v):  # type: ignore[no-untyped-def]
+    """``u x v`` for (3,) arrays, as three numbers."""
+    return u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]
+
+
+@kernel(inline=True)
+def _k_normal(a1, a2):  # type: ignore[no-untyped-def]
+    """For A = [a1 a2]: the normal ``n = a1 x a2`` of its range (three numbers), ``|n|^2`` and ``|A|_F^2``."""
+    n0, n1, n2 = _k_cross(a1, a2)
     f = 0.0
     for K in range(3):
-        I, J = (K + 1) % 3, (K + 2) % 3
-        n = a1[I] * a2[J] - a1[J] * a2[I]
-        nn += n * n
-        t0 += (a2[I] * r[J] - a2[J] * r[I]) * n
-        t1 += (r[I] * a1[J] - r[J] * a1[I]) * n
         f += a1[K] * a1[K] + a2[K] * a2[K]
-    s0, s1 = t0 / nn, t1 / nn
+    return n0, n1, n2, n0 * n0 + n1 * n1 + n2 * n2, f
+
+
+@kernel
+def _k_gn_step(a1, a2, r):  # type: ignore[no-untyped-def]
+    """``-pinv([a1 a2]) r`` in closed form (the module docstring, "Step") for (3,) columns: (s0, s1) =
+    ``((a2 x r) . n, (r x a1) . n) / |n|^2``, n = a1 x a2."""
+    n0, n1, n2, nn, f = _k_normal(a1, a2)
+    b0, b1, b2 = _k_cross(a2, r)
+    c0, c1, c2 = _k_cross(r, a1)
+    s0, s1 = (b0 * n0 + b1 * n1 + b2 * n2) / nn, (c0 * n0 + c1 * n1 + c2 * n2) / nn
     if nn <= (STEP_RCOND * STEP_RCOND) * f * f:
         u0, u1, fs = _k_rank1(a1, a2, r, f)
         s0, s1 = -u0 / fs, -u1 / fs
@@ -118,16 +127,8 @@ def _k_gn_step(a1, a2, r):  # type: ignore[no-untyped-def]
 def _k_normal_residual(a1, a2, r):  # type: ignore[no-untyped-def]
     """|r - A A^+ r| and |A|_F for A = [a1 a2] (the part of r off the range of A: rank 2 ``|r . n| / |n|``,
     n = a1 x a2; rank-1 projection where ``sigma_2 <= STEP_RCOND sigma_1``)."""
-    nn = 0.0
-    f = 0.0
-    rn = 0.0
-    for K in range(3):
-        I, J = (K + 1) % 3, (K + 2) % 3
-        n = a1[I] * a2[J] - a1[J] * a2[I]
-        nn += n * n
-        rn += r[K] * n
-        f += a1[K] * a1[K] + a2[K] * a2[K]
-    out = abs(rn) / np.sqrt(nn)
+    n0, n1, n2, nn, f = _k_normal(a1, a2)
+    out = abs(r[0] * n0 + r[1] * n1 + r[2] * n2) / np.sqrt(nn)
     if not nn > (STEP_RCOND * STEP_RCOND) * f * f:
         u0, u1, fs = _k_rank1(a1, a2, r, f)
         pp = 0.0

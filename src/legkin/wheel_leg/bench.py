@@ -293,11 +293,6 @@ def build(n: int | None, rng: np.random.Generator, quick: bool) -> ModelBench:
         Method("pinocchio closed-loop IK (LM on loops + contact point)", inputs, setup.pin_ik, setup.pin_score,
                max_targets=n_iter, repeats=3),
     ]
-    return ModelBench(
-        methods=methods,
-        units={"ik": "m"},
-        tolerance=f"contact error <= {SOLVE_TOL:g} m, loop |r| <= {SOLVE_TOL:g}, theta in [17, 160] deg",
-        notes=_notes(n_batch, n_scalar, n_iter),
-        summary=_summary,
-        secondary="loop |r|",
-    )
+    tolerance = f"contact error <= {SOLVE_TOL:g} m, loop |r| <= {SOLVE_TOL:g}, theta in [17, 160] deg"
+    return ModelBench(methods=methods, units={"ik": "m"}, tolerance=tolerance, notes=_notes(n_batch, n_scalar, n_iter),
+                      summary=_summary, secondary="loop |r|")

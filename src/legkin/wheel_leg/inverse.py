@@ -20,11 +20,12 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .. import _batch
-from .._batch import as_input, check_choice, check_flag, check_integer, check_number, finish, in_chunks
+from .._batch import F64, as_input, check_choice, check_flag, check_integer, check_number, dispatch, in_chunks
+from .._kernels import OK
 from ..errors import InvalidInputError, InvalidParameterError, UnreachableError
 from . import ik_iterative
 from ._common import _LIMITS, _SCALARS, _SOLVED, Leg, Rim, _check_alpha, _check_theta, _check_w, rim_name
-from .frames import _context, _fk, _kctx_cached
+from .frames import _NO_JAC, _context, _Ctx, _k_contact, _kctx
 from .geometry import (
     _DEFAULT_GEOMETRY,
     _LIMIT_ROUNDING,
@@ -33,11 +34,10 @@ from .geometry import (
     THETA_MIN,
     Geometry,
     _geometry,
-    _leg,
     abad_limit_error,
 )
 from .ik_radial import _NO_Q0, _RADIAL_SOLS, _ik_radial, _k_ik_radial, _radial_table
-from .rim import _k_select
+from .rim import _k_select, _select
 
 Method = Literal["radial", "damped", "gauss_newton_fd"]
 METHODS = ("radial", "damped", "gauss_newton_fd")
@@ -97,74 +97,121 @@ def _options(options: object) -> IKOptions:
     return options
 
 
-# ---------------------------------------------------------------- single-target fast paths
+# ---------------------------------------------------------------- the context, built once per keyword set
+class _IKCtx(NamedTuple):
+    """What :func:`ik` and :func:`ik_all` need besides the targets, validated and built once per keyword set."""
+
+    base: _Ctx  # the contact FK's context (leg, rim, radius, geometry); its per-item rim choice is set per batch
+    kc: tuple  # the contact kernels' constants (:func:`.frames._kctx`)
+    tables: tuple  # the method's tables (radial: :func:`.ik_radial._radial_table`; iterative: the start grid)
+    leg: Any
+    w_max: float  # |w| <= T / 2, within rounding (m)
+
+
 @lru_cache(maxsize=64, typed=True)  # typed: leg=1 must not admit leg=True or 1.0 (issue 25)
-def _single_ctx(leg, rim, radius, geo: Geometry, method: str):
-    """The contact kernels' constants and the method's tables for one keyword set (validated)."""
-    kc = _kctx_cached(leg, rim, radius, geo)
-    if method == "radial":
-        return kc, _radial_table(geo.R, kc[0])
-    return kc, ik_iterative.guess_table(geo.R, kc[0])
+def _ik_ctx_cached(leg, rim, radius, geometry, method) -> _IKCtx:
+    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+    rim = rim_name(rim)
+    check_choice(method, "method", METHODS)
+    base = _context(np.zeros(0), np.zeros(0), leg, rim, geo, radius)
+    kc = _kctx(leg, rim, radius, geo)
+    tables = _radial_table(geo.R, kc[0]) if method == "radial" else ik_iterative.guess_table(geo.R, kc[0])
+    return _IKCtx(base, kc, tables, leg, geo.T / 2 + 1e-15)
 
 
-def _single(target, alpha, w, leg, rim, radius, geo, method, opts, return_mask, return_info, limits=True,
-            q0=None):
-    """One target (numbers and float64 (3,) arrays): the method's kernel called directly; ``q0``: q_near
-    (radial) or the start (iterative methods). None (the general path then decides, and raises) unless
-    solved."""
-    if not (abs(alpha) <= math.pi + 1e-12 and abs(w) <= geo.T / 2 + 1e-15):
+def _ik_ctx(leg: object, rim: object, radius: object, geometry: object, method: object) -> _IKCtx:
+    """The keywords of :func:`ik` / :func:`ik_all` checked, and their context (:func:`_ik_ctx_cached`, an
+    unhashable value named by the checks)."""
+    try:
+        return _ik_ctx_cached(leg, rim, radius, geometry, method)
+    except TypeError:
+        geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
+        check_choice(method, "method", METHODS)
+        _context(np.zeros(0), np.zeros(0), leg, rim_name(rim), geo, radius)
+        raise
+
+
+# ---------------------------------------------------------------- one target: the method's kernel
+#: alpha's range (rad), within rounding.
+_ALPHA_MAX = math.pi + 1e-12
+
+
+def _ik_one(target, a, b, near, start, ctx, method, opts, limits, sink):
+    """One float64 target straight to the method's kernel (the fast path of :func:`ik`; alpha ``a``, w ``b``
+    numbers; ``near``, ``start``: q_near, q_start, (3,) or None): q (3,) if solved, else None (the general path then
+    decides, and raises).
+
+    ``sink``: None, or a list that gets (q, iterations, error, reason, evaluations, solutions) ((S, 3) every radial
+    solution; iterative methods: None), solved or not (the info; the failure path's reason).
+    """
+    if type(a) is not float or not (abs(a) <= _ALPHA_MAX and abs(b) <= ctx.w_max):
         return None
+    q0 = near if method == "radial" or start is None else start
     if q0 is not None and not (THETA_MIN - 1e-12 <= q0[0] <= THETA_MAX + 1e-12 and math.isfinite(q0[1])
                                and math.isfinite(q0[2])):
         return None
-    try:
-        kc, tables = _single_ctx(leg, rim, radius, geo, method)
-    except Exception:  # noqa: BLE001 - the general path raises the documented error
-        return None
-    seed, rho, K, KC, s, dwheel, _half_T, o0, o1, o2 = kc
-    upper, right, e = _k_select(alpha, seed, rho, K[0])
+    seed, rho, K, KC, s, dwheel, _half_T, o0, o1, o2 = ctx.kc
+    upper, right, e = _k_select(a, seed, rho, K[0])
+    aw = dwheel + s * b
     q = np.empty(3)
-    a = dwheel + s * w
     sols = None
     if method == "radial":
         max_iter = 60 if opts.max_iter is None else opts.max_iter
         sols = np.empty((_RADIAL_SOLS, 3))
         q_near = _NO_Q0[0] if q0 is None else q0
-        its, err, reason, _nr, nsol = _k_ik_radial(target, upper, right, e, a, seed, K, KC, s, o0, o1, o2, *tables,
-                                                   opts.tol, max_iter, q_near, q0 is not None, limits, q, sols)
-        ev = its + 1
-        if reason == _SOLVED and return_info and nsol > _RADIAL_SOLS:
+        its, err, reason, _nr, nsol = _k_ik_radial(target, upper, right, e, aw, seed, K, KC, s, o0, o1, o2,
+                                                   *ctx.tables, opts.tol, max_iter, q_near, q0 is not None, limits, q,
+                                                   sols)
+        if sink is not None and reason == _SOLVED and nsol > _RADIAL_SOLS:  # keep every solution
             sols = np.empty((nsol, 3))
-            _k_ik_radial(target, upper, right, e, a, seed, K, KC, s, o0, o1, o2, *tables, opts.tol, max_iter,
+            _k_ik_radial(target, upper, right, e, aw, seed, K, KC, s, o0, o1, o2, *ctx.tables, opts.tol, max_iter,
                          q_near, q0 is not None, limits, np.empty(3), sols)
-        sols = sols[:nsol]
+        sols, ev = sols[:nsol], its + 1
     else:
         max_iter = ik_iterative.DEFAULT_MAX_ITER[method] if opts.max_iter is None else opts.max_iter
         its, err, reason, ev = ik_iterative._k_ik_iterative(
-            target, upper, right, e, a, seed, K, KC, s, o0, o1, o2, *tables, ik_iterative.METHOD_IDS[method],
+            target, upper, right, e, aw, seed, K, KC, s, o0, o1, o2, *ctx.tables, ik_iterative.METHOD_IDS[method],
             ik_iterative._STARTS[method], opts.tol, max_iter, opts.delta,
             ik_iterative._NO_START[0] if q0 is None else q0, q0 is not None, limits, q)
-    if reason != _SOLVED:
-        return None
-    out = (q, np.array(True)) if return_mask else q
-    if not return_info:
-        return out
-    info = IKInfo(np.array(its), np.array(err), sols, np.array(ev))
-    return (*out, info) if return_mask else (out, info)
+    if sink is not None:
+        sink.append((q, its, err, reason, ev, sols))
+    return q if reason == _SOLVED else None
 
 
-# ---------------------------------------------------------------- the general path
-class _Run(NamedTuple):
-    q: np.ndarray  # (..., 3), NaN where not solved
-    ok: np.ndarray
-    reason: np.ndarray
-    info: IKInfo
-    target: np.ndarray
-    closest: np.ndarray | None  # single unsolved target: the point reached
+def _closest(q_raw, alpha, w, ctx):
+    """The contact point of an unsolved answer, theta clipped into its range (None if not finite)."""
+    qc = q_raw.copy()
+    qc[0] = min(max(qc[0], THETA_MIN), THETA_MAX)
+    p = np.empty(3)
+    return p if _k_contact(qc, alpha, w, *ctx.kc, False, p, _NO_JAC) == OK else None
 
 
+def _ik_fail(target, out, ok, alpha, w, near, start, ctx: _IKCtx, method, opts, limits, sink) -> Exception:
+    """Why the single target was not solved: it is solved again (the failure path only) for its reason."""
+    one: list[tuple] = []
+    _ik_one(target, alpha, w, near, start, ctx, method, opts, limits, one)
+    q, its, err, reason, _ev, _sols = one[0]
+    closest = _closest(q, alpha, w, ctx)
+    where = f"target {target.tolist()} for leg {ctx.leg!r} (alpha={alpha!r}, w={w!r})"
+    if reason == _LIMITS:
+        return abad_limit_error(
+            f"{where} is reachable only with the ABAD angle outside its limits [-pi/2, pi/2] "
+            f"(gamma={float(q[2]):.6g} rad); pass limits=False to accept it",
+            ctx.leg, target, float(q[2]), closest,
+        )
+    distance = math.nan if closest is None else float(np.linalg.norm(closest - target))
+    return UnreachableError(
+        f"{where} not reached with method {method!r}: final error {err:.3e} m after "
+        f"{its} iterations (tolerance {opts.tol:.1e} m, theta in [17, 160] deg); closest point "
+        f"reached {None if closest is None else closest.tolist()} ({distance:.3g} m away)",
+        target=target, closest=closest, distance=distance,
+    )
+
+
+# ---------------------------------------------------------------- the inputs besides the target
 def _broadcast(target, alpha, w, q_near, q_start):
-    """Inputs checked and broadcast together: (target, alpha, w, q_near, q_start, shape)."""
+    """Inputs checked and broadcast together: (target (..., 3), alpha, w, q_near, q_start), the last four numbers /
+    (3,) rows for one target, else one per target ((n,), (n, 3), the targets' batch flattened)."""
     target = as_input(target, "target", (3,))
     alpha, w = as_input(alpha, "alpha"), as_input(w, "w")
     q_near = None if q_near is None else as_input(q_near, "q_near", (3,))
@@ -176,71 +223,90 @@ def _broadcast(target, alpha, w, q_near, q_start):
         names = f"target{target.shape}, alpha{alpha.shape}, w{w.shape}" + "".join(
             f", {n}{x.shape}" for n, x in (("q_near", q_near), ("q_start", q_start)) if x is not None)
         raise InvalidInputError(f"inputs do not broadcast together: {names}") from exc
-    n = int(np.prod(shape, dtype=int))
 
-    def rows(x, name):
+    def items(x, core):
         if x is None:
             return None
-        x = np.array(np.broadcast_to(x, shape + (3,)), dtype=float)
-        _check_theta(x[..., 0], f"theta ({name}[..., 0])")
-        return x.reshape(n, 3)
+        x = np.array(np.broadcast_to(x, shape + core), dtype=float)
+        return x if not shape else x.reshape((-1,) + core)
 
-    target = np.broadcast_to(target, shape + (3,)).astype(float)
-    alpha, w = np.broadcast_to(alpha, shape).astype(float), np.broadcast_to(w, shape).astype(float)
-    return target, alpha, w, rows(q_near, "q_near"), rows(q_start, "q_start"), shape
+    a, b = items(alpha, ()), items(w, ())
+    return (items(target, (3,)).reshape(shape + (3,)), float(a) if not shape else a, float(b) if not shape else b,
+            items(q_near, (3,)), items(q_start, (3,)))
 
 
-def _run(target, alpha, w, leg, q_near, q_start, method, rim, radius, limits, opts, geo, all_solutions=False):
-    limits = check_flag(limits, "limits")
-    target, alpha, w, q_near, q_start, shape = _broadcast(target, alpha, w, q_near, q_start)
+def _targets(target, alpha, w, q_near, q_start):
+    """(target, alpha, w, q_near, q_start) for :func:`legkin._batch.dispatch`: as they are when alpha, w are numbers
+    and q_near, q_start None or float64 (3,) arrays (the fast path), else :func:`_broadcast`."""
+    if type(alpha) in _SCALARS and type(w) in _SCALARS and (q_near is None or _row3(q_near)) and (
+            q_start is None or _row3(q_start)):
+        return target, float(alpha), float(w), q_near, q_start
+    return _broadcast(target, alpha, w, q_near, q_start)
+
+
+def _row3(x: object) -> bool:
+    return type(x) is np.ndarray and x.dtype is F64 and x.shape == (3,)
+
+
+def _rows(rows: np.ndarray, a, b, near, start, ctx: _IKCtx):
+    """The per-target inputs of a batch of n targets, range-checked: alpha, w (n,); q_near, q_start (n, 3) or None."""
+    n = rows.shape[0]
+    alpha = np.full(n, a) if type(a) is float else a
+    w = np.full(n, b) if type(b) is float else b
     _check_alpha(alpha)
-    _check_w(w, geo)
-    check_choice(method, "method", METHODS)
-    _leg(leg)
-    if method == "radial" and q_start is not None:
-        raise InvalidParameterError("q_start is the start of an iteration (methods 'damped', 'gauss_newton_fd'); "
-                                    "the radial method takes q_near (the configuration to stay near)")
-    n = int(np.prod(shape, dtype=int))
-    ctx = _context(alpha.reshape(n), w.reshape(n), leg, rim, geo, radius)  # validated once
-    flat = target.reshape(n, 3)
-    solutions = None
+    _check_w(w, ctx.base.geo)
+    out = [alpha, w]
+    for x, name in ((near, "q_near"), (start, "q_start")):
+        if x is not None:  # finite (InvalidInputError), theta in range
+            x = np.ascontiguousarray(np.broadcast_to(as_input(x, name, (3,)), (n, 3)))
+            _check_theta(x[:, 0], f"theta ({name}[..., 0])")
+        out.append(x)
+    return out
+
+
+def _solve_rows(rows, alpha, w, near, start, ctx: _IKCtx, method: str, opts: IKOptions, limits: bool):
+    """The method's compiled loop on targets (n, 3): (q, iterations, error, solved, solutions, evaluations)."""
+    sel = _select(alpha, ctx.kc[0], ctx.kc[1], ctx.base.geo.R)
+    c = ctx.base._replace(sel=sel, w=w)
     if method == "radial":
-        q, it, err, ok, solutions, reason = _ik_radial(flat, ctx, opts.tol, opts.max_iter, q_near, limits)
-        solutions = solutions.reshape(shape + solutions.shape[1:])
-        ev = it + 1
+        q, it, err, ok, sols, _reason = _ik_radial(rows, c, opts.tol, opts.max_iter, near, limits)
+        return q, it, err, ok, sols, it + 1
+    q, it, err, ok, _reason, ev = ik_iterative.solve(rows, c, start if start is not None else near, method, opts.tol,
+                                                     opts.max_iter, opts.delta, limits)
+    return q, it, err, ok, None, ev
+
+
+# ---------------------------------------------------------------- ik on legkin._batch.dispatch
+def _ik_batch(rows, a, b, near, start, ctx: _IKCtx, method, opts, limits, sink) -> tuple[np.ndarray, np.ndarray]:
+    """The compiled loop on targets (n, 3): a large batch without ``return_info`` :data:`~legkin._batch.CHUNK`
+    targets at a time (:func:`legkin._batch.in_chunks`: the radial method's temporaries take ~310 B a target)."""
+    alpha, w, near, start = _rows(rows, a, b, near, start, ctx)
+    if sink is None and rows.shape[0] > _batch.CHUNK:
+        def solve(*chunk):
+            q, _it, _err, ok, _sols, _ev = _solve_rows(*chunk, ctx, method, opts, limits)
+            return q, ok
+
+        q, ok = in_chunks(solve, [rows, alpha, w, near, start], 3)
     else:
-        start = q_start if q_start is not None else q_near
-        q, it, err, ok, reason, ev = ik_iterative.solve(flat, ctx, start, method, opts.tol, opts.max_iter,
-                                                        opts.delta, limits)
-    q = q.reshape(shape + (3,))
-    it, err, ok, reason, ev = (x.reshape(shape) for x in (it, err, ok, reason, ev))
-    closest = None
-    if shape == () and not bool(ok) and not all_solutions:
-        with np.errstate(invalid="ignore"):
-            qc = q.copy()
-            qc[0] = np.clip(qc[0], THETA_MIN, THETA_MAX)
-            closest = _fk(qc, ctx.take(0), False)[0] if np.all(np.isfinite(qc)) else None
-    q_out = np.where(ok[..., None], q, np.nan)
-    return _Run(q_out, ok, reason, IKInfo(it, err, solutions, ev), target, closest), q
+        q, it, err, ok, sols, ev = _solve_rows(rows, alpha, w, near, start, ctx, method, opts, limits)
+        if sink is not None:
+            sink.append(IKInfo(it, err, sols, ev))
+    q[~ok] = np.nan
+    return q, ok
 
 
-def _error(run: _Run, q_raw, leg, alpha, w, method, tol) -> Exception:
-    target = np.asarray(run.target).reshape(3)
-    where = f"target {target.tolist()} for leg {leg!r} (alpha={float(alpha)!r}, w={float(w)!r})"
-    if int(run.reason) == _LIMITS:
-        return abad_limit_error(
-            f"{where} is reachable only with the ABAD angle outside its limits [-pi/2, pi/2] "
-            f"(gamma={float(q_raw[2]):.6g} rad); pass limits=False to accept it",
-            leg, target, float(q_raw[2]), run.closest,
-        )
-    closest = run.closest
-    distance = math.nan if closest is None else float(np.linalg.norm(closest - target))
-    return UnreachableError(
-        f"{where} not reached with method {method!r}: final error {float(run.info.error):.3e} m after "
-        f"{int(run.info.iterations)} iterations (tolerance {tol:.1e} m, theta in [17, 160] deg); closest point "
-        f"reached {None if closest is None else closest.tolist()} ({distance:.3g} m away)",
-        target=target, closest=closest, distance=distance,
-    )
+def _with_info(res: Any, info: Any, return_mask: bool) -> Any:
+    """``res`` of :func:`ik` with its :class:`IKInfo`: one target's (:func:`_ik_one`'s tuple), or a batch's rows
+    reshaped to the targets' batch shape."""
+    if type(info) is tuple:
+        _q, its, err, _reason, ev, sols = info
+        info = IKInfo(np.array(its), np.array(err), sols, np.array(ev))
+    else:
+        shape = (res[0] if return_mask else res).shape[:-1]
+        sols = info.solutions
+        info = IKInfo(info.iterations.reshape(shape), info.error.reshape(shape),
+                      None if sols is None else sols.reshape(shape + sols.shape[-2:]), info.evaluations.reshape(shape))
+    return (*res, info) if return_mask else (res, info)
 
 
 # ---------------------------------------------------------------- public
@@ -310,63 +376,25 @@ def ik(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.
         InvalidInputError: NaN/inf, complex or wrong shapes, alpha or w out of range.
         InvalidParameterError: unknown ``method``, ``rim`` or ``leg``; a keyword out of its range.
     """
-    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     opts = _options(options)
-    rim_ = rim_name(rim)
-    if (type(target) is np.ndarray and target.shape == (3,) and target.dtype == np.float64 and type(alpha) in _SCALARS
-            and type(w) in _SCALARS and type(method) is str and method in METHODS and type(limits) is bool
-            and type(return_mask) is bool and type(return_info) is bool):
-        start = q_start if q_near is None else (q_near if q_start is None else None)
-        both = q_near is not None and q_start is not None
-        if not both and (start is None or (type(start) is np.ndarray and start.shape == (3,)
-                                           and start.dtype == np.float64 and (q_start is None or method != "radial"))):
-            out = _single(target, float(alpha), float(w), leg, rim_, radius, geo, method, opts, return_mask,
-                          return_info, limits, start)
-            if out is not None:
-                return out
-    return_mask = check_flag(return_mask, "return_mask")
-    return_info = check_flag(return_info, "return_info")
-    if not return_info and _large_batch(target, alpha, w, q_near, q_start):
-        return _ik_in_chunks(np.asarray(target), leg, alpha, w, q_near, q_start, return_mask, method=method, rim=rim_,
-                             radius=radius, limits=limits, options=opts, geometry=geo)
-    run, q_raw = _run(target, alpha, w, leg, q_near, q_start, method, rim_, radius, limits, opts, geo)
-    out = finish(run.q, run.ok, run.ok.shape == (), return_mask,
-                 lambda: _error(run, q_raw, leg, alpha, w, method, opts.tol))
-    if return_info:
-        return (*out, run.info) if isinstance(out, tuple) else (out, run.info)
-    return out
-
-
-def _large_batch(target, alpha, w, q_near, q_start) -> bool:
-    """True for a batch of more than ``CHUNK`` float64 targets with alpha and w numbers or one per target, and
-    q_near / q_start None or one row per target: :func:`ik` then solves it by chunks (the radial method's
-    temporaries take ~310 B a target, 13x the answer)."""
-    if not (type(target) is np.ndarray and target.dtype == np.float64 and target.ndim >= 2
-            and target.shape[-1] == 3 and target.size > 3 * _batch.CHUNK):
-        return False
-    rows_ok = all(x is None or (type(x) is np.ndarray and x.shape == target.shape) for x in (q_near, q_start))
-    items_ok = all(type(x) in _SCALARS or (type(x) is np.ndarray and x.shape == target.shape[:-1]) for x in (alpha, w))
-    return rows_ok and items_ok
-
-
-def _ik_in_chunks(target: np.ndarray, leg: Leg, alpha, w, q_near, q_start, return_mask: bool, **keywords):
-    """:func:`ik` of a large batch (:func:`_large_batch`), ``CHUNK`` targets at a time (``legkin._batch.in_chunks``):
-    its working memory beyond the answer stays ~20 MB. The inputs are checked whole first, so that an error names
-    the row in the whole batch."""
-    shape = target.shape[:-1]
-    rows: list[np.ndarray | None] = [
-        as_input(x, name, (3,)).reshape(-1, 3) if x is not None else None
-        for x, name in ((target, "target"), (q_near, "q_near"), (q_start, "q_start"))]
-    rows += [as_input(x, name).reshape(-1) if type(x) is np.ndarray else None
-             for x, name in ((alpha, "alpha"), (w, "w"))]
-
-    def solve(t, qn, qs, a, ww):
-        a = float(alpha) if a is None else a
-        ww = float(w) if ww is None else ww
-        return ik(t, leg, alpha=a, w=ww, q_near=qn, q_start=qs, return_mask=True, **keywords)
-
-    q, ok = in_chunks(solve, rows, 3)
-    return finish(q.reshape(shape + (3,)), ok.reshape(shape), False, return_mask, lambda: AssertionError())
+    if limits is not True and limits is not False:
+        limits = check_flag(limits, "limits")
+    if return_mask is not False and return_mask is not True:
+        return_mask = check_flag(return_mask, "return_mask")
+    if return_info is not False and return_info is not True:
+        return_info = check_flag(return_info, "return_info")
+    ctx = _ik_ctx(leg, rim, radius, geometry, method)
+    if method == "radial" and q_start is not None:
+        raise InvalidParameterError("q_start is the start of an iteration (methods 'damped', 'gauss_newton_fd'); "
+                                    "the radial method takes q_near (the configuration to stay near)")
+    if type(alpha) in _SCALARS and type(w) in _SCALARS and q_near is None and q_start is None:  # the common call
+        a, b, near, start = float(alpha), float(w), None, None  # type: ignore[arg-type]
+    else:
+        target, a, b, near, start = _targets(target, alpha, w, q_near, q_start)
+    sink: list[Any] | None = [] if return_info else None
+    res = dispatch(target, "target", (3,), _ik_one, _ik_batch, _ik_fail, (a, b, near, start, ctx, method, opts,
+                                                                          limits, sink), return_mask)
+    return res if sink is None else _with_info(res, sink[-1], return_mask)
 
 
 def _in_limits(sols: np.ndarray) -> np.ndarray:
@@ -376,6 +404,37 @@ def _in_limits(sols: np.ndarray) -> np.ndarray:
         inside = np.abs(sols[..., 2]) <= ABAD_LIMIT + _LIMIT_ROUNDING
     sols[..., 2] = np.where(inside, np.clip(sols[..., 2], -ABAD_LIMIT, ABAD_LIMIT), sols[..., 2])
     return inside
+
+
+def _all_fast(target, a, b, ctx: _IKCtx, opts: IKOptions, limits: bool, return_mask: bool) -> Any:
+    """One float64 target: every radial solution from the kernel, with its mask if asked (None if none: the general
+    path then raises)."""
+    one: list[tuple] = []
+    if _ik_one(target, a, b, None, None, ctx, "radial", opts, False, one) is None:
+        return None
+    sols = one[0][5]
+    sols = sols[_in_limits(sols)] if limits else sols
+    if not len(sols):
+        return None
+    return (sols, np.ones(len(sols), dtype=bool)) if return_mask else sols
+
+
+def _all_batch(rows, a, b, ctx: _IKCtx, opts: IKOptions, limits: bool, _mask: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Every radial solution of targets (n, 3): (n, S, 3), the kept ones first in their order, NaN-padded; mask."""
+    alpha, w, _near, _start = _rows(rows, a, b, None, None, ctx)
+    sols = _solve_rows(rows, alpha, w, None, None, ctx, "radial", opts, False)[4]
+    keep = np.isfinite(sols).all(axis=-1)
+    if limits:
+        keep &= _in_limits(sols)
+    order = np.argsort(~keep, axis=-1, kind="stable")  # the kept ones first, in their order
+    sols = np.take_along_axis(np.where(keep[..., None], sols, np.nan), order[..., None], axis=-2)
+    width = int(keep.sum(axis=-1).max()) if len(rows) else 0
+    return sols[:, :width], np.take_along_axis(keep, order, axis=-1)[:, :width]
+
+
+def _all_fail(target, out, ok, a, b, ctx: _IKCtx, opts: IKOptions, limits: bool, _mask: bool) -> Exception:
+    return UnreachableError(f"target {target.tolist()} for leg {ctx.leg!r} has no solution"
+                            + (" inside the ABAD limits" if limits else ""), target=target)
 
 
 @overload
@@ -408,33 +467,15 @@ def ik_all(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike 
     Raises:
         UnreachableError: (single) the target has no solution (inside the ABAD limits, with ``limits=True``).
     """
-    geo = _DEFAULT_GEOMETRY if geometry is None else _geometry(geometry)
     opts = _options(options)
-    return_mask = check_flag(return_mask, "return_mask")
-    limits = check_flag(limits, "limits")
-    rim_ = rim_name(rim)
-    if type(target) is np.ndarray and target.shape == (3,) and target.dtype == np.float64 and isinstance(alpha, float) \
-            and isinstance(w, float):
-        out = _single(target, alpha, w, leg, rim_, radius, geo, "radial", opts, False, True, False)
-        if out is not None:
-            sols = out[1].solutions
-            sols = sols[_in_limits(sols)] if limits else sols
-            if len(sols):
-                return (sols, np.ones(len(sols), dtype=bool)) if return_mask else sols
-    run, _q = _run(target, alpha, w, leg, None, None, "radial", rim_, radius, False, opts, geo, True)
-    sols = run.info.solutions
-    assert sols is not None
-    keep = np.isfinite(sols).all(axis=-1)
-    if limits:
-        keep &= _in_limits(sols)
-    order = np.argsort(~keep, axis=-1, kind="stable")  # the kept ones first, in their order
-    sols = np.take_along_axis(np.where(keep[..., None], sols, np.nan), order[..., None], axis=-2)
-    count = keep.sum(axis=-1)
-    width = int(count.max()) if count.size else 0
-    sols = sols[..., :width, :]
-    mask = np.take_along_axis(keep, order, axis=-1)[..., :width]
-    if count.shape == () and not count:
-        t = np.asarray(run.target).reshape(3)
-        raise UnreachableError(f"target {t.tolist()} for leg {leg!r} has no solution"
-                               + (" inside the ABAD limits" if limits else ""), target=t)
-    return (sols, mask) if return_mask else sols
+    if return_mask is not False and return_mask is not True:
+        return_mask = check_flag(return_mask, "return_mask")
+    if limits is not True and limits is not False:
+        limits = check_flag(limits, "limits")
+    ctx = _ik_ctx(leg, rim, radius, geometry, "radial")
+    if type(alpha) in _SCALARS and type(w) in _SCALARS:  # the common call
+        a, b = float(alpha), float(w)  # type: ignore[arg-type]
+    else:
+        target, a, b, _near, _start = _broadcast(target, alpha, w, None, None)
+    return dispatch(target, "target", (3,), _all_fast, _all_batch, _all_fail, (a, b, ctx, opts, limits, return_mask),
+                    return_mask)  # type: ignore[no-any-return]

@@ -411,8 +411,11 @@ def _k_pair_batch(x, y, inverse, u, v):
             u[i], v[i] = _k_motor_angles(x[i], y[i])
 
 
-def _pair(x, y, names: tuple[str, str], inverse: bool) -> tuple[np.ndarray, np.ndarray]:
-    """The wrapper of :func:`motor_angles` / :func:`theta_beta`: two numbers -> the kernel, else the batch."""
+def _pair(x, y, names: tuple[str, str], inverse: bool, geometry: object) -> tuple[np.ndarray, np.ndarray]:
+    """The wrapper of :func:`motor_angles` / :func:`theta_beta`: two numbers -> the kernel, else the batch;
+    ``geometry`` only checked (neither depends on it)."""
+    if geometry is not None:
+        _geometry(geometry)
     if type(x) is float and type(y) is float and math.isfinite(x) and math.isfinite(y):
         u, v = _k_theta_beta(x, y) if inverse else _k_motor_angles(x, y)
         return np.asarray(u), np.asarray(v)
@@ -438,9 +441,7 @@ def motor_angles(theta: ArrayLike, beta: ArrayLike, *,
     Returns:
         (phi_L, phi_R) (rad), each of the broadcast shape.
     """
-    if geometry is not None:
-        _geometry(geometry)
-    return _pair(theta, beta, ("theta", "beta"), False)
+    return _pair(theta, beta, ("theta", "beta"), False, geometry)
 
 
 def theta_beta(phi_L: ArrayLike, phi_R: ArrayLike, *,
@@ -457,7 +458,5 @@ def theta_beta(phi_L: ArrayLike, phi_R: ArrayLike, *,
     Returns:
         (theta, beta) (rad), each of the broadcast shape.
     """
-    if geometry is not None:
-        _geometry(geometry)
-    return _pair(phi_L, phi_R, ("phi_L", "phi_R"), True)
+    return _pair(phi_L, phi_R, ("phi_L", "phi_R"), True, geometry)
 

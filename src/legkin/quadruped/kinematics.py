@@ -29,50 +29,17 @@ from .._kernels import OK
 from ..legs._fk_kernels import _fk_k, _jacobian_k
 from ..legs._ik_kernels import _ik_all_k, _ik_k
 from ..legs.kinematics import Leg, _vector3
+from . import constants as _constants
 from ._common import foot_z_of, leg_index, rows
-from .constants import (
-    BRANCHES,
-    JOINT_LIMITS,
-    KNEE_OFFSET,
-    LEGS,
-    LIMIT_TOL,
-    X01,
-    X23,
-    X34,
-    Y01,
-    Y12,
-    Z01,
-    Z23,
-)
+from .constants import *  # noqa: F403 - the quadruped's constants (LEGS, JOINT_LIMITS, X01, ...), re-exported
+from .constants import JOINT_LIMITS, LEGS, LIMIT_TOL
 from .geometry import DEFAULT_GEOMETRY, Geometry
 from .measured import CACHE_SIZE, SEED_ORDER, legs
 from .textbook import textbook_frame, textbook_ik, textbook_to_joints
 
-__all__ = [
-    "Geometry",
-    "DEFAULT_GEOMETRY",
-    "LEGS",
-    "X01",
-    "Y01",
-    "Z01",
-    "Y12",
-    "X23",
-    "Z23",
-    "X34",
-    "JOINT_LIMITS",
-    "BRANCHES",
-    "LIMIT_TOL",
-    "KNEE_OFFSET",
-    "fk",
-    "jacobian",
-    "ik",
-    "ik_all",
-    "hip_position",
-    "within_limits",
-    "legs",
-    "textbook_ik",
-    "textbook_frame",
-    "textbook_to_joints",
+__all__ = _constants.__all__ + [
+    "Geometry", "DEFAULT_GEOMETRY", "fk", "jacobian", "ik", "ik_all", "hip_position", "within_limits", "legs",
+    "textbook_ik", "textbook_frame", "textbook_to_joints",
 ]
 
 Mask = tuple[np.ndarray, np.ndarray]
@@ -166,11 +133,7 @@ def fk(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
     """
     if return_mask is False and q.__class__ is _ND and q.shape == _S3 and q.dtype is _F64:
         args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
-    else:
-        args = None
-    if args is not None:
-        out = np.empty(3)
-        if _fk_k(q, args[0], out) == OK:
+        if args is not None and _fk_k(q, args[0], out := np.empty(3)) == OK:
             return out
     x = _leg(leg, geometry).fk(q)
     return x if return_mask is False else _with_mask(x, 1, return_mask)
@@ -203,11 +166,7 @@ def jacobian(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
     """
     if return_mask is False and q.__class__ is _ND and q.shape == _S3 and q.dtype is _F64:
         args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
-    else:
-        args = None
-    if args is not None:
-        out = np.empty((3, 3))
-        if _jacobian_k(q, args[0], out) == OK:
+        if args is not None and _jacobian_k(q, args[0], out := np.empty((3, 3))) == OK:
             return out
     x = _leg(leg, geometry).jacobian(q)
     return x if return_mask is False else _with_mask(x, 2, return_mask)

@@ -13,7 +13,8 @@ import argparse
 from legkin.mjcf.floating import load_ground
 from legkin.mjcf.scenarios import SCENARIOS, run_scenario
 
-MODELS = ("wheel_leg", "quadruped", "go2", "talos", "romeo", "icub", "alexander", "g1", "hybrid_leg")
+MODELS = ("wheel_leg", "quadruped", "go2", "talos", "romeo", "icub", "alexander", "g1", "simple_humanoid",
+          "hybrid_leg")
 
 
 def main() -> None:

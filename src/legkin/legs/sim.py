@@ -12,8 +12,8 @@ import numpy as np
 from ..mjcf.ground import Foot, FootGround, sphere_radius
 from .extract import from_model
 
-__all__ = ["ground_model", "supports", "UNSUPPORTED", "STRAIGHT_LEGS", "NOT_THE_ROBOT", "NO_SQUAT", "SQUAT_START",
-           "sole_spheres", "SOLE_RADIUS", "SOLE_BAND", "DEFAULT_SOLE"]
+__all__ = ["ground_model", "supports", "UNSUPPORTED", "HELD_TILT", "STRAIGHT_LEGS", "NOT_THE_ROBOT", "NO_SQUAT",
+           "SQUAT_START", "sole_spheres", "SOLE_RADIUS", "SOLE_BAND", "DEFAULT_SOLE"]
 
 #: Radius (m) of the four corner spheres of a sole measured from a mesh (:func:`sole_spheres`): g1's URDF uses
 #: 5 mm spheres at its sole corners, kept for every humanoid.
@@ -30,10 +30,13 @@ SOLE_BAND = 0.003
 DEFAULT_SOLE = (-0.1095, 0.0987, -0.0620, 0.0621, -0.107)
 
 
-#: The robots of :mod:`legkin.legs` without a ground model, and why.
-UNSUPPORTED = {
-    "bolt": "a biped on two point feet: it cannot stand without a balance controller",
-}
+#: The robots of :mod:`legkin.legs` without a ground model, and why (none).
+UNSUPPORTED: dict[str, str] = {}
+
+#: A biped on two point feet (bolt) cannot stand: the line between its feet is its only support. Its scenarios
+#: hold its base's roll and pitch by a torque of this many times its toppling stiffness m g h per radian
+#: (:attr:`legkin.mjcf.ground.GroundModel.held_tilt`; bolt: 100 x 8.00 N m / rad).
+HELD_TILT = 100.0
 
 #: The robots that stand on straight legs (every leg joint at 0: soles level, feet under the hips) instead of their
 #: reference pose, and why (:attr:`legkin.mjcf.ground.FootGround.stance`).
@@ -169,6 +172,8 @@ def ground_model(robot: Any) -> FootGround:
     out = FootGround(robot, feet, fk, ik)
     out.no_squat = NO_SQUAT.get(robot.name)
     out.collision_skip |= frozenset(NOT_THE_ROBOT.get(robot.name, ()))
+    if len(legs) == 2 and all(len(leg.idx_q) == 3 for leg in legs.values()):  # two point feet
+        out.held_tilt = HELD_TILT * out.toppling()
     if robot.name in STRAIGHT_LEGS:
         out.stance = {i: 0.0 for leg in legs.values() for i in leg.idx_q}
     if not robot.spec.reference_pose:  # g1 (no SRDF): q0 has straight knees, where d q / d height is unbounded

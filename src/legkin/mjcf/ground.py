@@ -29,6 +29,10 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["ContactGeom", "GroundModel", "FootGround", "Foot", "ground_model", "has_ground_model"]
 
 
+#: The damping of :attr:`GroundModel.held_tilt`, in seconds (damping / stiffness).
+HELD_TILT_DAMPING = 0.02
+
+
 @dataclass(frozen=True)
 class ContactGeom:
     """One collision primitive of the export.
@@ -67,6 +71,10 @@ class GroundModel(ABC):
         no_squat: why the ``squat`` scenario cannot run on this robot, or None.
         fixed_base: a fixed mechanism (its registry spec not floating: the hybrid leg), whose floor is put under its
             contacts and whose scenario is ``press``.
+        held_tilt: the stiffness (N m / rad) of a torque on the base that holds its roll and pitch at 0 in the
+            scenarios (a biped on two point feet, bolt: its only support is the line between its feet), with
+            :data:`HELD_TILT_DAMPING` times as much damping (N m s / rad); a torque, no force: the base's height and
+            its contacts are the contacts' alone. 0: none.
     """
 
     robot: "Robot"
@@ -80,6 +88,7 @@ class GroundModel(ABC):
     timestep: float | None = None
     no_squat: str | None = None
     fixed_base: bool = False
+    held_tilt: float = 0.0
 
     @abstractmethod
     def geoms(self) -> list[ContactGeom]:
@@ -282,12 +291,16 @@ class FootGround(GroundModel):
         centre of mass's height above the soles in the reference pose. The robot standing on its soles is an
         inverted pendulum that an ankle softer than ``m g h`` lets topple (g1's 98.7 N m / rad from its foot's
         inertia, for m g h = 230 N m / rad: it fell forwards 0.04 rad in 2 s)."""
-        model, q = self.robot.model, self.pose(self.robot.q0)
-        data = model.createData()
-        height = float(pin.centerOfMass(model, data, q)[2]) + self.standing_height(q)
-        weight = -float(model.gravity.linear[2]) * sum(i.mass for i in model.inertias)
+        model = self.robot.model
         joints = [model.idx_qs.tolist().index(i) for f in self.legs.values() if len(f) > 1 for i in f[0].idx_q]
-        return {model.names[j]: STIFFNESS * weight * height for j in joints}
+        return {model.names[j]: STIFFNESS * self.toppling() for j in joints}
+
+    def toppling(self) -> float:
+        """The robot's toppling stiffness ``m g h`` (N m / rad): its weight times its centre of mass's height above
+        the floor in the reference pose (:meth:`pose`, level base)."""
+        model, q = self.robot.model, self.pose(self.robot.q0)
+        height = float(pin.centerOfMass(model, model.createData(), q)[2]) + self.standing_height(q)
+        return -float(model.gravity.linear[2]) * sum(i.mass for i in model.inertias) * height
 
     def pose(self, q: np.ndarray) -> np.ndarray:
         """``q`` with the :attr:`stance` joints set, then every flat foot levelled (its yaw and position kept; leg IK

@@ -261,6 +261,11 @@ def _key(mech: GroundMechanism, pose: str | None) -> tuple[int, np.ndarray]:
     return key, mech.ground.pose({**robot.poses, robot.spec.reference_pose: robot.q0}[pose])
 
 
+def _label(mech: GroundMechanism) -> str:
+    """The robot's name in its rows, saying when its base is held (:attr:`.GroundModel.held_tilt`)."""
+    return f"{mech.robot.name} (base held in roll and pitch)" if mech.ground.held_tilt else mech.robot.name
+
+
 def _stand(run: _Runner, pose: str | None, seconds: float, drop: float) -> list["CheckResult"]:
     from .._checkkit import compare
 
@@ -273,7 +278,7 @@ def _stand(run: _Runner, pose: str | None, seconds: float, drop: float) -> list[
     height = mech.ground.standing_height(q)
     pred = run.predicted()
     cop = run.pressure(pred)
-    name = mech.robot.name
+    name = _label(mech)
     gap = cop - pred
     gap[:, 1] = np.sign(gap[:, 1]) * np.maximum(np.abs(gap[:, 1]) - mech.ground.line_half_width, 0.0)
     return [
@@ -333,7 +338,7 @@ def _squat(run: _Runner, pose: str | None, seconds: float, depth: float) -> list
         run.run(seconds / 20, target)
         slip.append(run.slip_max.copy())
     run.run(_SETTLE_AFTER, target)
-    name = mech.robot.name
+    name = _label(mech)
     return [
         compare(f"{name} squat: base {depth:g} m down and up in {seconds:g} s, slip of each contact (m)",
                 np.array(slip), TOL_SLIP),

@@ -3,7 +3,7 @@
 
     PYTHONPATH=src python scripts/mujoco_scenarios.py [MODEL ...] [--runs 3]
 
-Default models: wheel_leg, quadruped, go2, the humanoids with a ground model and the hybrid leg.
+Default models: wheel_leg, quadruped, go2, the humanoids, bolt and the hybrid leg.
 """
 
 from __future__ import annotations
@@ -13,7 +13,8 @@ import argparse
 from legkin.mjcf.floating import load_ground
 from legkin.mjcf.scenarios import SCENARIOS, run_scenario
 
-MODELS = ("wheel_leg", "quadruped", "go2", "talos", "romeo", "icub", "alexander", "g1", "hybrid_leg")
+MODELS = ("wheel_leg", "quadruped", "go2", "talos", "romeo", "icub", "alexander", "g1", "simple_humanoid",
+          "bolt", "hybrid_leg")
 
 
 def main() -> None:

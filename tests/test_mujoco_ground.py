@@ -182,15 +182,42 @@ def test_sim_video(tmp_path):
     assert out.stat().st_size > 1000 and out.read_bytes()[4:8] == b"ftyp"
 
 
-@pytest.mark.parametrize("name", ["bolt", "simple_humanoid", "tripod"])
-def test_models_without_a_ground_model_have_no_ground_rows(name):
-    """bolt (two point feet), simple_humanoid (its SRDF pose outside its URDF limits) and the fixed mechanisms have
-    no ground model: `legkin check` gives them no ground rows instead of failing."""
+def test_models_without_a_ground_model_have_no_ground_rows(monkeypatch):
+    """A fixed mechanism (tripod) and a robot of legkin.legs.sim.UNSUPPORTED have no ground model: `legkin check`
+    gives them no ground rows instead of failing, and the ground export says why."""
+    import legkin.legs.sim as sim
     from legkin.mjcf.ground import has_ground_model
     from legkin.mjcf.scenarios import ground_rows
 
-    assert not has_ground_model(name)
-    assert ground_rows(name) == []
+    monkeypatch.setattr(sim, "UNSUPPORTED", {"bolt": "a reason"})
+    for name in ("tripod", "bolt"):
+        assert not has_ground_model(name)
+        assert ground_rows(name) == []
+        with pytest.raises(legkin.errors.InvalidParameterError, match="no ground model") as exc:
+            load_ground(name)
+        assert ("a reason" in str(exc.value)) == (name == "bolt")
+
+
+def test_bolt_stands_with_its_base_held_in_roll_and_pitch():
+    """bolt on its two point feet: its base held in roll and pitch by a torque (100 m g h per rad, no force), it
+    stands and squats; the contacts carry its weight; the torque is the moment of its centre of mass 19 mm behind
+    its feet; without it, it falls."""
+    mech = load_ground("bolt")
+    assert mech.ground.held_tilt == pytest.approx(100.0 * mech.ground.toppling())
+    assert "this file does not" in mech.xml
+    _passed(run_scenario(mech, "stand"))  # 2 s: after 1 s the contacts carried 1.3 % less than its weight
+    assert np.all(mech.data.qfrc_applied[:3] == 0.0)
+    weight = -mech.model.opt.gravity[2] * mech.model.body_mass.sum()
+    force, fz = np.zeros(6), 0.0
+    for i in range(mech.data.ncon):
+        mujoco.mj_contactForce(mech.model, mech.data, i, force)
+        fz += force[0]
+    assert fz == pytest.approx(weight, rel=1e-3)
+    com = mech.data.subtree_com[0] - np.mean([mech.data.contact.pos[i] for i in range(mech.data.ncon)], axis=0)
+    assert np.linalg.norm(mech.data.qfrc_applied[3:6]) == pytest.approx(weight * abs(com[0]), rel=0.05)
+    _passed(run_scenario(mech, "squat", seconds=1.0))
+    mech.ground.held_tilt = 0.0
+    assert run_scenario(mech, "stand", seconds=1.0).rows[0].max_error > 0.02
 
 
 # ---------------------------------------------------------------------------------------- humanoids: flat feet
@@ -246,6 +273,28 @@ def test_humanoids_squat():
     """talos from half_sitting; g1 (no SRDF: straight knees) from 2 cm below its zero pose."""
     _passed(run_scenario("talos", "squat", seconds=1.0))
     _passed(run_scenario("g1", "squat", seconds=1.0))
+
+
+def test_simple_humanoid_stands_on_straight_legs():
+    """Its SRDF half_sitting lies outside its URDF limits (ankle pitch -0.419 rad, range [0, 2.618]): it stands on
+    straight legs, inside them, soles level; its base's test capsule (1 m) is left out; it has no squat. Standing in
+    its half_sitting instead (soles levelled, the stance emptied), MuJoCo's joint limits leave its base 8 cm from
+    legkin's height."""
+    mech = load_ground("simple_humanoid")
+    robot, ground = mech.robot, mech.ground
+    q, legs = ground.pose(robot.q0), sorted(ground.stance)
+    lo, hi = robot.model.lowerPositionLimit[legs], robot.model.upperPositionLimit[legs]
+    assert len(legs) == 12 and np.all((lo <= q[legs]) & (q[legs] <= hi))
+    assert not np.all((lo <= robot.q0[legs]) & (robot.q0[legs] <= hi))
+    assert np.ptp(ground.contacts(q)[:, 2]) < 1e-12
+    names = [mech.model.geom(i).name for i in range(mech.model.ngeom) if mech.model.geom_contype[i]]
+    assert len(names) == 8 and all("_sole" in n for n in names)
+    _passed(run_scenario(mech, "stand", seconds=1.0))
+    with pytest.raises(legkin.errors.InvalidParameterError, match="simple_humanoid does not squat"):
+        run_scenario(mech, "squat")
+    ground.stance = {}
+    res = run_scenario(mech, "stand", seconds=1.0)
+    assert res.rows[0].max_error > 0.02
 
 
 def test_romeo_has_no_squat():

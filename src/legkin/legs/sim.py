@@ -12,8 +12,8 @@ import numpy as np
 from ..mjcf.ground import Foot, FootGround, sphere_radius
 from .extract import from_model
 
-__all__ = ["ground_model", "supports", "UNSUPPORTED", "NO_SQUAT", "SQUAT_START", "sole_spheres", "SOLE_RADIUS",
-           "SOLE_BAND", "DEFAULT_SOLE"]
+__all__ = ["ground_model", "supports", "UNSUPPORTED", "HELD_TILT", "STRAIGHT_LEGS", "NOT_THE_ROBOT", "NO_SQUAT",
+           "SQUAT_START", "sole_spheres", "SOLE_RADIUS", "SOLE_BAND", "DEFAULT_SOLE"]
 
 #: Radius (m) of the four corner spheres of a sole measured from a mesh (:func:`sole_spheres`): g1's URDF uses
 #: 5 mm spheres at its sole corners, kept for every humanoid.
@@ -22,22 +22,41 @@ SOLE_RADIUS = 0.005
 #: rectangle of those within 3 mm is 0.208 x 0.124 m, the whole mesh 0.221 x 0.134 m).
 SOLE_BAND = 0.003
 #: The sole (x min, x max, y min, y max, z) in the foot frame (m) of a 6-DOF leg without any foot shape in its
-#: URDF (simple_humanoid: "FIXME: fill missing data: sole", its foot frame the ankle centre): talos's sole
-#: measured from its collision mesh (:data:`SOLE_BAND`), 0.107 m below its ankle (talos's sole frame).
+#: URDF (simple_humanoid: "FIXME: fill missing data: sole", no visual, its foot frame the ankle centre): talos's sole
+#: measured from its collision mesh (:data:`SOLE_BAND`), 0.107 m below its ankle (talos's sole frame). Talos's legs
+#: have simple_humanoid's proportions (thigh, shank, hip spacing: 0.348, 0.293, 0.170 m against 0.3535, 0.300,
+#: 0.180 m); on straight legs simple_humanoid's centre of mass is 0.035 m ahead of its ankles, 0.064 m inside the
+#: sole's toe, and its feet (0.124 m wide) are 0.056 m apart.
 DEFAULT_SOLE = (-0.1095, 0.0987, -0.0620, 0.0621, -0.107)
 
 
-#: The robots of :mod:`legkin.legs` without a ground model, and why.
-UNSUPPORTED = {
-    "bolt": "a biped on two point feet: it cannot stand without a balance controller",
-    "simple_humanoid": "its SRDF half_sitting lies outside its URDF ankle-pitch limits (-0.419 rad, range [0, 2.618]): "
-                       "MuJoCo's joint limit throws it off its feet, and no flat-foot squat stays in the range",
+#: The robots of :mod:`legkin.legs` without a ground model, and why (none).
+UNSUPPORTED: dict[str, str] = {}
+
+#: A biped on two point feet (bolt) cannot stand: the line between its feet is its only support. Its scenarios
+#: hold its base's roll and pitch by a torque of this many times its toppling stiffness m g h per radian
+#: (:attr:`legkin.mjcf.ground.GroundModel.held_tilt`; bolt: 100 x 8.00 N m / rad).
+HELD_TILT = 100.0
+
+#: The robots that stand on straight legs (every leg joint at 0: soles level, feet under the hips) instead of their
+#: reference pose, and why (:attr:`legkin.mjcf.ground.FootGround.stance`).
+STRAIGHT_LEGS = {
+    "simple_humanoid": "its SRDF half_sitting lies outside its URDF limits (ankle pitch -0.419 rad, range [0, 2.618]);"
+                       " a level sole needs ankle pitch = -(hip pitch + knee) (hip roll, yaw 0), so with both "
+                       "ankles' pitch >= 0 and the right knee >= 0 the right foot is under its hip only on a straight "
+                       "leg",
 }
 
+#: URDF collision shapes (Pinocchio names) that are not the robot's, left out of its ground export:
+#: simple_humanoid's BODY carries example-robot-data's test shapes for Pinocchio's ``<collision_checking>`` (a capsule
+#: of radius 1 m and length 1 m around the base, 0.76 m above the floor, and a box mesh).
+NOT_THE_ROBOT = {"simple_humanoid": ("BODY_0", "BODY_1")}
 
 #: The robots of :mod:`legkin.legs` whose ground model has no ``squat`` scenario, and why.
 NO_SQUAT = {
     "romeo": "5 cm below its half_sitting its feet are reachable only outside its joint limits (by 1.5e-3 rad)",
+    "simple_humanoid": "its base 1 mm below its straight-leg stance, its right foot is reachable only outside its "
+                       "URDF limits (by 0.060 rad; 5 cm: 0.43 rad; Leg6.ik over its 8 solutions)",
 }
 #: How far (m) below its reference pose a robot whose reference pose has straight knees (g1, no SRDF) starts the
 #: squat (:attr:`legkin.mjcf.ground.GroundModel.squat_start`): from straight knees g1's feet slid 14 mm.
@@ -152,6 +171,11 @@ def ground_model(robot: Any) -> FootGround:
 
     out = FootGround(robot, feet, fk, ik)
     out.no_squat = NO_SQUAT.get(robot.name)
+    out.collision_skip |= frozenset(NOT_THE_ROBOT.get(robot.name, ()))
+    if len(legs) == 2 and all(len(leg.idx_q) == 3 for leg in legs.values()):  # two point feet
+        out.held_tilt = HELD_TILT * out.toppling()
+    if robot.name in STRAIGHT_LEGS:
+        out.stance = {i: 0.0 for leg in legs.values() for i in leg.idx_q}
     if not robot.spec.reference_pose:  # g1 (no SRDF): q0 has straight knees, where d q / d height is unbounded
         out.squat_start = SQUAT_START
     return out

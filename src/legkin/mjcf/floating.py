@@ -199,6 +199,9 @@ def to_ground_mjcf(robot_or_name: "Robot | str", *, ground: GroundModel | None =
     where = (f"fixed base, floor at z = {height:.6f} m under the lowest contact (legkin's prediction)"
              if ground.fixed_base else
              f"floor at z = 0, keyframe 0 standing at base height {height:.6f} m (legkin's prediction)")
+    if ground.held_tilt:
+        where += (f"; legkin's scenarios hold the base's roll and pitch by a torque of {ground.held_tilt:.4g} N m / rad"
+                  " (GroundModel.held_tilt), this file does not: on its point feet it falls without a controller")
     root.insert(1, ET.Comment(f" ground export: {n} contact geoms (class contact), {where} "))
     ET.indent(root, space="  ")
     return ET.tostring(root, encoding="unicode") + "\n"

@@ -29,6 +29,10 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["ContactGeom", "GroundModel", "FootGround", "Foot", "ground_model", "has_ground_model"]
 
 
+#: The damping of :attr:`GroundModel.held_tilt`, in seconds (damping / stiffness).
+HELD_TILT_DAMPING = 0.02
+
+
 @dataclass(frozen=True)
 class ContactGeom:
     """One collision primitive of the export.
@@ -67,6 +71,10 @@ class GroundModel(ABC):
         no_squat: why the ``squat`` scenario cannot run on this robot, or None.
         fixed_base: a fixed mechanism (its registry spec not floating: the hybrid leg), whose floor is put under its
             contacts and whose scenario is ``press``.
+        held_tilt: the stiffness (N m / rad) of a torque on the base that holds its roll and pitch at 0 in the
+            scenarios (a biped on two point feet, bolt: its only support is the line between its feet), with
+            :data:`HELD_TILT_DAMPING` times as much damping (N m s / rad); a torque, no force: the base's height and
+            its contacts are the contacts' alone. 0: none.
     """
 
     robot: "Robot"
@@ -80,6 +88,7 @@ class GroundModel(ABC):
     timestep: float | None = None
     no_squat: str | None = None
     fixed_base: bool = False
+    held_tilt: float = 0.0
 
     @abstractmethod
     def geoms(self) -> list[ContactGeom]:
@@ -192,11 +201,17 @@ class FootGround(GroundModel):
 
     The predicted contact of a sphere is its centre minus ``radius`` along z; :meth:`hold` runs the leg IK on the
     foot pose that puts the sphere centres on ``target + radius z`` (a flat foot keeping its orientation).
+
+    Attributes:
+        stance: joint values (rad, by index in ``q``) that every pose takes before its soles are levelled
+            (:meth:`pose`): a robot whose reference pose lies outside its joint limits stands in another one
+            (simple_humanoid: straight legs, :data:`legkin.legs.sim.STRAIGHT_LEGS`); empty for the others.
     """
 
     def __init__(self, robot: "Robot", feet: Sequence[Foot], fk: Callable[[str, np.ndarray], np.ndarray],
                  ik: Callable[[str, np.ndarray, np.ndarray], np.ndarray]) -> None:
         self.robot, self.feet, self._fk, self._ik = robot, list(feet), fk, ik
+        self.stance: dict[int, float] = {}
         self.legs = {f.leg: [g for g in self.feet if g.leg == f.leg] for f in self.feet}
         model = robot.model
         flat = {model.frames[model.getFrameId(f[0].frame)].parentJoint for f in self.legs.values() if len(f) > 1}
@@ -276,19 +291,25 @@ class FootGround(GroundModel):
         centre of mass's height above the soles in the reference pose. The robot standing on its soles is an
         inverted pendulum that an ankle softer than ``m g h`` lets topple (g1's 98.7 N m / rad from its foot's
         inertia, for m g h = 230 N m / rad: it fell forwards 0.04 rad in 2 s)."""
-        model, q = self.robot.model, self.pose(self.robot.q0)
-        data = model.createData()
-        height = float(pin.centerOfMass(model, data, q)[2]) + self.standing_height(q)
-        weight = -float(model.gravity.linear[2]) * sum(i.mass for i in model.inertias)
+        model = self.robot.model
         joints = [model.idx_qs.tolist().index(i) for f in self.legs.values() if len(f) > 1 for i in f[0].idx_q]
-        return {model.names[j]: STIFFNESS * weight * height for j in joints}
+        return {model.names[j]: STIFFNESS * self.toppling() for j in joints}
+
+    def toppling(self) -> float:
+        """The robot's toppling stiffness ``m g h`` (N m / rad): its weight times its centre of mass's height above
+        the floor in the reference pose (:meth:`pose`, level base)."""
+        model, q = self.robot.model, self.pose(self.robot.q0)
+        height = float(pin.centerOfMass(model, model.createData(), q)[2]) + self.standing_height(q)
+        return -float(model.gravity.linear[2]) * sum(i.mass for i in model.inertias) * height
 
     def pose(self, q: np.ndarray) -> np.ndarray:
-        """``q`` with every flat foot levelled (its yaw and position kept; leg IK nearest ``q``): an SRDF pose whose
-        soles are not level with the base (icub's half_sitting: pitched 0.063 rad) would land on an edge."""
+        """``q`` with the :attr:`stance` joints set, then every flat foot levelled (its yaw and position kept; leg IK
+        nearest ``q``): an SRDF pose whose soles are not level with the base (icub's half_sitting: pitched
+        0.063 rad) would land on an edge."""
         out = np.array(q, dtype=float)
+        out[list(self.stance)] = list(self.stance.values())
         for leg, feet in self.legs.items():
-            pose = self._fk(leg, q[list(feet[0].idx_q)])
+            pose = self._fk(leg, out[list(feet[0].idx_q)])
             if len(feet) > 1 and np.abs(pose[:3, :3] - _level(pose[:3, :3])).max() > _LEVEL_TOL:
                 out = self._solve(out, leg, _level(pose[:3, :3]), pose[:3, 3])
         return out
@@ -320,8 +341,8 @@ def sphere_radius(robot: "Robot", frame: str, default: float = 0.02) -> float:
 
 def has_ground_model(robot: "Robot | str") -> bool:
     """Whether the package of a robot (or registered model name) provides a ``sim`` module (:func:`ground_model`)
-    that serves it: a shared package's ``sim.supports(name)`` says which of its models it serves (legkin.legs: the
-    quadrupeds; the humanoids' flat feet have no ground model yet)."""
+    that serves it: a shared package's ``sim.supports(name)`` says which of its models it serves (legkin.legs: all
+    but its ``sim.UNSUPPORTED``)."""
     from .._registry import get_spec
 
     spec = get_spec(robot) if isinstance(robot, str) else robot.spec
@@ -342,6 +363,9 @@ def ground_model(robot: "Robot") -> GroundModel:
         raise InvalidParameterError(
             f"{robot.name}: the ground simulation needs legkin.load(name, floating={robot.spec.floating})")
     if not has_ground_model(robot):
-        raise InvalidParameterError(f"{robot.name} has no ground model ({robot.spec.package}.sim)")
+        found = importlib.util.find_spec(f"{robot.spec.package}.sim") is not None
+        why = getattr(importlib.import_module(f"{robot.spec.package}.sim"), "UNSUPPORTED", {}) if found else {}
+        raise InvalidParameterError(f"{robot.name} has no ground model ({robot.spec.package}.sim"
+                                    f"{': ' + why[robot.spec.name] if robot.spec.name in why else ''})")
     module = importlib.import_module(f"{robot.spec.package}.sim")
     return module.ground_model(robot)

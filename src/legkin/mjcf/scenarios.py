@@ -33,6 +33,7 @@ import numpy as np
 from ..errors import InvalidParameterError
 from ._base import _mujoco
 from .floating import GroundMechanism, load_ground
+from .ground import HELD_TILT_DAMPING
 
 if TYPE_CHECKING:  # pragma: no cover
     from .._checkkit import CheckResult
@@ -140,6 +141,8 @@ class _Runner:
             if self.landed < 1.0 and d.ncon >= self.feet:
                 self.landed = min(1.0, self.landed + dt / _RAMP)
             d.ctrl[:] = self.target + self.integral + self.landed * self.feedforward
+            if self.mech.ground.held_tilt:
+                self._hold_tilt()
             step(m, d)
             self.time += dt
             self.steps += 1
@@ -148,6 +151,18 @@ class _Runner:
             if self.steps % _SAMPLE_EVERY == 0:
                 self._sample()
         self.wall += time.process_time() - t0
+
+    def _hold_tilt(self) -> None:
+        """The base's torque of :attr:`~legkin.mjcf.ground.GroundModel.held_tilt`: turning its z axis back to the
+        vertical, damping its angular velocity about the horizontal axes (world frame; applied in the free
+        joint's rotational coordinates, the base frame)."""
+        d = self.mech.data
+        k = self.mech.ground.held_tilt
+        rot = d.xmat[self.mech.body_ids[1]].reshape(3, 3)
+        omega = rot @ d.qvel[3:6]
+        omega[2] = 0.0
+        torque = k * np.cross(rot[:, 2], [0.0, 0.0, 1.0]) - k * HELD_TILT_DAMPING * omega
+        d.qfrc_applied[3:6] = rot.T @ torque
 
     def _sample(self) -> None:
         """Every ``_SAMPLE_EVERY`` steps: the slip tracking, a video frame."""
@@ -246,6 +261,11 @@ def _key(mech: GroundMechanism, pose: str | None) -> tuple[int, np.ndarray]:
     return key, mech.ground.pose({**robot.poses, robot.spec.reference_pose: robot.q0}[pose])
 
 
+def _label(mech: GroundMechanism) -> str:
+    """The robot's name in its rows, saying when its base is held (:attr:`.GroundModel.held_tilt`)."""
+    return f"{mech.robot.name} (base held in roll and pitch)" if mech.ground.held_tilt else mech.robot.name
+
+
 def _stand(run: _Runner, pose: str | None, seconds: float, drop: float) -> list["CheckResult"]:
     from .._checkkit import compare
 
@@ -258,7 +278,7 @@ def _stand(run: _Runner, pose: str | None, seconds: float, drop: float) -> list[
     height = mech.ground.standing_height(q)
     pred = run.predicted()
     cop = run.pressure(pred)
-    name = mech.robot.name
+    name = _label(mech)
     gap = cop - pred
     gap[:, 1] = np.sign(gap[:, 1]) * np.maximum(np.abs(gap[:, 1]) - mech.ground.line_half_width, 0.0)
     return [
@@ -318,7 +338,7 @@ def _squat(run: _Runner, pose: str | None, seconds: float, depth: float) -> list
         run.run(seconds / 20, target)
         slip.append(run.slip_max.copy())
     run.run(_SETTLE_AFTER, target)
-    name = mech.robot.name
+    name = _label(mech)
     return [
         compare(f"{name} squat: base {depth:g} m down and up in {seconds:g} s, slip of each contact (m)",
                 np.array(slip), TOL_SLIP),

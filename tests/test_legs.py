@@ -756,10 +756,10 @@ def test_haa_arc_test_drops_only_angles_off_the_limits():
 @pytest.mark.parametrize("robot", ["quadruped", "go2", "solo12"])
 def test_no_candidate_exit_gives_the_complete_paths_verdict(robot):
     """``Leg.ik`` decides a target with no candidate branch without its complete path when the verdict is beyond
-    doubt (``_no_candidate_k``: the workspace study's common case). Its status and data must be those of the complete path (``_ik_all_core``, whose
-    ``UNREACHABLE`` they copy): on targets in a box around each leg's hip (most out of reach), every row that
-    ``ik_all`` finds out of reach is out of reach for ``ik`` with the same miss and reason, and every row ``ik``
-    finds out of reach is one that ``ik_all`` does."""
+    doubt (``_no_candidate_k``: the workspace study's common case), with the complete path's verdict. On targets
+    in a box around each leg's hip: the rows ``ik_all`` finds out of reach (``_ik_all_core``) are exactly those
+    ``ik`` finds out of reach, with the same miss and reason; on the rows ``ik`` finds reachable only outside the
+    limits, every branch of ``ik_all`` is outside them and the single call's error measures by how much."""
     import legkin
     from legkin.legs._ik_kernels import _ik_all_batch, _ik_batch
     from legkin.legs._layout import _JOINT_LIMIT, _UNREACHABLE, IK_TOL

@@ -249,13 +249,12 @@ def _row3(x: object) -> bool:
 
 
 def _rows(rows: np.ndarray, a, b, near, start, ctx: _IKCtx):
-    """The per-target inputs of a batch of n targets, range-checked: alpha, w (n,); q_near, q_start (n, 3) or None."""
+    """The per-target inputs of a batch of n targets, range-checked: alpha, w (n,) or numbers; q_near, q_start (n, 3)
+    or None."""
     n = rows.shape[0]
-    alpha = np.full(n, a) if type(a) is float else a
-    w = np.full(n, b) if type(b) is float else b
-    _check_alpha(alpha)
-    _check_w(w, ctx.base.geo)
-    out = [alpha, w]
+    _check_alpha(np.array([a]) if type(a) is float else a)
+    _check_w(np.array([b]) if type(b) is float else b, ctx.base.geo)
+    out = [a, b]  # a number stays a number (expanded per chunk by _solve_rows: no n-sized copy)
     for x, name in ((near, "q_near"), (start, "q_start")):
         if x is not None:  # finite (InvalidInputError), theta in range
             x = np.ascontiguousarray(np.broadcast_to(as_input(x, name, (3,)), (n, 3)))
@@ -266,6 +265,8 @@ def _rows(rows: np.ndarray, a, b, near, start, ctx: _IKCtx):
 
 def _solve_rows(rows, alpha, w, near, start, ctx: _IKCtx, method: str, opts: IKOptions, limits: bool):
     """The method's compiled loop on targets (n, 3): (q, iterations, error, solved, solutions, evaluations)."""
+    alpha = np.full(rows.shape[0], alpha) if type(alpha) is float else alpha
+    w = np.full(rows.shape[0], w) if type(w) is float else w
     sel = _select(alpha, ctx.kc[0], ctx.kc[1], ctx.base.geo.R)
     c = ctx.base._replace(sel=sel, w=w)
     if method == "radial":
@@ -282,11 +283,13 @@ def _ik_batch(rows, a, b, near, start, ctx: _IKCtx, method, opts, limits, sink) 
     targets at a time (:func:`legkin._batch.in_chunks`: the radial method's temporaries take ~310 B a target)."""
     alpha, w, near, start = _rows(rows, a, b, near, start, ctx)
     if sink is None and rows.shape[0] > _batch.CHUNK:
-        def solve(*chunk):
-            q, _it, _err, ok, _sols, _ev = _solve_rows(*chunk, ctx, method, opts, limits)
+        def solve(r, al, ww, nr, st):  # a number alpha or w is passed whole (None in the sliced rows)
+            q, _it, _err, ok, _sols, _ev = _solve_rows(r, alpha if al is None else al, w if ww is None else ww, nr,
+                                                       st, ctx, method, opts, limits)
             return q, ok
 
-        q, ok = in_chunks(solve, [rows, alpha, w, near, start], 3)
+        per_row = [None if type(x) is float else x for x in (alpha, w)]
+        q, ok = in_chunks(solve, [rows, *per_row, near, start], 3)
     else:
         q, it, err, ok, sols, ev = _solve_rows(rows, alpha, w, near, start, ctx, method, opts, limits)
         if sink is not None:

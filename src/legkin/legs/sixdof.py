@@ -49,6 +49,7 @@ from ._sixdof_layout import (
     _ANK,
     _AX,
     _BAD_INPUT,
+    _GRID,
     _HI6,
     _HIP,
     _JOINT_LIMIT,
@@ -64,6 +65,7 @@ from ._sixdof_layout import (
     HIP_SPHERICAL,
     IK_TOL,
     OFFSET_HIP,
+    SEARCH_GRID,
     THREE_PARALLEL,
 )
 
@@ -216,6 +218,7 @@ class Leg6:
         g[_ANK:_ANK + 3] = ank if spherical else 0.0
         g[_LO6:_LO6 + 6], g[_HI6:_HI6 + 6] = lo, hi
         g[_KIND], g[_NSOLS] = _KINDS[structure], _ROWS[structure]
+        g[_GRID] = SEARCH_GRID.get(structure, 0)
         finite = np.isfinite(lo) & np.isfinite(hi)
         mid = np.where(finite, 0.5 * (np.where(finite, lo, 0.0) + np.where(finite, hi, 0.0)), np.clip(0.0, lo, hi))
         return cls(

@@ -178,19 +178,32 @@ def _solve6(a, b, x) -> bool:
 
 
 @kernel
-def _polish6(tg, g, q, ws) -> float:
+def _split_error(e) -> float:
+    """``max(|e_position|, |e_rotation|)`` of a pose error ``e`` (6,) (m, rad)."""
+    return max(math.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2), math.sqrt(e[3] ** 2 + e[4] ** 2 + e[5] ** 2))
+
+
+@kernel
+def _polish6(tg, g, q, ws, fixed=0) -> float:
     """Damped Newton steps ``dq = (J^T J + lambda^2 I)^-1 J^T e`` on the exact forward map (at most
-    :data:`POLISH_STEPS6`, each kept only if it reduces ``|e|``) while ``|e|`` exceeds :data:`POLISH_BELOW6`.
-    ``ws``: a work array of at least 32 rows of 6. Returns the final ``|e|`` (m and rad combined)."""
+    :data:`POLISH_STEPS6`, each kept only if it reduces ``|e|``) while ``|e|`` exceeds :data:`POLISH_BELOW6`; the
+    joints of the bit mask ``fixed`` do not move (their Jacobian columns are zeroed). ``ws``: a work array of at least
+    32 rows of 6. Returns the error of the final ``q``: the larger of its position error (m) and its rotation error
+    (rad)."""
     jac, a, aw, ow = ws[0:6], ws[6:12], ws[12:18, 0:3], ws[18:24, 0:3]
     rm, p, e, b, dq, qn = ws[24:27, 0:3], ws[27, 0:3], ws[28], ws[29], ws[30], ws[31]
     _pose6(q, g, rm, p, aw, ow)
     err = _pose_error(tg, rm, p, e)
+    split = _split_error(e)
     lam2 = POLISH_DAMPING6 * POLISH_DAMPING6
     for _ in range(POLISH_STEPS6):
         if err <= POLISH_BELOW6:
             break
         _jac6(q, g, jac, rm, p, aw, ow)
+        for c in range(6):
+            if fixed >> c & 1:
+                for i in range(6):
+                    jac[i, c] = 0.0
         for i in range(6):
             b[i] = 0.0
             for k in range(6):
@@ -208,10 +221,10 @@ def _polish6(tg, g, q, ws) -> float:
         new = _pose_error(tg, rm, p, e)
         if not new < err:
             break
-        err = new
+        err, split = new, _split_error(e)
         for i in range(6):
             q[i] = qn[i]
-    return err
+    return split
 
 
 @kernel

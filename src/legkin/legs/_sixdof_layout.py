@@ -11,8 +11,12 @@ __all__ = ["_BAD_INPUT", "_JOINT_LIMIT", "_UNREACHABLE", "IK_TOL"]
 #: URDF angles written with 4-6 digits (icub: ``rpy="... 1.5708 ..."``) leave axes up to ~2e-5 m / rad off the
 #: ideal; the closed form then lands that close and the Newton polish (:data:`POLISH_STEPS6`) finishes the job.
 AXIS_TOL = 1e-4
-# IK_TOL (default ``tol`` of Leg6.ik / Leg6.ik_all, 1e-9): a pose is solved when the polished answer reproduces it
-# to this (m and rad, the norm of the 6-vector position error, rotation error); the same default as Leg's.
+# IK_TOL (default ``tol`` of Leg6.ik / Leg6.ik_all, 1e-7, derived in ._layout): a pose is solved when the polished
+# answer reproduces it to this (m and rad, the norm of the 6-vector position error, rotation error); Leg's default.
+#: A solution up to this far outside the URDF limits (rad) is clipped onto them and kept if it still reproduces the
+#: target to ``tol``: a target rounded to float32 next to a limit (near a stretched knee its solution moves by up to
+#: ~sqrt(1e-7) rad) is then solved at the nearest in-limit pose.
+LIMIT_SLACK6 = 1e-4
 #: Damped Newton steps (at most) of the polish on the exact forward map.
 POLISH_STEPS6 = 12
 #: Damping of the polish steps (m): bounds a step near a singularity.

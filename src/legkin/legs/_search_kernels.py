@@ -475,9 +475,12 @@ def _cell(t, prev_t, prev2_t, b, r, was_r, was_r2, gr, gt, g, ws, cand, n) -> in
 def _from_fold(good, good_r, bad, b, gr, gt, g, ws, cand, n):
     """The piece from the fold between ``good`` (the branch exists, residual ``good_r``) and ``bad`` (it does not) to
     ``good``, where the residual moves like ``sqrt(|t - f|)``: :data:`_FOLD_CELLS` cells of quadratically growing
-    width, and a dip at the fold. Returns ``(n, t, r)``: the last point before ``good`` and its residual."""
+    width, a dip at the fold, the fold itself where the residual nearly vanishes there. Returns ``(n, t, r)``: the
+    last point before ``good`` and its residual."""
     x0 = _fold(good, bad, b, gr, gt, g, ws)
     r0, x1, r1 = _eval1(x0, b, gr, gt, g, ws)[1], math.nan, math.nan
+    if abs(r0) <= TANGENT_TOL:  # a root at the fold (a stretched knee), or a target just beyond it: the polish decides
+        n = _rows(x0, b, gr, gt, g, ws, cand, n)
     for j in range(1, _FOLD_CELLS + 1):
         x = x0 + (good - x0) * (j / _FOLD_CELLS) ** 2 if j < _FOLD_CELLS else good
         okx, rx = _eval1(x, b, gr, gt, g, ws) if j < _FOLD_CELLS else (True, good_r)

@@ -26,9 +26,11 @@ forward map is the product of exponentials (what Pinocchio computes, with the me
 * ``"6R-general"``: any other 6R chain: ``fk`` and ``jacobian`` only; :meth:`Leg6.ik` raises
   :class:`~legkin.errors.LegStructureError`.
 
-Every answer is polished and kept only if it reproduces the target to ``tol`` (default :data:`IK_TOL` = 1e-9,
-m and rad); a target within ``tol`` of the reachable set is solved at its nearest reachable pose (the polish's
-least-squares limit). Single/batch contract of :mod:`legkin._batch`; kernels in :mod:`._sixdof_kernels`.
+Every answer is polished and kept only if it reproduces the target to ``tol`` (default :data:`IK_TOL` = 1e-7:
+position error <= ``tol`` m and rotation error <= ``tol`` rad, above what float32 rounding does to a pose, see
+``legs.kinematics.IK_TOL``; pass ``tol=1e-9`` for a tighter check); a target within ``tol`` of the
+reachable set is solved at its nearest reachable pose (the polish's least-squares limit). Single/batch contract
+of :mod:`legkin._batch`; kernels in :mod:`._sixdof_kernels`.
 """
 
 from __future__ import annotations
@@ -353,7 +355,8 @@ class Leg6:
         Args:
             target: foot poses in the root frame (m).
             q_near: each angle is given as its 2 pi representative nearest ``q_near`` (default :attr:`q_ref`).
-            tol: a solution reproduces the target to this (m and rad); (0, 1e-3].
+            tol: a solution reproduces the target to this: position error (m) and rotation error (rad) each;
+                (0, 1e-3], default 1e-7.
             return_mask: also return the mask of the rows that exist.
 
         Returns:

@@ -46,7 +46,7 @@ import numpy as np
 from .._kernels import kernel
 from ._sixdof_kernels import _axis, _mat_t_vec, _mat_vec, _origin, _target_motion
 from ._sixdof_layout import _GRID, _HIP, _KIND, TANGENT_TOL, THREE_PARALLEL
-from .subproblems import cross, dot, rot, sp1, sp2, sp3
+from .subproblems import cross, dot, rot, rot_cs, sp1, sp2, sp3
 
 _REFINE_STEPS = 100
 #: The golden-section search of a dip stops at this width (rad): a tangential root's residual is then off by
@@ -152,14 +152,6 @@ _NCO = 62
 
 
 @kernel
-def _rot_cs(k, c, s, p):
-    """``R(k, t) p`` for ``c = cos t``, ``s = sin t`` (Rodrigues, no trigonometry)."""
-    w = (1.0 - c) * dot(k, p)
-    x = cross(k, p)
-    return c * p[0] + s * x[0] + w * k[0], c * p[1] + s * x[1] + w * k[1], c * p[2] + s * x[2] + w * k[2]
-
-
-@kernel
 def _put(co, i, v) -> None:
     co[i], co[i + 1], co[i + 2] = v[0], v[1], v[2]
 
@@ -252,7 +244,7 @@ def _off_r(u, i4, y5, c6, s6, g, co):
     num, den = dot(a5, cross(y5, e5)), dot(y5, e5) - ky * ke
     hy = math.sqrt(num * num + den * den)
     c5, s5 = (den / hy, num / hy) if hy > 0.0 else (1.0, 0.0)
-    v = _rot_cs(a6, c6, -s6, _rot_cs(a5, c5, -s5, _at(co, _CV, c4, s4)))
+    v = rot_cs(a6, c6, -s6, rot_cs(a5, c5, -s5, _at(co, _CV, c4, s4)))
     return m4, dot(u, v) - co[_CC + 7], c4, -s4, c5, s5
 
 
@@ -273,8 +265,8 @@ def _off_rows(t, b, gr, g, co, cand, n) -> int:
     c, s = math.cos(t), math.sin(t)
     _, _, c4, s4, c5, s5, c6, s6 = _off_at(c, s, b, g, co)
     v = _unit_normal(a3, a2, a1)
-    w3 = _rot_cs(a1, c, -s, _mat_vec(gr, _rot_cs(a6, c6, -s6, _rot_cs(a5, c5, -s5, _rot_cs(a4, c4, -s4, a3)))))
-    wv = _rot_cs(a1, c, -s, _mat_vec(gr, _rot_cs(a6, c6, -s6, _rot_cs(a5, c5, -s5, _rot_cs(a4, c4, -s4, v)))))
+    w3 = rot_cs(a1, c, -s, _mat_vec(gr, rot_cs(a6, c6, -s6, rot_cs(a5, c5, -s5, rot_cs(a4, c4, -s4, a3)))))
+    wv = rot_cs(a1, c, -s, _mat_vec(gr, rot_cs(a6, c6, -s6, rot_cs(a5, c5, -s5, rot_cs(a4, c4, -s4, v)))))
     q2 = sp1(a3, w3, a2)
     q3 = sp1(v, rot(a2, -q2, wv), a3)
     return _add_row(cand, n, t, q2, q3, math.atan2(s4, c4), math.atan2(s5, c5), math.atan2(s6, c6))

@@ -298,7 +298,7 @@ class Leg6:
                 f"{AXIS_TOL:g})", found=self.structure, expected=list(STRUCTURES[:2]),
             )
         tol = check_number(tol, "tol", 0.0, 1e-3, low_open=True)
-        arr = _pose_input(target)
+        arr = as_input(target, "target", _T44)  # the rotation and bottom row are checked by the kernel (_bad_poses)
         batch = arr.shape[:-2]
         if q_near is None:
             ref = self.q_ref.reshape(1, 6).copy()
@@ -333,6 +333,19 @@ class Leg6:
         if st != _BAD_INPUT:
             raise self._error(st, info, target, IK_TOL)
         return None
+
+    @staticmethod
+    def _bad_poses(status: np.ndarray, rows: np.ndarray) -> None:
+        """Raise where the kernel refused a pose (``_BAD_INPUT``: not a homogeneous transform, the test of
+        :func:`_pose_input`, which then says why).
+
+        Raises:
+            InvalidInputError: some row of ``rows`` (n, 16) is not a 4x4 homogeneous transform.
+        """
+        bad = status == _BAD_INPUT
+        if bad.any():
+            _pose_input(rows[bad].reshape(-1, 4, 4))
+            raise InvalidInputError("target must be 4x4 homogeneous transforms (R^T R = I and det R = 1 to 1e-6)")
 
     def _error(self, status: int, info: np.ndarray, target: np.ndarray, tol: float):
         t = target.reshape(4, 4)
@@ -378,6 +391,7 @@ class Leg6:
         k = self.n_solutions
         out, status, info = np.empty((n, k, 6)), np.empty(n, dtype=np.int64), np.zeros((n, 2))
         _ik_all6_batch(rows, self.params, ref, tol, out, status, info)
+        self._bad_poses(status, rows)
         if single and status[0] != OK:
             raise self._error(int(status[0]), info[0], rows[0], tol)
         q_all = out.reshape(batch + (k, 6))
@@ -412,6 +426,7 @@ class Leg6:
         n = rows.shape[0]
         out, status, info = np.empty((n, 6)), np.empty(n, dtype=np.int64), np.zeros((n, 2))
         _ik6_batch(rows, self.params, ref, tol, out, status, info)
+        self._bad_poses(status, rows)
         ok = status == OK
         if single:
             return finish(out[0], ok[0], True, flag, lambda: self._error(int(status[0]), info[0], rows[0], tol))

@@ -337,14 +337,17 @@ def test_bad_options_and_no_closed_form(talos_left, humanoids):
 
 
 # ------------------------------------------------------------------------------------------- the squat clip
-@pytest.mark.parametrize("name", ["talos", "g1"])
-def test_squat_keeps_the_soles_on_the_floor(name):
-    """``legkin view NAME --animate squat --floating``: the pelvis goes SQUAT_DEPTH down and back, every sole stays
-    flat where it was (Pinocchio's oMf, 1e-9), every frame inside the joint limits."""
+@pytest.mark.parametrize("name, deep", [("talos", True), ("g1", True), ("romeo", False), ("simple_humanoid", False)])
+def test_squat_keeps_the_soles_on_the_floor(name, deep):
+    """``legkin view NAME --animate squat --floating``: the pelvis goes squat_depth down and back (SQUAT_DEPTH where
+    the legs can; romeo and simple_humanoid stand near their limits: less, but some), every sole stays flat where it
+    was (Pinocchio's oMf, 1e-9), every frame inside the joint limits."""
     import legkin
-    from legkin.legs.clips import SQUAT_DEPTH, squat
+    from legkin.legs.clips import SQUAT_DEPTH, squat, squat_depth
 
     robot = legkin.load(name, floating=True)
+    depth = squat_depth(robot)
+    assert (depth == SQUAT_DEPTH) == deep and depth >= SQUAT_DEPTH / 4
     qs = np.array(squat(robot))
     data = robot.model.createData()
     soles = []
@@ -355,5 +358,5 @@ def test_squat_keeps_the_soles_on_the_floor(name):
     soles = np.array(soles)
     assert np.abs(soles - soles[0]).max() <= 1e-9
     assert abs(soles[0, :, 2, 3].min()) <= 1e-12  # the lowest sole on the floor
-    assert qs[0, 2] - qs[:, 2].min() == pytest.approx(SQUAT_DEPTH, rel=1e-3)
+    assert qs[0, 2] - qs[:, 2].min() == pytest.approx(depth, rel=1e-3)
     assert all(leg.within_limits(qs[:, list(leg.idx_q)]).all() for leg in robot.geometry.values())

@@ -673,18 +673,31 @@ def test_continuous_joints_are_legs_with_unbounded_limits(tmp_path):
 
 @pytest.mark.parametrize("name", ["go2", "anymal_c", "solo12"])
 def test_float32_targets_are_solved_within_tol(erd, name):
-    """Feet of in-limit joints rounded to float32 (a simulator's): none refused with tol=1e-9 ... unless the rounding
-    pushed them out of reach by more (then tol=1e-7 solves them at the nearest point, 1e-7 m away at most)."""
+    """Feet of in-limit joints rounded to float32 (a simulator's): none refused with the default tol (IK_TOL = 1e-7 m,
+    above the rounding's sqrt(3) 2^-25 = 5.2e-8 m), each solved within 1e-7 m; a few refused with tol=1e-9 (the
+    rounding pushed them out of reach by more)."""
     _, found = erd[name]
     rng = np.random.default_rng(32)
     for leg in found.values():
         q = rng.uniform(leg.lower, leg.upper, (20_000, 3))
         p32 = leg.fk(q).astype(np.float32).astype(float)
-        _, ok = leg.ik(p32, return_mask=True)
-        sol, ok7 = leg.ik(p32, tol=1e-7, return_mask=True)
-        assert ok7.all(), f"{name} {leg.name}: {int((~ok7).sum())} refused with tol=1e-7"
+        sol, ok = leg.ik(p32, return_mask=True)
+        assert ok.all(), f"{name} {leg.name}: {int((~ok).sum())} refused with the default tol"
         assert np.linalg.norm(leg.fk(sol) - p32, axis=-1).max() <= 1e-7
-        assert (~ok).sum() <= 20, f"{name} {leg.name}: {int((~ok).sum())} of 20000 refused with tol=1e-9"
+        _, ok9 = leg.ik(p32, tol=1e-9, return_mask=True)
+        assert (~ok9).sum() <= 20, f"{name} {leg.name}: {int((~ok9).sum())} of 20000 refused with tol=1e-9"
+
+
+def test_default_tol_refuses_a_target_1um_out_of_reach(erd):
+    fl = erd["solo12"][1]["FL"]
+    stretched = fl.fk(np.array([0.0, 0.0, 0.0]))  # knee straight: the full stretch
+    unit = (stretched - fl.origin) / np.linalg.norm(stretched - fl.origin)
+    with pytest.raises(UnreachableError):
+        fl.ik(stretched + 1e-6 * unit)
+    with pytest.raises(UnreachableError):
+        fl.ik_all(stretched + 1e-6 * unit)
+    q = fl.ik(stretched + 5e-8 * unit)  # within the default 1e-7 m: solved, the foot within tol of the target
+    assert 1e-9 < float(np.linalg.norm(fl.fk(q) - (stretched + 5e-8 * unit))) <= legs.kinematics.IK_TOL
 
 
 def test_tol_bounds_the_nearest_point_solution(erd):

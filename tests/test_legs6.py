@@ -272,14 +272,36 @@ def test_q_near_picks_the_solution_and_joint_limit_error(talos_left):
 
 
 def test_tol_solves_a_pose_just_out_of_reach(talos_left):
+    """The default tol (IK_TOL = 1e-7) solves a pose 5e-8 beyond full stretch at its nearest pose, refuses one 1e-6
+    beyond; a tighter tol refuses the first, a looser one solves the second."""
     leg = talos_left
     stretched = leg.fk(np.zeros(6))  # the straight leg: the reach boundary
-    beyond = stretched.copy()
-    beyond[2, 3] -= 1e-7  # 0.1 um beyond full stretch
+    near, beyond = stretched.copy(), stretched.copy()
+    near[2, 3] -= 5e-8
+    beyond[2, 3] -= 1e-6  # 1 um beyond full stretch
+    q = leg.ik(near)
+    assert np.linalg.norm(leg.fk(q)[:3, 3] - near[:3, 3]) == pytest.approx(5e-8, rel=1e-3)
+    with pytest.raises(UnreachableError):
+        leg.ik(near, tol=1e-9)
     with pytest.raises(UnreachableError):
         leg.ik(beyond)
-    q = leg.ik(beyond, tol=1e-6)
-    assert np.linalg.norm(leg.fk(q)[:3, 3] - beyond[:3, 3]) == pytest.approx(1e-7, rel=1e-3)
+    with pytest.raises(UnreachableError):
+        leg.ik_all(beyond)
+    q = leg.ik(beyond, tol=1e-5)
+    assert np.linalg.norm(leg.fk(q)[:3, 3] - beyond[:3, 3]) == pytest.approx(1e-6, rel=1e-3)
+
+
+def test_float32_poses_are_solved_with_the_default_tol(talos_left):
+    """4x4 foot poses of in-limit joints rounded to float32 (position and rotation block): every one solved with the
+    default tol, the answer within IK_TOL of the rounded pose (the bound of legs._layout.IK_TOL: <= 8.2e-8)."""
+    leg = talos_left
+    rng = np.random.default_rng(33)
+    t32 = leg.fk(rng.uniform(leg.lower, leg.upper, (2000, 6))).astype(np.float32).astype(float)
+    q, ok = leg.ik(t32, return_mask=True)
+    assert ok.all()
+    back = leg.fk(q)
+    assert np.linalg.norm(back[:, :3, 3] - t32[:, :3, 3], axis=-1).max() <= legs.kinematics.IK_TOL
+    assert np.abs(back[:, :3, :3] - t32[:, :3, :3]).max() <= legs.kinematics.IK_TOL
 
 
 @pytest.mark.parametrize("bad, match", [
@@ -315,14 +337,17 @@ def test_bad_options_and_no_closed_form(talos_left, humanoids):
 
 
 # ------------------------------------------------------------------------------------------- the squat clip
-@pytest.mark.parametrize("name", ["talos", "g1"])
-def test_squat_keeps_the_soles_on_the_floor(name):
-    """``legkin view NAME --animate squat --floating``: the pelvis goes SQUAT_DEPTH down and back, every sole stays
-    flat where it was (Pinocchio's oMf, 1e-9), every frame inside the joint limits."""
+@pytest.mark.parametrize("name, deep", [("talos", True), ("g1", True), ("romeo", False), ("simple_humanoid", False)])
+def test_squat_keeps_the_soles_on_the_floor(name, deep):
+    """``legkin view NAME --animate squat --floating``: the pelvis goes squat_depth down and back (SQUAT_DEPTH where
+    the legs can; romeo and simple_humanoid stand near their limits: less, but some), every sole stays flat where it
+    was (Pinocchio's oMf, 1e-9), every frame inside the joint limits."""
     import legkin
-    from legkin.legs.clips import SQUAT_DEPTH, squat
+    from legkin.legs.clips import SQUAT_DEPTH, squat, squat_depth
 
     robot = legkin.load(name, floating=True)
+    depth = squat_depth(robot)
+    assert (depth == SQUAT_DEPTH) == deep and depth >= SQUAT_DEPTH / 4
     qs = np.array(squat(robot))
     data = robot.model.createData()
     soles = []
@@ -333,5 +358,5 @@ def test_squat_keeps_the_soles_on_the_floor(name):
     soles = np.array(soles)
     assert np.abs(soles - soles[0]).max() <= 1e-9
     assert abs(soles[0, :, 2, 3].min()) <= 1e-12  # the lowest sole on the floor
-    assert qs[0, 2] - qs[:, 2].min() == pytest.approx(SQUAT_DEPTH, rel=1e-3)
+    assert qs[0, 2] - qs[:, 2].min() == pytest.approx(depth, rel=1e-3)
     assert all(leg.within_limits(qs[:, list(leg.idx_q)]).all() for leg in robot.geometry.values())

@@ -21,6 +21,7 @@ from ._sixdof_layout import (
     _NSOLS,
     _UNREACHABLE,
     HIP_SPHERICAL,
+    LIMIT_SLACK6,
 )
 
 _NAN = math.nan
@@ -85,6 +86,25 @@ def _limited(q, ref, g, x) -> tuple[float, bool]:
     return cost, True
 
 
+@kernel
+def _clip_solution(tg, g, q, ref, tol, out, ws) -> bool:
+    """A solution ``q`` a hair outside the limits (a target rounded to float32 near a limit): each angle at its 2 pi
+    representative nearest ``ref``, clipped onto the limits, into ``out``, the other joints re-solved by the polish
+    with the clipped ones fixed; True if that reproduces ``tg`` to ``tol`` (the target is then within ``tol`` of the
+    in-limit reachable set), else ``out`` is NaN."""
+    fixed = 0
+    for j in range(6):
+        lo, hi = g[_LO6 + j], g[_HI6 + j]
+        x = _near_k(q[j], min(max(ref[j], lo), hi))
+        out[j] = min(max(x, lo), hi)
+        fixed |= (out[j] != x) << j
+    if _polish6(tg, g, out, ws, fixed) <= tol and _limited(out, ref, g, ws[29])[1]:
+        return True
+    for j in range(6):
+        out[j] = _NAN
+    return False
+
+
 @kernel(entry=True)
 def _ik6_k(tg, g, ref, tol, out, info) -> int:
     """The solution inside the limits nearest ``ref`` (least sum of squared differences): the candidates are ranked
@@ -103,7 +123,7 @@ def _ik6_k(tg, g, ref, tol, out, info) -> int:
     for b in range(n):
         c, inside = _limited(cand[b], ref, g, lim[b])
         cost[b] = c if inside else math.inf
-    best, viol, nb = math.inf, math.inf, 0
+    best = math.inf
     for _ in range(n):  # the in-limit candidates, cheapest first
         i = int(np.argmin(cost[:n]))
         if cost[i] == math.inf:
@@ -119,14 +139,38 @@ def _ik6_k(tg, g, ref, tol, out, info) -> int:
             for j in range(6):
                 out[j] = _NAN
         best = min(best, res)
-    for b in range(n):  # none inside the limits: is any candidate a solution at all?
+    return _polished_fallback(tg, g, ref, tol, cand, lim, n, best, out, info, ws)
+
+
+@kernel
+def _polished_fallback(tg, g, ref, tol, cand, lim, n, best, out, info, ws) -> int:
+    """:func:`_ik6_k` when no in-limit candidate polished to a solution: every candidate polished first, then moved
+    inside the limits (a candidate outside them can polish to an in-limit solution near a stretched knee; one a hair
+    outside, up to :data:`LIMIT_SLACK6`, is clipped onto them, :func:`_clip_solution`); the in-limit solution nearest
+    ``ref`` wins. Else ``info``: the least limit violation (rad) and the count of solutions, or the least residual."""
+    qb = ws[32]
+    viol, nb, best_in = math.inf, 0, math.inf
+    for b in range(n):
         for j in range(6):
             qb[j] = cand[b, j]
-        if _polish6(tg, g, qb, ws) <= tol:
-            nb += 1
-            viol = min(viol, _limited(qb, ref, g, lim[b])[0])
-        else:
-            best = min(best, _polish6(tg, g, qb, ws))
+        res = _polish6(tg, g, qb, ws)
+        if not res <= tol:
+            best = min(best, res)
+            continue
+        nb += 1
+        c, inside = _limited(qb, ref, g, lim[b])
+        if not inside and c <= LIMIT_SLACK6 and _clip_solution(tg, g, qb, ref, tol, lim[b], ws):
+            c, inside = 0.0, True
+            for j in range(6):
+                c += (lim[b, j] - ref[j]) ** 2
+        if inside and c < best_in:
+            best_in = c
+            for j in range(6):
+                out[j] = lim[b, j]
+        elif not inside:
+            viol = min(viol, c)
+    if best_in < math.inf:
+        return OK
     if nb == 0:
         info[0], info[1] = best, 0.0
         return _UNREACHABLE

@@ -11,9 +11,15 @@ PERPENDICULAR_TOL = 1e-9
 PARALLEL_TOL = 1e-9
 #: The closed form's own reach slack (m): a branch is polished until its foot is this close.
 REACH_TOL = 1e-12
-#: Default ``tol`` of :meth:`Leg.ik` / :meth:`Leg.ik_all` (m): a target up to this far outside the reachable set is
-#: solved at its nearest reachable point (float32 rounding of a 0.5 m foot position is ~3e-8 m, see docs/legs.md).
-IK_TOL = 1e-9
+#: Default ``tol`` of :meth:`Leg.ik` / :meth:`Leg.ik_all` (m) and of :class:`~legkin.legs.Leg6`'s pose error (m and
+#: rad): a target up to this far outside the reachable set is solved at its nearest reachable point. Why 1e-7: a
+#: target rounded to float32 (a simulator's, a sensor's) moves each coordinate in [0.5, 1) m by up to 2^-25 m, so a
+#: foot within 1 m of the root by up to sqrt(3) 2^-25 = 5.2e-8 m, and near a stretched knee or a joint limit that
+#: lands outside the reachable set; a float32 rotation matrix (entries rounded by <= 2^-25) is turned by at most
+#: 3 2^-25 / sqrt(2) = 6.3e-8 rad, so a float32 4x4 pose is off by <= 8.2e-8 (m and rad combined) < 1e-7. Targets
+#: farther out are refused (UnreachableError); pass a smaller ``tol`` (down to the solvers' 1e-12) for a tighter
+#: check of exact float64 targets.
+IK_TOL = 1e-7
 #: A joint angle up to this far (rad) outside the URDF limits is clipped onto the limit when re-solving the other
 #: joints (LIMIT_SLACK) does not reach the target (the foot then moves by at most LIMIT_TOL x the leg's reach).
 LIMIT_TOL = 1e-10

@@ -19,11 +19,20 @@ one joint ``t`` is searched over a full turn; for each trial value the others fo
 3. ``R_23 = R(a_1, -t) R_G R_6^T R_5^T R_4^T`` must turn about the two hip axes only:
    ``r_b(t) = a_2 . (R_23 a_3) - a_2 . a_3``; at a root SP1 gives ``q_2`` (``R_2 a_3 = R_23 a_3``) and ``q_3``.
 
-The search: every sign change of ``r_b`` between the :data:`SEARCH_GRID` grid points is bracketed (also between
-a grid point and a *fold* where the branch stops existing, found by bisection) and refined by the Illinois method
-to 1e-15 rad; where ``|r_b|`` dips at a grid point without a sign change (or next to a fold, where g1's knee
-nears full stretch and the two ``q_4`` branches meet), a golden-section search finds the dip's extremum: two close
-roots are bracketed on its sides, a tangential root (``|r| <=`` :data:`TANGENT_TOL`) kept.
+On the offset hip every quantity of one point is ``X_0 + X_c cos t + X_s sin t`` with per-target coefficients
+(:func:`_off_prepare`) and the subproblems' roots are taken as cosine/sine pairs: a point costs one cosine, one sine
+and a few square roots for all 4 branches, no allocation.
+
+The search (:data:`SEARCH_GRID` points by structure): every sign change of ``r_b`` between two grid points is
+bracketed and refined by the Illinois method to 1e-15 rad; where ``|r_b|`` dips at a grid point without a sign
+change, Brent's minimisation finds the dip's extremum: two close roots are bracketed on its sides, a tangential root
+(``|r| <=`` :data:`TANGENT_TOL`) kept. Where a branch stops existing (a *fold*, where g1's knee nears full stretch
+and two branches meet; found by the Illinois method on the existence margin), the residual moves like
+``sqrt(|t - f|)``: the piece from the fold to the grid point is searched on :data:`_FOLD_CELLS` cells of
+quadratically growing width, with a dip at the fold. A bracket that holds a gap of its branch is split at the gap's
+folds; and where the margin peaks near zero between three grid points (an *island* where the branch exists, or a
+*hole* where it does not; the parabola through the three margins decides), Brent's method finds it and the pieces
+from its folds are searched.
 Every candidate is then polished on the exact forward map and kept only if it reproduces the target
 (:mod:`._ik6_kernels`).
 """
@@ -36,10 +45,15 @@ import numpy as np
 
 from .._kernels import kernel
 from ._sixdof_kernels import _axis, _mat_t_vec, _mat_vec, _origin, _target_motion
-from ._sixdof_layout import _HIP, _KIND, SEARCH_GRID, TANGENT_TOL, THREE_PARALLEL
-from .subproblems import cross, dot, rot, sp1, sp2, sp3, sp4
+from ._sixdof_layout import _GRID, _HIP, _KIND, TANGENT_TOL, THREE_PARALLEL
+from .subproblems import cross, dot, rot, rot_cs, sp1, sp2, sp3
 
 _REFINE_STEPS = 100
+#: The golden-section search of a dip stops at this width (rad): a tangential root's residual is then off by
+#: ~|r''| _DIP_WIDTH^2 / 8, far below :data:`TANGENT_TOL`, and two roots on its sides are bracketed.
+_DIP_WIDTH = 1e-8
+#: Cells of the search from a fold to the next grid point (widths growing quadratically, as the sqrt(t - f) of a fold).
+_FOLD_CELLS = 6
 _NB = 4  # branches at most
 
 
@@ -97,7 +111,8 @@ def _par_eval(t, gr, gt, g, ok, r) -> None:
     """Both branches at ``q_6 = t``, sharing the SP2 solve."""
     n, a1, a2, a6, o3 = _axis(g, 2), _axis(g, 0), _axis(g, 1), _axis(g, 5), _origin(g, 2)
     cnt, t1a, t2a, t1b, t2b, _ = sp2(_mat_vec(gr, rot(a6, -t, n)), n, a1, a2)
-    ok[0], ok[1], ok[2], ok[3] = cnt == 2, cnt == 2, False, False
+    m = 1.0 if cnt == 2 else -1.0
+    ok[0], ok[1], ok[2], ok[3] = m, m, -1.0, -1.0
     r[0] = dot(n, _sub(_h_point(o3, t, -t1a, t2a, gr, gt, g), o3))
     r[1] = dot(n, _sub(_h_point(o3, t, -t1b, t2b, gr, gt, g), o3))
 
@@ -123,86 +138,155 @@ def _par_rows(t, b, gr, gt, g, cand, n) -> int:
 
 
 # ---------------------------------------------------------------- offset hip (search over q1)
+# The per-target coefficients ``co`` of the offset-hip search (:func:`_off_prepare`): every quantity that the
+# residual needs at ``q_1 = t`` is ``X_0 + X_c cos t + X_s sin t`` or a constant, so one point of the search costs
+# a cosine, a sine, a few square roots and products (no other transcendental function).
+_CP = 0  # p(t) = d(t) - o_6 (3 vectors: constant, cos, sin)
+_CX = 9  # a_6 x p(t)
+_CU = 18  # u(t) = R_G^T R(a_1, t) a_2
+_CK = 27  # a_6 . p(t) (3 numbers), then SP4's A(t) (3) and B(t) (3)
+_CE = 36  # E_4^-1 h - o_5 (vectors of 1, cos q_4, -sin q_4)
+_CV = 45  # R_4^T a_3 (idem)
+_CC = 54  # constants: SP4's a_4 . (h - o_6), a_6 . a_4; SP3's x offset and ry^2 factor, radius, cos/sin phi; a_2 . a_3
+_NCO = 62
+
+
 @kernel
-def _off_q6(t, gr, gt, g):
-    """``(count, q6_a, q6_b, d)``: SP4 for the ankle roll at ``q_1 = t``, with ``d = G^-1 E_1(t) h``."""
-    a1, a4, a6 = _axis(g, 0), _axis(g, 3), _axis(g, 5)
-    o1, o6 = _origin(g, 0), _origin(g, 5)
+def _put(co, i, v) -> None:
+    co[i], co[i + 1], co[i + 2] = v[0], v[1], v[2]
+
+
+@kernel
+def _at(co, i, c, s):
+    """The vector ``X_0 + c X_c + s X_s`` stored at ``co[i:i + 9]``."""
+    return (co[i] + c * co[i + 3] + s * co[i + 6], co[i + 1] + c * co[i + 4] + s * co[i + 7],
+            co[i + 2] + c * co[i + 5] + s * co[i + 8])
+
+
+@kernel
+def _off_prepare(gr, gt, g, co) -> None:
+    """Fill ``co`` for the target motion ``(gr, gt)``: ``d(t) = G^-1 E_1(t) h`` is a circle, so ``p = d - o_6``,
+    ``a_6 x p``, SP4's coefficients and ``u(t) = R_G^T R(a_1, t) a_2`` are each ``X_0 + X_c cos t + X_s sin t``;
+    ``E_4^-1 h - o_5`` and ``R_4^T a_3`` are ``X_0 + X_c cos q_4 - X_s sin q_4``."""
+    a1, a2, a3, a4, a6 = _axis(g, 0), _axis(g, 1), _axis(g, 2), _axis(g, 3), _axis(g, 5)
+    o1, o4, o5, o6 = _origin(g, 0), _origin(g, 3), _origin(g, 4), _origin(g, 5)
     h = (g[_HIP], g[_HIP + 1], g[_HIP + 2])
-    d = _mat_t_vec(gr, _sub(_add(rot(a1, t, _sub(h, o1)), o1), gt))
-    c6, t6a, t6b, _ = sp4(a4, _sub(d, o6), a6, dot(a4, _sub(h, o6)))
-    return c6, t6a, t6b, d
+    p = _sub(h, o1)
+    ap, a12 = dot(a1, p), dot(a1, a2)
+    base = _sub(_add(o1, (ap * a1[0], ap * a1[1], ap * a1[2])), gt)
+    parts = (_sub(_mat_t_vec(gr, base), o6), _mat_t_vec(gr, _sub(p, (ap * a1[0], ap * a1[1], ap * a1[2]))),
+             _mat_t_vec(gr, cross(a1, p)))
+    us = (_mat_t_vec(gr, (a12 * a1[0], a12 * a1[1], a12 * a1[2])),
+          _mat_t_vec(gr, _sub(a2, (a12 * a1[0], a12 * a1[1], a12 * a1[2]))), _mat_t_vec(gr, cross(a1, a2)))
+    a46, n46 = dot(a6, a4), cross(a4, a6)
+    p1, p2 = _sub(h, o4), _sub(o5, o4)  # SP3 |R(a_4, -q_4) p1 - p2| = |y - o_5|: only the distance changes
+    k1, k3 = dot(a4, p1), dot(a4, a3)
+    es = (_add((k1 * a4[0], k1 * a4[1], k1 * a4[2]), _sub(o4, o5)), _sub(p1, (k1 * a4[0], k1 * a4[1], k1 * a4[2])),
+          cross(a4, p1))
+    vs = ((k3 * a4[0], k3 * a4[1], k3 * a4[2]), _sub(a3, (k3 * a4[0], k3 * a4[1], k3 * a4[2])), cross(a4, a3))
+    for k in range(3):
+        v = parts[k]
+        _put(co, _CP + 3 * k, v)
+        _put(co, _CX + 3 * k, cross(a6, v))
+        _put(co, _CU + 3 * k, us[k])
+        _put(co, _CE + 3 * k, es[k])
+        _put(co, _CV + 3 * k, vs[k])
+        co[_CK + k] = dot(a6, v)
+        co[_CK + 3 + k] = dot(a4, v) - co[_CK + k] * a46
+        co[_CK + 6 + k] = dot(n46, v)
+    n2 = math.sqrt(dot(p2, p2))
+    hh = (p2[0] / n2, p2[1] / n2, p2[2] / n2)
+    kk = k1 * dot(a4, hh)
+    aa, bb = dot(hh, p1) - kk, dot(hh, cross(a4, p1))
+    rr = math.hypot(aa, bb)
+    co[_CC], co[_CC + 1] = dot(a4, _sub(h, o6)), a46
+    co[_CC + 2], co[_CC + 3] = (dot(p1, p1) + n2 * n2) / (2.0 * n2) - kk, 1.0 / (2.0 * n2)
+    co[_CC + 4], co[_CC + 5], co[_CC + 6], co[_CC + 7] = rr, aa / rr, bb / rr, dot(a2, a3)
 
 
 @kernel
-def _off_q4(d, q6, g):
-    """``(count, q4_a, q4_b, y)``: SP3 for the knee, with ``y = E_6(q6) d``."""
-    a4, a6 = _axis(g, 3), _axis(g, 5)
-    o4, o5, o6 = _origin(g, 3), _origin(g, 4), _origin(g, 5)
-    h = (g[_HIP], g[_HIP + 1], g[_HIP + 2])
-    y = _add(rot(a6, q6, _sub(d, o6)), o6)
-    ry = math.sqrt(dot(_sub(y, o5), _sub(y, o5)))
-    c4, t4a, t4b, _ = sp3(_sub(h, o4), _sub(o5, o4), a4, ry)
-    return c4, -t4a, -t4b, y
+def _branch_cs(x, r, cphi, sphi, sgn):
+    """``(margin, cos, sin)`` of ``phi + sgn g`` with ``cos g = x / r`` (SP4's two roots without trigonometry); the
+    roots exist where ``margin = r - |x| >= 0``."""
+    cg = min(1.0, max(-1.0, x / r)) if r > 0.0 else 1.0
+    sg = math.sqrt(1.0 - cg * cg)
+    return r - abs(x), cphi * cg - sgn * sphi * sg, sphi * cg + sgn * cphi * sg
 
 
 @kernel
-def _off_r(t, q4, q6, y, gr, g):
-    """``(q5, r)``: SP1 for the ankle pitch and the hip residual ``a_2 . (R_23 a_3) - a_2 . a_3``."""
-    a1, a2, a3, a4, a5, a6 = _axis(g, 0), _axis(g, 1), _axis(g, 2), _axis(g, 3), _axis(g, 4), _axis(g, 5)
-    o4, o5 = _origin(g, 3), _origin(g, 4)
-    h = (g[_HIP], g[_HIP + 1], g[_HIP + 2])
-    e = _add(rot(a4, -q4, _sub(h, o4)), o4)
-    q5 = sp1(_sub(y, o5), _sub(e, o5), a5)
-    w = rot(a1, -t, _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, a3)))))  # R_23 a_3
-    return q5, dot(a2, w) - dot(a2, a3)
+def _off_q6(c, s, i6, g, co):
+    """``(margin, cos q_6, sin q_6, y - o_5)``: SP4 ``a_4 . R(a_6, q_6) p = a_4 . (h - o_6)`` (root ``i6``) at
+    ``(cos q_1, sin q_1) = (c, s)``, and ``y = o_6 + R(a_6, q_6) p``."""
+    a6, o5, o6 = _axis(g, 5), _origin(g, 4), _origin(g, 5)
+    p, x6 = _at(co, _CP, c, s), _at(co, _CX, c, s)
+    kp = co[_CK] + c * co[_CK + 1] + s * co[_CK + 2]
+    aa = co[_CK + 3] + c * co[_CK + 4] + s * co[_CK + 5]
+    bb = co[_CK + 6] + c * co[_CK + 7] + s * co[_CK + 8]
+    rr = math.sqrt(aa * aa + bb * bb)
+    rr_ = rr if rr > 0.0 else 1.0
+    m6, c6, s6 = _branch_cs(co[_CC] - kp * co[_CC + 1], rr, aa / rr_, bb / rr_, -1.0 if i6 == 0 else 1.0)
+    w = (1.0 - c6) * kp
+    y5 = (c6 * p[0] + s6 * x6[0] + w * a6[0] + o6[0] - o5[0], c6 * p[1] + s6 * x6[1] + w * a6[1] + o6[1] - o5[1],
+          c6 * p[2] + s6 * x6[2] + w * a6[2] + o6[2] - o5[2])
+    return m6, c6, s6, y5
 
 
 @kernel
-def _off_chain(t, b, gr, gt, g):
-    """``(exists, q4, q5, q6, r)`` of branch ``b`` (``q_6`` branch ``b // 2``, ``q_4`` branch ``b % 2``) at
-    ``q_1 = t``."""
-    c6, t6a, t6b, d = _off_q6(t, gr, gt, g)
-    q6 = t6a if b < 2 else t6b
-    c4, q4a, q4b, y = _off_q4(d, q6, g)
-    q4 = q4a if b % 2 == 0 else q4b
-    q5, r = _off_r(t, q4, q6, y, gr, g)
-    return c6 == 2 and c4 == 2, q4, q5, q6, r
+def _off_r(u, i4, y5, c6, s6, g, co):
+    """``(margin, r, cos q_4, sin q_4, cos q_5, sin q_5)`` of the ``q_4`` root ``i4`` given ``y - o_5`` and ``q_6``:
+    SP3 ``|R(a_4, -q_4)(h - o_4) - (o_5 - o_4)| = |y - o_5|``, SP1 ``R(a_5, q_5)(y - o_5) = E_4^-1 h - o_5``, and
+    ``r = u . R_6^T R_5^T R_4^T a_3 - a_2 . a_3`` (``u = R_G^T R(a_1, q_1) a_2``)."""
+    a5, a6 = _axis(g, 4), _axis(g, 5)
+    m4, c4, s4 = _branch_cs(co[_CC + 2] - co[_CC + 3] * dot(y5, y5), co[_CC + 4], co[_CC + 5], co[_CC + 6],
+                            -1.0 if i4 == 0 else 1.0)  # (c4, s4): cos, sin of -q_4
+    e5 = _at(co, _CE, c4, s4)
+    ky, ke = dot(a5, y5), dot(a5, e5)
+    num, den = dot(a5, cross(y5, e5)), dot(y5, e5) - ky * ke
+    hy = math.sqrt(num * num + den * den)
+    c5, s5 = (den / hy, num / hy) if hy > 0.0 else (1.0, 0.0)
+    v = rot_cs(a6, c6, -s6, rot_cs(a5, c5, -s5, _at(co, _CV, c4, s4)))
+    return m4, dot(u, v) - co[_CC + 7], c4, -s4, c5, s5
 
 
 @kernel
-def _off_eval(t, gr, gt, g, ok, r) -> None:
-    """All four branches at ``q_1 = t``, sharing the SP4 and SP3 solves."""
-    c6, t6a, t6b, d = _off_q6(t, gr, gt, g)
-    for i6 in range(2):
-        q6 = t6a if i6 == 0 else t6b
-        c4, q4a, q4b, y = _off_q4(d, q6, g)
-        for i4 in range(2):
-            b = 2 * i6 + i4
-            ok[b] = c6 == 2 and c4 == 2
-            r[b] = _off_r(t, q4a if i4 == 0 else q4b, q6, y, gr, g)[1]
+def _off_at(c, s, b, g, co):
+    """Branch ``b`` (``q_6`` root ``b // 2``, ``q_4`` root ``b % 2``) at ``(cos q_1, sin q_1) = (c, s)``:
+    ``(margin, r, cos q_4, sin q_4, cos q_5, sin q_5, cos q_6, sin q_6)``; the branch exists where ``margin >= 0``,
+    ``r = a_2 . R_23 a_3 - a_2 . a_3`` (:func:`_off_r`)."""
+    m6, c6, s6, y5 = _off_q6(c, s, b // 2, g, co)
+    m4, r, c4, s4, c5, s5 = _off_r(_at(co, _CU, c, s), b % 2, y5, c6, s6, g, co)
+    return min(m6, m4), r, c4, s4, c5, s5, c6, s6
 
 
 @kernel
-def _off_rows(t, b, gr, gt, g, cand, n) -> int:
+def _off_rows(t, b, gr, g, co, cand, n) -> int:
     """The hip pair (SP1, SP1) at the root ``q_1 = t`` of branch ``b``: one row of ``cand``."""
     a1, a2, a3, a4, a5, a6 = _axis(g, 0), _axis(g, 1), _axis(g, 2), _axis(g, 3), _axis(g, 4), _axis(g, 5)
-    _, q4, q5, q6, _ = _off_chain(t, b, gr, gt, g)
-    w = rot(a1, -t, _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, a3)))))
-    q2 = sp1(a3, w, a2)
+    c, s = math.cos(t), math.sin(t)
+    _, _, c4, s4, c5, s5, c6, s6 = _off_at(c, s, b, g, co)
     v = _unit_normal(a3, a2, a1)
-    rv = rot(a2, -q2, rot(a1, -t, _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, rot(a4, -q4, v))))))
-    return _add_row(cand, n, t, q2, sp1(v, rv, a3), q4, q5, q6)
+    w3 = rot_cs(a1, c, -s, _mat_vec(gr, rot_cs(a6, c6, -s6, rot_cs(a5, c5, -s5, rot_cs(a4, c4, -s4, a3)))))
+    wv = rot_cs(a1, c, -s, _mat_vec(gr, rot_cs(a6, c6, -s6, rot_cs(a5, c5, -s5, rot_cs(a4, c4, -s4, v)))))
+    q2 = sp1(a3, w3, a2)
+    q3 = sp1(v, rot(a2, -q2, wv), a3)
+    return _add_row(cand, n, t, q2, q3, math.atan2(s4, c4), math.atan2(s5, c5), math.atan2(s6, c6))
 
 
 # ---------------------------------------------------------------- the search
 @kernel
-def _eval(t, gr, gt, g, ok, r) -> None:
-    """Every branch's existence ``ok`` (4,) and residual ``r`` (4,) at the searched value ``t``."""
+def _eval(t, gr, gt, g, ws, ok, r) -> None:
+    """Every branch's existence margin ``ok`` (4,) (:func:`_margin`) and residual ``r`` (4,) at the searched value
+    ``t`` (``ws``: the offset-hip coefficients of :func:`_off_prepare`)."""
     if g[_KIND] == THREE_PARALLEL:
         _par_eval(t, gr, gt, g, ok, r)
-    else:
-        _off_eval(t, gr, gt, g, ok, r)
+        return
+    c, s = math.cos(t), math.sin(t)
+    u = _at(ws, _CU, c, s)
+    for i6 in range(2):
+        m6, c6, s6, y5 = _off_q6(c, s, i6, g, ws)
+        for i4 in range(2):
+            m4, rb = _off_r(u, i4, y5, c6, s6, g, ws)[:2]
+            ok[2 * i6 + i4], r[2 * i6 + i4] = min(m6, m4), rb
 
 
 @kernel
@@ -212,15 +296,25 @@ def _eval1(t, b, gr, gt, g, ws):
         ok, q1, q2 = _par_hip(t, b, gr, g)
         n, o3 = _axis(g, 2), _origin(g, 2)
         return ok, dot(n, _sub(_h_point(o3, t, q1, q2, gr, gt, g), o3))
-    ok, _, _, _, r = _off_chain(t, b, gr, gt, g)
-    return ok, r
+    res = _off_at(math.cos(t), math.sin(t), b, g, ws)
+    return res[0] >= 0.0, res[1]
 
 
 @kernel
-def _rows(t, b, gr, gt, g, cand, n) -> int:
+def _rows(t, b, gr, gt, g, ws, cand, n) -> int:
     if g[_KIND] == THREE_PARALLEL:
         return _par_rows(t, b, gr, gt, g, cand, n)
-    return _off_rows(t, b, gr, gt, g, cand, n)
+    return _off_rows(t, b, gr, g, ws, cand, n)
+
+
+@kernel
+def _illinois(t, f, a, b, fa, fb, side):
+    """One step of the Illinois method: the bracket ``(a, b)`` (``fa``, ``fb`` of opposite signs) with the new point
+    ``(t, f)``; ``side``: which end moved last (the other end's value is halved when the same end moves twice).
+    Returns ``(a, b, fa, fb, side)``."""
+    if (f > 0.0) == (fb > 0.0):
+        return a, t, fa * 0.5 if side == 1 else fa, f, 1
+    return t, b, f, fb * 0.5 if side == -1 else fb, -1
 
 
 @kernel
@@ -234,94 +328,214 @@ def _refine(lo, hi, rlo, rhi, b, gr, gt, g, ws) -> float:
         ok, r = _eval1(t, b, gr, gt, g, ws)
         if not ok or r == 0.0:
             return t
-        if (r > 0.0) == (rhi > 0.0):
-            hi, rhi = t, r
-            if side == 1:
-                rlo *= 0.5
-            side = 1
-        else:
-            lo, rlo = t, r
-            if side == -1:
-                rhi *= 0.5
-            side = -1
+        lo, hi, rlo, rhi, side = _illinois(t, r, lo, hi, rlo, rhi, side)
         if abs(hi - lo) <= 1e-15 * (1.0 + abs(t)):
             break
     return (lo * rhi - hi * rlo) / (rhi - rlo)
 
 
 @kernel
-def _root(lo, hi, rlo, rhi, b, gr, gt, g, ws, cand, n) -> int:
-    """Refine the bracket ``[lo, hi]`` of branch ``b`` and add the root's rows to ``cand`` (nothing when ``rlo`` and
-    ``rhi`` have the same sign)."""
+def _root1(lo, hi, rlo, rhi, b, gr, gt, g, ws, cand, n):
+    """Refine the bracket ``[lo, hi]`` of branch ``b`` and add the root's rows to ``cand``: ``(n, t)`` with ``t`` the
+    point where the branch does not exist if the refinement met one (NaN otherwise)."""
     if (rlo > 0.0) == (rhi > 0.0) and rlo != 0.0 and rhi != 0.0:
-        return n
+        return n, math.nan
     t = _refine(lo, hi, rlo, rhi, b, gr, gt, g, ws)
-    return _rows(t, b, gr, gt, g, cand, n) if _eval1(t, b, gr, gt, g, ws)[0] else n
+    if _eval1(t, b, gr, gt, g, ws)[0]:
+        return _rows(t, b, gr, gt, g, ws, cand, n), math.nan
+    return n, t
+
+
+@kernel
+def _root(lo, hi, rlo, rhi, b, gr, gt, g, ws, cand, n) -> int:
+    """:func:`_root1`; where the bracket holds a gap of the branch (two folds between the grid points), each side is
+    bracketed up to its fold."""
+    n, gap = _root1(lo, hi, rlo, rhi, b, gr, gt, g, ws, cand, n)
+    if gap == gap:
+        f1, f2 = _fold(lo, gap, b, gr, gt, g, ws), _fold(hi, gap, b, gr, gt, g, ws)
+        n = _root1(lo, f1, rlo, _eval1(f1, b, gr, gt, g, ws)[1], b, gr, gt, g, ws, cand, n)[0]
+        n = _root1(f2, hi, _eval1(f2, b, gr, gt, g, ws)[1], rhi, b, gr, gt, g, ws, cand, n)[0]
+    return n
+
+
+@kernel
+def _margin(t, b, gr, gt, g, ws) -> float:
+    """Where branch ``b`` exists: ``>= 0`` at ``t``; a smooth function of ``t`` for the offset hip (SP4's and SP3's
+    ``r - |x|``), else ``+1`` / ``-1``."""
+    if g[_KIND] == THREE_PARALLEL:
+        return 1.0 if _eval1(t, b, gr, gt, g, ws)[0] else -1.0
+    return _off_at(math.cos(t), math.sin(t), b, g, ws)[0]
 
 
 @kernel
 def _fold(t_ok, t_bad, b, gr, gt, g, ws) -> float:
-    """Where branch ``b`` stops existing between ``t_ok`` and ``t_bad``, by bisection (the existing side)."""
-    for _ in range(60):
-        mid = 0.5 * (t_ok + t_bad)
-        if _eval1(mid, b, gr, gt, g, ws)[0]:
-            t_ok = mid
-        else:
-            t_bad = mid
+    """Where branch ``b`` stops existing between ``t_ok`` and ``t_bad`` (the existing side, to ~1e-15 rad): the
+    Illinois method on :func:`_margin` (bisection where the margin is only a sign)."""
+    m_ok, m_bad = _margin(t_ok, b, gr, gt, g, ws), _margin(t_bad, b, gr, gt, g, ws)
+    side = 0
+    for _ in range(_REFINE_STEPS):
+        t = (t_ok * m_bad - t_bad * m_ok) / (m_bad - m_ok)
+        if not (t_ok < t < t_bad) and not (t_bad < t < t_ok):
+            t = 0.5 * (t_ok + t_bad)
+        m = _margin(t, b, gr, gt, g, ws)
+        t_bad, t_ok, m_bad, m_ok, side = _illinois(t, m if m != 0.0 else 1e-300, t_bad, t_ok, m_bad, m_ok, side)
+        if abs(t_bad - t_ok) <= 1e-15 * (1.0 + abs(t)):
+            break
     return t_ok
+
+
+@kernel
+def _parabola_step(x, w, v, fx, fw, fv):
+    """``(p, q)``: the step ``p / q`` from ``x`` to the vertex of the parabola through ``(x, fx), (w, fw), (v, fv)``
+    (``q >= 0``)."""
+    r = (x - w) * (fx - fv)
+    q = (x - v) * (fx - fw)
+    p = (x - v) * q - (x - w) * r
+    q = 2.0 * (q - r)
+    return (-p, q) if q > 0.0 else (p, -q)
+
+
+@kernel
+def _dip_f(t, sg, b, gr, gt, g, ws) -> float:
+    """``sg r_b(t)`` (``sg = +-1``), or ``-margin_b(t)`` for ``sg = 0``, ``margin_b(t)`` for ``sg = 2``."""
+    if sg == 0.0 or sg == 2.0:
+        return (sg - 1.0) * _margin(t, b, gr, gt, g, ws)
+    return sg * _eval1(t, b, gr, gt, g, ws)[1]
+
+
+@kernel
+def _dip_minimum(lo, hi, sg, b, gr, gt, g, ws):
+    """``(t, f)``: the minimum of ``f`` (:func:`_dip_f`) on ``[lo, hi]`` by Brent's method (parabolic steps
+    safeguarded by golden sections), to :data:`_DIP_WIDTH`; it stops early where ``f`` goes negative (a sign change
+    of ``r_b``, or a point where the branch exists)."""
+    gold = 0.5 * (3.0 - math.sqrt(5.0))
+    x = w = v = lo + gold * (hi - lo)
+    fx = fw = fv = _dip_f(x, sg, b, gr, gt, g, ws)
+    d = e = 0.0
+    for _ in range(100):
+        mid = 0.5 * (lo + hi)
+        if fx < 0.0 or abs(x - mid) <= 2.0 * _DIP_WIDTH - 0.5 * (hi - lo):
+            break
+        p, q = _parabola_step(x, w, v, fx, fw, fv) if abs(e) > _DIP_WIDTH else (0.0, 0.0)
+        if q != 0.0 and abs(p) < abs(0.5 * q * e) and q * (lo - x) < p < q * (hi - x):
+            e, d = d, p / q
+        else:
+            e = hi - x if x < mid else lo - x
+            d = gold * e
+        u = x + (d if abs(d) >= _DIP_WIDTH else math.copysign(_DIP_WIDTH, d))
+        fu = _dip_f(u, sg, b, gr, gt, g, ws)
+        if fu <= fx:
+            lo, hi = (lo, x) if u < x else (x, hi)
+            v, fv, w, fw, x, fx = w, fw, x, fx, u, fu
+        else:
+            lo, hi = (u, hi) if u < x else (lo, u)
+            if fu <= fw or w == x:
+                v, fv, w, fw = w, fw, u, fu
+            elif fu <= fv or v == x or v == w:
+                v, fv = u, fu
+    return x, fx
 
 
 @kernel
 def _dip(t0, t2, r1, b, gr, gt, g, ws, cand, n) -> int:
     """``r_b`` dips toward zero between ``t0`` and ``t2`` without a sign change (``r1``: a value of that sign): the
-    golden-section search for the extremum of ``r_b`` (the minimum of ``sign(r1) r_b``); two roots bracketed on its
-    sides if it crosses zero, a tangential root if within :data:`TANGENT_TOL` of it."""
-    sg = 1.0 if r1 > 0.0 else -1.0
-    k = 0.5 * (math.sqrt(5.0) - 1.0)
-    lo, hi = t0, t2
-    x1, x2 = hi - k * (hi - lo), lo + k * (hi - lo)
-    f1, f2 = sg * _eval1(x1, b, gr, gt, g, ws)[1], sg * _eval1(x2, b, gr, gt, g, ws)[1]
-    for _ in range(80):
-        if f1 < f2:
-            hi, x2, f2 = x2, x1, f1
-            x1 = hi - k * (hi - lo)
-            f1 = sg * _eval1(x1, b, gr, gt, g, ws)[1]
-        else:
-            lo, x1, f1 = x1, x2, f2
-            x2 = lo + k * (hi - lo)
-            f2 = sg * _eval1(x2, b, gr, gt, g, ws)[1]
-        if hi - lo <= 1e-15 * (1.0 + abs(lo)):
-            break
-    tm = 0.5 * (lo + hi)
+    minimum of ``sign(r1) r_b`` (:func:`_dip_minimum`); two roots bracketed on its sides if it crosses zero, a
+    tangential root if within :data:`TANGENT_TOL` of it."""
+    tm, fm = _dip_minimum(t0, t2, 1.0 if r1 > 0.0 else -1.0, b, gr, gt, g, ws)
     okm, rm = _eval1(tm, b, gr, gt, g, ws)
     if not okm:
         return n
-    if (rm > 0.0) != (r1 > 0.0):
+    if fm < 0.0:
         r0, r2 = _eval1(t0, b, gr, gt, g, ws)[1], _eval1(t2, b, gr, gt, g, ws)[1]
         n = _root(t0, tm, r0, rm, b, gr, gt, g, ws, cand, n)
         return _root(tm, t2, rm, r2, b, gr, gt, g, ws, cand, n)
-    return _rows(tm, b, gr, gt, g, cand, n) if abs(rm) <= TANGENT_TOL else n
+    return _rows(tm, b, gr, gt, g, ws, cand, n) if abs(rm) <= TANGENT_TOL else n
+
+
+@kernel
+def _cell(t, prev_t, prev2_t, b, r, was_r, was_r2, gr, gt, g, ws, cand, n) -> int:
+    """The search between the points ``prev_t`` and ``t`` (the branch exists at both, residuals ``was_r``, ``r``;
+    ``was_r2`` at ``prev2_t``, NaN if none): a sign change is refined, a dip of ``|r_b|`` at ``prev_t`` searched."""
+    if (r > 0.0) != (was_r > 0.0) or r == 0.0:
+        return _root(prev_t, t, was_r, r, b, gr, gt, g, ws, cand, n)
+    if (was_r2 > 0.0) == (r > 0.0) and abs(was_r) < abs(was_r2) and abs(was_r) <= abs(r):
+        return _dip(min(prev2_t, t), max(prev2_t, t), was_r, b, gr, gt, g, ws, cand, n)
+    return n
+
+
+@kernel
+def _from_fold(good, good_r, bad, b, gr, gt, g, ws, cand, n):
+    """The piece from the fold between ``good`` (the branch exists, residual ``good_r``) and ``bad`` (it does not) to
+    ``good``, where the residual moves like ``sqrt(|t - f|)``: :data:`_FOLD_CELLS` cells of quadratically growing
+    width, a dip at the fold, the fold itself where the residual nearly vanishes there. Returns ``(n, t, r)``: the
+    last point before ``good`` and its residual."""
+    x0 = _fold(good, bad, b, gr, gt, g, ws)
+    r0, x1, r1 = _eval1(x0, b, gr, gt, g, ws)[1], math.nan, math.nan
+    if abs(r0) <= TANGENT_TOL:  # a root at the fold (a stretched knee), or a target just beyond it: the polish decides
+        n = _rows(x0, b, gr, gt, g, ws, cand, n)
+    for j in range(1, _FOLD_CELLS + 1):
+        x = x0 + (good - x0) * (j / _FOLD_CELLS) ** 2 if j < _FOLD_CELLS else good
+        okx, rx = _eval1(x, b, gr, gt, g, ws) if j < _FOLD_CELLS else (True, good_r)
+        if not okx:  # another fold between the two: left to the polish of its neighbours
+            return n, math.nan, math.nan
+        if j == 1 and (rx > 0.0) == (r0 > 0.0) and abs(r0) <= abs(rx):  # |r_b| least at the fold: a dip there?
+            n = _dip(min(x0, x), max(x0, x), r0, b, gr, gt, g, ws, cand, n)
+        n = _cell(x, x0, x1, b, rx, r0, r1, gr, gt, g, ws, cand, n)
+        x1, r1, x0, r0 = x0, r0, x, rx
+    return n, x1, r1
 
 
 @kernel
 def _step(t, prev_t, step, b, ok, r, was_ok, was_r, was_r2, gr, gt, g, ws, cand, n) -> int:
-    """The search between grid points ``prev_t`` and ``t`` on branch ``b``."""
+    """The search between grid points ``prev_t`` and ``t`` on branch ``b``; where the branch ends between them, the
+    piece from the fold (:func:`_from_fold`) and a dip at the grid point next to it."""
     if ok and was_ok:
-        if (r > 0.0) != (was_r > 0.0) or r == 0.0:
-            return _root(prev_t, t, was_r, r, b, gr, gt, g, ws, cand, n)
-        if (was_r2 > 0.0) == (r > 0.0) and abs(was_r) < abs(was_r2) and abs(was_r) <= abs(r):
-            return _dip(prev_t - step, t, was_r, b, gr, gt, g, ws, cand, n)
-    elif ok or was_ok:  # a fold between the two grid points: bracket up to it, and look for a dip next to it
-        good, bad, good_r = (t, prev_t, r) if ok else (prev_t, t, was_r)
-        f = _fold(good, bad, b, gr, gt, g, ws)
-        rf = _eval1(f, b, gr, gt, g, ws)[1]
-        if (rf > 0.0) != (good_r > 0.0):
-            lo, hi, rlo, rhi = (f, good, rf, good_r) if f < good else (good, f, good_r, rf)
-            return _root(lo, hi, rlo, rhi, b, gr, gt, g, ws, cand, n)
-        far = good + step if f < good else good - step
-        if _eval1(far, b, gr, gt, g, ws)[0]:
-            return _dip(min(far, f), max(far, f), good_r, b, gr, gt, g, ws, cand, n)
+        return _cell(t, prev_t, prev_t - step, b, r, was_r, was_r2, gr, gt, g, ws, cand, n)
+    good, bad, good_r = (t, prev_t, r) if ok else (prev_t, t, was_r)
+    n, x1, r1 = _from_fold(good, good_r, bad, b, gr, gt, g, ws, cand, n)
+    far = good + (good - bad)  # the grid has no value before good
+    okf, rf = _eval1(far, b, gr, gt, g, ws)
+    if x1 == x1 and okf and (rf > 0.0) == (good_r > 0.0) and rf != 0.0:
+        return _cell(far, good, x1, b, rf, good_r, r1, gr, gt, g, ws, cand, n)
     return n
+
+
+@kernel
+def _island(lo, hi, b, gr, gt, g, ws, cand, n) -> int:
+    """The branch does not exist at the grid points ``lo``, ``(lo + hi) / 2``, ``hi`` but its margin peaks near zero
+    between them: where the peak is positive (the branch exists on an island between two folds), both halves of the
+    island are searched from their folds (:func:`_from_fold`)."""
+    x, f = _dip_minimum(lo, hi, 0.0, b, gr, gt, g, ws)
+    if not f < 0.0:
+        return n
+    rx = _eval1(x, b, gr, gt, g, ws)[1]
+    n = _from_fold(x, rx, lo, b, gr, gt, g, ws, cand, n)[0]
+    return _from_fold(x, rx, hi, b, gr, gt, g, ws, cand, n)[0]
+
+
+@kernel
+def _hole(lo, hi, b, gr, gt, g, ws, cand, n) -> int:
+    """The branch exists at the grid points ``lo``, ``(lo + hi) / 2``, ``hi`` but its margin dips near zero between
+    them: where the dip is negative (a gap between two folds), the pieces from each fold to the grid points on its
+    side are searched (:func:`_from_fold`)."""
+    x, f = _dip_minimum(lo, hi, 2.0, b, gr, gt, g, ws)
+    if not f < 0.0:
+        return n
+    mid = 0.5 * (lo + hi)
+    for good in (lo, mid, hi):
+        if good != x:
+            n = _from_fold(good, _eval1(good, b, gr, gt, g, ws)[1], x, b, gr, gt, g, ws, cand, n)[0]
+    return n
+
+
+@kernel
+def _peak(m2, m1, m0) -> bool:
+    """Three negative margins at consecutive grid points with a peak in the middle whose parabola comes within half
+    its second difference of zero: the branch may exist between the grid points (an island)."""
+    c2 = m2 - 2.0 * m1 + m0
+    if not (m0 < 0.0 and m1 < 0.0 and m2 < 0.0 and m1 > m2 and m1 >= m0 and c2 < 0.0):
+        return False
+    return m1 - (m2 - m0) ** 2 / (8.0 * c2) >= 0.5 * c2
 
 
 @kernel
@@ -329,22 +543,33 @@ def _search_candidates(tg, g, cand) -> int:
     """The candidate rows (``cand`` (K, 6)) of the target ``tg`` (16 floats); returns how many are filled."""
     gr = np.empty((3, 3))
     gt = _target_motion(tg, g, gr)
-    ws = np.empty((2, _NB))
-    cur = np.empty((2, _NB))  # existence, residual at t
-    prev = np.empty((3, _NB))  # existence, residual at the previous grid point, residual one before (NaN: none)
-    step = 2.0 * math.pi / SEARCH_GRID
+    ws = np.empty(_NCO)
+    if g[_KIND] != THREE_PARALLEL:
+        _off_prepare(gr, gt, g, ws)
+    cur = np.empty((2, _NB))  # existence margin, residual at t
+    prev = np.empty((4, _NB))  # margin, residual at the previous grid point, residual one before (NaN: none), margin
+    grid = int(g[_GRID])
+    step = 2.0 * math.pi / grid
     prev_t = -math.pi
-    _eval(prev_t, gr, gt, g, prev[0], prev[1])
+    _eval(prev_t, gr, gt, g, ws, prev[0], prev[1])
     for b in range(_NB):
-        prev[2, b] = math.nan
+        prev[2, b], prev[3, b] = math.nan, math.nan
     n = 0
-    for i in range(1, SEARCH_GRID + 1):
+    for i in range(1, grid + 1):
         t = -math.pi + i * step
-        _eval(t, gr, gt, g, cur[0], cur[1])
+        _eval(t, gr, gt, g, ws, cur[0], cur[1])
         for b in range(_NB):
-            ok, r, was_ok = cur[0, b] > 0.0, cur[1, b], prev[0, b] > 0.0
-            n = _step(t, prev_t, step, b, ok, r, was_ok, prev[1, b], prev[2, b], gr, gt, g, ws, cand, n)
+            ok, r, was_ok, was_r = cur[0, b] >= 0.0, cur[1, b], prev[0, b] >= 0.0, prev[1, b]
+            if not (ok or was_ok):
+                if _peak(prev[3, b], prev[0, b], cur[0, b]):
+                    n = _island(prev_t - step, t, b, gr, gt, g, ws, cand, n)
+            else:
+                if ok and was_ok and _peak(-prev[3, b], -prev[0, b], -cur[0, b]):
+                    n = _hole(prev_t - step, t, b, gr, gt, g, ws, cand, n)
+                if not (ok and was_ok and (r > 0.0) == (was_r > 0.0) and r != 0.0 and not (
+                        abs(was_r) < abs(prev[2, b]) and abs(was_r) <= abs(r))):  # else nothing between them
+                    n = _step(t, prev_t, step, b, ok, r, was_ok, was_r, prev[2, b], gr, gt, g, ws, cand, n)
             prev[2, b] = prev[1, b] if (ok and was_ok) else math.nan
-            prev[0, b], prev[1, b] = cur[0, b], r
+            prev[3, b], prev[0, b], prev[1, b] = prev[0, b], cur[0, b], r
         prev_t = t
     return n

@@ -26,7 +26,7 @@ from ._sixdof_layout import (
     POLISH_DAMPING6,
     POLISH_STEPS6,
 )
-from .subproblems import cross, dot, rot, sp1, sp2, sp3
+from .subproblems import cross, dot, rot, rot_cs, sp1, sp2, sp3
 
 _NAN = math.nan
 
@@ -178,19 +178,32 @@ def _solve6(a, b, x) -> bool:
 
 
 @kernel
-def _polish6(tg, g, q, ws) -> float:
+def _split_error(e) -> float:
+    """``max(|e_position|, |e_rotation|)`` of a pose error ``e`` (6,) (m, rad)."""
+    return max(math.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2), math.sqrt(e[3] ** 2 + e[4] ** 2 + e[5] ** 2))
+
+
+@kernel
+def _polish6(tg, g, q, ws, fixed=0) -> float:
     """Damped Newton steps ``dq = (J^T J + lambda^2 I)^-1 J^T e`` on the exact forward map (at most
-    :data:`POLISH_STEPS6`, each kept only if it reduces ``|e|``) while ``|e|`` exceeds :data:`POLISH_BELOW6`.
-    ``ws``: a work array of at least 32 rows of 6. Returns the final ``|e|`` (m and rad combined)."""
+    :data:`POLISH_STEPS6`, each kept only if it reduces ``|e|``) while ``|e|`` exceeds :data:`POLISH_BELOW6`; the
+    joints of the bit mask ``fixed`` do not move (their Jacobian columns are zeroed). ``ws``: a work array of at least
+    32 rows of 6. Returns the error of the final ``q``: the larger of its position error (m) and its rotation error
+    (rad)."""
     jac, a, aw, ow = ws[0:6], ws[6:12], ws[12:18, 0:3], ws[18:24, 0:3]
     rm, p, e, b, dq, qn = ws[24:27, 0:3], ws[27, 0:3], ws[28], ws[29], ws[30], ws[31]
     _pose6(q, g, rm, p, aw, ow)
     err = _pose_error(tg, rm, p, e)
+    split = _split_error(e)
     lam2 = POLISH_DAMPING6 * POLISH_DAMPING6
     for _ in range(POLISH_STEPS6):
         if err <= POLISH_BELOW6:
             break
         _jac6(q, g, jac, rm, p, aw, ow)
+        for c in range(6):
+            if fixed >> c & 1:
+                for i in range(6):
+                    jac[i, c] = 0.0
         for i in range(6):
             b[i] = 0.0
             for k in range(6):
@@ -208,10 +221,10 @@ def _polish6(tg, g, q, ws) -> float:
         new = _pose_error(tg, rm, p, e)
         if not new < err:
             break
-        err = new
+        err, split = new, _split_error(e)
         for i in range(6):
             q[i] = qn[i]
-    return err
+    return split
 
 
 @kernel
@@ -265,15 +278,17 @@ def _hip_candidates(tg, g, cand) -> int:
     n = 0
     for i4 in range(2):
         q4 = -(t4a if i4 == 0 else t4b)
-        e = rot(a4, -q4, (c[0] - o4[0], c[1] - o4[1], c[2] - o4[2]))
+        c4, s4 = math.cos(q4), -math.sin(q4)  # R(a_4, -q_4)
+        e = rot_cs(a4, c4, s4, (c[0] - o4[0], c[1] - o4[1], c[2] - o4[2]))
         ea = (e[0] + o4[0] - an[0], e[1] + o4[1] - an[1], e[2] + o4[2] - an[2])
         _, t5a, t6a, t5b, t6b, _ = sp2(ea, da, a5, a6)
-        r4a3, r4v = rot(a4, -q4, a3), rot(a4, -q4, v)
+        r4a3, r4v = rot_cs(a4, c4, s4, a3), rot_cs(a4, c4, s4, v)
         for i56 in range(2):
             q5, q6 = -(t5a if i56 == 0 else t5b), (t6a if i56 == 0 else t6b)
+            c5, s5, c6, s6 = math.cos(q5), -math.sin(q5), math.cos(q6), -math.sin(q6)
             # R_h y = R_G R_6^T R_5^T R_4^T y
-            h3 = _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, r4a3)))
-            hv = _mat_vec(gr, rot(a6, -q6, rot(a5, -q5, r4v)))
+            h3 = _mat_vec(gr, rot_cs(a6, c6, s6, rot_cs(a5, c5, s5, r4a3)))
+            hv = _mat_vec(gr, rot_cs(a6, c6, s6, rot_cs(a5, c5, s5, r4v)))
             _, t1a, t2a, t1b, t2b, _ = sp2(h3, a3, a1, a2)
             for i12 in range(2):
                 q1, q2 = -(t1a if i12 == 0 else t1b), (t2a if i12 == 0 else t2b)

@@ -11,8 +11,12 @@ __all__ = ["_BAD_INPUT", "_JOINT_LIMIT", "_UNREACHABLE", "IK_TOL"]
 #: URDF angles written with 4-6 digits (icub: ``rpy="... 1.5708 ..."``) leave axes up to ~2e-5 m / rad off the
 #: ideal; the closed form then lands that close and the Newton polish (:data:`POLISH_STEPS6`) finishes the job.
 AXIS_TOL = 1e-4
-# IK_TOL (default ``tol`` of Leg6.ik / Leg6.ik_all, 1e-9): a pose is solved when the polished answer reproduces it
-# to this (m and rad, the norm of the 6-vector position error, rotation error); the same default as Leg's.
+# IK_TOL (default ``tol`` of Leg6.ik / Leg6.ik_all, 1e-7, derived in ._layout): a pose is solved when the polished
+# answer reproduces it to this (m and rad, the norm of the 6-vector position error, rotation error); Leg's default.
+#: A solution up to this far outside the URDF limits (rad) is clipped onto them and kept if it still reproduces the
+#: target to ``tol``: a target rounded to float32 next to a limit (near a stretched knee its solution moves by up to
+#: ~sqrt(1e-7) rad) is then solved at the nearest in-limit pose.
+LIMIT_SLACK6 = 1e-4
 #: Damped Newton steps (at most) of the polish on the exact forward map.
 POLISH_STEPS6 = 12
 #: Damping of the polish steps (m): bounds a step near a singularity.
@@ -23,10 +27,12 @@ POLISH_BELOW6 = 1e-13
 #: one-dimensional search of three parallel axes keeps at most 16 (a 6R chain has at most 16).
 _NSOL = 8
 _NSOL_SEARCH = 16
-#: Grid of the one-dimensional search (points over a full turn of the searched joint): every sign change of the
-#: residual between two grid points is bracketed, then refined (see :mod:`._search_kernels`). 180 points already
-#: found every sampled configuration of 2x10^4 per robot on alexander and g1 (docs/legs.md); 360 for margin.
-SEARCH_GRID = 360
+#: Grid of the one-dimensional search by structure (points over a full turn of the searched joint): every sign change
+#: of the residual between two grid points is bracketed, then refined (see :mod:`._search_kernels`). g1 (offset hip):
+#: 90 points found the sampled configuration on 159,999 of 160,000 random in-limit samples (8 seeds x 2 legs x 10^4;
+#: the one miss a pose 2e-4 rad from a fold, where four roots lie within 0.04 rad at a residual of 3e-5), 60 points
+#: also missed 1, 45 missed 1-6 per 2x10^4 (docs/legs.md); alexander keeps 360.
+SEARCH_GRID = {"6R-three-parallel": 360, "6R-offset-hip": 90}
 #: A dip of the search residual to within this (m) of zero without a sign change is kept as a tangential root (the
 #: polish then decides).
 TANGENT_TOL = 1e-9
@@ -45,4 +51,5 @@ _ANK = 51  # the ankle centre a (the point nearest axes 5, 6)
 _LO6, _HI6 = 54, 60  # the URDF limits (6 each)
 _KIND = 66  # the structure code
 _NSOLS = 67  # the rows of ik_all
-_NP6 = 68
+_GRID = 68  # the grid points of the one-dimensional search (0: none)
+_NP6 = 69

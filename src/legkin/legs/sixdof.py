@@ -26,9 +26,11 @@ forward map is the product of exponentials (what Pinocchio computes, with the me
 * ``"6R-general"``: any other 6R chain: ``fk`` and ``jacobian`` only; :meth:`Leg6.ik` raises
   :class:`~legkin.errors.LegStructureError`.
 
-Every answer is polished and kept only if it reproduces the target to ``tol`` (default :data:`IK_TOL` = 1e-9,
-m and rad); a target within ``tol`` of the reachable set is solved at its nearest reachable pose (the polish's
-least-squares limit). Single/batch contract of :mod:`legkin._batch`; kernels in :mod:`._sixdof_kernels`.
+Every answer is polished and kept only if it reproduces the target to ``tol`` (default :data:`IK_TOL` = 1e-7:
+position error <= ``tol`` m and rotation error <= ``tol`` rad, above what float32 rounding does to a pose, see
+``legs.kinematics.IK_TOL``; pass ``tol=1e-9`` for a tighter check); a target within ``tol`` of the
+reachable set is solved at its nearest reachable pose (the polish's least-squares limit). Single/batch contract
+of :mod:`legkin._batch`; kernels in :mod:`._sixdof_kernels`.
 """
 
 from __future__ import annotations
@@ -49,6 +51,7 @@ from ._sixdof_layout import (
     _ANK,
     _AX,
     _BAD_INPUT,
+    _GRID,
     _HI6,
     _HIP,
     _JOINT_LIMIT,
@@ -64,6 +67,7 @@ from ._sixdof_layout import (
     HIP_SPHERICAL,
     IK_TOL,
     OFFSET_HIP,
+    SEARCH_GRID,
     THREE_PARALLEL,
 )
 
@@ -216,6 +220,7 @@ class Leg6:
         g[_ANK:_ANK + 3] = ank if spherical else 0.0
         g[_LO6:_LO6 + 6], g[_HI6:_HI6 + 6] = lo, hi
         g[_KIND], g[_NSOLS] = _KINDS[structure], _ROWS[structure]
+        g[_GRID] = SEARCH_GRID.get(structure, 0)
         finite = np.isfinite(lo) & np.isfinite(hi)
         mid = np.where(finite, 0.5 * (np.where(finite, lo, 0.0) + np.where(finite, hi, 0.0)), np.clip(0.0, lo, hi))
         return cls(
@@ -293,7 +298,7 @@ class Leg6:
                 f"{AXIS_TOL:g})", found=self.structure, expected=list(STRUCTURES[:2]),
             )
         tol = check_number(tol, "tol", 0.0, 1e-3, low_open=True)
-        arr = _pose_input(target)
+        arr = as_input(target, "target", _T44)  # the rotation and bottom row are checked by the kernel (_bad_poses)
         batch = arr.shape[:-2]
         if q_near is None:
             ref = self.q_ref.reshape(1, 6).copy()
@@ -329,6 +334,19 @@ class Leg6:
             raise self._error(st, info, target, IK_TOL)
         return None
 
+    @staticmethod
+    def _bad_poses(status: np.ndarray, rows: np.ndarray) -> None:
+        """Raise where the kernel refused a pose (``_BAD_INPUT``: not a homogeneous transform, the test of
+        :func:`_pose_input`, which then says why).
+
+        Raises:
+            InvalidInputError: some row of ``rows`` (n, 16) is not a 4x4 homogeneous transform.
+        """
+        bad = status == _BAD_INPUT
+        if bad.any():
+            _pose_input(rows[bad].reshape(-1, 4, 4))
+            raise InvalidInputError("target must be 4x4 homogeneous transforms (R^T R = I and det R = 1 to 1e-6)")
+
     def _error(self, status: int, info: np.ndarray, target: np.ndarray, tol: float):
         t = target.reshape(4, 4)
         if status == _JOINT_LIMIT:
@@ -350,7 +368,8 @@ class Leg6:
         Args:
             target: foot poses in the root frame (m).
             q_near: each angle is given as its 2 pi representative nearest ``q_near`` (default :attr:`q_ref`).
-            tol: a solution reproduces the target to this (m and rad); (0, 1e-3].
+            tol: a solution reproduces the target to this: position error (m) and rotation error (rad) each;
+                (0, 1e-3], default 1e-7.
             return_mask: also return the mask of the rows that exist.
 
         Returns:
@@ -372,6 +391,7 @@ class Leg6:
         k = self.n_solutions
         out, status, info = np.empty((n, k, 6)), np.empty(n, dtype=np.int64), np.zeros((n, 2))
         _ik_all6_batch(rows, self.params, ref, tol, out, status, info)
+        self._bad_poses(status, rows)
         if single and status[0] != OK:
             raise self._error(int(status[0]), info[0], rows[0], tol)
         q_all = out.reshape(batch + (k, 6))
@@ -406,6 +426,7 @@ class Leg6:
         n = rows.shape[0]
         out, status, info = np.empty((n, 6)), np.empty(n, dtype=np.int64), np.zeros((n, 2))
         _ik6_batch(rows, self.params, ref, tol, out, status, info)
+        self._bad_poses(status, rows)
         ok = status == OK
         if single:
             return finish(out[0], ok[0], True, flag, lambda: self._error(int(status[0]), info[0], rows[0], tol))

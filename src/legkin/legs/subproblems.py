@@ -24,7 +24,7 @@ import math
 
 from .._kernels import kernel
 
-__all__ = ["sp1", "sp2", "sp3", "sp4", "rot", "dot", "cross"]
+__all__ = ["sp1", "sp2", "sp3", "sp4", "rot", "rot_cs", "dot", "cross"]
 
 
 @kernel
@@ -42,7 +42,12 @@ def cross(a, b):
 @kernel
 def rot(k, t, p):
     """``R(k, t) p`` (Rodrigues' formula), ``k`` a unit vector."""
-    c, s = math.cos(t), math.sin(t)
+    return rot_cs(k, math.cos(t), math.sin(t), p)
+
+
+@kernel
+def rot_cs(k, c, s, p):
+    """``R(k, t) p`` for ``c = cos t``, ``s = sin t`` (Rodrigues without trigonometry), ``k`` a unit vector."""
     w = (1.0 - c) * (k[0] * p[0] + k[1] * p[1] + k[2] * p[2])
     return (
         c * p[0] + s * (k[1] * p[2] - k[2] * p[1]) + w * k[0],

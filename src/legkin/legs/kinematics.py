@@ -563,7 +563,7 @@ class Leg:
         Args:
             target: targets (3,) or (..., 3).
             q_near: reference joint values (3,) or broadcastable with ``target``.
-            tol: a target up to ``tol`` (m; (0, 1e-3], default :data:`IK_TOL` = 1e-9) outside the reachable set
+            tol: a target up to ``tol`` (m; (0, 1e-3], default :data:`IK_TOL` = 1e-7) outside the reachable set
                 is solved at its nearest reachable point (a float32-rounded target, say); farther out it is not.
             return_mask: also return the boolean mask of the branches that exist (legkin 0.2.0 convention).
 

@@ -497,31 +497,48 @@ def test_uncompiled_path_raises_the_same_errors():
 
 # --- memory, and a check row's tolerance ------------------------------------------------------------------------
 
-def test_large_wheel_leg_ik_batch_works_in_chunks():
-    """A wheel_leg.ik batch needed ~330 bytes a target, 13x its answer (3.2 GiB extra for 10^7 targets). Now it runs
-    by chunks (here of 4096 targets, so that the test is fast): the memory beyond the answer stays below the answer's
-    size, and the answers are the same bit for bit as one batch's."""
+def test_large_batches_work_in_chunks():
+    """A wheel_leg.ik batch needed ~330 bytes a target, 13x its answer (3.2 GiB extra for 10^7 targets); tripod.ik
+    168 B against a 25 B answer, wheel_leg.ik_all 370 B against 50 B, a 6-DOF leg's ik 95 B against 49 B. Now every
+    batch runs by chunks (here of 1024 targets, so that the test is fast; scripts/batch_memory.py measures all of
+    them at 10^6): the memory beyond the answer stays below the answer's size, and the answers are the same bit for
+    bit as one whole batch's."""
     proc = run_py("""
         import tracemalloc, numpy as np
-        from legkin import _batch, wheel_leg
-        n = 100_000
-        rng = np.random.default_rng(0)
-        q = np.column_stack([rng.uniform(0.5, 2.5, n), rng.uniform(-1, 1, n), rng.uniform(-0.3, 0.3, n)])
-        p = wheel_leg.fk(q, "FL")
-        whole, whole_ok = wheel_leg.ik(p, "FL", return_mask=True)
-        _batch.CHUNK = 4096
-        tracemalloc.start()
-        out, ok = wheel_leg.ik(p, "FL", return_mask=True)
-        peak = tracemalloc.get_traced_memory()[1]
-        tracemalloc.stop()
-        answer = out.nbytes + ok.nbytes
-        print(round((peak - answer) / n, 1), round(answer / n, 1))
-        print(np.array_equal(out, whole, equal_nan=True) and np.array_equal(ok, whole_ok))
+        from legkin import _batch, hybrid_leg, legs, tripod, wheel_leg
+        n, rng = 40_000, np.random.default_rng(0)
+        box = lambda lo, hi: np.asarray(lo) + (np.asarray(hi) - np.asarray(lo)) * rng.random((n, len(lo)))
+        wq = box([0.9, -0.3, -0.3], [1.5, 0.3, 0.3])
+        tq = tripod.ik(np.column_stack([rng.uniform(-0.5, 0.5, n), rng.uniform(-1, 1, n)]))
+        leg = next(iter(legs.from_model(legs.load_erd("talos")[0]).values()))
+        mid, half = (leg.lower + leg.upper) / 2, (leg.upper - leg.lower) / 2
+        calls = {
+            "wheel_leg.ik": lambda x=wheel_leg.fk(wq, "FL"): wheel_leg.ik(x, "FL", return_mask=True),
+            "wheel_leg.ik_all": lambda x=wheel_leg.fk(wq, "FL"): wheel_leg.ik_all(x, "FL", return_mask=True),
+            "tripod.fk": lambda: tripod.fk(tq, return_mask=True),
+            "tripod.ik": lambda x=tripod.fk(tq): tripod.ik(x, return_mask=True),
+            "hybrid_leg.ik": lambda x=hybrid_leg.fk(box([-0.2, -0.2, 2.8], [0.2, 0.2, 3.2])):
+                hybrid_leg.ik(x, return_mask=True),
+            "Leg6.ik": lambda x=leg.fk(box(mid - 0.3 * half, mid + 0.3 * half)): leg.ik(x, return_mask=True),
+        }
+        for name, call in calls.items():
+            _batch.CHUNK = 10 ** 9
+            whole = call()
+            _batch.CHUNK = 1024
+            tracemalloc.start()
+            out = call()
+            peak = tracemalloc.get_traced_memory()[1]
+            tracemalloc.stop()
+            answer = sum(a.nbytes for a in out)
+            same = all(np.array_equal(a, b, equal_nan=True) for a, b in zip(out, whole))
+            print(name, round((peak - answer) / n, 1), round(answer / n, 1), same)
     """)
     assert proc.returncode == 0, proc.stderr[-2000:]
-    extra, answer = map(float, proc.stdout.split()[:2])
-    assert extra < answer, f"{extra} bytes a target beyond the answer ({answer} bytes a target)"
-    assert proc.stdout.split()[2] == "True"
+    lines = [line.split() for line in proc.stdout.splitlines()]
+    assert len(lines) == 6, proc.stdout
+    for name, extra, answer, same in lines:
+        assert float(extra) < float(answer), f"{name}: {extra} bytes a target beyond the answer ({answer} bytes)"
+        assert same == "True", f"{name}: the chunks' answers differ from one batch's"
 
 
 def test_tripod_jacobian_rows_hold_to_their_conditioning_bound():

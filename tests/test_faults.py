@@ -308,9 +308,13 @@ def test_signal_stops_check_and_its_workers(signum, status):
 
 
 def _legkin(*argv: str) -> subprocess.Popen:
-    """``python -m legkin ARGV`` started (stdout and stderr piped, text)."""
+    """``python -m legkin ARGV`` started (stdout and stderr piped, text), with Ctrl-C's default action: a shell's
+    background job (``pytest &``, nohup) ignores SIGINT, and Python then installs no KeyboardInterrupt for it."""
+    import signal
+
     return subprocess.Popen([sys.executable, "-m", "legkin", *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
-                            text=True, env={**os.environ, "PYTHONPATH": SRC})
+                            text=True, env={**os.environ, "PYTHONPATH": SRC},
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
 
 
 def _left_behind(pids: list[int], until: float) -> list[int]:

@@ -154,6 +154,8 @@ def dispatch(
     error: Callable[..., Exception],
     args: tuple[Any, ...],
     return_mask: bool,
+    *,
+    chunks: bool = True,
 ) -> Any:
     """The single/batch rule of a kinematic function of one array argument, written once.
 
@@ -180,6 +182,8 @@ def dispatch(
         error: ``error(item, out, ok, *args) -> Exception``: why the single item ``item`` failed.
         args: the checked options.
         return_mask: also return the mask (True / False, already checked).
+        chunks: run a large batch by chunks (False: in one call, for a function whose temporaries are already well
+            below its answer, where copying the chunks' answers would only cost time).
 
     Returns:
         ``out`` (shape ``batch shape + item shape``), or ``(out, mask)`` with ``return_mask``.
@@ -197,7 +201,10 @@ def dispatch(
     arr = as_input(x, name, core)
     shape = arr.shape[: arr.ndim - len(core)]
     rows = np.ascontiguousarray(arr.reshape((-1,) + core))
-    out, ok = in_chunks(lambda r: batch(r, *args), [rows])  # a large batch's temporaries: CHUNK rows' worth
+    if chunks:  # a large batch's temporaries: CHUNK rows' worth
+        out, ok = in_chunks(lambda r: batch(r, *args), [rows])
+    else:
+        out, ok = batch(rows, *args)
     if not shape:
         if not ok[0].any():
             raise error(arr, out[0], ok[0], *args)

@@ -270,13 +270,21 @@ def _cmd_view(args) -> int:
         if args.html:
             print(f"wrote {write_animation_html(robot, qs, args.html, ground=not args.no_ground)}")
             return 0
-        show(robot, qs[0], animation=qs, ground=not args.no_ground, host=args.host)
-        return 0
+        return _stopped_by(show(robot, qs[0], animation=qs, ground=not args.no_ground, host=args.host))
     if args.html:
         print(f"wrote {write_html(robot, q, args.html, ground=not args.no_ground)}")
         return 0
-    show(robot, q, ground=not args.no_ground, host=args.host)
-    return 0
+    return _stopped_by(show(robot, q, ground=not args.no_ground, host=args.host))
+
+
+def _stopped_by(signum: int) -> int:
+    """The viewer stopped by signal ``signum`` (its server stopped): raised as :func:`main` reports a signal,
+    which exits with 128 + ``signum`` (130 Ctrl-C, 143 SIGTERM, 129 SIGHUP)."""
+    import signal
+
+    if signum == signal.SIGINT:
+        raise KeyboardInterrupt
+    raise Terminated(signum)
 
 
 def _cmd_export(args) -> int:
@@ -430,8 +438,9 @@ def main(argv: list[str] | None = None) -> int:
         return _fail(str(exc), 2)
     except errors.LegkinError as exc:
         return _fail(f"legkin: error: {exc}", 2)
-    except KeyboardInterrupt:
-        return _stop(argv, _fail("legkin: interrupted", 130))
+    except KeyboardInterrupt as exc:  # Ctrl-C; or SIGTERM, SIGHUP in the viewer (legkin._signals.SignalInterrupt)
+        signum = getattr(exc, "signum", 2)
+        return _stop(argv, _fail("legkin: interrupted" if signum == 2 else "legkin: terminated", 128 + signum))
     except BrokenPipeError:  # e.g. `legkin list | head -1`: stop quietly
         try:
             sys.stdout = open(os.devnull, "w")  # noqa: SIM115 - Python flushes stdout at exit

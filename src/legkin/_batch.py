@@ -83,32 +83,53 @@ def _not_finite(arr: np.ndarray, name: str, core: int) -> str:
     return f"{name} must be finite: row {row} has {value} ({name}[{', '.join(map(str, where))}])"
 
 
-#: Items per chunk of a batch that a function splits to bound its working memory (:func:`in_chunks`): 65,536 items
-#: keep a wheel_leg.ik chunk's temporaries (~310 B an item) near 20 MB.
+#: Items per chunk of a batch (:func:`in_chunks`): a batch's temporaries take at most this many items' worth of
+#: memory (65,536 items keep a wheel_leg.ik chunk's temporaries, ~310 B an item, near 20 MB).
 CHUNK = 1 << 16
 
 
-def in_chunks(solve: Callable[..., tuple[np.ndarray, np.ndarray]], rows: Sequence[np.ndarray | None],
-              out_core: int, chunk: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+def in_chunks(solve: Callable[..., tuple[np.ndarray, ...]], rows: Sequence[np.ndarray | None],
+              chunk: int | None = None) -> tuple[np.ndarray, ...]:
     """Run a batch ``chunk`` items at a time, so that its temporaries take ``chunk`` items' worth of memory, not n's.
 
     Args:
-        solve: ``solve(*rows_slice) -> (values (m, out_core), mask (m,))`` on consecutive slices of the rows.
+        solve: ``solve(*rows_slice) -> (arrays, each (m, ...))`` on consecutive slices of the rows (e.g. the values
+            and the mask).
         rows: the per-item inputs, each (n, ...) (sliced) or None (passed as None); the first is not None.
-        out_core: the width of one item's values.
         chunk: items per call (default :data:`CHUNK`).
 
     Returns:
-        ``(values (n, out_core), mask (n,))``, filled chunk by chunk (the only arrays of n items allocated here).
+        ``solve``'s arrays for the n items: its own answer when n <= ``chunk``, else arrays of n items filled chunk
+        by chunk (the only arrays of n items allocated here).
     """
     n = next(x for x in rows if x is not None).shape[0]
     chunk = CHUNK if chunk is None else chunk
-    values, mask = np.empty((n, out_core)), np.empty(n, dtype=bool)
+    part = solve(*(None if x is None else x[:chunk] for x in rows))
+    if n <= chunk:
+        return part
+    whole = tuple(np.empty((n,) + a.shape[1:], a.dtype) for a in part)
     for lo in range(0, n, chunk):
-        hi = min(n, lo + chunk)
-        v, m = solve(*(None if x is None else x[lo:hi] for x in rows))
-        values[lo:hi], mask[lo:hi] = v, m
-    return values, mask
+        if lo:
+            part = solve(*(None if x is None else x[lo:lo + chunk] for x in rows))
+        for a, b in zip(whole, part):
+            a[lo:lo + chunk] = b
+    return whole
+
+
+def _batch_rows(batch: Callable[..., tuple[np.ndarray, np.ndarray]], rows: np.ndarray,
+                args: tuple[Any, ...]) -> tuple[np.ndarray, ...]:
+    """``batch(rows, *args)`` by chunks of :data:`CHUNK` rows (:func:`in_chunks`); an argument that is an array with
+    one row per item (first dimension n, e.g. a ``q_near`` per target) is cut with the rows."""
+    n = rows.shape[0]
+    per_row = [i for i, a in enumerate(args) if type(a) is np.ndarray and a.ndim > 0 and a.shape[0] == n]
+
+    def solve(r: np.ndarray, *cut: np.ndarray) -> tuple[np.ndarray, ...]:
+        part = list(args)
+        for i, c in zip(per_row, cut):
+            part[i] = c
+        return batch(r, *part)
+
+    return in_chunks(solve, [rows, *(args[i] for i in per_row)])
 
 
 def as_angles(*xs: object, names: tuple[str, ...]) -> tuple[np.ndarray, ...]:
@@ -149,6 +170,8 @@ def dispatch(
     error: Callable[..., Exception],
     args: tuple[Any, ...],
     return_mask: bool,
+    *,
+    chunks: bool = True,
 ) -> Any:
     """The single/batch rule of a kinematic function of one array argument, written once.
 
@@ -159,7 +182,9 @@ def dispatch(
     2. **single call**: any other single input (a list, ints, NaN...) is checked by :func:`as_input` (which raises
        :class:`~legkin.errors.InvalidInputError`) and run through ``batch`` as one row, so that a single call equals
        its row of a batch bit for bit; if the row is not solved, ``error(item, out, ok, *args)`` is raised;
-    3. **batch**: leading dimensions: ``batch(rows, *args)`` on the C-contiguous float64 rows ``(n, *core)``.
+    3. **batch**: leading dimensions: ``batch(rows, *args)`` on the C-contiguous float64 rows ``(n, *core)``, by
+       chunks of :data:`CHUNK` rows (:func:`in_chunks`): its memory beyond the answer stays bounded; an argument
+       of ``args`` that is an array with one row per item (first dimension n) is cut with the rows.
 
     ``batch`` returns ``(out, ok)``, ``out`` (n, ...) NaN where not solved, ``ok`` (n,) (or (n, K) for ``ik_all``:
     then a single item counts as solved when any of its K is). The wrapper only checks its options and binds them
@@ -174,6 +199,8 @@ def dispatch(
         error: ``error(item, out, ok, *args) -> Exception``: why the single item ``item`` failed.
         args: the checked options.
         return_mask: also return the mask (True / False, already checked).
+        chunks: run a large batch by chunks (False: in one call, for a function whose temporaries are already well
+            below its answer, where copying the chunks' answers would only cost time).
 
     Returns:
         ``out`` (shape ``batch shape + item shape``), or ``(out, mask)`` with ``return_mask``.
@@ -191,7 +218,7 @@ def dispatch(
     arr = as_input(x, name, core)
     shape = arr.shape[: arr.ndim - len(core)]
     rows = np.ascontiguousarray(arr.reshape((-1,) + core))
-    out, ok = batch(rows, *args)
+    out, ok = _batch_rows(batch, rows, args) if chunks and rows.shape[0] > CHUNK else batch(rows, *args)
     if not shape:
         if not ok[0].any():
             raise error(arr, out[0], ok[0], *args)

@@ -14,7 +14,9 @@ def progress_bar(total: int, desc: str, enabled: bool = True) -> Iterator[Any]:
     """A tqdm bar on stderr (steps done, elapsed time, what runs now in its postfix), redrawn every second.
 
     A step can take several seconds: a thread redraws the bar so that its clock keeps running. Disabled,
-    the bar prints nothing and starts no thread.
+    the bar prints nothing, starts no thread and is no tqdm: a tqdm bar creates tqdm's multiprocessing lock, a
+    named semaphore that a killed process (``legkin check``'s workers after Ctrl-C or SIGTERM) leaves to the
+    resource tracker, which then warns of a "leaked semaphore".
 
     Args:
         total: the number of steps.
@@ -24,12 +26,15 @@ def progress_bar(total: int, desc: str, enabled: bool = True) -> Iterator[Any]:
     Yields:
         The tqdm bar (``update``, ``set_postfix_str``).
     """
+    if not enabled:
+        yield _SilentBar()
+        return
     import threading
 
     from tqdm import tqdm
 
     bar = tqdm(
-        total=total, desc=desc, unit="step", file=sys.stderr, disable=not enabled, leave=False,
+        total=total, desc=desc, unit="step", file=sys.stderr, leave=False,
         dynamic_ncols=True, bar_format="{desc}: {n_fmt}/{total_fmt} |{bar:20}| {elapsed}{postfix}",
     )
     stop = threading.Event()
@@ -38,13 +43,21 @@ def progress_bar(total: int, desc: str, enabled: bool = True) -> Iterator[Any]:
         while not stop.wait(1.0):
             bar.refresh()
 
-    ticker = threading.Thread(target=tick, daemon=True) if enabled else None
-    if ticker is not None:
-        ticker.start()
+    ticker = threading.Thread(target=tick, daemon=True)
+    ticker.start()
     try:
         yield bar
     finally:
         stop.set()
-        if ticker is not None:
-            ticker.join()
+        ticker.join()
         bar.close()
+
+
+class _SilentBar:
+    """A disabled bar: tqdm's methods that legkin calls, doing nothing."""
+
+    def update(self, n: int = 1) -> None:
+        """Nothing (a step done)."""
+
+    def set_postfix_str(self, s: str = "") -> None:
+        """Nothing (what runs now)."""

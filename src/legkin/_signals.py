@@ -9,6 +9,14 @@ import threading
 from typing import Callable, Iterator
 
 
+class SignalInterrupt(KeyboardInterrupt):
+    """SIGTERM or SIGHUP delivered as a KeyboardInterrupt (``legkin view`` stops as on Ctrl-C), with its number."""
+
+    def __init__(self, signum: int):
+        super().__init__(f"signal {signum}")
+        self.signum = signum
+
+
 @contextlib.contextmanager
 def signals_raise(make: Callable[[int], BaseException]) -> Iterator[None]:
     """Inside the block, SIGTERM and SIGHUP raise ``make(signum)`` in the main thread.

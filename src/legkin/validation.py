@@ -163,11 +163,14 @@ def _groups(names: list[str]) -> list[list[str]]:
 
 
 def _run_models(names: list[str], *, samples: int, seed: int, ik_targets: int | None, classify: int | None,
-                bar: Any = None) -> dict[str, tuple[list[CheckResult], float]]:
-    """The rows of each model, advancing ``bar`` per model and stage (None, in a worker process: no bar)."""
+                bar: Any = None, mujoco: bool = True) -> dict[str, tuple[list[CheckResult], float]]:
+    """The rows of each model, advancing ``bar`` per model and stage (None, in a worker process: no bar);
+    ``mujoco=False`` leaves out the MuJoCo export's rows (:func:`_mujoco_rows`: they do not depend on
+    ``samples``, so ``scripts/check_sweep.py`` runs them once per seed)."""
     if bar is None:
         with progress_bar(0, "", enabled=False) as bar:
-            return _run_models(names, samples=samples, seed=seed, ik_targets=ik_targets, classify=classify, bar=bar)
+            return _run_models(names, samples=samples, seed=seed, ik_targets=ik_targets, classify=classify, bar=bar,
+                               mujoco=mujoco)
     out = {}
     for name in names:
         module = _checks_module(get_spec(name))
@@ -175,7 +178,7 @@ def _run_models(names: list[str], *, samples: int, seed: int, ik_targets: int | 
         t0 = time.perf_counter()
         bar.set_postfix_str(f"{name}: checks ({samples} samples)")
         rows = list(module.run(samples, rng))
-        rows += _mujoco_rows(name, samples, seed)
+        rows += _mujoco_rows(name, samples, seed) if mujoco else []
         bar.update(1)
         if hasattr(module, "ik_robustness"):
             n = samples if ik_targets is None else ik_targets

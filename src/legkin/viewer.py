@@ -10,7 +10,7 @@ from typing import Any, Iterator, Sequence
 
 import numpy as np
 
-from ._signals import signals_raise
+from ._signals import SignalInterrupt, signals_raise
 from .robot import Robot
 
 __all__ = ["open_viewer", "show", "write_html", "write_animation_html"]
@@ -22,7 +22,7 @@ DEFAULT_CAMERA = (1.2, 0.7, 1.2)
 def _sigterm_interrupts() -> contextlib.AbstractContextManager[None]:
     """Inside the block, SIGTERM and SIGHUP (a closed terminal) raise KeyboardInterrupt (as Ctrl-C does), so that
     ``finally`` clauses run: the meshcat server, in a session of its own, would not get the terminal's SIGHUP."""
-    return signals_raise(lambda signum: KeyboardInterrupt(f"signal {signum}"))
+    return signals_raise(SignalInterrupt)
 
 
 @contextlib.contextmanager
@@ -201,10 +201,23 @@ def write_animation_html(
 
 
 def show(robot: Robot, q: np.ndarray, animation: Sequence[np.ndarray] | None = None, ground: bool = True,
-         host: str = "127.0.0.1") -> None:
+         host: str = "127.0.0.1") -> int:
     """Serve a live meshcat view of ``robot`` at ``q`` (playing ``animation`` if given) until Ctrl-C, SIGTERM or
-    SIGHUP; on ``host`` (127.0.0.1: this machine only; ``"0.0.0.0"``: every network interface, see
-    :func:`open_viewer`)."""
+    SIGHUP.
+
+    Args:
+        robot: the model to show.
+        q: its configuration (rad, m).
+        animation: configurations (rad, m) played in a loop at 30 frames a second, or None.
+        ground: a ground plane under a walking robot.
+        host: the address the page is served on (127.0.0.1: this machine only; ``"0.0.0.0"``: every network
+            interface, see :func:`open_viewer`).
+
+    Returns:
+        The number of the signal that stopped the viewer: 2 (SIGINT, Ctrl-C), 15 (SIGTERM) or 1 (SIGHUP); its
+        server is stopped (``legkin view`` exits with 128 + that number).
+    """
+    import signal
     import time
 
     q = robot.check_q(q)
@@ -216,8 +229,8 @@ def show(robot: Robot, q: np.ndarray, animation: Sequence[np.ndarray] | None = N
             print(f"meshcat viewer: {viz.viewer.url()}  (Ctrl-C to stop)", flush=True)
             while True:
                 time.sleep(1.0)
-        except KeyboardInterrupt:
-            pass
+        except KeyboardInterrupt as exc:
+            return int(getattr(exc, "signum", signal.SIGINT))
 
 
 def chromium_path() -> str | None:

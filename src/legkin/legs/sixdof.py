@@ -42,7 +42,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input, check_flag, check_number, finish
+from .. import _batch
+from .._batch import as_input, check_flag, check_number, finish, in_chunks
 from .._kernels import OK, as_rows
 from ..errors import InvalidInputError, JointLimitError, LegStructureError, UnreachableError
 from ._ik6_kernels import _ik6_batch, _ik6_k, _ik_all6_batch, _ik_all6_k
@@ -126,10 +127,14 @@ def _pose_input(target, name: str = "target") -> np.ndarray:
     """``target`` (4, 4) or (..., 4, 4) as a checked float array: finite, bottom row ``(0, 0, 0, 1)``, rotation
     orthonormal with determinant +1 to 1e-6."""
     arr = as_input(target, name, _T44)
-    rot = arr[..., :3, :3]
-    bottom = np.abs(arr[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max(initial=0.0)
-    ortho = np.abs(np.einsum("...ji,...jk->...ik", rot, rot) - np.eye(3)).max(initial=0.0)
-    det = np.abs(np.linalg.det(rot) - 1.0).max(initial=0.0) if rot.size else 0.0
+    bottom = ortho = det = 0.0
+    flat = arr.reshape(-1, 4, 4)
+    for lo in range(0, flat.shape[0], _batch.CHUNK):  # by chunks: the (n, 3, 3) temporaries were 2x the answer of ik
+        part = flat[lo:lo + _batch.CHUNK]
+        rot = part[:, :3, :3]
+        bottom = max(bottom, float(np.abs(part[:, 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max()))
+        ortho = max(ortho, float(np.abs(np.einsum("...ji,...jk->...ik", rot, rot) - np.eye(3)).max()))
+        det = max(det, float(np.abs(np.linalg.det(rot) - 1.0).max()))
     if not (bottom <= 1e-12 and ortho <= 1e-6 and det <= 1e-6):
         raise InvalidInputError(
             f"{name} must be 4x4 homogeneous transforms (bottom row 0 0 0 1, a rotation block with R^T R = I and "
@@ -347,6 +352,18 @@ class Leg6:
             _pose_input(rows[bad].reshape(-1, 4, 4))
             raise InvalidInputError("target must be 4x4 homogeneous transforms (R^T R = I and det R = 1 to 1e-6)")
 
+    def _solve(self, kernel: Any, shape: tuple[int, ...], rows: np.ndarray, ref: np.ndarray,
+               tol: float) -> tuple[np.ndarray, ...]:
+        """An IK batch kernel on the pose rows (n, 16), by chunks (``legkin._batch.in_chunks``: the temporaries of a
+        large batch take one chunk's memory): ``(out (n, *shape), status (n,), info (n, 2))``."""
+        def solve(r: np.ndarray, rf: np.ndarray | None) -> tuple[np.ndarray, ...]:
+            m = r.shape[0]
+            out, status, info = np.empty((m,) + shape), np.empty(m, dtype=np.int64), np.zeros((m, 2))
+            kernel(r, self.params, ref if rf is None else rf, tol, out, status, info)
+            return out, status, info
+
+        return in_chunks(solve, [rows, ref if ref.shape[0] == rows.shape[0] else None])
+
     def _error(self, status: int, info: np.ndarray, target: np.ndarray, tol: float):
         t = target.reshape(4, 4)
         if status == _JOINT_LIMIT:
@@ -387,10 +404,8 @@ class Leg6:
                 return fast
         rows, ref, batch, single, tol = self._prepare(target, q_near, tol)
         flag = check_flag(return_mask, "return_mask")
-        n = rows.shape[0]
         k = self.n_solutions
-        out, status, info = np.empty((n, k, 6)), np.empty(n, dtype=np.int64), np.zeros((n, 2))
-        _ik_all6_batch(rows, self.params, ref, tol, out, status, info)
+        out, status, info = self._solve(_ik_all6_batch, (k, 6), rows, ref, tol)
         self._bad_poses(status, rows)
         if single and status[0] != OK:
             raise self._error(int(status[0]), info[0], rows[0], tol)
@@ -423,9 +438,7 @@ class Leg6:
                 return fast
         rows, ref, batch, single, tol = self._prepare(target, q_near, tol)
         flag = check_flag(return_mask, "return_mask")
-        n = rows.shape[0]
-        out, status, info = np.empty((n, 6)), np.empty(n, dtype=np.int64), np.zeros((n, 2))
-        _ik6_batch(rows, self.params, ref, tol, out, status, info)
+        out, status, info = self._solve(_ik6_batch, _Q6, rows, ref, tol)
         self._bad_poses(status, rows)
         ok = status == OK
         if single:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numpy as np
 
@@ -38,6 +39,10 @@ AMP_CONSTANT = 100.0
 #: ik stay moderate (relative error measured <= 3e-10 at 10,000 samples).
 H = 1e-4
 TOL_FD = 1e-9
+#: ... and |det M| > FD_DET (the actuation singularity: ik refuses |det M| < DET_GUARD = 1e-6 and A_u ~ 1 / det M):
+#: a sample 2e-4 rad from the curve det M = 0 had a difference point refused there (NaN: the row failed at
+#: alpha = pi/4, seed 13, 10^4 samples; scripts/check_sweep.py).
+FD_DET = 1e-2
 #: fk vs solve_loops: the configuration solve_loops closes (residual ~1e-15, A_q1 and B_q1 held) is only as
 #: accurate as 1e-15 x gain, gain = 1 / sigma_min(constraint Jacobian on the free joints), which is large near
 #: bifurcations of the legs' branches (measured: 1.75e-12 rad at gain 3.9e4, alpha = pi/4, seed 2; error / gain
@@ -230,6 +235,7 @@ def _jacobian_rows(robot, geo: at.Geometry, alpha: float, pre: str, q: np.ndarra
                         err / (eps * amp), AMP_CONSTANT))
     s2 = np.abs(np.sin(q[:, [1, 5, 9]])).min(axis=-1)
     fd_ok = (s2 > 0.1) & (np.abs(np.cos(ay)) > 0.1) & (1 + np.cos(ay) * np.cos(az) > 0.1)
+    fd_ok &= np.abs(_home_det(ay, az, geo._vector)) > FD_DET  # the differences' points stay clear of ik's DET_GUARD
     a_fd = _fd_actuation_jacobian(ay[fd_ok], az[fd_ok], alpha)
     a_an = at.jacobian(np.stack([ay[fd_ok], az[fd_ok]], axis=-1), geometry=geo)
     scale = np.maximum(1.0, np.abs(a_an).max(axis=(-1, -2)))
@@ -393,17 +399,23 @@ def made_targets(n: int, rng: np.random.Generator, alpha: float = at.ALPHA) -> t
     return np.concatenate(ys)[:n], np.concatenate(zs)[:n]
 
 
+def _home_det(y: Any, z: Any, G: np.ndarray) -> np.ndarray:
+    """det M of the home mode's motor planes at (alpha_y, alpha_z) (ik's kernel, also where its guards refuse the
+    pose), NaN outside the workspace."""
+    ay, az = np.broadcast_arrays(np.asarray(y, dtype=float), np.asarray(z, dtype=float))
+    aux = _run(ay, az, G, HOME_MODE)[1][..., 0, :]
+    inside = (aux[..., 3] > SINGULAR_TOL) & np.all(1.0 - np.abs(aux[..., :3]) > BOUNDARY_TOL, axis=-1)
+    return np.where(inside, aux[..., 4], np.nan)
+
+
 def _det_curve_points(rng: np.random.Generator, alpha: float, grid: int = 121) -> np.ndarray:
     """Points (alpha_y, alpha_z) on the actuation-singular curves det M = 0 of the home mode's motors: bisection
     between grid neighbours where det M changes sign, along alpha_y (random alpha_z) and along alpha_z (random
     alpha_y; at alpha = pi/2 det M vanishes on the lines alpha_z = +-pi/2)."""
     G = at.Geometry(alpha=alpha)._vector
 
-    def det_of(y, z):  # det M of the home mode's motor planes (ik's kernel, also where its guards refuse the pose)
-        yz = np.broadcast_arrays(np.asarray(y, dtype=float), np.asarray(z, dtype=float))
-        aux = _run(*yz, G, HOME_MODE)[1][..., 0, :]
-        inside = (aux[..., 3] > SINGULAR_TOL) & np.all(1.0 - np.abs(aux[..., :3]) > BOUNDARY_TOL, axis=-1)
-        return np.where(inside, aux[..., 4], np.nan)
+    def det_of(y, z):
+        return _home_det(y, z, G)
 
     out = []
     for along_y in (True, False):

@@ -150,6 +150,14 @@ def _fk_batch(rows: np.ndarray, g: Geometry, mode: str, tol: float, max_iter: in
     return out[:, 0], status[:, 0] == OK
 
 
+def _fk_orientation_batch(rows: np.ndarray, g: Geometry, mode: str, tol: float, max_iter: int,
+                          max_inc: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_fk_batch` without the inconsistency column: (alpha_y, alpha_z) only, so that a large batch, run by
+    chunks, keeps no array of n items beyond its answer."""
+    out, ok = _fk_batch(rows, g, mode, tol, max_iter, max_inc)
+    return np.ascontiguousarray(out[..., :2]), ok
+
+
 def _fk_fail(qm: np.ndarray, out: np.ndarray, ok: np.ndarray, g: Geometry, mode: str, tol: float, max_iter: int,
              max_inc: float) -> Exception:
     """The exception of a failed single :func:`fk` call (``mode="all"``: diagnosed in the home mode)."""
@@ -264,7 +272,8 @@ def fk(q: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | None = None,
     return_mask = flag(return_mask, "return_mask")
     return_info = flag(return_info, "return_info")
     g = geometry_of(geometry)
-    out, ok = dispatch(q, "q", (3,), _fk_fast, _fk_batch, _fk_fail, (g, mode, tol, max_iter, max_inc), True)
+    batch = _fk_batch if return_info else _fk_orientation_batch
+    out, ok = dispatch(q, "q", (3,), _fk_fast, batch, _fk_fail, (g, mode, tol, max_iter, max_inc), True)
     if not return_mask and not return_info:  # the common call: the orientation only
-        return out[..., :2].copy()
+        return np.ascontiguousarray(out[..., :2])
     return _finish(out, ok, return_mask, return_info)

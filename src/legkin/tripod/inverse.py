@@ -162,6 +162,8 @@ def _all_fast(t: np.ndarray, G: np.ndarray, width: int) -> tuple[np.ndarray, np.
     return (q, ok) if _k_ik_all(ay, az, G, q, ok) == OK else None
 
 
+#: ``dispatch(..., chunks=False)`` for :func:`_all_batch`: its temporaries (status, 8 B a target) are far below its
+#: answer (16 modes, 400 B a target); copying chunks of that answer cost 10% of ik_all's CPU time.
 def _all_batch(rows: np.ndarray, G: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray]:
     n = rows.shape[0]
     q, ok, status = np.empty((n, 16, width)), np.empty((n, 16), dtype=np.bool_), np.empty(n, dtype=np.int64)
@@ -243,7 +245,8 @@ def ik(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | None = 
     """
     mode, G, return_mask = _checked(mode, geometry, return_mask)
     if mode == "all":
-        return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3), return_mask)
+        return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3), return_mask,
+                        chunks=False)
     return dispatch(target, "target", (2,), _ik_fast, _ik_batch, _ik_fail, (G, mode, 3), return_mask)
 
 
@@ -270,7 +273,8 @@ def ik_all(target: ArrayLike, *, geometry: Geometry | None = None, return_mask: 
         then the mask, if asked.
     """
     _, G, return_mask = _checked(HOME_MODE, geometry, return_mask)
-    return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3), return_mask)
+    return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3), return_mask,
+                        chunks=False)
 
 
 @overload
@@ -296,7 +300,8 @@ def ik_joints(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | 
     """
     mode, G, return_mask = _checked(mode, geometry, return_mask)
     if mode == "all":
-        return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 12), return_mask)
+        return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 12), return_mask,
+                        chunks=False)
     return dispatch(target, "target", (2,), _ik_fast, _ik_batch, _ik_fail, (G, mode, 12), return_mask)
 
 

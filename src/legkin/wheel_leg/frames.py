@@ -181,6 +181,14 @@ def _fk(q: np.ndarray, ctx: _Ctx, want_jac: bool):
     return p, (J.reshape(shape + (3, 3)) if want_jac else None)
 
 
+def _writeable(x: np.ndarray) -> np.ndarray:
+    """``x`` itself if it is a writeable C-contiguous float64 array, else a copy that is (the inputs of a batch with
+    per-target alpha or w: no copy of n items where the caller's arrays serve as they are)."""
+    if x.dtype == np.float64 and x.flags.c_contiguous and x.flags.writeable:
+        return x
+    return np.array(x, dtype=np.float64)
+
+
 def _q_inputs(q, alpha, w, geo):
     q = as_input(q, "q", (3,))
     alpha = as_input(alpha, "alpha")
@@ -191,8 +199,9 @@ def _q_inputs(q, alpha, w, geo):
         raise InvalidInputError(
             f"inputs do not broadcast together: q{q.shape}, alpha{alpha.shape}, w{w.shape}"
         ) from exc
-    q = np.broadcast_to(q, shape + (3,))
-    alpha, w = np.broadcast_to(alpha, shape), np.broadcast_to(w, shape)
+    q = q if q.shape == shape + (3,) else np.broadcast_to(q, shape + (3,))  # (a view only where it broadcasts)
+    alpha = alpha if alpha.shape == shape else np.broadcast_to(alpha, shape)
+    w = w if w.shape == shape else np.broadcast_to(w, shape)
     _check_theta(q[..., 0], "theta (q[..., 0])")
     _check_alpha(alpha)
     _check_w(w, geo)
@@ -232,9 +241,9 @@ def _contact_call(q: ArrayLike, alpha: ArrayLike, w: ArrayLike, leg: Leg, rim: s
         checked = None
     else:  # broadcast together (and range-checked) before the single/batch rule
         qb, a_arr, w_arr = _q_inputs(q, alpha, w, geo)
-        q = np.array(qb)  # writeable copies: numba types read-only arrays apart (a second compilation)
-        a, b = (float(a_arr), float(w_arr)) if a_arr.ndim == 0 else (np.array(a_arr).reshape(-1),
-                                                                     np.array(w_arr).reshape(-1))
+        q = _writeable(qb)  # numba types read-only arrays apart (a second compilation): copies only where needed
+        a, b = (float(a_arr), float(w_arr)) if a_arr.ndim == 0 else (_writeable(a_arr).reshape(-1),
+                                                                     _writeable(w_arr).reshape(-1))
         checked = True
     if return_mask is not False and return_mask is not True:
         return_mask = check_flag(return_mask, "return_mask")

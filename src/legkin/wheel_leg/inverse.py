@@ -25,7 +25,7 @@ from .._kernels import OK
 from ..errors import InvalidInputError, InvalidParameterError, UnreachableError
 from . import ik_iterative
 from ._common import _LIMITS, _SCALARS, _SOLVED, Leg, Rim, _check_alpha, _check_theta, _check_w, rim_name
-from .frames import _NO_JAC, _context, _Ctx, _k_contact, _kctx
+from .frames import _NO_JAC, _context, _Ctx, _k_contact, _kctx, _writeable
 from .geometry import (
     _DEFAULT_GEOMETRY,
     _LIMIT_ROUNDING,
@@ -227,7 +227,9 @@ def _broadcast(target, alpha, w, q_near, q_start):
     def items(x, core):
         if x is None:
             return None
-        x = np.array(np.broadcast_to(x, shape + core), dtype=float)
+        # a copy only where it broadcasts or is not a writeable C-contiguous float64 array (no n-sized copy of the
+        # caller's per-target arrays)
+        x = _writeable(x if x.shape == shape + core else np.broadcast_to(x, shape + core))
         return x if not shape else x.reshape((-1,) + core)
 
     a, b = items(alpha, ()), items(w, ())
@@ -289,7 +291,7 @@ def _ik_batch(rows, a, b, near, start, ctx: _IKCtx, method, opts, limits, sink) 
             return q, ok
 
         per_row = [None if type(x) is float else x for x in (alpha, w)]
-        q, ok = in_chunks(solve, [rows, *per_row, near, start], 3)
+        q, ok = in_chunks(solve, [rows, *per_row, near, start])
     else:
         q, it, err, ok, sols, ev = _solve_rows(rows, alpha, w, near, start, ctx, method, opts, limits)
         if sink is not None:
@@ -396,7 +398,8 @@ def ik(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.
         target, a, b, near, start = _targets(target, alpha, w, q_near, q_start)
     sink: list[Any] | None = [] if return_info else None
     res = dispatch(target, "target", (3,), _ik_one, _ik_batch, _ik_fail, (a, b, near, start, ctx, method, opts,
-                                                                          limits, sink), return_mask)
+                                                                          limits, sink), return_mask,
+                   chunks=False)  # _ik_batch runs its own chunks: alpha, w, q_near, q_start are per target
     return res if sink is None else _with_info(res, sink[-1], return_mask)
 
 
@@ -423,8 +426,28 @@ def _all_fast(target, a, b, ctx: _IKCtx, opts: IKOptions, limits: bool, return_m
 
 
 def _all_batch(rows, a, b, ctx: _IKCtx, opts: IKOptions, limits: bool, _mask: bool) -> tuple[np.ndarray, np.ndarray]:
-    """Every radial solution of targets (n, 3): (n, S, 3), the kept ones first in their order, NaN-padded; mask."""
+    """Every radial solution of targets (n, 3): (n, S, 3), the kept ones first in their order, NaN-padded; mask.
+
+    By chunks of :data:`~legkin._batch.CHUNK` targets: the padded answer is allocated once and widened when a
+    chunk has more solutions than those before, so that the memory beyond the answer is one chunk's (it was
+    ~370 B a target, 7x the answer)."""
     alpha, w, _near, _start = _rows(rows, a, b, None, None, ctx)
+    n, chunk = rows.shape[0], _batch.CHUNK
+    sols, keep = np.full((n, 0, 3), np.nan), np.zeros((n, 0), dtype=bool)
+    for lo in range(0, n, chunk):
+        part = slice(lo, lo + chunk)
+        s, k = _all_rows(rows[part], alpha if type(alpha) is float else alpha[part],
+                         w if type(w) is float else w[part], ctx, opts, limits)
+        if s.shape[1] > sols.shape[1]:  # more solutions than any chunk before: widen (NaN, mask False)
+            wider = np.full((n, s.shape[1], 3), np.nan)
+            wider[:, : sols.shape[1]] = sols
+            sols, keep = wider, np.pad(keep, ((0, 0), (0, s.shape[1] - keep.shape[1])))
+        sols[part, : s.shape[1]], keep[part, : s.shape[1]] = s, k
+    return sols, keep
+
+
+def _all_rows(rows, alpha, w, ctx: _IKCtx, opts: IKOptions, limits: bool) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_all_batch` on one chunk: the solutions (m, S, 3) with the kept ones first, and their mask."""
     sols = _solve_rows(rows, alpha, w, None, None, ctx, "radial", opts, False)[4]
     keep = np.isfinite(sols).all(axis=-1)
     if limits:
@@ -481,4 +504,4 @@ def ik_all(target: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike 
     else:
         target, a, b, _near, _start = _broadcast(target, alpha, w, None, None)
     return dispatch(target, "target", (3,), _all_fast, _all_batch, _all_fail, (a, b, ctx, opts, limits, return_mask),
-                    return_mask)  # type: ignore[no-any-return]
+                    return_mask, chunks=False)  # type: ignore[no-any-return] # _all_batch runs its own chunks

@@ -8,19 +8,23 @@ leading dimensions) returns arrays with NaN where an item fails, and with
 
 from __future__ import annotations
 
+import inspect
 import math
 import numbers
-from typing import Any, Callable, Iterable, Sequence
+from typing import Any, Callable, Iterable, Sequence, TypeVar, cast
 
 import numpy as np
 
 from .errors import InvalidArgumentError, InvalidInputError
+
+F = TypeVar("F", bound=Callable[..., Any])
 
 __all__ = [
     "as_input",
     "dispatch",
     "as_angles",
     "finish",
+    "same_signature",
     "real_number",
     "check_number",
     "check_integer",
@@ -254,6 +258,34 @@ def finish(
             return (*value, ok)
         return value, ok
     return value
+
+
+def same_signature(template: F) -> Callable[[Callable[..., Any]], F]:
+    """Decorator: the decorated function takes exactly the arguments of ``template`` and is typed as it is.
+
+    For functions that share one signature whose return type depends on an argument (``return_mask``): the
+    ``@overload`` stack is written once, on ``template``, and a type checker reads the decorated function's calls
+    against it. The decorated function itself is returned unchanged (no call overhead); its parameters (names,
+    kinds, defaults and annotations) are compared with ``template``'s when the module is imported.
+
+    Args:
+        template: the function whose parameters and (overloaded) type the decorated function shares.
+
+    Returns:
+        the decorator.
+
+    Raises:
+        TypeError: (at import) the decorated function's parameters differ from ``template``'s.
+    """
+    want = list(inspect.signature(template).parameters.values())
+
+    def apply(fn: Callable[..., Any]) -> F:
+        got = list(inspect.signature(fn).parameters.values())
+        if got != want:
+            raise TypeError(f"{fn.__qualname__} must take the arguments of {template.__qualname__}: {got} != {want}")
+        return cast(F, fn)
+
+    return apply
 
 
 def real_number(value: object, name: str, valid: str | Callable[[], str]) -> float:

@@ -9,7 +9,7 @@ from typing import Literal, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_angles, dispatch
+from .._batch import as_angles, dispatch, same_signature
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import ConvergenceError, SingularityError
 from ._options import SCALARS, ST_ASSEMBLE, ST_BAND, ST_INPUT, ST_SINGULAR, Branch, flat, mode_args, resolve
@@ -239,12 +239,7 @@ def fk(q: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, geometry: Ge
     return dispatch(q, "q", (3,), _fk_fast, _fk_batch, _fk_fail, args[:4], args[4])
 
 
-@overload
-def jacobian(q: ArrayLike, *, branch: Branch = ..., assembly: int = ..., geometry: Geometry | None = ...,
-             return_mask: Literal[False] = ...) -> np.ndarray: ...
-@overload
-def jacobian(q: ArrayLike, *, branch: Branch = ..., assembly: int = ..., geometry: Geometry | None = ...,
-             return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+@same_signature(fk)
 def jacobian(q: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, geometry: Geometry | None = None,
              return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """d(foot position)/d(theta1, theta2, theta0), shape (..., 3, 3), of the closed-loop leg (the Jacobian of

@@ -15,7 +15,7 @@ from typing import Literal, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_angles, check_flag, finish
+from .._batch import as_angles, check_flag, finish, same_signature
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import SingularityError
 from ._options import SCALARS, ST_REACH, ST_SINGULAR, Branch, check_branch, fast_branch, flat, resolve, unreachable
@@ -199,12 +199,7 @@ def _jacobian_and_mode(r: np.ndarray, p: np.ndarray, b: np.ndarray
     return jac.reshape(sh + (2, 2)), k.reshape(sh + (2,)), st.reshape(sh), mode.reshape(sh)
 
 
-@overload
-def motor_jacobian(roll: ArrayLike, pitch: ArrayLike, branch: Branch = ..., *, geometry: Geometry | None = ...,
-                   return_mask: Literal[False] = ...) -> np.ndarray: ...
-@overload
-def motor_jacobian(roll: ArrayLike, pitch: ArrayLike, branch: Branch = ..., *, geometry: Geometry | None = ...,
-                   return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+@same_signature(motor_angles)
 def motor_jacobian(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *, geometry: Geometry | None = None,
                    return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """d(theta1, theta2)/d(roll, pitch), shape (..., 2, 2), by implicit differentiation of the rod lengths.
@@ -245,12 +240,7 @@ def motor_jacobian(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *
     return finish(jac, st == OK, r.ndim == 0, return_mask, error)
 
 
-@overload
-def assembly_mode(roll: ArrayLike, pitch: ArrayLike, branch: Branch = ..., *, geometry: Geometry | None = ...,
-                  return_mask: Literal[False] = ...) -> np.ndarray: ...
-@overload
-def assembly_mode(roll: ArrayLike, pitch: ArrayLike, branch: Branch = ..., *, geometry: Geometry | None = ...,
-                  return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+@same_signature(motor_angles)
 def assembly_mode(roll: ArrayLike, pitch: ArrayLike, branch: Branch = (1, 1), *, geometry: Geometry | None = None,
                   return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Assembly mode (..., ) of platform poses on a motor branch: +1, -1 (0 on the forward singularity).

@@ -14,7 +14,7 @@ from typing import Callable, Literal, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input, check_flag, finish
+from .._batch import as_input, check_flag, finish, same_signature
 from .._kernels import OK, batch_kernel, kernel
 from ..errors import InvalidInputError
 from ._options import ST_INPUT, Branch, check_branch, fast_branch, resolve, unreachable
@@ -162,12 +162,7 @@ def motor_angles_from_rotation(rotation: ArrayLike, branch: Branch = (1, 1), *, 
     return _rotation_call(rot_angles_k, _rot_angles_b, (2,), rotation, branch, return_mask, geometry)
 
 
-@overload
-def sphere_joint_angles(rotation: ArrayLike, branch: Branch = ..., *, geometry: Geometry | None = ...,
-                        return_mask: Literal[False] = ...) -> np.ndarray: ...
-@overload
-def sphere_joint_angles(rotation: ArrayLike, branch: Branch = ..., *, geometry: Geometry | None = ...,
-                        return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+@same_signature(motor_angles_from_rotation)
 def sphere_joint_angles(rotation: ArrayLike, branch: Branch = (1, 1), *, geometry: Geometry | None = None,
                         return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Angles (..., 2, 3) of each lever-tip spherical joint (z, y, x revolutes) that close the chains.
@@ -193,12 +188,7 @@ def sphere_joint_angles(rotation: ArrayLike, branch: Branch = (1, 1), *, geometr
     return _rotation_call(sphere_k, _sphere_b, (2, 3), rotation, branch, return_mask, geometry)
 
 
-@overload
-def spherical_free_axis(rotation: ArrayLike, branch: Branch = ..., *, geometry: Geometry | None = ...,
-                        return_mask: Literal[False] = ...) -> np.ndarray: ...
-@overload
-def spherical_free_axis(rotation: ArrayLike, branch: Branch = ..., *, geometry: Geometry | None = ...,
-                        return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+@same_signature(motor_angles_from_rotation)
 def spherical_free_axis(rotation: ArrayLike, branch: Branch = (1, 1), *, geometry: Geometry | None = None,
                         return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """Unit axis (..., 3) in CCS of the rotation left free by the seed's spherical centre, motors locked.

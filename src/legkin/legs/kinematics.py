@@ -58,7 +58,7 @@ from typing import Any, Literal, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input, check_flag, check_number, finish
+from .._batch import as_input, check_flag, check_number, finish, same_signature
 from .._kernels import OK, as_rows
 from ..errors import InvalidInputError, JointLimitError, UnreachableError
 from ..errors import LegStructureError as _LegStructureError
@@ -601,18 +601,7 @@ class Leg:
             return q_all
         return q_all, np.isfinite(q_all[..., 0])
 
-    @overload
-    def ik(self, target: ArrayLike, *, q_near: ArrayLike | None = ..., tol: float = ...,
-           return_mask: Literal[False] = ...) -> np.ndarray: ...
-
-    @overload
-    def ik(self, target: ArrayLike, *, q_near: ArrayLike | None = ..., tol: float = ...,
-           return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
-
-    @overload
-    def ik(self, target: ArrayLike, *, q_near: ArrayLike | None = ..., tol: float = ...,
-           return_mask: bool = ...) -> np.ndarray | tuple[np.ndarray, np.ndarray]: ...
-
+    @same_signature(ik_all)
     def ik(self, target: ArrayLike, *, q_near: ArrayLike | None = None, tol: float = IK_TOL,
            return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
         """Joint values placing the foot at ``target``: the branch inside the URDF limits nearest ``q_near``.

@@ -8,7 +8,7 @@ from typing import Any, Literal, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import dispatch
+from .._batch import dispatch, same_signature
 from .._kernels import OK
 from ..errors import SingularityError, UnreachableError
 from ._common import (
@@ -277,12 +277,7 @@ def ik_all(target: ArrayLike, *, geometry: Geometry | None = None, return_mask: 
                         chunks=False)
 
 
-@overload
-def ik_joints(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
-              return_mask: Literal[False] = ...) -> np.ndarray: ...
-@overload
-def ik_joints(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
-              return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+@same_signature(ik)
 def ik_joints(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | None = None,
               return_mask: bool = False) -> Any:
     """Every joint for ``target`` (..., 2): (..., 12) ordered A_q1..A_q4, B_q1..B_q4, C_q1..C_q4 (the Pinocchio
@@ -305,12 +300,7 @@ def ik_joints(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | 
     return dispatch(target, "target", (2,), _ik_fast, _ik_batch, _ik_fail, (G, mode, 12), return_mask)
 
 
-@overload
-def jacobian(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
-             return_mask: Literal[False] = ...) -> np.ndarray: ...
-@overload
-def jacobian(target: ArrayLike, *, mode: str = ..., geometry: Geometry | None = ...,
-             return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+@same_signature(ik)
 def jacobian(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | None = None,
              return_mask: bool = False) -> Any:
     """A_u = d(q_A1, q_B1, q_C1) / d(alpha_y, alpha_z), the Jacobian of :func:`ik`: seed Appendix D, eqs (103)-(105),

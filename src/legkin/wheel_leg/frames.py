@@ -9,7 +9,7 @@ from typing import Any, Literal, NamedTuple, overload
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .._batch import as_input, check_choice, check_flag, check_number, dispatch
+from .._batch import as_input, check_choice, check_flag, check_number, dispatch, same_signature
 from .._kernels import OK, as_items, as_rows, batch_kernel, kernel
 from ..errors import InvalidInputError
 from ._common import _SCALARS, RIMS, Leg, Rim, _check_alpha, _check_theta, _check_w, rim_name
@@ -326,14 +326,7 @@ def fk(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, ri
     return _contact_call(q, alpha, w, leg, rim_name(rim), radius, geometry, False, return_mask)
 
 
-@overload
-def jacobian(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
-             radius: float | None = None, geometry: Geometry | None = None,
-             return_mask: Literal[False] = False) -> np.ndarray: ...
-@overload
-def jacobian(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
-             radius: float | None = None, geometry: Geometry | None = None,
-             return_mask: Literal[True]) -> tuple[np.ndarray, np.ndarray]: ...
+@same_signature(fk)
 def jacobian(q: ArrayLike, leg: Leg, *, alpha: ArrayLike = 0.0, w: ArrayLike = 0.0, rim: Rim = "continuous",
              radius: float | None = None, geometry: Geometry | None = None,
              return_mask: bool = False) -> np.ndarray | tuple[np.ndarray, np.ndarray]:

@@ -81,39 +81,58 @@ def urdf_chain(urdf, frame: str) -> tuple[str, str, list[str]]:
     return path[0], end, path
 
 
-class _Foot:
-    """Pinocchio's foot of one leg (the other joints at ``q_base``) and the score of a joint answer."""
+class _LegFrame:
+    """Pinocchio's foot frame of one leg (the other joints at ``q_base``) and the score of a joint answer: the
+    error of a subclass's :meth:`_value` of the frame placement against the target, and the joint limits."""
+
+    shape: tuple[int, ...] = ()
 
     def __init__(self, model, leg, q_base: np.ndarray) -> None:
-        self.model = model
-        self.data = model.createData()
+        self.model, self.data = model, model.createData()
         self.fid = model.getFrameId(leg.foot_frame)
         self.iq, self.iv = list(leg.idx_q), list(leg.idx_v)
-        self.lower, self.upper, self.q_ref = leg.lower, leg.upper, leg.q_ref
+        self.leg, self.lower, self.upper, self.q_ref = leg, leg.lower, leg.upper, leg.q_ref
         self.q_base = q_base
 
     def __call__(self, qleg: np.ndarray) -> np.ndarray:
-        """Pinocchio's foot position (m) at each row of leg joints (NaN for a row with a NaN)."""
+        """Pinocchio's foot value at each row of leg joints (NaN for a row with a NaN)."""
         import pinocchio as pin
 
-        model, data, fid = self.model, self.data, self.fid
-        out = np.full((len(qleg), 3), np.nan)
+        out = np.full((len(qleg),) + self.shape, np.nan)
         q = self.q_base.copy()
         for k in np.flatnonzero(np.isfinite(qleg).all(axis=-1)):
             q[self.iq] = qleg[k]
-            pin.forwardKinematics(model, data, q)
-            out[k] = pin.updateFramePlacement(model, data, fid).translation
+            pin.forwardKinematics(self.model, self.data, q)
+            out[k] = self._value(pin.updateFramePlacement(self.model, self.data, self.fid))
         return out
 
-    def score(self, p: np.ndarray, q: np.ndarray, iters=None) -> Score:
+    def _value(self, placement: Any) -> np.ndarray:
+        raise NotImplementedError
+
+    def _error(self, got: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        raise NotImplementedError
+
+    def score(self, targets: np.ndarray, q, iters=None) -> Score:
         q = np.asarray(q, dtype=float)
-        err = np.linalg.norm(self(q) - p, axis=-1)  # NaN where there is no answer
+        err = self._error(self(q), targets)  # NaN where there is no answer
         inside = np.all((q >= self.lower) & (q <= self.upper), axis=-1)  # False on NaN
         reached = err <= SOLVE_TOL
         return Score(error=err, solved=reached & inside, reached=reached, iterations=iters)
 
-    def score_iter(self, p, out) -> Score:
-        return self.score(p, out[0], out[1])
+    def score_iter(self, targets, out) -> Score:
+        return self.score(targets, out[0], out[1])
+
+
+class _Foot(_LegFrame):
+    """The foot position (m); error: the distance to the target."""
+
+    shape = (3,)
+
+    def _value(self, placement: Any) -> np.ndarray:
+        return placement.translation
+
+    def _error(self, got: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        return np.linalg.norm(got - targets, axis=-1)
 
 
 def _legkin_methods(leg, targets: np.ndarray, foot: _Foot, n_batch: int, n_single: int) -> list[Method]:

@@ -14,11 +14,12 @@ mid-limit (picked outside the timing). Pinocchio CLIK: damped Newton on the SE(3
 
 from __future__ import annotations
 
-from typing import Callable
+from typing import Any, Callable
 
 import numpy as np
 
-from .._benchkit import SOLVE_TOL, Method, MethodResult, ModelBench, Score, missing, sizes
+from .._benchkit import SOLVE_TOL, Method, MethodResult, ModelBench, Score, missing, rotation_error, sizes
+from .bench import _LegFrame
 
 __all__ = ["build6", "CLIK_MAX_ITER", "CLIK_DAMPING"]
 
@@ -26,40 +27,17 @@ CLIK_MAX_ITER = 100
 CLIK_DAMPING = 1e-12
 
 
-class _Pose:
-    """Pinocchio's foot pose of one leg (the other joints at ``q_base``) and the score of a joint answer."""
+class _Pose(_LegFrame):
+    """The foot pose (4x4); error: max(|position error| (m), rotation error (rad))."""
 
-    def __init__(self, model, leg, q_base: np.ndarray) -> None:
-        self.model, self.data = model, model.createData()
-        self.fid = model.getFrameId(leg.foot_frame)
-        self.iq, self.iv = list(leg.idx_q), list(leg.idx_v)
-        self.leg, self.q_base = leg, q_base
+    shape = (4, 4)
 
-    def __call__(self, qleg: np.ndarray) -> np.ndarray:
-        import pinocchio as pin
+    def _value(self, placement: Any) -> np.ndarray:
+        return placement.homogeneous
 
-        out = np.full((len(qleg), 4, 4), np.nan)
-        q = self.q_base.copy()
-        for k in np.flatnonzero(np.isfinite(qleg).all(axis=-1)):
-            q[self.iq] = qleg[k]
-            pin.forwardKinematics(self.model, self.data, q)
-            out[k] = pin.updateFramePlacement(self.model, self.data, self.fid).homogeneous
-        return out
-
-    def score(self, targets: np.ndarray, q, iters=None) -> Score:
-        q = np.asarray(q, dtype=float)
-        got = self(q)
+    def _error(self, got: np.ndarray, targets: np.ndarray) -> np.ndarray:
         pos = np.linalg.norm(got[:, :3, 3] - targets[:, :3, 3], axis=-1)
-        rel = np.einsum("nji,njk->nik", targets[:, :3, :3], got[:, :3, :3])
-        skew = np.stack([rel[:, 2, 1] - rel[:, 1, 2], rel[:, 0, 2] - rel[:, 2, 0], rel[:, 1, 0] - rel[:, 0, 1]], -1)
-        rot = np.arctan2(0.5 * np.linalg.norm(skew, axis=-1), 0.5 * (np.trace(rel, axis1=1, axis2=2) - 1.0))
-        err = np.maximum(pos, rot)  # NaN where there is no answer
-        inside = np.all((q >= self.leg.lower) & (q <= self.leg.upper), axis=-1)
-        reached = err <= SOLVE_TOL
-        return Score(error=err, solved=reached & inside, reached=reached, iterations=iters)
-
-    def score_iter(self, targets, out) -> Score:
-        return self.score(targets, out[0], out[1])
+        return np.maximum(pos, rotation_error(targets[:, :3, :3], got[:, :3, :3]))
 
 
 def _legkin(leg, targets: np.ndarray, pose: _Pose, n_batch: int, n_single: int) -> list[Method]:

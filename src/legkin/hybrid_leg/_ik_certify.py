@@ -25,26 +25,10 @@ from .polynomial import quadratics_at_k, roll_poly_k
 
 __all__ = ["certify_k", "CERTIFY_WORK"]
 
-#: Deepest subdivision of the root interval (widths down to 2^-MAX_DEPTH of it).
-MAX_DEPTH = 14
-#: Margins: of a pose's distance from R_P = I and from the limits (rad), of the candidate's own root (rad), of a
-#: chain's reach ratio from the boundary, and relative ones of det N / the rods' Cramer determinant.
-NORM_MARGIN = 1e-6
-SELF_TOL = 1e-8
-BOUNDARY_MARGIN = 1e-6
-DET_MARGIN = 1e-9
-CRAMER_MARGIN = 1e-4
-#: Bernstein coefficients within this (relative to the largest on the whole interval) of zero count as zero.
-ZERO_TOL = 1e-9
-SLOPE_TOL = 1e-13
-
+# ----------------------------------------------------------------------------- the Bernstein form (degree 8)
 _N = 8
 _BINOM = np.array([[math.comb(i, j) for j in range(_N + 1)] for i in range(_N + 1)], dtype=np.float64)
 _BERN = np.array([[_BINOM[i, j] / _BINOM[_N, j] if j <= i else 0.0 for j in range(_N + 1)] for i in range(_N + 1)])
-
-UNKNOWN = -1
-NOT_NEARER = 0
-SELF = 1
 
 
 @kernel(inline=True)  # small and hot: inlined
@@ -134,6 +118,24 @@ def _root_k(c, a, b, fa):
     return x
 
 
+# ----------------------------------------------------------------------------- what a root is to the candidate
+#: Verdicts of :func:`classify_k`.
+UNKNOWN = -1
+NOT_NEARER = 0
+SELF = 1
+#: A root whose (roll, pitch) lies within this (rad) of the candidate's is the candidate itself.
+SELF_TOL = 1e-8
+#: Margin (rad) of a pose's distance from R_P = I and from the platform limits: a pose beyond a limit, or farther
+#: from R_P = I than the candidate, by more than this is not nearer; one within this of a limit is left to the
+#: forward kinematics (and so is a candidate within it of a limit).
+NORM_MARGIN = 1e-6
+#: A chain whose reach ratio |k| lies within this of 1 is on its reach boundary (labelled with both branches).
+BOUNDARY_MARGIN = 1e-6
+#: Relative margins of det N (the assembly mode's sign) and of the rods' Cramer determinant (one pitch per roll).
+DET_MARGIN = 1e-9
+CRAMER_MARGIN = 1e-4
+
+
 @kernel
 def classify_k(t, tip, dtip, al, be, ga, pose, b1, b2, s, rc, work):
     """What the pose at the root t = tan(roll / 2) is to the candidate pose (3,) (theta_LL, roll, pitch) of mode
@@ -171,10 +173,17 @@ def classify_k(t, tip, dtip, al, be, ga, pose, b1, b2, s, rc, work):
     return UNKNOWN
 
 
+# ----------------------------------------------------------------------------- root isolation by subdivision
+#: Deepest subdivision of the root interval (widths down to 2^-MAX_DEPTH of it).
+MAX_DEPTH = 14
 _S = MAX_DEPTH + 2  # stack entries
 _STACK = 78
 #: Length of certify_k's work array.
 CERTIFY_WORK = _STACK + _S * (_N + 4)
+#: Bernstein coefficients within ZERO_TOL (relative to the largest on the whole interval) of zero count as zero;
+#: their successive differences within SLOPE_TOL (likewise relative) count as no slope.
+ZERO_TOL = 1e-9
+SLOPE_TOL = 1e-13
 
 
 @kernel

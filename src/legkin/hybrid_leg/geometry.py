@@ -71,6 +71,9 @@ FOOT_IK_BRANCHES = tuple((ll, rb, b1, b2) for ll in (-1, 1) for rb in (1, -1) fo
 LL0 = math.hypot(LL_ORIGIN[0], LL_ORIGIN[2])
 #: theta_LL (rad) at which the foot is nearest the LCS centre: the two LL branches of the IK meet there.
 LL_DELTA = math.atan2(-LL_ORIGIN[2], LL_ORIGIN[0])
+#: Reach tolerance of the LL arc (as :data:`K_TOL` for the motor chains): |cos(theta_LL - LL_DELTA)| up to
+#: 1 + LL_TOL is reachable (~1e-12 m at the arc's ends).
+LL_TOL = 1e-12
 H = abs(FOOT_X)
 
 # ----------------------------------------------------------------------------- tolerances and limits
@@ -87,8 +90,6 @@ CLIP_FOOT_TOL = 1e-10
 #: boundary, matching both motor branches: the motor angles the IK clips there give FK poses that close the chain
 #: within ~1e-11 of |k| = 1 on either side.
 BOUNDARY_TOL = 1e-10
-#: The same for the LL arc: |cos(theta_LL - LL_DELTA)| up to 1 + LL_TOL is reachable (~1e-12 m at the arc's ends).
-LL_TOL = 1e-12
 #: Feet within this distance (m) of the roll axis (x through the LCS centre), but not exactly on it: the roll moves
 #: the foot by at most 2 RHO_TOL, so the IK takes roll = 0 (roll_branch +1) or pi (-1).
 RHO_TOL = 1e-12

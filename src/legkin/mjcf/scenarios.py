@@ -42,25 +42,17 @@ __all__ = ["SCENARIOS", "ScenarioResult", "run_scenario", "TOL_HEIGHT", "TOL_CON
            "TOL_ROLL", "TOL_SLIP"]
 
 SCENARIOS = ("stand", "roll", "squat", "press")
+#: Tolerances of the rows (the figures measured on each model: docs/mujoco.md). Base height (m): after the stand
+#: against legkin's prediction, after the squat against the start.
 TOL_HEIGHT = 2e-3
+#: Centre of pressure against legkin's contact point (or line) at MuJoCo's configuration (m).
 TOL_CONTACT = 2e-3
+#: Deepest penetration over the run (m).
 TOL_PENETRATION = 1e-3
+#: Roll: base travel / (rolling radius x rim angle) - 1 (relative).
 TOL_ROLL = 0.02
+#: Squat: slip of each contact, the largest horizontal drift of its centre of pressure (m).
 TOL_SLIP = 2e-3
-#: Integral time constant (s) of the actuators' integral term.
-_TAU_I = 0.5
-#: Steps between two samples (:meth:`_Runner._sample`: slip tracking, frames): 5 ms at the ground
-#: export's 1 ms step; the slip over 2 s did not change (3.442e-4 m, wheel-leg squat) from 2 steps to 5.
-_SAMPLE_EVERY = 5
-#: Seconds of holding after the squat before the base height is compared with the start. go2 is 1.99e-3 m lower
-#: after 1 s and still 1.94e-3 m after 2 s: not the integral term settling but the feet, which slid 0.7 mm and
-#: stay where friction holds them (the same joint angles on a slightly different stance).
-_SETTLE_AFTER = 1.0
-#: Seconds over which the feedforward comes in once every contact touches (in the air it would bend the legs
-#: away from the pose they land in: anymal's feet then splayed and stood 3 mm high).
-_RAMP = 0.05
-#: Seconds of standing before ``roll`` and ``squat`` start moving.
-_SETTLE = 0.5
 
 
 @dataclass
@@ -83,6 +75,23 @@ class ScenarioResult:
     wall: float
     rtf: float
     frames: list[np.ndarray] = field(default_factory=list, repr=False)
+
+
+# ----------------------------------------------------------------- timing of the runs
+#: Integral time constant (s) of the actuators' integral term.
+_TAU_I = 0.5
+#: Steps between two samples (:meth:`_Runner._sample`: slip tracking, frames): 5 ms at the ground
+#: export's 1 ms step; the slip over 2 s did not change (3.442e-4 m, wheel-leg squat) from 2 steps to 5.
+_SAMPLE_EVERY = 5
+#: Seconds of holding after the squat before the base height is compared with the start. go2 is 1.99e-3 m lower
+#: after 1 s and still 1.94e-3 m after 2 s: not the integral term settling but the feet, which slid 0.7 mm and
+#: stay where friction holds them (the same joint angles on a slightly different stance).
+_SETTLE_AFTER = 1.0
+#: Seconds over which the feedforward comes in once every contact touches (in the air it would bend the legs
+#: away from the pose they land in: anymal's feet then splayed and stood 3 mm high).
+_RAMP = 0.05
+#: Seconds of standing before ``roll`` and ``squat`` start moving.
+_SETTLE = 0.5
 
 
 class _Runner:

@@ -150,6 +150,30 @@ def test_parfor_twin_has_its_own_cache_files():
     assert _fk_batch.parfor.py_func.__code__ is _fk_batch.kernel.py_func.__code__
 
 
+def test_batch_loop_is_the_loop_over_its_kernel_filed_under_the_kernel_module():
+    """``batch_loop(name_k)``: the loop ``bad += name_k(x[i], shared, out[i]) != OK`` (each row as one kernel call,
+    the count of failed rows returned), named ``name_batch``, cached under the kernel's module and source file (so
+    that editing that file recompiles it); a kernel not named ``..._k`` is refused."""
+    import legkin
+    from legkin._kernels import batch_loop
+    from legkin.legs import _fk_kernels as fk
+
+    leg = legkin.load("go2").geometry["FL"]
+    q = np.random.default_rng(3).uniform(-1.0, 1.0, (40, 3))
+    q[[5, 17]] = np.nan
+    out, want = np.empty((40, 3)), np.empty((40, 3))
+    bad = sum(fk._fk_k(q[i], leg.params, want[i]) != 0 for i in range(40))
+    assert bad == 2 and fk._fk_batch(q, leg.params, out) == bad
+    np.testing.assert_array_equal(out[np.isfinite(q[:, 0])], want[np.isfinite(q[:, 0])])
+    py = fk._fk_batch.kernel.py_func
+    assert (py.__qualname__, py.__module__) == ("_fk_batch", "legkin.legs._fk_kernels")
+    assert py.__code__.co_filename == fk._fk_k.py_func.__code__.co_filename
+    fk._fk_batch.kernel.ensure_cache()
+    assert "_fk_kernels._fk_batch-" in fk._fk_batch.kernel._cache._cache_file._index_path
+    with pytest.raises(TypeError, match="must end in _k"):
+        batch_loop(_leaf, min_parallel=8)
+
+
 def _thin_py(x):
     return 3.0 * _leaf(x)
 

@@ -7,7 +7,8 @@ The rule (issue 16), for every analytic module:
   preallocated output arrays), writes its result into the outputs and returns a status code
   (:data:`OK` or a module-specific failure code); it never raises.
 * The batch is a compiled loop over that same kernel, decorated with :func:`batch_kernel`: a plain
-  ``for i in range(n)`` loop compiled once, without the GIL (``nogil=True``). From ``min_parallel`` items on,
+  ``for i in range(n)`` loop compiled once, without the GIL (``nogil=True``); for a kernel of one input row and
+  one output row per item, :func:`batch_loop` writes that loop. From ``min_parallel`` items on,
   the call splits the item rows into contiguous chunks and runs one chunk per thread, the thread count being
   numba's own setting (``numba.set_num_threads(k)`` or the ``NUMBA_NUM_THREADS`` environment variable); below it
   the loop runs on the calling thread. (Not numba's ``prange``, except for the cheapest closed forms: numba's
@@ -52,7 +53,7 @@ from numba.core.registry import CPUDispatcher
 
 from . import _cache
 
-__all__ = ["kernel", "batch_kernel", "BatchLoop", "OK", "as_items", "as_rows", "prange", "threads"]
+__all__ = ["kernel", "batch_kernel", "batch_loop", "BatchLoop", "OK", "as_items", "as_rows", "prange", "threads"]
 
 F = TypeVar("F", bound=Callable[..., Any])
 
@@ -332,6 +333,43 @@ def batch_kernel(rows: str, min_parallel: int, parfor: bool = False) -> Callable
     cost of handing work to a thread). ``parfor``: the loop is written with ``prange`` (``range`` below
     ``min_parallel``) and runs on numba's parallel backend."""
     return lambda fn: BatchLoop(fn, rows, min_parallel, parfor)
+
+
+# The source of every batch_loop (the kernel is the global _kernel of each copy). Its cache files are those of the
+# kernel's module: after editing this loop, delete the *.nbi/*.nbc files (as after editing a kernel other files call).
+def _row_loop(x, shared, out):
+    n, bad = x.shape[0], 0
+    for i in prange(n):
+        bad += _kernel(x[i], shared, out[i]) != OK  # noqa: F821
+    return bad
+
+
+def batch_loop(kernel_: Any, min_parallel: int, parfor: bool = False) -> BatchLoop:
+    """The batch loop of a kernel ``name_k(x, shared, out) -> status`` that reads one row ``x`` and writes one row
+    ``out`` per item: ``for i in prange(n): bad += name_k(x[i], shared, out[i]) != OK``, returning the number of
+    failed items; a :class:`BatchLoop` (see :func:`batch_kernel` for ``min_parallel`` and ``parfor``).
+
+    The loop, named ``name_batch``, is one source (``_row_loop``) given the kernel as its global, and filed under
+    the kernel's module: numba keys its cache files on the loop's name and on that module's source file, so the
+    loop is compiled again when the kernel's file changes, as a loop written there would be.
+
+    Args:
+        kernel_: the kernel (a :func:`kernel`), named ``..._k``.
+        min_parallel: the item count from which the loop runs on several threads.
+        parfor: run the loop on numba's parallel backend.
+
+    Returns:
+        the batch loop ``(x, shared, out) -> int``.
+    """
+    py = getattr(kernel_, "py_func", None) or kernel_.__wrapped__  # (NUMBA_DISABLE_JIT: the Python kernel)
+    if not py.__name__.endswith("_k"):
+        raise TypeError(f"batch_loop: the kernel's name must end in _k, got {py.__name__}")
+    name = py.__name__[:-2] + "_batch"
+    code = _row_loop.__code__.replace(co_filename=py.__code__.co_filename, co_name=name)
+    fn = pytypes.FunctionType(code, {"_kernel": kernel_, "prange": prange, "OK": OK}, name)
+    fn.__qualname__, fn.__module__ = name, py.__module__
+    fn.__doc__ = f"{py.__name__} over the rows of x and out; returns the number of failed items."
+    return BatchLoop(fn, "x out", min_parallel, parfor)
 
 
 def as_rows(x: np.ndarray, core: int) -> np.ndarray:

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from .._kernels import OK, batch_kernel, kernel, prange
+from .._kernels import OK, batch_loop, kernel
 from ._layout import _A1, _A2, _A3, _BAD_INPUT, _O, _V3F, _V21, _V32
 
 
@@ -93,17 +93,5 @@ def _jacobian_k(q, g, out) -> int:
     return OK
 
 
-@batch_kernel(rows="q out", min_parallel=256, parfor=True)
-def _fk_batch(q, g, out) -> int:
-    n, bad = q.shape[0], 0
-    for i in prange(n):
-        bad += _fk_k(q[i], g, out[i]) != OK
-    return bad
-
-
-@batch_kernel(rows="q out", min_parallel=256, parfor=True)
-def _jacobian_batch(q, g, out) -> int:
-    n, bad = q.shape[0], 0
-    for i in prange(n):
-        bad += _jacobian_k(q[i], g, out[i]) != OK
-    return bad
+_fk_batch = batch_loop(_fk_k, min_parallel=256, parfor=True)
+_jacobian_batch = batch_loop(_jacobian_k, min_parallel=256, parfor=True)

@@ -14,7 +14,7 @@ import math
 
 import numpy as np
 
-from .._kernels import OK, batch_kernel, kernel
+from .._kernels import OK, batch_loop, kernel
 from ._sixdof_layout import (
     _ANK,
     _AX,
@@ -316,17 +316,5 @@ def _valid_pose(tg) -> bool:
     return abs(det - 1.0) <= 1e-6
 
 
-@batch_kernel(rows="q out", min_parallel=2048)
-def _fk6_batch(q, g, out) -> int:
-    n, bad = q.shape[0], 0
-    for i in range(n):
-        bad += _fk6_k(q[i], g, out[i]) != OK
-    return bad
-
-
-@batch_kernel(rows="q out", min_parallel=1024)
-def _jacobian6_batch(q, g, out) -> int:
-    n, bad = q.shape[0], 0
-    for i in range(n):
-        bad += _jacobian6_k(q[i], g, out[i]) != OK
-    return bad
+_fk6_batch = batch_loop(_fk6_k, min_parallel=2048)
+_jacobian6_batch = batch_loop(_jacobian6_k, min_parallel=1024)

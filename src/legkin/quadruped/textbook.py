@@ -15,7 +15,7 @@ import numpy as np
 import numpy.typing as npt
 
 from .._batch import check_flag, check_number
-from .._kernels import OK, as_rows, batch_kernel, kernel, prange
+from .._kernels import OK, as_rows, batch_kernel, batch_loop, kernel, prange
 from .._rotations import wrap_k
 from ..legs._fk_kernels import _finite3
 from ._common import foot_z_of, leg_index, raise_bad, rows
@@ -35,12 +35,7 @@ def _textbook_frame_k(p, li, out) -> int:
     return OK
 
 
-@batch_kernel(rows="p out", min_parallel=256, parfor=True)
-def _textbook_frame_batch(p, li, out) -> int:
-    n, bad = p.shape[0], 0
-    for i in prange(n):
-        bad += _textbook_frame_k(p[i], li, out[i]) != OK
-    return bad
+_textbook_frame_batch = batch_loop(_textbook_frame_k, min_parallel=256, parfor=True)
 
 
 def textbook_frame(p: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None) -> np.ndarray:

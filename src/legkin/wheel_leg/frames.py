@@ -260,7 +260,8 @@ def _contact_call(q: ArrayLike, alpha: ArrayLike, w: ArrayLike, leg: Leg, rim: s
         checked = True
     if return_mask is not False and return_mask is not True:
         return_mask = check_flag(return_mask, "return_mask")
-    C, K, KC = _kctx(leg, rim, radius, geo)[1]
+    kc = _KCTX_DEFAULT.get((leg, rim)) if radius is None and geo is _DEFAULT_GEOMETRY and type(leg) is str else None
+    C, K, KC = (_kctx(leg, rim, radius, geo) if kc is None else kc)[1]  # (the look-up of _kctx, without its call)
     return dispatch(q, "q", (3,), _contact_fast, _contact_batch, _contact_fail, (a, b, C, K, KC, want_jac, geo,
                                                                                  checked), return_mask)
 

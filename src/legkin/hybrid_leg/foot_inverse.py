@@ -315,7 +315,8 @@ def ik_all(target: ArrayLike, *, geometry: Geometry | None = None,
 def _all_fast(p: np.ndarray, args: tuple[float]) -> tuple[np.ndarray, np.ndarray] | None:
     (sv,) = args
     out = _all_outputs(())
-    if ik_all_out_k(p[0] - CX, p[1] - CY, p[2] - CZ, sv, *out) and out[2].tobytes() != _NO_BRANCH:
+    x, y, z = p.tolist()  # Python floats: numba dispatches them faster than numpy scalars
+    if ik_all_out_k(x - CX, y - CY, z - CZ, sv, *out) and out[2].tobytes() != _NO_BRANCH:
         return out[0], out[2]
     return None
 

@@ -271,9 +271,9 @@ def _contact_fast(q: np.ndarray, args: tuple) -> np.ndarray | None:
     ``args``: those of :func:`_contact_batch`."""
     a, b, C, K, KC, want_jac, _geo, _checked = args
     p = np.empty(3)
-    J = np.empty(9) if want_jac else _NO_JAC
+    J = np.empty((3, 3)) if want_jac else _NO_JAC
     if _k_contact(q, a, b, C, K, KC, want_jac, p, J) == OK:
-        return J.reshape(3, 3) if want_jac else p
+        return J if want_jac else p
     return None
 
 
@@ -301,7 +301,7 @@ def _contact_fail(q: np.ndarray, out: np.ndarray, ok: np.ndarray, a: Any, b: Any
     return InvalidInputError(f"the contact {'Jacobian' if want_jac else 'point'} is not finite at q={q.tolist()}")
 
 
-_NO_JAC = np.empty(0)
+_NO_JAC = np.empty((0, 0))  # no Jacobian asked (a single call's J is (3, 3), a batch row's (9,): see _k_contact)
 
 
 @overload
@@ -409,7 +409,9 @@ def _k_fk(theta, beta, gamma, upper, right, e, seed, K, KC, s, a, o0, o1, o2, wa
 @kernel(entry=True, inline=True)
 def _k_contact(q, alpha, w, C, K, KC, want_jac, p, J):
     """:func:`fk` / :func:`jacobian` for one item, inputs range-checked (status codes); ``C`` (8,): the packed
-    constants of :func:`_kctx` (seed, rho, s, d_wheel, T/2, origin): 9 arguments, a cheaper call from Python."""
+    constants of :func:`_kctx` (seed, rho, s, d_wheel, T/2, origin): 9 arguments, a cheaper call from Python.
+    ``J``: (3, 3) (a single call's answer, no reshape in Python) or (9,) (a batch row), (0, 0) / (0,) if not
+    ``want_jac``; :func:`_k_fk` writes it flat."""
     theta = q[0]
     if not (math.isfinite(theta) and math.isfinite(q[1]) and math.isfinite(q[2]) and math.isfinite(alpha)
             and math.isfinite(w)):
@@ -422,7 +424,8 @@ def _k_contact(q, alpha, w, C, K, KC, want_jac, p, J):
         return _W_RANGE
     seed, s = C[0] != 0.0, C[2]
     upper, right, e = _k_select(alpha, seed, C[1], K[0])
-    return _k_fk(theta, q[1], q[2], upper, right, e, seed, K, KC, s, C[3] + s * w, C[5], C[6], C[7], want_jac, p, J)
+    return _k_fk(theta, q[1], q[2], upper, right, e, seed, K, KC, s, C[3] + s * w, C[5], C[6], C[7], want_jac, p,
+                 J.reshape(J.size))
 
 
 @batch_kernel(rows="q alpha w P J status", min_parallel=32768)

@@ -268,7 +268,8 @@ def jacobian(q: ArrayLike, *, branch: Branch = (1, 1), assembly: int = 1, geomet
     return dispatch(q, "q", (3,), _jac_fast, _jac_batch, _jac_fail, args[:4], args[4])
 
 
-def _fk_fast(q: np.ndarray, sv: float, b1: float, b2: float, s: float) -> np.ndarray | None:
+def _fk_fast(q: np.ndarray, args: tuple[float, float, float, float]) -> np.ndarray | None:
+    sv, b1, b2, s = args
     out, aux = np.empty(3), np.empty(3)
     q0, q1, q2 = q.tolist()
     return out if foot_position_k(q0, q1, q2, sv, b1, b2, s, out, aux) == OK else None
@@ -295,7 +296,8 @@ def _fk_fail(q: np.ndarray, out: np.ndarray, ok: np.ndarray, sv: float, b1: floa
     return SingularityError(band_message(_motors_text(q), aux[0, :2], aux[0, 2]))
 
 
-def _jac_fast(q: np.ndarray, sv: float, b1: float, b2: float, s: float) -> np.ndarray | None:
+def _jac_fast(q: np.ndarray, args: tuple[float, float, float, float]) -> np.ndarray | None:
+    sv, b1, b2, s = args
     jac = np.empty((3, 3))
     q0, q1, q2 = q.tolist()
     return jac if foot_jacobian_k(q0, q1, q2, sv, b1, b2, s, jac) == OK else None

@@ -97,14 +97,17 @@ def _free_axis_b(m, b1, b2, out, kout, st):
         st[j] = free_axis_k(m[j], b1, b2, out[j], kout[j])
 
 
+_F64 = np.dtype(np.float64)  # ``dtype is _F64``: 3x cheaper than ``== np.float64``
+
+
 def _rotation_call(single: Callable[..., int], kernels: Callable[..., object], core: tuple[int, ...],
                    rotation: ArrayLike, branch: Branch, return_mask: bool, geometry: Geometry | None
                    ) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
     """The three functions of a platform rotation (motor angles, sphere joint angles, free axis): one float64
     rotation with the default keywords straight to its kernel ``single``, else the batch loop ``kernels`` on the
     rotations checked (InvalidInputError unless orthonormal with det +1 within 1e-9)."""
-    if (return_mask is False and geometry is None and type(rotation) is np.ndarray and rotation.shape == (3, 3)
-            and rotation.dtype == np.float64):
+    if (return_mask is False and geometry is None and type(rotation) is np.ndarray and rotation.dtype is _F64
+            and rotation.shape == (3, 3)):
         fb = fast_branch(branch)
         if fb is not None:
             out1, k1 = np.empty(core), np.empty(2)

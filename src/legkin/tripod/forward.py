@@ -127,10 +127,10 @@ _SOLVED = np.asarray(True)  # the mask of a solved single call (read-only, share
 _SOLVED.setflags(write=False)
 
 
-def _fk_fast(qm: np.ndarray, g: Geometry, mode: str, tol: float, max_iter: int,
-             max_inc: float) -> tuple[np.ndarray, np.ndarray] | None:
+def _fk_fast(qm: np.ndarray, args: tuple[Geometry, str, float, int, float]) -> tuple[np.ndarray, np.ndarray] | None:
     """One motor triple straight to the kernel: (alpha_y, alpha_z, inconsistency), True; None unless solved (and
-    for ``mode="all"``, which the batch loop solves)."""
+    for ``mode="all"``, which the batch loop solves); ``args`` = (g, mode, tol, max_iter, max_inc)."""
+    g, mode, tol, max_iter, max_inc = args
     if mode == "all":
         return None
     qa, qb, qc = qm.tolist()  # Python floats: numba dispatches them faster than numpy scalars

@@ -32,6 +32,7 @@ __all__ = ["ik", "ik_all", "ik_joints", "jacobian"]
 
 _G_DEFAULT = DEFAULT._vector
 _F64 = np.dtype(np.float64)  # the fast paths test ``dtype is _F64`` (3x cheaper than ``== np.float64``)
+_BOOL = np.dtype(np.bool_)  # np.empty(n, _BOOL): 30 ns less than dtype=np.bool_
 
 
 # ------------------------------------------------------------------------------------------ diagnosis
@@ -133,12 +134,13 @@ def _yz(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 #: The kernels' diagnostic output on the fast paths, never read there (a failure is diagnosed again by the
-#: error function), so one buffer serves every call.
-_SCRATCH_AUX, _SCRATCH_AUX4 = np.empty(6), np.empty(4)
+#: error function), so one buffer serves every call; so does ik_all's mask (16,) when it is not returned.
+_SCRATCH_AUX, _SCRATCH_AUX4, _SCRATCH_OK16 = np.empty(6), np.empty(4), np.empty(16, _BOOL)
 
 
 # ---- ik / ik_joints: one mode (width 3: the motors, 12: every joint)
-def _ik_fast(t: np.ndarray, G: np.ndarray, mode: str, width: int) -> np.ndarray | None:
+def _ik_fast(t: np.ndarray, args: tuple[np.ndarray, str, int]) -> np.ndarray | None:
+    G, mode, width = args
     home, e, s = MODE_ARGS[mode]
     out = np.empty(width)
     ay, az = t.tolist()  # Python floats: numba dispatches them faster than numpy scalars
@@ -156,27 +158,33 @@ def _ik_fail(t: np.ndarray, out: np.ndarray, ok: np.ndarray, G: np.ndarray, mode
 
 
 # ---- ik_all: every mode
-def _all_fast(t: np.ndarray, G: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray] | None:
-    q, ok = np.empty((16, width)), np.empty(16, dtype=np.bool_)
+def _all_fast(t: np.ndarray, args: tuple[np.ndarray, int, bool]) -> Any:
+    """One orientation: q (16, width), or (q, mask) with ``return_mask`` (else the mask goes to a scratch buffer)."""
+    G, width, return_mask = args
+    q, ok = np.empty((16, width)), (np.empty(16, _BOOL) if return_mask else _SCRATCH_OK16)
     ay, az = t.tolist()
-    return (q, ok) if _k_ik_all(ay, az, G, q, ok) == OK else None
+    if _k_ik_all(ay, az, G, q, ok) != OK:
+        return None
+    return (q, ok) if return_mask else q
 
 
 #: ``dispatch(..., chunks=False)`` for :func:`_all_batch`: its temporaries (status, 8 B a target) are far below its
 #: answer (16 modes, 400 B a target); copying chunks of that answer cost 10% of ik_all's CPU time.
-def _all_batch(rows: np.ndarray, G: np.ndarray, width: int) -> tuple[np.ndarray, np.ndarray]:
+def _all_batch(rows: np.ndarray, G: np.ndarray, width: int, return_mask: bool) -> tuple[np.ndarray, np.ndarray]:
     n = rows.shape[0]
     q, ok, status = np.empty((n, 16, width)), np.empty((n, 16), dtype=np.bool_), np.empty(n, dtype=np.int64)
     IK_ALL_LOOP(*_yz(rows), G, q, ok, status)
     return q, ok
 
 
-def _all_fail(t: np.ndarray, out: np.ndarray, ok: np.ndarray, G: np.ndarray, width: int) -> Exception:
+def _all_fail(t: np.ndarray, out: np.ndarray, ok: np.ndarray, G: np.ndarray, width: int,
+              return_mask: bool) -> Exception:
     return _ik_fail(t, out, ok, G, HOME_MODE, width)
 
 
 # ---- jacobian
-def _jac_fast(t: np.ndarray, G: np.ndarray, mode: str) -> np.ndarray | None:
+def _jac_fast(t: np.ndarray, args: tuple[np.ndarray, str]) -> np.ndarray | None:
+    G, mode = args
     home, e, s = MODE_ARGS[mode]
     a = np.empty((3, 2))
     ay, az = t.tolist()
@@ -245,7 +253,7 @@ def ik(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | None = 
     """
     mode, G, return_mask = _checked(mode, geometry, return_mask)
     if mode == "all":
-        return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3), return_mask,
+        return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3, return_mask), return_mask,
                         chunks=False)
     return dispatch(target, "target", (2,), _ik_fast, _ik_batch, _ik_fail, (G, mode, 3), return_mask)
 
@@ -272,9 +280,11 @@ def ik_all(target: ArrayLike, *, geometry: Geometry | None = None, return_mask: 
         (..., 16, 3) motor angles (rad) in :data:`MODES` order, NaN rows where a mode does not solve the target;
         then the mask, if asked.
     """
-    _, G, return_mask = _checked(HOME_MODE, geometry, return_mask)
-    return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3), return_mask,
-                        chunks=False)
+    G = _G_DEFAULT if geometry is None else geometry_of(geometry)._vector  # (no mode to check: _checked's rest)
+    if return_mask is not False and return_mask is not True:
+        return_mask = flag(return_mask, "return_mask")
+    return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 3, return_mask), return_mask,
+                    chunks=False)
 
 
 @same_signature(ik)
@@ -295,7 +305,7 @@ def ik_joints(target: ArrayLike, *, mode: str = HOME_MODE, geometry: Geometry | 
     """
     mode, G, return_mask = _checked(mode, geometry, return_mask)
     if mode == "all":
-        return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 12), return_mask,
+        return dispatch(target, "target", (2,), _all_fast, _all_batch, _all_fail, (G, 12, return_mask), return_mask,
                         chunks=False)
     return dispatch(target, "target", (2,), _ik_fast, _ik_batch, _ik_fail, (G, mode, 12), return_mask)
 

@@ -209,7 +209,7 @@ def _q_inputs(q, alpha, w, geo):
 
 
 @lru_cache(maxsize=64, typed=True)  # typed: leg=1 must not admit leg=True or 1.0 (issue 25)
-def _kctx_cached(leg, rim, radius, geo: Geometry):
+def _kctx_cached(leg, rim, radius, geo: Geometry) -> tuple[tuple, tuple]:
     ctx = _context(np.zeros(()), 0.0, leg, rim, geo, radius)
     if radius is None:
         rho = geo.R + TYRE_THICKNESS if ctx.seed else geo.R
@@ -217,11 +217,24 @@ def _kctx_cached(leg, rim, radius, geo: Geometry):
         rho = float(radius)
     K, KC = _kconst(geo.R, geo.R + TYRE_THICKNESS)
     o = ctx.origin
-    return (ctx.seed, rho, K, KC, ctx.s, geo.d_wheel, geo.T / 2, float(o[0]), float(o[1]), float(o[2]))
+    kc = (ctx.seed, rho, K, KC, ctx.s, geo.d_wheel, geo.T / 2, float(o[0]), float(o[1]), float(o[2]))
+    C = np.array([ctx.seed, rho, ctx.s, geo.d_wheel, geo.T / 2, o[0], o[1], o[2]], dtype=np.float64)
+    C.setflags(write=False)
+    return kc, (C, K, KC)
 
 
-def _kctx(leg, rim, radius, geo: Geometry):
-    """The contact kernels' per-call constants (validated: leg, rim, radius), cached per keyword set."""
+#: :func:`_kctx` of the default geometry and radius by (leg name, rim): one dict look-up on the single-call path.
+_KCTX_DEFAULT: dict[tuple[str, str], tuple[tuple, tuple]] = {}
+
+
+def _kctx(leg, rim, radius, geo: Geometry) -> tuple[tuple, tuple]:
+    """The contact kernels' per-call constants (validated: leg, rim, radius), cached per keyword set: the unpacked
+    tuple (seed, rho, K, KC, s, d_wheel, T/2, o (3)) and :func:`_k_contact`'s packed ``(C, K, KC)``."""
+    if radius is None and geo is _DEFAULT_GEOMETRY and type(leg) is str:
+        hit = _KCTX_DEFAULT.get((leg, rim))
+        if hit is None:
+            hit = _KCTX_DEFAULT[(leg, rim)] = _kctx_cached(leg, rim, None, geo)
+        return hit
     try:
         return _kctx_cached(leg, rim, radius, geo)
     except TypeError:  # unhashable: let the checks name it
@@ -247,23 +260,25 @@ def _contact_call(q: ArrayLike, alpha: ArrayLike, w: ArrayLike, leg: Leg, rim: s
         checked = True
     if return_mask is not False and return_mask is not True:
         return_mask = check_flag(return_mask, "return_mask")
-    kc = _kctx(leg, rim, radius, geo)
-    return dispatch(q, "q", (3,), _contact_fast, _contact_batch, _contact_fail, (a, b, geo, kc, want_jac, checked),
-                    return_mask)
+    kc = _KCTX_DEFAULT.get((leg, rim)) if radius is None and geo is _DEFAULT_GEOMETRY and type(leg) is str else None
+    C, K, KC = (_kctx(leg, rim, radius, geo) if kc is None else kc)[1]  # (the look-up of _kctx, without its call)
+    return dispatch(q, "q", (3,), _contact_fast, _contact_batch, _contact_fail, (a, b, C, K, KC, want_jac, geo,
+                                                                                 checked), return_mask)
 
 
-def _contact_fast(q: np.ndarray, a: Any, b: Any, geo: Geometry, kc: tuple, want_jac: bool,
-                  checked: Any) -> np.ndarray | None:
-    """One joint vector straight to :func:`_k_contact` (None unless solved: NaN, theta / alpha / w out of range)."""
+def _contact_fast(q: np.ndarray, args: tuple) -> np.ndarray | None:
+    """One joint vector straight to :func:`_k_contact` (None unless solved: NaN, theta / alpha / w out of range);
+    ``args``: those of :func:`_contact_batch`."""
+    a, b, C, K, KC, want_jac, _geo, _checked = args
     p = np.empty(3)
-    J = np.empty(9) if want_jac else _NO_JAC
-    if _k_contact(q, a, b, *kc, want_jac, p, J) == OK:  # type: ignore[call-arg]
-        return J.reshape(3, 3) if want_jac else p
+    J = np.empty((3, 3)) if want_jac else _NO_JAC
+    if _k_contact(q, a, b, C, K, KC, want_jac, p, J) == OK:
+        return J if want_jac else p
     return None
 
 
-def _contact_batch(rows: np.ndarray, a: Any, b: Any, geo: Geometry, kc: tuple, want_jac: bool,
-                   checked: Any) -> tuple[np.ndarray, np.ndarray]:
+def _contact_batch(rows: np.ndarray, a: Any, b: Any, C: np.ndarray, K: np.ndarray, KC: np.ndarray, want_jac: bool,
+                   geo: Geometry, checked: Any) -> tuple[np.ndarray, np.ndarray]:
     """The compiled loop on joint rows (n, 3), after the range checks (an out-of-range theta, alpha or w raises,
     in a batch too)."""
     n = rows.shape[0]
@@ -274,19 +289,19 @@ def _contact_batch(rows: np.ndarray, a: Any, b: Any, geo: Geometry, kc: tuple, w
     P = np.empty((n, 3))
     J = np.empty((n, 9) if want_jac else (n, 0))
     status = np.empty(n, dtype=np.int64)
-    _k_contact_batch(rows, alpha, w, *kc, want_jac, P, J, status)
+    _k_contact_batch(rows, alpha, w, C, K, KC, want_jac, P, J, status)
     ok = status == OK
     value = J.reshape(n, 3, 3) if want_jac else P
     value[~ok] = np.nan
     return value, ok
 
 
-def _contact_fail(q: np.ndarray, out: np.ndarray, ok: np.ndarray, a: Any, b: Any, geo: Geometry, kc: tuple,
-                  want_jac: bool, checked: Any) -> Exception:
+def _contact_fail(q: np.ndarray, out: np.ndarray, ok: np.ndarray, a: Any, b: Any, C: np.ndarray, K: np.ndarray,
+                  KC: np.ndarray, want_jac: bool, geo: Geometry, checked: Any) -> Exception:
     return InvalidInputError(f"the contact {'Jacobian' if want_jac else 'point'} is not finite at q={q.tolist()}")
 
 
-_NO_JAC = np.empty(0)
+_NO_JAC = np.empty((0, 0))  # no Jacobian asked (a single call's J is (3, 3), a batch row's (9,): see _k_contact)
 
 
 @overload
@@ -385,8 +400,11 @@ def _k_fk(theta, beta, gamma, upper, right, e, seed, K, KC, s, a, o0, o1, o2, wa
 
 
 @kernel(entry=True, inline=True)
-def _k_contact(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac, p, J):
-    """:func:`fk` / :func:`jacobian` for one item, inputs range-checked (status codes)."""
+def _k_contact(q, alpha, w, C, K, KC, want_jac, p, J):
+    """:func:`fk` / :func:`jacobian` for one item, inputs range-checked (status codes); ``C`` (8,): the packed
+    constants of :func:`_kctx` (seed, rho, s, d_wheel, T/2, origin): 9 arguments, a cheaper call from Python.
+    ``J``: (3, 3) (a single call's answer, no reshape in Python) or (9,) (a batch row), (0, 0) / (0,) if not
+    ``want_jac``; :func:`_k_fk` writes it flat."""
     theta = q[0]
     if not (math.isfinite(theta) and math.isfinite(q[1]) and math.isfinite(q[2]) and math.isfinite(alpha)
             and math.isfinite(w)):
@@ -395,18 +413,19 @@ def _k_contact(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, wan
         return _THETA_RANGE
     if abs(alpha) > math.pi + 1e-12:
         return _ALPHA_RANGE
-    if abs(w) > half_T + 1e-15:
+    if abs(w) > C[4] + 1e-15:
         return _W_RANGE
-    upper, right, e = _k_select(alpha, seed, rho, K[0])
-    return _k_fk(theta, q[1], q[2], upper, right, e, seed, K, KC, s, dwheel + s * w, o0, o1, o2, want_jac, p, J)
+    seed, s = C[0] != 0.0, C[2]
+    upper, right, e = _k_select(alpha, seed, C[1], K[0])
+    return _k_fk(theta, q[1], q[2], upper, right, e, seed, K, KC, s, C[3] + s * w, C[5], C[6], C[7], want_jac, p,
+                 J.reshape(J.size))
 
 
 @batch_kernel(rows="q alpha w P J status", min_parallel=32768)
-def _k_contact_batch(q, alpha, w, seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac, P, J, status):
+def _k_contact_batch(q, alpha, w, C, K, KC, want_jac, P, J, status):
     """:func:`_k_contact` over q (n, 3), alpha, w (n,) into P (n, 3), J (n, 9), status (n,)."""
     for i in range(q.shape[0]):
-        status[i] = _k_contact(q[i], alpha[i], w[i], seed, rho, K, KC, s, dwheel, half_T, o0, o1, o2, want_jac,
-                               P[i], J[i])
+        status[i] = _k_contact(q[i], alpha[i], w[i], C, K, KC, want_jac, P[i], J[i])
 
 
 @batch_kernel(rows="q upper right e a P J", min_parallel=32768)

@@ -103,6 +103,7 @@ class _IKCtx(NamedTuple):
 
     base: _Ctx  # the contact FK's context (leg, rim, radius, geometry); its per-item rim choice is set per batch
     kc: tuple  # the contact kernels' constants (:func:`.frames._kctx`)
+    packed: tuple  # and packed for :func:`.frames._k_contact`
     tables: tuple  # the method's tables (radial: :func:`.ik_radial._radial_table`; iterative: the start grid)
     leg: Any
     w_max: float  # |w| <= T / 2, within rounding (m)
@@ -114,9 +115,9 @@ def _ik_ctx_cached(leg, rim, radius, geometry, method) -> _IKCtx:
     rim = rim_name(rim)
     check_choice(method, "method", METHODS)
     base = _context(np.zeros(0), np.zeros(0), leg, rim, geo, radius)
-    kc = _kctx(leg, rim, radius, geo)
+    kc, packed = _kctx(leg, rim, radius, geo)
     tables = _radial_table(geo.R, kc[0]) if method == "radial" else ik_iterative.guess_table(geo.R, kc[0])
-    return _IKCtx(base, kc, tables, leg, geo.T / 2 + 1e-15)
+    return _IKCtx(base, kc, packed, tables, leg, geo.T / 2 + 1e-15)
 
 
 def _ik_ctx(leg: object, rim: object, radius: object, geometry: object, method: object) -> _IKCtx:
@@ -136,14 +137,16 @@ def _ik_ctx(leg: object, rim: object, radius: object, geometry: object, method: 
 _ALPHA_MAX = math.pi + 1e-12
 
 
-def _ik_one(target, a, b, near, start, ctx, method, opts, limits, sink):
-    """One float64 target straight to the method's kernel (the fast path of :func:`ik`; alpha ``a``, w ``b``
-    numbers; ``near``, ``start``: q_near, q_start, (3,) or None): q (3,) if solved, else None (the general path then
-    decides, and raises).
+def _ik_one(target, args):
+    """One float64 target straight to the method's kernel (the fast path of :func:`ik`): q (3,) if solved, else None
+    (the general path then decides, and raises).
 
-    ``sink``: None, or a list that gets (q, iterations, error, reason, evaluations, solutions) ((S, 3) every radial
-    solution; iterative methods: None), solved or not (the info; the failure path's reason).
+    ``args`` = (a, b, near, start, ctx, method, opts, limits, sink): alpha ``a``, w ``b`` numbers; ``near``,
+    ``start``: q_near, q_start, (3,) or None; ``sink``: None, or a list that gets (q, iterations, error, reason,
+    evaluations, solutions) ((S, 3) every radial solution; iterative methods: None), solved or not (the info; the
+    failure path's reason).
     """
+    a, b, near, start, ctx, method, opts, limits, sink = args
     if type(a) is not float or not (abs(a) <= _ALPHA_MAX and abs(b) <= ctx.w_max):
         return None
     q0 = near if method == "radial" or start is None else start
@@ -183,13 +186,13 @@ def _closest(q_raw, alpha, w, ctx):
     qc = q_raw.copy()
     qc[0] = min(max(qc[0], THETA_MIN), THETA_MAX)
     p = np.empty(3)
-    return p if _k_contact(qc, alpha, w, *ctx.kc, False, p, _NO_JAC) == OK else None
+    return p if _k_contact(qc, alpha, w, *ctx.packed, False, p, _NO_JAC) == OK else None
 
 
 def _ik_fail(target, out, ok, alpha, w, near, start, ctx: _IKCtx, method, opts, limits, sink) -> Exception:
     """Why the single target was not solved: it is solved again (the failure path only) for its reason."""
     one: list[tuple] = []
-    _ik_one(target, alpha, w, near, start, ctx, method, opts, limits, one)
+    _ik_one(target, (alpha, w, near, start, ctx, method, opts, limits, one))
     q, its, err, reason, _ev, _sols = one[0]
     closest = _closest(q, alpha, w, ctx)
     where = f"target {target.tolist()} for leg {ctx.leg!r} (alpha={alpha!r}, w={w!r})"
@@ -412,11 +415,12 @@ def _in_limits(sols: np.ndarray) -> np.ndarray:
     return inside
 
 
-def _all_fast(target, a, b, ctx: _IKCtx, opts: IKOptions, limits: bool, return_mask: bool) -> Any:
+def _all_fast(target, args: tuple) -> Any:
     """One float64 target: every radial solution from the kernel, with its mask if asked (None if none: the general
-    path then raises)."""
+    path then raises); ``args`` = (a, b, ctx, opts, limits, return_mask)."""
+    a, b, ctx, opts, limits, return_mask = args
     one: list[tuple] = []
-    if _ik_one(target, a, b, None, None, ctx, "radial", opts, False, one) is None:
+    if _ik_one(target, (a, b, None, None, ctx, "radial", opts, False, one)) is None:
         return None
     sols = one[0][5]
     sols = sols[_in_limits(sols)] if limits else sols

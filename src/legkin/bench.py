@@ -5,11 +5,13 @@ How a model is benchmarked: its module ``legkin.<model>.bench`` defines
 same random reachable targets for every method of a group), a ``run`` callable (the timed part) and a
 ``score`` callable (untimed: turns the output into per-target errors measured the same way for every
 method, by Pinocchio). This module times each method (median of ``repeats`` runs over the same inputs,
-in one process), scores it, and prints one table per model; ``--json`` writes the same numbers.
+in one process, wall time: a batch may run on several threads), scores it, and prints one table per model;
+``--json`` writes the same numbers.
 
 The single-call table (issue 16): a bench module may also define ``single_calls() -> list[SingleCall]``
 (:mod:`legkin._single_call`), one entry per public analytic function with its inputs bound. Each is timed
-``timeit``-style (loops of ``number`` calls, median over repeats) next to its yardstick, the Pinocchio call
+``timeit``-style (loops of ``number`` calls, the best of the repeats, in CPU time of the calling thread: another
+process on a shared machine does not move the ratio) next to its yardstick, the Pinocchio call
 for the same quantity (:data:`legkin._single_call.YARDSTICKS`) timed the same way in the same run on the
 same model. For the quadruped the bench also runs the peer IK libraries of :mod:`legkin.peers`.
 """

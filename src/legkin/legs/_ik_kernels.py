@@ -109,14 +109,12 @@ def _polish_k(p, g, q0, q1, q2, fixed):
 
 
 @kernel
-def _settle_k(p, g, q0, q1, q2, clean):
-    """A closed-form branch as is when ``clean`` (well-conditioned on the exact ideal structure, see
-    :data:`WELL_CONDITIONED`; the foot error is then not evaluated and returned as 0), else polished
+def _settle_k(p, g, q0, q1, q2):
+    """A closed-form branch that is not well-conditioned on the exact ideal structure (see
+    :data:`WELL_CONDITIONED`: the callers return those as they are, without a call) polished
     (:func:`_polish_k`); if its foot error stays above :data:`REACH_TOL` (near a
     fold of the ideal structure, where Newton stalls) it is restarted off the fold, each joint moved by
     ``+-eta = +-4 sqrt(|e| / min(|k|, |l|))`` in turn, keeping the best. Returns ``(q1, q2, q3, |e|)``."""
-    if clean:
-        return q0, q1, q2, 0.0
     q0, q1, q2, res = _polish_k(p, g, q0, q1, q2, 0)
     if res <= REACH_TOL:
         return q0, q1, q2, res
@@ -268,12 +266,13 @@ def _ik_all_core(p, g, ref, tol, out):
         # within the slack of the ideal structure's boundary: kept only if the exact foot error is <= tol
         check = cyl > tol or miss > tol
         for ik in range(2):
-            q3 = _knee_k(g, ik, acb)
-            j1, j2, j3, res = _settle_k(p, g, q1, _hip_k(g, ik, wx, wy, c), q3, clean_a and clean_w and not check)
-            if check and res > tol:  # clamped onto the ideal structure's boundary, and missing the target
-                if cyl <= tol and res < best:
-                    best, why = res, reason
-                continue
+            j1, j2, j3 = q1, _hip_k(g, ik, wx, wy, c), _knee_k(g, ik, acb)
+            if not (clean_a and clean_w and not check):  # (a call with arrays costs their reference counts)
+                j1, j2, j3, res = _settle_k(p, g, j1, j2, j3)
+                if check and res > tol:  # clamped onto the ideal structure's boundary, and missing the target
+                    if cyl <= tol and res < best:
+                        best, why = res, reason
+                    continue
             b = 2 * ia + ik
             out[b, 0], out[b, 1], out[b, 2] = _near_k(j1, ref[0]), _near_k(j2, ref[1]), _near_k(j3, ref[2])
             found += 1
@@ -483,7 +482,7 @@ def _ik_core(p, g, ref, tol, out):
         if status != OK:
             return status, i0, i1
     else:
-        j1, j2, j3, res = _settle_k(p, g, c1, c2, c3, clean)
+        j1, j2, j3, res = (c1, c2, c3, 0.0) if clean else _settle_k(p, g, c1, c2, c3)
         if res <= tol or not check:
             ok, _m, x0, x1, x2 = _accept_k(p, g, j1, j2, j3, ref)
             if ok:

@@ -232,10 +232,14 @@ class Leg:
     params: np.ndarray = field(default=None, repr=False)  # type: ignore[arg-type]  # always set by from_geometry
     _ref: np.ndarray = field(init=False, repr=False)  # q_ref, writeable: the kernels' one type of reference array
     _ref1: np.ndarray = field(init=False, repr=False)  # the same, one row (1, 3)
+    #: params, writeable: what the kernels read. numba types a read-only array apart, and its dispatcher converts
+    #: one by its slow path: ~50 ns more a call (a third of a single fk's kernel call).
+    _g: np.ndarray = field(init=False, repr=False)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "_ref", np.array(self.q_ref, dtype=float).reshape(3))
         object.__setattr__(self, "_ref1", self._ref.reshape(1, 3))
+        object.__setattr__(self, "_g", np.array(self.params, dtype=float))
 
     #: The leg's structure (see :data:`legkin.legs.extract.EXPECTED`) and its number of joints.
     structure = "HAA-HFE-KFE"
@@ -423,16 +427,16 @@ class Leg:
         """
         if q.__class__ is np.ndarray and q.shape == _S3SHAPE and q.dtype is _F64:  # a single call, fast
             out = np.empty(3)
-            if _fk_k(q, self.params, out) == OK:
+            if _fk_k(q, self._g, out) == OK:
                 return out
         arr = as_input(q, "q", _S3SHAPE)
         if arr.ndim == 1:
             out = np.empty(3)
-            _fk_k(arr, self.params, out)
+            _fk_k(arr, self._g, out)
             return out
         rows = as_rows(arr, 3)
         out = np.empty_like(rows)
-        _fk_batch(rows, self.params, out)
+        _fk_batch(rows, self._g, out)
         return out.reshape(arr.shape)
 
     def jacobian(self, q: ArrayLike) -> np.ndarray:
@@ -454,16 +458,16 @@ class Leg:
         """
         if q.__class__ is np.ndarray and q.shape == _S3SHAPE and q.dtype is _F64:  # a single call, fast
             out = np.empty((3, 3))
-            if _jacobian_k(q, self.params, out) == OK:
+            if _jacobian_k(q, self._g, out) == OK:
                 return out
         arr = as_input(q, "q", _S3SHAPE)
         if arr.ndim == 1:
             out = np.empty((3, 3))
-            _jacobian_k(arr, self.params, out)
+            _jacobian_k(arr, self._g, out)
             return out
         rows = as_rows(arr, 3)
         out = np.empty((rows.shape[0], 3, 3))
-        _jacobian_batch(rows, self.params, out)
+        _jacobian_batch(rows, self._g, out)
         return out.reshape(arr.shape + (3,))
 
     def _prepare(self, p, q_near, tol):
@@ -522,7 +526,7 @@ class Leg:
         status = np.empty(1, dtype=np.int64)
         info = np.zeros((1, 2))
         ref1 = np.array(ref, dtype=float).reshape(1, 3)
-        batch_loop(rows, self.params, ref1, IK_TOL, np.empty((1,) + width), status, info)
+        batch_loop(rows, self._g, ref1, IK_TOL, np.empty((1,) + width), status, info)
         return self._error(int(status[0]), info[0], rows[0])
 
     def _least_violation(self, branches: np.ndarray) -> tuple[int, float, np.ndarray, float]:
@@ -583,7 +587,7 @@ class Leg:
             ref = self._ref if q_near is None else _vector3(q_near)
             if ref is not None:
                 out = np.empty((4, 3))
-                st = _ik_all_k(p, self.params, ref, out)
+                st = _ik_all_k(p, self._g, ref, out)
                 if st == OK:
                     return (out, np.isfinite(out[:, 0])) if return_mask else out
                 if st != _BAD_INPUT:
@@ -593,7 +597,7 @@ class Leg:
         out = np.empty((n, 4, 3))
         status = np.empty(n, dtype=np.int64)
         info = np.zeros((n, 2))
-        _ik_all_batch(rows, self.params, ref, tol, out, status, info)
+        _ik_all_batch(rows, self._g, ref, tol, out, status, info)
         if single and status[0] != OK:
             raise self._error(int(status[0]), info[0], rows[0], tol)
         q_all = out.reshape(batch + (4, 3))
@@ -647,7 +651,7 @@ class Leg:
             ref = self._ref if q_near is None else _vector3(q_near)
             if ref is not None:
                 out = np.empty(3)
-                st = _ik_k(p, self.params, ref, out)
+                st = _ik_k(p, self._g, ref, out)
                 if st == OK:
                     return (out, np.array(True)) if return_mask else out
                 if st != _BAD_INPUT:
@@ -655,7 +659,7 @@ class Leg:
         if q_near is None and tol is IK_TOL and _rows3(p):  # a batch (n, 3) the kernels read as is: no copy
             out = np.empty(p.shape)
             status = np.empty(p.shape[0], dtype=np.int64)
-            if not _ik_batch(p, self.params, self._ref1, IK_TOL, out, status, np.empty((p.shape[0], 2))):
+            if not _ik_batch(p, self._g, self._ref1, IK_TOL, out, status, np.empty((p.shape[0], 2))):
                 return (out, np.ones(p.shape[0], dtype=bool)) if return_mask else out
             if not (status == _BAD_INPUT).any():  # NaN rows for the targets that failed (else as_input raises)
                 return (out, status == OK) if return_mask else out
@@ -664,7 +668,7 @@ class Leg:
         out = np.empty((n, 3))
         status = np.empty(n, dtype=np.int64)
         info = np.zeros((n, 2))
-        _ik_batch(rows, self.params, ref, tol, out, status, info)
+        _ik_batch(rows, self._g, ref, tol, out, status, info)
         ok = status == OK
         if single:
             return finish(out[0], ok[0], True, return_mask, lambda: self._error(int(status[0]), info[0], rows[0], tol))

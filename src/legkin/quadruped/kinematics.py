@@ -71,7 +71,7 @@ def _kernel_args(leg: object, geometry: object) -> tuple[np.ndarray, np.ndarray]
         one = legs(geometry)[leg]  # type: ignore[arg-type]
         if len(_KERNEL_ARGS_OF) >= 4 * CACHE_SIZE:  # a sweep over foot_z: keep the memory bounded
             _KERNEL_ARGS_OF.clear()
-        found = _KERNEL_ARGS_OF[key] = (one.params, one.q_ref.copy())
+        found = _KERNEL_ARGS_OF[key] = (one._g, one._ref)
     return found
 
 
@@ -84,7 +84,7 @@ def _leg(leg: object, geometry: Geometry | None) -> Leg:
     found = legs(geometry)
     if geometry is None:
         _DEFAULT.update(found)
-        _KERNEL_ARGS.update({name: (one.params, one.q_ref.copy()) for name, one in found.items()})
+        _KERNEL_ARGS.update({name: (one._g, one._ref) for name, one in found.items()})
     try:
         return found[leg]  # type: ignore[index]
     except (KeyError, TypeError):

@@ -5,15 +5,19 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from .._kernels import OK, batch_kernel, kernel, prange
 from ._layout import _A1, _A2, _A3, _BAD_INPUT, _O, _V3F, _V21, _V32
 
 
+@kernel(inline=True)
+def _finite_k(x, y, z) -> bool:
+    """Whether three floats are finite."""
+    return math.isfinite(x) and math.isfinite(y) and math.isfinite(z)
+
+
 @kernel
 def _finite3(x) -> bool:
-    return np.isfinite(x[0]) and np.isfinite(x[1]) and np.isfinite(x[2])
+    return _finite_k(x[0], x[1], x[2])
 
 
 @kernel

@@ -232,9 +232,10 @@ def _near_k(a, r):
 
 
 @kernel
-def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out):
+def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out, flip):
     """Every branch (rows in :data:`BRANCHES` order, NaN rows for absent ones) of the target ``p = (px, py, pz)``
-    into ``out`` (4, 3), each angle nearest the reference ``(r0, r1, r2)`` (scalars: a call passing arrays costs
+    into ``out`` (4, 3) (branch ``b`` into row ``b ^ flip``: 0, or a caller's own order, as the quadruped's seed
+    order), each angle nearest the reference ``(r0, r1, r2)`` (scalars: a call passing arrays costs
     their reference counts, a third of the kernel's time).
 
     ``r^2 = y^2 + z^2``, ``u3 = s_a sqrt(r^2 - d^2)``, ``q1 = atan2(z, y) - atan2(u3, d)``;
@@ -280,7 +281,7 @@ def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out):
                     if cyl <= tol and res < best:
                         best, why = res, reason
                     continue
-            b = 2 * ia + ik
+            b = (2 * ia + ik) ^ flip
             out[b, 0], out[b, 1], out[b, 2] = _near_k(j1, r0), _near_k(j2, r1), _near_k(j3, r2)
             found += 1
     if found == 0:
@@ -383,7 +384,7 @@ def _ik_every_k(px, py, pz, g, r0, r1, r2, tol):
     to the earlier branch). Returns ``(status, info0, info1, q1, q2, q3)``: the miss (m) and reason, or the least
     limit violation (rad) and the number of geometric branches; the angles (NaN unless solved)."""
     qa = np.empty((4, 3))  # the rare path allocates
-    status, i0, i1 = _ik_all_core(px, py, pz, g, r0, r1, r2, tol, qa)
+    status, i0, i1 = _ik_all_core(px, py, pz, g, r0, r1, r2, tol, qa, 0)
     if status != OK:
         return status, i0, i1, _NAN, _NAN, _NAN
     best, viol, nb = math.inf, math.inf, 0
@@ -502,10 +503,10 @@ def _ik_core(px, py, pz, g, r0, r1, r2, tol):
 
 
 @kernel(entry=True)
-def _ik_all_k(p, g, ref, out) -> int:
+def _ik_all_k(p, g, ref, flip, out) -> int:
     """:func:`_ik_all_core` of one target with the default ``tol`` (the single call; one argument fewer for numba's
-    dispatch): its status."""
-    return _ik_all_core(p[0], p[1], p[2], g, ref[0], ref[1], ref[2], IK_TOL, out)[0]
+    dispatch), rows in the order ``flip`` gives: its status."""
+    return _ik_all_core(p[0], p[1], p[2], g, ref[0], ref[1], ref[2], IK_TOL, out, flip)[0]
 
 
 @kernel(entry=True)
@@ -522,7 +523,7 @@ def _ik_all_batch(p, g, ref, tol, out, status, info) -> int:
     n, m, bad = p.shape[0], ref.shape[0], 0
     for i in prange(n):
         j = i if m > 1 else i - i
-        s, a, b = _ik_all_core(p[i, 0], p[i, 1], p[i, 2], g, ref[j, 0], ref[j, 1], ref[j, 2], tol, out[i])
+        s, a, b = _ik_all_core(p[i, 0], p[i, 1], p[i, 2], g, ref[j, 0], ref[j, 1], ref[j, 2], tol, out[i], 0)
         status[i], info[i, 0], info[i, 1] = s, a, b
         bad += s != OK
     return bad

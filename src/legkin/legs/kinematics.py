@@ -587,7 +587,7 @@ class Leg:
             ref = self._ref if q_near is None else _vector3(q_near)
             if ref is not None:
                 out = np.empty((4, 3))
-                st = _ik_all_k(p, self._g, ref, out)
+                st = _ik_all_k(p, self._g, ref, 0, out)
                 if st == OK:
                     return (out, np.isfinite(out[:, 0])) if return_mask else out
                 if st != _BAD_INPUT:

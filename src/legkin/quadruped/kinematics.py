@@ -48,21 +48,24 @@ _LO, _HI = tuple(JOINT_LIMITS[:, 0].tolist()), tuple(JOINT_LIMITS[:, 1].tolist()
 _REVERSED = np.array((3, 2, 1, 0))
 #: Per leg, the rows of Leg.ik_all in seed 004's order (the left legs' is reversed: that array itself, a slice serves).
 _ORDER = {leg: _REVERSED if order == (3, 2, 1, 0) else np.array(order) for leg, order in SEED_ORDER.items()}
+#: The same order as the kernels' ``flip`` (seed row ``s`` holds Leg row ``s ^ flip``): the single call's kernel
+#: writes its rows in seed order (a slice or ``take`` of its answer would cost ~150 ns of a ~1 us call).
+_FLIP = {leg: order[0] for leg, order in SEED_ORDER.items()}  # (3, 2, 1, 0): 3, (1, 0, 3, 2): 1
 
 
 #: The default geometry's measured legs by name, once measured (the single calls' look-up: one dict access).
 _DEFAULT: dict[str, Leg] = {}
-#: Their kernels' arrays by leg name, ``(params, q_ref)``: the single-call fast paths below call the compiled
-#: kernels of :class:`~legkin.legs.Leg` directly (one Python call fewer: ~100-200 ns of a ~1 us call).
-_KERNEL_ARGS: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+#: Their kernels' arguments by leg name, ``(params, q_ref, flip)``: the single-call fast paths below call the
+#: compiled kernels of :class:`~legkin.legs.Leg` directly (one Python call fewer: ~100-200 ns of a ~1 us call).
+_KERNEL_ARGS: dict[str, tuple[np.ndarray, np.ndarray, int]] = {}
 #: The same for other geometries, by ``(leg, foot_z)`` (as many as :func:`legs` keeps).
-_KERNEL_ARGS_OF: dict[tuple[str, float], tuple[np.ndarray, np.ndarray]] = {}
+_KERNEL_ARGS_OF: dict[tuple[str, float], tuple[np.ndarray, np.ndarray, int]] = {}
 _F64, _S3, _ND = np.dtype(np.float64), (3,), np.ndarray
 
 
-def _kernel_args(leg: object, geometry: object) -> tuple[np.ndarray, np.ndarray] | None:
-    """The kernel arrays ``(params, q_ref)`` of ``leg`` for a :class:`Geometry` (measured on first use), or None
-    (a bad leg or geometry: the general path then raises its error)."""
+def _kernel_args(leg: object, geometry: object) -> tuple[np.ndarray, np.ndarray, int] | None:
+    """The kernel arguments ``(params, q_ref, flip)`` of ``leg`` for a :class:`Geometry` (measured on first use), or
+    None (a bad leg or geometry: the general path then raises its error)."""
     if leg.__class__ is not str or leg not in LEGS or geometry.__class__ is not Geometry:
         return None
     key = (leg, geometry.foot_z)  # type: ignore[attr-defined]
@@ -71,7 +74,7 @@ def _kernel_args(leg: object, geometry: object) -> tuple[np.ndarray, np.ndarray]
         one = legs(geometry)[leg]  # type: ignore[arg-type]
         if len(_KERNEL_ARGS_OF) >= 4 * CACHE_SIZE:  # a sweep over foot_z: keep the memory bounded
             _KERNEL_ARGS_OF.clear()
-        found = _KERNEL_ARGS_OF[key] = (one._g, one._ref)
+        found = _KERNEL_ARGS_OF[key] = (one._g, one._ref, _FLIP[leg])  # type: ignore[index]
     return found
 
 
@@ -84,7 +87,7 @@ def _leg(leg: object, geometry: Geometry | None) -> Leg:
     found = legs(geometry)
     if geometry is None:
         _DEFAULT.update(found)
-        _KERNEL_ARGS.update({name: (one._g, one._ref) for name, one in found.items()})
+        _KERNEL_ARGS.update({name: (one._g, one._ref, _FLIP[name]) for name, one in found.items()})
     try:
         return found[leg]  # type: ignore[index]
     except (KeyError, TypeError):
@@ -259,8 +262,8 @@ def ik_all(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = No
         args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
         if args is not None:
             out = np.empty((4, 3))
-            if _ik_all_k(p, args[0], args[1], out) == OK:
-                return out[::-1] if _ORDER[leg] is _REVERSED else out.take(_ORDER[leg], axis=0)
+            if _ik_all_k(p, args[0], args[1], args[2], out) == OK:
+                return out
     found = _leg(leg, geometry)
     order = _ORDER[leg]
     if not (return_mask if return_mask is False or return_mask is True else _flag(return_mask)):

@@ -531,12 +531,15 @@ def _ik_all_batch(p, g, ref, tol, out, status, info) -> int:
 
 @batch_kernel(rows="p ref out status info", min_parallel=1024, parfor=True)
 def _ik_batch(p, g, ref, tol, out, status, info) -> int:
-    """:func:`_ik_core` over rows; returns the number of targets that failed (status != OK)."""
+    """:func:`_ik_core` over rows; returns the number of targets that failed (status != OK), NaN rows in ``out``.
+    ``status`` and ``info`` with no row: not recorded (a caller that needs neither allocates neither)."""
     n, m, bad = p.shape[0], ref.shape[0], 0
+    record = status.shape[0] == n
     for i in prange(n):
         j = i if m > 1 else i - i
         s, a, b, out[i, 0], out[i, 1], out[i, 2] = _ik_core(p[i, 0], p[i, 1], p[i, 2], g, ref[j, 0], ref[j, 1],
                                                             ref[j, 2], tol)
-        status[i], info[i, 0], info[i, 1] = s, a, b
+        if record:
+            status[i], info[i, 0], info[i, 1] = s, a, b
         bad += s != OK
     return bad

@@ -56,6 +56,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal, overload
 
 import numpy as np
+from numba.core import types as _nbtypes
 from numpy.typing import ArrayLike
 
 from .._batch import as_input, check_flag, check_number, finish
@@ -140,9 +141,47 @@ def _vector3(x: object) -> np.ndarray | None:
 
 
 def _rows3(x: object) -> bool:
-    """Whether ``x`` is a C-contiguous writeable float64 array (n, 3), n >= 1 (a batch the kernels take as is)."""
+    """Whether ``x`` is a C-contiguous, aligned, writeable float64 array (n, 3), n >= 1 (a batch the kernels take as
+    is; ``flags.carray``: the three flags at once)."""
     return (x.__class__ is np.ndarray and x.ndim == 2 and x.shape[1] == 3 and x.dtype is _F64  # type: ignore[attr-defined]
-            and x.shape[0] > 0 and x.flags.c_contiguous and x.flags.writeable)  # type: ignore[attr-defined]
+            and x.shape[0] > 0 and x.flags.carray)  # type: ignore[attr-defined]
+
+
+#: The status and info arguments of a batch loop whose caller needs neither (no row: the loop records nothing).
+_NO_STATUS = np.empty(0, dtype=np.int64)
+_NO_INFO = np.empty((0, 2))
+
+
+class _Entry:
+    """A kernel's compiled entry point for one signature, called without numba's dispatcher: the single calls'
+    fast paths (numba's dispatcher resolves the argument types on each call: ~120 ns of a ~300 ns kernel call).
+
+    Compiled (or loaded from numba's cache) on the first call. The signature reads the caller's arrays with any
+    strides (layout ``"A"``): a float64 array of the right shape is all a fast path checks. Under
+    ``NUMBA_DISABLE_JIT`` the kernel itself is called."""
+
+    __slots__ = ("call", "_kernel", "_sig")
+
+    def __init__(self, kernel: Any, *sig: Any) -> None:
+        self._kernel, self._sig = kernel, sig
+        self.call: Any = self._first
+
+    def _first(self, *args: Any) -> int:
+        compile_ = getattr(self._kernel, "compile", None)
+        self.call = self._kernel if compile_ is None else compile_(self._sig)
+        return self.call(*args)  # type: ignore[no-any-return]
+
+
+_ANY1, _C1 = _nbtypes.Array(_nbtypes.float64, 1, "A"), _nbtypes.Array(_nbtypes.float64, 1, "C")
+_C2 = _nbtypes.Array(_nbtypes.float64, 2, "C")
+#: The single calls' entries: ``(q or p, params, [ref, [flip,]] out)``.
+_FK = _Entry(_fk_k, _ANY1, _C1, _C1)
+_JACOBIAN = _Entry(_jacobian_k, _ANY1, _C1, _C2)
+_IK = _Entry(_ik_k, _ANY1, _C1, _ANY1, _C1)
+_IK_ALL = _Entry(_ik_all_k, _ANY1, _C1, _ANY1, _nbtypes.int64, _C2)
+#: The batch IK loop on (n, 3) rows with one reference row (a batch below ``_ik_batch.min_parallel`` rows).
+_IK_ROWS = _Entry(_ik_batch.kernel, _C2, _C1, _C2, _nbtypes.float64, _C2, _nbtypes.Array(_nbtypes.int64, 1, "C"),
+                  _C2)
 
 
 # ---------------------------------------------------------------- geometry helpers (Python)
@@ -427,12 +466,12 @@ class Leg:
         """
         if q.__class__ is np.ndarray and q.shape == _S3SHAPE and q.dtype is _F64:  # a single call, fast
             out = np.empty(3)
-            if _fk_k(q, self._g, out) == OK:
+            if _FK.call(q, self._g, out) == OK:
                 return out
         arr = as_input(q, "q", _S3SHAPE)
         if arr.ndim == 1:
             out = np.empty(3)
-            _fk_k(arr, self._g, out)
+            _FK.call(arr, self._g, out)
             return out
         rows = as_rows(arr, 3)
         out = np.empty_like(rows)
@@ -458,12 +497,12 @@ class Leg:
         """
         if q.__class__ is np.ndarray and q.shape == _S3SHAPE and q.dtype is _F64:  # a single call, fast
             out = np.empty((3, 3))
-            if _jacobian_k(q, self._g, out) == OK:
+            if _JACOBIAN.call(q, self._g, out) == OK:
                 return out
         arr = as_input(q, "q", _S3SHAPE)
         if arr.ndim == 1:
             out = np.empty((3, 3))
-            _jacobian_k(arr, self._g, out)
+            _JACOBIAN.call(arr, self._g, out)
             return out
         rows = as_rows(arr, 3)
         out = np.empty((rows.shape[0], 3, 3))
@@ -587,7 +626,7 @@ class Leg:
             ref = self._ref if q_near is None else _vector3(q_near)
             if ref is not None:
                 out = np.empty((4, 3))
-                st = _ik_all_k(p, self._g, ref, 0, out)
+                st = _IK_ALL.call(p, self._g, ref, 0, out)
                 if st == OK:
                     return (out, np.isfinite(out[:, 0])) if return_mask else out
                 if st != _BAD_INPUT:
@@ -651,18 +690,18 @@ class Leg:
             ref = self._ref if q_near is None else _vector3(q_near)
             if ref is not None:
                 out = np.empty(3)
-                st = _ik_k(p, self._g, ref, out)
+                st = _IK.call(p, self._g, ref, out)
                 if st == OK:
                     return (out, np.array(True)) if return_mask else out
                 if st != _BAD_INPUT:
                     raise self._single_error(_ik_batch, (3,), p, ref)
         if q_near is None and tol is IK_TOL and _rows3(p):  # a batch (n, 3) the kernels read as is: no copy
             out = np.empty(p.shape)
-            status = np.empty(p.shape[0], dtype=np.int64)
-            if not _ik_batch(p, self._g, self._ref1, IK_TOL, out, status, np.empty((p.shape[0], 2))):
+            loop = _IK_ROWS.call if p.shape[0] < _ik_batch.min_parallel else _ik_batch
+            if not loop(p, self._g, self._ref1, IK_TOL, out, _NO_STATUS, _NO_INFO):
                 return (out, np.ones(p.shape[0], dtype=bool)) if return_mask else out
-            if not (status == _BAD_INPUT).any():  # NaN rows for the targets that failed (else as_input raises)
-                return (out, status == OK) if return_mask else out
+            if np.isfinite(p).all():  # NaN rows for the targets that failed (else as_input raises)
+                return (out, np.isfinite(out[:, 0])) if return_mask else out
         rows, ref, batch, single, tol = self._prepare(p, q_near, tol)
         n = rows.shape[0]
         out = np.empty((n, 3))

@@ -26,9 +26,7 @@ import numpy.typing as npt
 
 from .._batch import check_flag, check_number
 from .._kernels import OK
-from ..legs._fk_kernels import _fk_k, _jacobian_k
-from ..legs._ik_kernels import _ik_all_k, _ik_k
-from ..legs.kinematics import Leg, _vector3
+from ..legs.kinematics import _FK, _IK, _IK_ALL, _JACOBIAN, Leg, _vector3
 from . import constants as _constants
 from ._common import foot_z_of, leg_index, rows
 from .constants import *  # noqa: F403 - the quadruped's constants (LEGS, JOINT_LIMITS, X01, ...), re-exported
@@ -136,7 +134,7 @@ def fk(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
     """
     if return_mask is False and q.__class__ is _ND and q.shape == _S3 and q.dtype is _F64:
         args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
-        if args is not None and _fk_k(q, args[0], out := np.empty(3)) == OK:
+        if args is not None and _FK.call(q, args[0], out := np.empty(3)) == OK:
             return out
     x = _leg(leg, geometry).fk(q)
     return x if return_mask is False else _with_mask(x, 1, return_mask)
@@ -169,7 +167,7 @@ def jacobian(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
     """
     if return_mask is False and q.__class__ is _ND and q.shape == _S3 and q.dtype is _F64:
         args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
-        if args is not None and _jacobian_k(q, args[0], out := np.empty((3, 3))) == OK:
+        if args is not None and _JACOBIAN.call(q, args[0], out := np.empty((3, 3))) == OK:
             return out
     x = _leg(leg, geometry).jacobian(q)
     return x if return_mask is False else _with_mask(x, 2, return_mask)
@@ -218,7 +216,7 @@ def ik(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = None, 
         args = ref = None
     if args is not None and ref is not None:
         out = np.empty(3)
-        if _ik_k(p, args[0], ref, out) == OK:
+        if _IK.call(p, args[0], ref, out) == OK:
             return out
     return _leg(leg, geometry).ik(target, q_near=q_near, return_mask=return_mask)  # type: ignore[no-any-return]
 
@@ -262,7 +260,7 @@ def ik_all(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = No
         args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
         if args is not None:
             out = np.empty((4, 3))
-            if _ik_all_k(p, args[0], args[1], args[2], out) == OK:
+            if _IK_ALL.call(p, args[0], args[1], args[2], out) == OK:
                 return out
     found = _leg(leg, geometry)
     order = _ORDER[leg]

@@ -56,24 +56,24 @@ _DEFAULT: dict[str, Leg] = {}
 #: Their kernels' arguments by leg name, ``(params, q_ref, flip)``: the single-call fast paths below call the
 #: compiled kernels of :class:`~legkin.legs.Leg` directly (one Python call fewer: ~100-200 ns of a ~1 us call).
 _KERNEL_ARGS: dict[str, tuple[np.ndarray, np.ndarray, int]] = {}
-#: The same for other geometries, by ``(leg, foot_z)`` (as many as :func:`legs` keeps).
-_KERNEL_ARGS_OF: dict[tuple[str, float], tuple[np.ndarray, np.ndarray, int]] = {}
+#: The same for other geometries, by ``foot_z`` then leg name (as many as :func:`legs` keeps; two look-ups: no key
+#: tuple to build and hash).
+_KERNEL_ARGS_OF: dict[float, dict[str, tuple[np.ndarray, np.ndarray, int]]] = {}
 _F64, _S3, _ND = np.dtype(np.float64), (3,), np.ndarray
 
 
 def _kernel_args(leg: object, geometry: object) -> tuple[np.ndarray, np.ndarray, int] | None:
     """The kernel arguments ``(params, q_ref, flip)`` of ``leg`` for a :class:`Geometry` (measured on first use), or
     None (a bad leg or geometry: the general path then raises its error)."""
-    if leg.__class__ is not str or leg not in LEGS or geometry.__class__ is not Geometry:
+    if geometry.__class__ is not Geometry:
         return None
-    key = (leg, geometry.foot_z)  # type: ignore[attr-defined]
-    found = _KERNEL_ARGS_OF.get(key)
+    found = _KERNEL_ARGS_OF.get(geometry.foot_z)  # type: ignore[attr-defined]
     if found is None:
-        one = legs(geometry)[leg]  # type: ignore[arg-type]
-        if len(_KERNEL_ARGS_OF) >= 4 * CACHE_SIZE:  # a sweep over foot_z: keep the memory bounded
+        if len(_KERNEL_ARGS_OF) >= CACHE_SIZE:  # a sweep over foot_z: keep the memory bounded
             _KERNEL_ARGS_OF.clear()
-        found = _KERNEL_ARGS_OF[key] = (one._g, one._ref, _FLIP[leg])  # type: ignore[index]
-    return found
+        found = _KERNEL_ARGS_OF[geometry.foot_z] = {  # type: ignore[attr-defined]
+            name: (one._g, one._ref, _FLIP[name]) for name, one in legs(geometry).items()}  # type: ignore[arg-type]
+    return found.get(leg) if leg.__class__ is str else None  # type: ignore[call-overload]
 
 
 def _leg(leg: object, geometry: Geometry | None) -> Leg:

@@ -293,10 +293,16 @@ def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out, flip):
 def _within_k(a, r, lo, hi, tol):
     """The representative ``a + 2 pi n`` inside ``[lo, hi]`` (slack ``tol``, then clipped) nearest ``r``; NaN if
     none. Also returns the distance to the limits of the nearest representative (0 when inside) and whether the
-    one returned was clipped. When ``a`` lies inside limits narrower than 2 pi - 2 ``tol`` it is the only
-    representative there: returned as it is."""
-    if a >= lo and a <= hi and hi - lo < _TWO_PI - 2.0 * tol:
-        return a, 0.0, False
+    one returned was clipped. Limits narrower than 2 pi - 2 ``tol`` hold one representative at most: ``a`` itself
+    when it lies inside (returned as it is), none when ``a`` lies in a gap between the window ``[lo - tol, hi +
+    tol]`` and its copy 2 pi away (NaN and the distance to the nearer copy, no ``floor``)."""
+    if hi - lo < _TWO_PI - 2.0 * tol:
+        if a >= lo and a <= hi:
+            return a, 0.0, False
+        if a > hi + tol and a < lo - tol + _TWO_PI:
+            return _NAN, min(a - hi, lo + _TWO_PI - a), False
+        if a < lo - tol and a > hi + tol - _TWO_PI:
+            return _NAN, min(lo - a, a + _TWO_PI - hi), False
     rc = lo if r < lo else (hi if r > hi else r)
     base = _near_k(a, rc)
     best, dist, miss, clipped = _NAN, math.inf, math.inf, False

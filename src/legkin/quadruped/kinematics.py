@@ -30,7 +30,7 @@ from ..legs.kinematics import _FK, _IK, _IK_ALL, _JACOBIAN, Leg, _vector3
 from . import constants as _constants
 from ._common import foot_z_of, leg_index, rows
 from .constants import *  # noqa: F403 - the quadruped's constants (LEGS, JOINT_LIMITS, X01, ...), re-exported
-from .constants import JOINT_LIMITS, LEGS, LIMIT_TOL
+from .constants import JOINT_LIMITS, LIMIT_TOL
 from .geometry import DEFAULT_GEOMETRY, Geometry
 from .measured import CACHE_SIZE, SEED_ORDER, legs
 from .textbook import textbook_frame, textbook_ik, textbook_to_joints

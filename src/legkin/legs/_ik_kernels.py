@@ -34,6 +34,7 @@ from ._layout import (
     _PK,
     _PL,
     _POLISH_DONE,
+    _REF,
     _S3,
     _SD,
     _SLACK,
@@ -509,15 +510,29 @@ def _ik_core(px, py, pz, g, r0, r1, r2, tol):
 
 
 @kernel(entry=True)
-def _ik_all_k(p, g, ref, flip, out) -> int:
-    """:func:`_ik_all_core` of one target with the default ``tol`` (the single call; one argument fewer for numba's
-    dispatch), rows in the order ``flip`` gives: its status."""
+def _ik_all_k(p, g, flip, out) -> int:
+    """:func:`_ik_all_core` of one target with the default ``tol`` and reference (:data:`_REF`: a single call,
+    one argument fewer for numba), rows in the order ``flip`` gives: its status."""
+    return _ik_all_core(p[0], p[1], p[2], g, g[_REF], g[_REF + 1], g[_REF + 2], IK_TOL, out, flip)[0]
+
+
+@kernel(entry=True)
+def _ik_all_near_k(p, g, ref, flip, out) -> int:
+    """:func:`_ik_all_k` with the reference ``ref`` (3,)."""
     return _ik_all_core(p[0], p[1], p[2], g, ref[0], ref[1], ref[2], IK_TOL, out, flip)[0]
 
 
 @kernel(entry=True)
-def _ik_k(p, g, ref, out) -> int:
-    """:func:`_ik_core` of one target with the default ``tol`` (the single call) into ``out``: its status."""
+def _ik_k(p, g, out) -> int:
+    """:func:`_ik_core` of one target with the default ``tol`` and reference (:data:`_REF`) into ``out``: its
+    status."""
+    s, _a, _b, out[0], out[1], out[2] = _ik_core(p[0], p[1], p[2], g, g[_REF], g[_REF + 1], g[_REF + 2], IK_TOL)
+    return s
+
+
+@kernel(entry=True)
+def _ik_near_k(p, g, ref, out) -> int:
+    """:func:`_ik_k` with the reference ``ref`` (3,)."""
     s, _a, _b, out[0], out[1], out[2] = _ik_core(p[0], p[1], p[2], g, ref[0], ref[1], ref[2], IK_TOL)
     return s
 

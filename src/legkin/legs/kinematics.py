@@ -64,7 +64,7 @@ from .._kernels import OK, as_rows
 from ..errors import InvalidInputError, JointLimitError, UnreachableError
 from ..errors import LegStructureError as _LegStructureError
 from ._fk_kernels import _fk_batch, _fk_k, _jacobian_batch, _jacobian_k
-from ._ik_kernels import _ik_all_batch, _ik_all_k, _ik_batch, _ik_k
+from ._ik_kernels import _ik_all_batch, _ik_all_k, _ik_all_near_k, _ik_batch, _ik_k, _ik_near_k
 from ._layout import (
     _A1,
     _A2,
@@ -91,6 +91,7 @@ from ._layout import (
     _O,
     _PK,
     _PL,
+    _REF,
     _S3,
     _SD,
     _SLACK,
@@ -174,11 +175,13 @@ class _Entry:
 
 _ANY1, _C1 = _nbtypes.Array(_nbtypes.float64, 1, "A"), _nbtypes.Array(_nbtypes.float64, 1, "C")
 _C2 = _nbtypes.Array(_nbtypes.float64, 2, "C")
-#: The single calls' entries: ``(q or p, params, [ref, [flip,]] out)``.
+#: The single calls' entries: ``(q or p, params, [ref (the _NEAR ones),] [flip,] out)``.
 _FK = _Entry(_fk_k, _ANY1, _C1, _C1)
 _JACOBIAN = _Entry(_jacobian_k, _ANY1, _C1, _C2)
-_IK = _Entry(_ik_k, _ANY1, _C1, _ANY1, _C1)
-_IK_ALL = _Entry(_ik_all_k, _ANY1, _C1, _ANY1, _nbtypes.int64, _C2)
+_IK = _Entry(_ik_k, _ANY1, _C1, _C1)
+_IK_NEAR = _Entry(_ik_near_k, _ANY1, _C1, _ANY1, _C1)
+_IK_ALL = _Entry(_ik_all_k, _ANY1, _C1, _nbtypes.int64, _C2)
+_IK_ALL_NEAR = _Entry(_ik_all_near_k, _ANY1, _C1, _ANY1, _nbtypes.int64, _C2)
 #: The batch IK loop on (n, 3) rows with one reference row (a batch below ``_ik_batch.min_parallel`` rows).
 _IK_ROWS = _Entry(_ik_batch.kernel, _C2, _C1, _C2, _nbtypes.float64, _C2, _nbtypes.Array(_nbtypes.int64, 1, "C"),
                   _C2)
@@ -375,6 +378,7 @@ class Leg:
         g[_IDEAL] = 1.0 if dot12 == 0.0 and cross23 == 0.0 else 0.0
         g[_CD], g[_SD] = math.cos(g[_PK] - g[_PL]), math.sin(g[_PK] - g[_PL])
         g[_ARC:_ARC + 5] = _limit_arc(float(lo[0]), float(hi[0]))
+        g[_REF:_REF + 3] = mid
         return cls(
             name=str(name), joint_names=(str(j1), str(j2), str(j3)), foot_frame=str(foot_frame),
             lower=_frozen(lo), upper=_frozen(hi), origin=_frozen(o[0]), axes=_frozen(np.stack([a1, a2, a3])),
@@ -626,7 +630,8 @@ class Leg:
             ref = self._ref if q_near is None else _vector3(q_near)
             if ref is not None:
                 out = np.empty((4, 3))
-                st = _IK_ALL.call(p, self._g, ref, 0, out)
+                st = (_IK_ALL.call(p, self._g, 0, out) if q_near is None
+                      else _IK_ALL_NEAR.call(p, self._g, ref, 0, out))
                 if st == OK:
                     return (out, np.isfinite(out[:, 0])) if return_mask else out
                 if st != _BAD_INPUT:
@@ -690,7 +695,7 @@ class Leg:
             ref = self._ref if q_near is None else _vector3(q_near)
             if ref is not None:
                 out = np.empty(3)
-                st = _IK.call(p, self._g, ref, out)
+                st = _IK.call(p, self._g, out) if q_near is None else _IK_NEAR.call(p, self._g, ref, out)
                 if st == OK:
                     return (out, np.array(True)) if return_mask else out
                 if st != _BAD_INPUT:

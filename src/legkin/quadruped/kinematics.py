@@ -26,7 +26,7 @@ import numpy.typing as npt
 
 from .._batch import check_flag, check_number
 from .._kernels import OK
-from ..legs.kinematics import _FK, _IK, _IK_ALL, _JACOBIAN, Leg, _vector3
+from ..legs.kinematics import _FK, _IK, _IK_ALL, _IK_NEAR, _JACOBIAN, Leg, _vector3
 from . import constants as _constants
 from ._common import foot_z_of, leg_index, rows
 from .constants import *  # noqa: F403 - the quadruped's constants (LEGS, JOINT_LIMITS, X01, ...), re-exported
@@ -216,7 +216,7 @@ def ik(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = None, 
         args = ref = None
     if args is not None and ref is not None:
         out = np.empty(3)
-        if _IK.call(p, args[0], ref, out) == OK:
+        if (_IK.call(p, args[0], out) if q_near is None else _IK_NEAR.call(p, args[0], ref, out)) == OK:
             return out
     return _leg(leg, geometry).ik(target, q_near=q_near, return_mask=return_mask)  # type: ignore[no-any-return]
 
@@ -260,7 +260,7 @@ def ik_all(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = No
         args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
         if args is not None:
             out = np.empty((4, 3))
-            if _IK_ALL.call(p, args[0], args[1], args[2], out) == OK:
+            if _IK_ALL.call(p, args[0], args[2], out) == OK:
                 return out
     found = _leg(leg, geometry)
     order = _ORDER[leg]

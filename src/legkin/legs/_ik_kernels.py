@@ -20,7 +20,6 @@ from ._layout import (
     _H,
     _HI,
     _IDEAL,
-    _IKL,
     _IN_CYLINDER,
     _INV_TWO_PI,
     _JOINT_LIMIT,
@@ -195,7 +194,7 @@ def _pitch_k(g, x1, u3):
     wn = math.sqrt(wx * wx + wy * wy)
     far = wn - (kn + ln)
     near = abs(kn - ln) - wn
-    c = (wn * wn - kn * kn - ln * ln) * g[_IKL]
+    c = (wn * wn - kn * kn - ln * ln) / (2.0 * kn * ln)
     c = 1.0 if c > 1.0 else (-1.0 if c < -1.0 else c)
     return wx, wy, (far if far > near else near), far > near, c, math.acos(c), wn >= WELL_CONDITIONED * (kn + ln)
 

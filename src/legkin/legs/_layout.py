@@ -66,8 +66,7 @@ _CD, _SD = 50, 51  # cos, sin (phi_k - phi_l): the knee's offset angle (the hip 
 #: q1 lies off the arc before computing the angle (two cross products instead of an atan2).
 _ARC = 52
 _REF = 57  # q_ref (3): the default reference of Leg.ik / Leg.ik_all (a single call passes no reference array)
-_IKL = 60  # 1 / (2 |k| |l|): the knee's law of cosines by a product (a division is ~15 cycles on the critical path)
-_NPARAMS = 61
+_NPARAMS = 60
 _WHOLE, _NARROW, _WIDE = 0.0, 1.0, 2.0
 
 _TWO_PI = 2.0 * math.pi

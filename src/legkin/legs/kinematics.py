@@ -79,7 +79,6 @@ from ._layout import (
     _H,
     _HI,
     _IDEAL,
-    _IKL,
     _IN_CYLINDER,
     _JOINT_LIMIT,
     _K,
@@ -380,7 +379,6 @@ class Leg:
         g[_CD], g[_SD] = math.cos(g[_PK] - g[_PL]), math.sin(g[_PK] - g[_PL])
         g[_ARC:_ARC + 5] = _limit_arc(float(lo[0]), float(hi[0]))
         g[_REF:_REF + 3] = mid
-        g[_IKL] = 1.0 / (2.0 * kn * ln)
         return cls(
             name=str(name), joint_names=(str(j1), str(j2), str(j3)), foot_frame=str(foot_frame),
             lower=_frozen(lo), upper=_frozen(hi), origin=_frozen(o[0]), axes=_frozen(np.stack([a1, a2, a3])),

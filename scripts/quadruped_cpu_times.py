@@ -38,7 +38,7 @@ def main(label: str) -> None:
     """Print one line ``label name=value ...`` (ratios to the yardstick; batch rows in ns per target)."""
     q = np.array([0.0, 0.75, 1.5])
     p = aq.fk(q, "LF")
-    qn, batch = q + 0.01, np.stack([p] * 8)
+    qn, batch, geometry = q + 0.01, np.stack([p] * 8), aq.Geometry(foot_z=-0.015)
     model = legkin.load("quadruped").model
     data, fid, q0 = model.createData(), model.getFrameId("LF_FOOT"), pin.neutral(model)
 
@@ -49,7 +49,8 @@ def main(label: str) -> None:
     y = cpu_time(yardstick)
     row = {"yardstick (ns)": y * 1e9}
     calls: dict[str, Callable[[], object]] = {
-        "fk": lambda: aq.fk(q, "LF"), "jacobian": lambda: aq.jacobian(q, "LF"), "ik": lambda: aq.ik(p, "LF"),
+        "fk": lambda: aq.fk(q, "LF"), "fk (geometry)": lambda: aq.fk(q, "LF", geometry=geometry),
+        "jacobian": lambda: aq.jacobian(q, "LF"), "ik": lambda: aq.ik(p, "LF"),
         "ik (q_near)": lambda: aq.ik(p, "LF", q_near=qn), "ik, batch of 8": lambda: aq.ik(batch, "LF"),
         "ik_all": lambda: aq.ik_all(p, "LF"),
     }

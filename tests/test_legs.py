@@ -785,8 +785,8 @@ def test_no_candidate_exit_gives_the_complete_paths_verdict(robot):
         n = len(p)
         st, info, st_all, info_all = (np.empty(n, dtype=np.int64), np.zeros((n, 2)),
                                       np.empty(n, dtype=np.int64), np.zeros((n, 2)))
-        _ik_batch(p, leg.params, leg._ref1, IK_TOL, np.empty((n, 3)), st, info)
-        _ik_all_batch(p, leg.params, leg._ref1, IK_TOL, np.empty((n, 4, 3)), st_all, info_all)
+        _ik_batch(p, leg._g, leg._ref1, IK_TOL, np.empty((n, 3)), st, info)
+        _ik_all_batch(p, leg._g, leg._ref1, IK_TOL, np.empty((n, 4, 3)), st_all, info_all)
         out = st_all == _UNREACHABLE
         assert out.sum() > n // 4  # the box is mostly out of reach: the exit is exercised
         np.testing.assert_array_equal(st == _UNREACHABLE, out)

@@ -5,21 +5,36 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
-from .._kernels import OK, batch_loop, kernel
+from .._kernels import OK, batch_kernel, kernel, prange
 from ._layout import _A1, _A2, _A3, _BAD_INPUT, _O, _V3F, _V21, _V32
+
+
+@kernel(inline=True)
+def _finite_k(x, y, z) -> bool:
+    """Whether three floats are finite."""
+    return math.isfinite(x) and math.isfinite(y) and math.isfinite(z)
 
 
 @kernel
 def _finite3(x) -> bool:
-    return np.isfinite(x[0]) and np.isfinite(x[1]) and np.isfinite(x[2])
+    return _finite_k(x[0], x[1], x[2])
 
 
 @kernel
 def _rot_k(g, ia, c, s, vx, vy, vz):
-    """Rodrigues: ``R(a, t) v = cos t v + sin t (a x v) + (1 - cos t) (a . v) a`` with ``a = g[ia:ia + 3]``."""
+    """Rodrigues: ``R(a, t) v = cos t v + sin t (a x v) + (1 - cos t) (a . v) a`` with ``a = g[ia:ia + 3]``; for an
+    axis along a root axis (``a = +-e_x``, ``+-e_y``, ``+-e_z``: the unit axes of most URDFs, exactly) the plane
+    rotation it reduces to (as Pinocchio's ``JointModelRX``... : 6 products, not 15)."""
     ax, ay, az = g[ia], g[ia + 1], g[ia + 2]
+    if ay == 0.0 and az == 0.0:
+        s *= ax
+        return vx, c * vy - s * vz, c * vz + s * vy
+    if ax == 0.0 and az == 0.0:
+        s *= ay
+        return c * vx + s * vz, vy, c * vz - s * vx
+    if ax == 0.0 and ay == 0.0:
+        s *= az
+        return c * vx - s * vy, c * vy + s * vx, vz
     k = (1.0 - c) * (ax * vx + ay * vy + az * vz)
     return (
         c * vx + s * (ay * vz - az * vy) + k * ax,
@@ -93,5 +108,31 @@ def _jacobian_k(q, g, out) -> int:
     return OK
 
 
-_fk_batch = batch_loop(_fk_k, min_parallel=256, parfor=True)
-_jacobian_batch = batch_loop(_jacobian_k, min_parallel=256, parfor=True)
+@batch_kernel(rows="q out", min_parallel=256, parfor=True)
+def _fk_batch(q, g, out) -> int:
+    """:func:`_fk3_k` over rows (scalars in and out: no array view, no reference count a row); returns the number
+    of rows with a non-finite entry (their rows of ``out`` are left as they are)."""
+    n, bad = q.shape[0], 0
+    for i in prange(n):
+        q0, q1, q2 = q[i, 0], q[i, 1], q[i, 2]
+        if _finite_k(q0, q1, q2):
+            out[i, 0], out[i, 1], out[i, 2] = _fk3_k(q0, q1, q2, g)
+        else:
+            bad += 1
+    return bad
+
+
+@batch_kernel(rows="q out", min_parallel=256, parfor=True)
+def _jacobian_batch(q, g, out) -> int:
+    """:func:`_jac3_t` over rows, as :func:`_fk_batch`."""
+    n, bad = q.shape[0], 0
+    for i in prange(n):
+        q0, q1, q2 = q[i, 0], q[i, 1], q[i, 2]
+        if _finite_k(q0, q1, q2):
+            j = _jac3_t(q0, q1, q2, g)
+            out[i, 0, 0], out[i, 0, 1], out[i, 0, 2] = j[0], j[1], j[2]
+            out[i, 1, 0], out[i, 1, 1], out[i, 1, 2] = j[3], j[4], j[5]
+            out[i, 2, 0], out[i, 2, 1], out[i, 2, 2] = j[6], j[7], j[8]
+        else:
+            bad += 1
+    return bad

@@ -8,7 +8,7 @@ import math
 import numpy as np
 
 from .._kernels import OK, batch_kernel, kernel, prange
-from ._fk_kernels import _finite3, _fk3_k, _jac3_t
+from ._fk_kernels import _finite_k, _fk3_k, _jac3_t
 from ._layout import (
     _ARC,
     _BAD_INPUT,
@@ -34,6 +34,7 @@ from ._layout import (
     _PK,
     _PL,
     _POLISH_DONE,
+    _REF,
     _S3,
     _SD,
     _SLACK,
@@ -54,7 +55,7 @@ from ._layout import (
 
 
 @kernel
-def _polish_k(p, g, q0, q1, q2, fixed):
+def _polish_k(px, py, pz, g, q0, q1, q2, fixed):
     """At most :data:`POLISH_STEPS` damped Newton steps on the exact forward map while the foot error exceeds
     :data:`POLISH_BELOW`, each kept only if it reduces the error: ``e = p - fk(q)``,
     ``dq = J^T (J J^T + lambda^2 I)^-1 e`` (``lambda`` = :data:`POLISH_DAMPING`).
@@ -63,10 +64,11 @@ def _polish_k(p, g, q0, q1, q2, fixed):
     with 11 digits (``rpy="0 1.57079632679 0"``) leave axes ~5e-12 off, i.e. ~1e-12 m at the foot, and near the
     fold of the knee (|w| -> 0 when |k| = |l|) the law of cosines loses digits: the steps remove both.
     ``fixed`` (bits 1, 2, 4 for q1, q2, q3): joints held where they are (their Jacobian columns zeroed).
-    Scalars in, scalars out (no array): returns the polished ``(q1, q2, q3)`` and the final foot error ``|e|`` (m).
+    Scalars in (the target ``(px, py, pz)``), scalars out: returns the polished ``(q1, q2, q3)`` and the final foot
+    error ``|e|`` (m).
     """
     fx, fy, fz = _fk3_k(q0, q1, q2, g)
-    ex, ey, ez = p[0] - fx, p[1] - fy, p[2] - fz
+    ex, ey, ez = px - fx, py - fy, pz - fz
     err = ex * ex + ey * ey + ez * ez
     lam2 = POLISH_DAMPING * POLISH_DAMPING
     f0, f1, f2 = (fixed & 1) == 0, (fixed & 2) == 0, (fixed & 4) == 0
@@ -99,7 +101,7 @@ def _polish_k(p, g, q0, q1, q2, fixed):
         n1 = q1 + j01 * yx + j11 * yy + j21 * yz
         n2 = q2 + j02 * yx + j12 * yy + j22 * yz
         fx, fy, fz = _fk3_k(n0, n1, n2, g)
-        nx, ny, nz = p[0] - fx, p[1] - fy, p[2] - fz
+        nx, ny, nz = px - fx, py - fy, pz - fz
         new = nx * nx + ny * ny + nz * nz
         if not new < err:
             break
@@ -109,15 +111,13 @@ def _polish_k(p, g, q0, q1, q2, fixed):
 
 
 @kernel
-def _settle_k(p, g, q0, q1, q2, clean):
-    """A closed-form branch as is when ``clean`` (well-conditioned on the exact ideal structure, see
-    :data:`WELL_CONDITIONED`; the foot error is then not evaluated and returned as 0), else polished
+def _settle_k(px, py, pz, g, q0, q1, q2):
+    """A closed-form branch that is not well-conditioned on the exact ideal structure (see
+    :data:`WELL_CONDITIONED`: the callers return those as they are, without a call) polished
     (:func:`_polish_k`); if its foot error stays above :data:`REACH_TOL` (near a
     fold of the ideal structure, where Newton stalls) it is restarted off the fold, each joint moved by
     ``+-eta = +-4 sqrt(|e| / min(|k|, |l|))`` in turn, keeping the best. Returns ``(q1, q2, q3, |e|)``."""
-    if clean:
-        return q0, q1, q2, 0.0
-    q0, q1, q2, res = _polish_k(p, g, q0, q1, q2, 0)
+    q0, q1, q2, res = _polish_k(px, py, pz, g, q0, q1, q2, 0)
     if res <= REACH_TOL:
         return q0, q1, q2, res
     eta = 4.0 * math.sqrt(res / min(g[_KN], g[_LN]))
@@ -127,7 +127,7 @@ def _settle_k(p, g, q0, q1, q2, clean):
         d0 = step if jr < 2 else 0.0
         d1 = step if jr // 2 == 1 else 0.0
         d2 = step if jr > 3 else 0.0
-        t0, t1, t2, rt = _polish_k(p, g, b0 + d0, b1 + d1, b2 + d2, 0)
+        t0, t1, t2, rt = _polish_k(px, py, pz, g, b0 + d0, b1 + d1, b2 + d2, 0)
         if rt < res:
             q0, q1, q2, res = t0, t1, t2, rt
         if res <= REACH_TOL:
@@ -136,12 +136,12 @@ def _settle_k(p, g, q0, q1, q2, clean):
 
 
 @kernel
-def _target_k(p, g):
+def _target_k(px, py, pz, g):
     """The target in the abduction frame: ``x1 = p'.e1``, ``t = sqrt(y^2 + z^2 - d^2)`` (0 inside the cylinder),
     ``y``, ``z``, ``cyl = |d| - r`` (> 0: inside the abduction cylinder), with ``p' = p - o1``, and
     whether the leg has the exact ideal structure with ``t >= WELL_CONDITIONED r`` (away from the abduction
     singularity: see :data:`WELL_CONDITIONED`)."""
-    px, py, pz = p[0] - g[_O], p[1] - g[_O + 1], p[2] - g[_O + 2]
+    px, py, pz = px - g[_O], py - g[_O + 1], pz - g[_O + 2]
     x1 = px * g[_E1] + py * g[_E1 + 1] + pz * g[_E1 + 2]
     y = px * g[_E2] + py * g[_E2 + 1] + pz * g[_E2 + 2]
     z = px * g[_E3] + py * g[_E3 + 1] + pz * g[_E3 + 2]
@@ -224,13 +224,20 @@ def _hip_k(g, ik, wx, wy, c):
 
 @kernel
 def _near_k(a, r):
-    """The representative ``a + 2 pi n`` nearest ``r``."""
-    return a + _TWO_PI * math.floor((r - a) * _INV_TWO_PI + 0.5)
+    """The representative ``a + 2 pi n`` nearest ``r``: ``a`` itself when ``|r - a| < pi`` (a compare off the
+    critical path: the common case of an angle from ``atan2`` and a reference inside the limits)."""
+    d = r - a
+    if abs(d) < math.pi:
+        return a
+    return a + _TWO_PI * np.floor(d * _INV_TWO_PI + 0.5)  # (np.floor: a float, math.floor rounds through an int)
 
 
 @kernel
-def _ik_all_core(p, g, ref, tol, out):
-    """Every branch (rows in :data:`BRANCHES` order, NaN rows for absent ones) of the target ``p``.
+def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out, flip):
+    """Every branch (rows in :data:`BRANCHES` order, NaN rows for absent ones) of the target ``p = (px, py, pz)``
+    into ``out`` (4, 3) (branch ``b`` into row ``b ^ flip``: 0, or a caller's own order, as the quadruped's seed
+    order), each angle nearest the reference ``(r0, r1, r2)`` (scalars: a call passing arrays costs
+    their reference counts, a third of the kernel's time).
 
     ``r^2 = y^2 + z^2``, ``u3 = s_a sqrt(r^2 - d^2)``, ``q1 = atan2(z, y) - atan2(u3, d)``;
     ``w = (u3, x1) - h``, ``cos beta = (|w|^2 - |k|^2 - |l|^2) / (2 |k||l|)``, ``beta = s_k acos(.)``,
@@ -242,9 +249,9 @@ def _ik_all_core(p, g, ref, tol, out):
     """
     for b in range(4):
         out[b, 0] = out[b, 1] = out[b, 2] = _NAN
-    if not (_finite3(p) and _finite3(ref)):
+    if not (_finite_k(px, py, pz) and _finite_k(r0, r1, r2)):
         return _BAD_INPUT, 0.0, 0.0
-    x, t, yz, cyl, clean_a = _target_k(p, g)
+    x, t, yz, cyl, clean_a = _target_k(px, py, pz, g)
     slack = g[_SLACK] - REACH_TOL + tol  # the ideal structure's deviation bound, plus tol
     if cyl > slack:
         return _UNREACHABLE, cyl, _IN_CYLINDER
@@ -268,14 +275,15 @@ def _ik_all_core(p, g, ref, tol, out):
         # within the slack of the ideal structure's boundary: kept only if the exact foot error is <= tol
         check = cyl > tol or miss > tol
         for ik in range(2):
-            q3 = _knee_k(g, ik, acb)
-            j1, j2, j3, res = _settle_k(p, g, q1, _hip_k(g, ik, wx, wy, c), q3, clean_a and clean_w and not check)
-            if check and res > tol:  # clamped onto the ideal structure's boundary, and missing the target
-                if cyl <= tol and res < best:
-                    best, why = res, reason
-                continue
-            b = 2 * ia + ik
-            out[b, 0], out[b, 1], out[b, 2] = _near_k(j1, ref[0]), _near_k(j2, ref[1]), _near_k(j3, ref[2])
+            j1, j2, j3 = q1, _hip_k(g, ik, wx, wy, c), _knee_k(g, ik, acb)
+            if not (clean_a and clean_w and not check):  # (a call with arrays costs their reference counts)
+                j1, j2, j3, res = _settle_k(px, py, pz, g, j1, j2, j3)
+                if check and res > tol:  # clamped onto the ideal structure's boundary, and missing the target
+                    if cyl <= tol and res < best:
+                        best, why = res, reason
+                    continue
+            b = (2 * ia + ik) ^ flip
+            out[b, 0], out[b, 1], out[b, 2] = _near_k(j1, r0), _near_k(j2, r1), _near_k(j3, r2)
             found += 1
     if found == 0:
         return _UNREACHABLE, best, why
@@ -286,7 +294,16 @@ def _ik_all_core(p, g, ref, tol, out):
 def _within_k(a, r, lo, hi, tol):
     """The representative ``a + 2 pi n`` inside ``[lo, hi]`` (slack ``tol``, then clipped) nearest ``r``; NaN if
     none. Also returns the distance to the limits of the nearest representative (0 when inside) and whether the
-    one returned was clipped."""
+    one returned was clipped. Limits narrower than 2 pi - 2 ``tol`` hold one representative at most: ``a`` itself
+    when it lies inside (returned as it is), none when ``a`` lies in a gap between the window ``[lo - tol, hi +
+    tol]`` and its copy 2 pi away (NaN and the distance to the nearer copy, no ``floor``)."""
+    if hi - lo < _TWO_PI - 2.0 * tol:
+        if a >= lo and a <= hi:
+            return a, 0.0, False
+        if a > hi + tol and a < lo - tol + _TWO_PI:
+            return _NAN, min(a - hi, lo + _TWO_PI - a), False
+        if a < lo - tol and a > hi + tol - _TWO_PI:
+            return _NAN, min(lo - a, a + _TWO_PI - hi), False
     rc = lo if r < lo else (hi if r > hi else r)
     base = _near_k(a, rc)
     best, dist, miss, clipped = _NAN, math.inf, math.inf, False
@@ -310,15 +327,15 @@ def _in_limits_k(a, r, lo, hi):
 
 
 @kernel
-def _repair_k(p, g, q, ref) -> bool:
+def _repair_k(px, py, pz, g, q, r0, r1, r2) -> bool:
     """A branch ``q`` (3,) at most :data:`LIMIT_SLACK` outside the limits, moved into them (rare path): each angle
-    at its representative nearest ``ref`` clipped onto the limits, the joints left alone re-solved by
+    at its representative nearest ``ref = (r0, r1, r2)`` clipped onto the limits, the joints left alone re-solved by
     :func:`_polish_k` with the clipped ones fixed (a joint the steps push outside is clipped and fixed in turn, as
     when a target is made with two joints on their limits); kept (True, ``q`` overwritten) if it reproduces ``p``
     within :data:`REACH_TOL`. Near the abduction singularity (foot on the cylinder ``r = |d|``) a branch's q1 errs
     by up to ~1e-8 rad along the singular direction while its foot is exact: a target made with q1 on its limit
     then comes back outside it, and the other joints absorb the clip."""
-    fixed = 0
+    fixed, ref = 0, (r0, r1, r2)
     for j in range(3):
         lo, hi = g[_LO + j], g[_HI + j]
         x = _near_k(q[j], lo if ref[j] < lo else (hi if ref[j] > hi else ref[j]))
@@ -331,7 +348,7 @@ def _repair_k(p, g, q, ref) -> bool:
             fixed |= 1 << j
         q[j] = x
     for _ in range(3):  # a free joint the steps push outside its limits is clipped and fixed in turn
-        q[0], q[1], q[2], res = _polish_k(p, g, q[0], q[1], q[2], fixed)
+        q[0], q[1], q[2], res = _polish_k(px, py, pz, g, q[0], q[1], q[2], fixed)
         inside = True
         for j in range(3):
             lo, hi = g[_LO + j], g[_HI + j]
@@ -345,21 +362,22 @@ def _repair_k(p, g, q, ref) -> bool:
 
 
 @kernel
-def _accept_k(p, g, j1, j2, j3, ref):
-    """A polished branch ``(j1, j2, j3)`` put inside the limits: each angle at its representative inside them
-    nearest ``ref``; a branch up to :data:`LIMIT_SLACK` outside is moved into them by :func:`_repair_k` (rare
-    path), failing that one up to :data:`LIMIT_TOL` outside is kept clipped onto them. Returns ``(ok, violation,
-    x1, x2, x3)``: whether it is kept, by how much (rad) it was outside, and the angles kept."""
-    x0, m0 = _in_limits_k(j1, ref[0], g[_LO], g[_HI])
-    x1, m1 = _in_limits_k(j2, ref[1], g[_LO + 1], g[_HI + 1])
-    x2, m2 = _in_limits_k(j3, ref[2], g[_LO + 2], g[_HI + 2])
+def _accept_k(px, py, pz, g, j1, j2, j3, r0, r1, r2):
+    """A polished branch ``(j1, j2, j3)`` of the target ``(px, py, pz)`` put inside the limits: each angle at its
+    representative inside them nearest ``(r0, r1, r2)``; a branch up to :data:`LIMIT_SLACK` outside is moved into
+    them by :func:`_repair_k` (rare path), failing that one up to :data:`LIMIT_TOL` outside is kept clipped onto
+    them. Returns ``(ok, violation, x1, x2, x3)``: whether it is kept, by how much (rad) it was outside, and the
+    angles kept."""
+    x0, m0 = _in_limits_k(j1, r0, g[_LO], g[_HI])
+    x1, m1 = _in_limits_k(j2, r1, g[_LO + 1], g[_HI + 1])
+    x2, m2 = _in_limits_k(j3, r2, g[_LO + 2], g[_HI + 2])
     m = max(m0, max(m1, m2))
     if m > LIMIT_SLACK:
         return False, m, x0, x1, x2
     if m > 0.0:  # a hair outside the limits: moved into them, the free joints re-solved (rare path)
         qr = np.empty(3)  # the rare path allocates its own scratch
         qr[0], qr[1], qr[2] = j1, j2, j3
-        if _repair_k(p, g, qr, ref):
+        if _repair_k(px, py, pz, g, qr, r0, r1, r2):
             return True, m, qr[0], qr[1], qr[2]
         if not (np.isfinite(x0) and np.isfinite(x1) and np.isfinite(x2)):
             return False, m, x0, x1, x2
@@ -367,29 +385,29 @@ def _accept_k(p, g, j1, j2, j3, ref):
 
 
 @kernel
-def _ik_every_k(p, g, ref, tol, out):
+def _ik_every_k(px, py, pz, g, r0, r1, r2, tol):
     """:func:`_ik_core`'s complete path: every branch of :func:`_ik_all_core` (all polished) put inside the limits
-    by :func:`_accept_k`, the one nearest ``ref`` kept (least sum of squared joint differences; ties to the earlier
-    branch). Returns ``(status, info0, info1)``: the miss (m) and reason, or the least limit violation (rad) and
-    the number of geometric branches."""
+    by :func:`_accept_k`, the one nearest ``ref = (r0, r1, r2)`` kept (least sum of squared joint differences; ties
+    to the earlier branch). Returns ``(status, info0, info1, q1, q2, q3)``: the miss (m) and reason, or the least
+    limit violation (rad) and the number of geometric branches; the angles (NaN unless solved)."""
     qa = np.empty((4, 3))  # the rare path allocates
-    status, i0, i1 = _ik_all_core(p, g, ref, tol, qa)
+    status, i0, i1 = _ik_all_core(px, py, pz, g, r0, r1, r2, tol, qa, 0)
     if status != OK:
-        return status, i0, i1
+        return status, i0, i1, _NAN, _NAN, _NAN
     best, viol, nb = math.inf, math.inf, 0
+    y0 = y1 = y2 = _NAN
     for b in range(4):
         if not np.isfinite(qa[b, 0]):
             continue
         nb += 1
-        ok, m, x0, x1, x2 = _accept_k(p, g, qa[b, 0], qa[b, 1], qa[b, 2], ref)
+        ok, m, x0, x1, x2 = _accept_k(px, py, pz, g, qa[b, 0], qa[b, 1], qa[b, 2], r0, r1, r2)
         viol = min(viol, m)
-        cost = (x0 - ref[0]) ** 2 + (x1 - ref[1]) ** 2 + (x2 - ref[2]) ** 2
+        cost = (x0 - r0) ** 2 + (x1 - r1) ** 2 + (x2 - r2) ** 2
         if ok and cost < best:
-            best = cost
-            out[0], out[1], out[2] = x0, x1, x2
+            best, y0, y1, y2 = cost, x0, x1, x2
     if best == math.inf:
-        return _JOINT_LIMIT, viol, float(nb)
-    return OK, 0.0, 0.0
+        return _JOINT_LIMIT, viol, float(nb), _NAN, _NAN, _NAN
+    return OK, 0.0, 0.0, y0, y1, y2
 
 
 @kernel
@@ -426,8 +444,10 @@ def _no_candidate_k(g, x, t, cyl, tol, slack, clean_a):
 
 
 @kernel
-def _ik_core(p, g, ref, tol, out):
-    """The branch of :func:`_ik_all_core` inside the limits nearest ``ref``, limits first, into ``out`` (3,).
+def _ik_core(px, py, pz, g, r0, r1, r2, tol):
+    """The branch of :func:`_ik_all_core` inside the limits nearest ``ref = (r0, r1, r2)``, limits first, for the
+    target ``(px, py, pz)`` (scalars, as every kernel on the common path: a call passing arrays costs their
+    reference counts).
 
     The fast path computes the closed form of each branch with scalars only, joint by joint in the order q1, q3,
     q2, and drops a branch as soon as a joint's representative nearest ``ref`` is more than
@@ -435,12 +455,11 @@ def _ik_core(p, g, ref, tol, out):
     only the best candidate is polished (:func:`_settle_k`, unless well-conditioned) and put inside the limits
     (:func:`_accept_k`). When it fails (no candidate, a branch off the ideal structure's reach, a polish leaving
     the limits) the complete path :func:`_ik_every_k` decides (every branch polished; the failure's data). Ties go
-    to the earlier branch (costs of the closed-form angles before the polish). Returns ``(status, info0, info1)`` as
-    :func:`_ik_every_k`."""
-    out[0] = out[1] = out[2] = _NAN
-    if not (_finite3(p) and _finite3(ref)):
-        return _BAD_INPUT, 0.0, 0.0
-    x, t, yz, cyl, clean_a = _target_k(p, g)
+    to the earlier branch (costs of the closed-form angles before the polish). Returns ``(status, info0, info1, q1,
+    q2, q3)`` as :func:`_ik_every_k`."""
+    if not (_finite_k(px, py, pz) and _finite_k(r0, r1, r2)):
+        return _BAD_INPUT, 0.0, 0.0, _NAN, _NAN, _NAN
+    x, t, yz, cyl, clean_a = _target_k(px, py, pz, g)
     slack = g[_SLACK] - REACH_TOL + tol
     best, c1, c2, c3, check, clean, inside = math.inf, 0.0, 0.0, 0.0, False, False, False
     y0 = y1 = y2 = 0.0
@@ -451,8 +470,8 @@ def _ik_core(p, g, ref, tol, out):
         if not _on_arc_k(g, vc, vs):  # q1 off the limits (by more than ARC_SLACK): no atan2
             continue
         q1 = math.atan2(vs, vc)
-        x0, m0, k0 = _within_k(q1, ref[0], g[_LO], g[_HI], CANDIDATE_SLACK)
-        cost0 = (x0 - ref[0]) ** 2
+        x0, m0, k0 = _within_k(q1, r0, g[_LO], g[_HI], CANDIDATE_SLACK)
+        cost0 = (x0 - r0) ** 2
         if m0 > CANDIDATE_SLACK or not cost0 < best:
             continue
         if not pitched or g[_H] != 0.0:  # h_X = 0: |w|, so the knee, is the same on both abduction branches
@@ -463,46 +482,59 @@ def _ik_core(p, g, ref, tol, out):
             continue
         for ik in range(2):
             q3 = _knee_k(g, ik, acb)
-            x2, m2, k2 = _within_k(q3, ref[2], g[_LO + 2], g[_HI + 2], CANDIDATE_SLACK)
-            cost = cost0 + (x2 - ref[2]) ** 2
+            x2, m2, k2 = _within_k(q3, r2, g[_LO + 2], g[_HI + 2], CANDIDATE_SLACK)
+            cost = cost0 + (x2 - r2) ** 2
             if m2 > CANDIDATE_SLACK or not cost < best:
                 continue
             q2 = _hip_k(g, ik, wx, wy, c)
-            x1, m1, k1 = _within_k(q2, ref[1], g[_LO + 1], g[_HI + 1], CANDIDATE_SLACK)
-            cost += (x1 - ref[1]) ** 2
+            x1, m1, k1 = _within_k(q2, r1, g[_LO + 1], g[_HI + 1], CANDIDATE_SLACK)
+            cost += (x1 - r1) ** 2
             if m1 <= CANDIDATE_SLACK and cost < best:
                 best, c1, c2, c3, y0, y1, y2 = cost, q1, q2, q3, x0, x1, x2
                 check = cyl > tol or miss > tol
                 clean = clean_a and clean_w and not check
                 inside = m0 == 0.0 and m1 == 0.0 and m2 == 0.0 and not (k0 or k1 or k2)
     if clean and inside:  # well-conditioned, strictly inside the limits: the representatives found are the answer
-        out[0], out[1], out[2] = y0, y1, y2
-        return OK, 0.0, 0.0
+        return OK, 0.0, 0.0, y0, y1, y2
     if best == math.inf:  # no candidate: decided here when it is clear (_no_candidate_k), else the complete path
         status, i0, i1 = _no_candidate_k(g, x, t, cyl, tol, slack, clean_a)
         if status != OK:
-            return status, i0, i1
+            return status, i0, i1, _NAN, _NAN, _NAN
     else:
-        j1, j2, j3, res = _settle_k(p, g, c1, c2, c3, clean)
+        j1, j2, j3, res = (c1, c2, c3, 0.0) if clean else _settle_k(px, py, pz, g, c1, c2, c3)
         if res <= tol or not check:
-            ok, _m, x0, x1, x2 = _accept_k(p, g, j1, j2, j3, ref)
+            ok, _m, x0, x1, x2 = _accept_k(px, py, pz, g, j1, j2, j3, r0, r1, r2)
             if ok:
-                out[0], out[1], out[2] = x0, x1, x2
-                return OK, 0.0, 0.0
-    return _ik_every_k(p, g, ref, tol, out)
+                return OK, 0.0, 0.0, x0, x1, x2
+    return _ik_every_k(px, py, pz, g, r0, r1, r2, tol)
 
 
 @kernel(entry=True)
-def _ik_all_k(p, g, ref, out) -> int:
-    """:func:`_ik_all_core` of one target with the default ``tol`` (the single call; one argument fewer for numba's
-    dispatch): its status."""
-    return _ik_all_core(p, g, ref, IK_TOL, out)[0]
+def _ik_all_k(p, g, flip, out) -> int:
+    """:func:`_ik_all_core` of one target with the default ``tol`` and reference (:data:`_REF`: a single call,
+    one argument fewer for numba), rows in the order ``flip`` gives: its status."""
+    return _ik_all_core(p[0], p[1], p[2], g, g[_REF], g[_REF + 1], g[_REF + 2], IK_TOL, out, flip)[0]
 
 
 @kernel(entry=True)
-def _ik_k(p, g, ref, out) -> int:
-    """:func:`_ik_core` of one target with the default ``tol`` (the single call): its status."""
-    return _ik_core(p, g, ref, IK_TOL, out)[0]
+def _ik_all_near_k(p, g, ref, flip, out) -> int:
+    """:func:`_ik_all_k` with the reference ``ref`` (3,)."""
+    return _ik_all_core(p[0], p[1], p[2], g, ref[0], ref[1], ref[2], IK_TOL, out, flip)[0]
+
+
+@kernel(entry=True)
+def _ik_k(p, g, out) -> int:
+    """:func:`_ik_core` of one target with the default ``tol`` and reference (:data:`_REF`) into ``out``: its
+    status."""
+    s, _a, _b, out[0], out[1], out[2] = _ik_core(p[0], p[1], p[2], g, g[_REF], g[_REF + 1], g[_REF + 2], IK_TOL)
+    return s
+
+
+@kernel(entry=True)
+def _ik_near_k(p, g, ref, out) -> int:
+    """:func:`_ik_k` with the reference ``ref`` (3,)."""
+    s, _a, _b, out[0], out[1], out[2] = _ik_core(p[0], p[1], p[2], g, ref[0], ref[1], ref[2], IK_TOL)
+    return s
 
 
 @batch_kernel(rows="p ref out status info", min_parallel=512, parfor=True)
@@ -511,7 +543,8 @@ def _ik_all_batch(p, g, ref, tol, out, status, info) -> int:
     # ref: one row for all targets (m = 1) or one per target; ``i - i`` keeps the index type of i
     n, m, bad = p.shape[0], ref.shape[0], 0
     for i in prange(n):
-        s, a, b = _ik_all_core(p[i], g, ref[i if m > 1 else i - i], tol, out[i])
+        j = i if m > 1 else i - i
+        s, a, b = _ik_all_core(p[i, 0], p[i, 1], p[i, 2], g, ref[j, 0], ref[j, 1], ref[j, 2], tol, out[i], 0)
         status[i], info[i, 0], info[i, 1] = s, a, b
         bad += s != OK
     return bad
@@ -519,10 +552,15 @@ def _ik_all_batch(p, g, ref, tol, out, status, info) -> int:
 
 @batch_kernel(rows="p ref out status info", min_parallel=1024, parfor=True)
 def _ik_batch(p, g, ref, tol, out, status, info) -> int:
-    """:func:`_ik_core` over rows; returns the number of targets that failed (status != OK)."""
+    """:func:`_ik_core` over rows; returns the number of targets that failed (status != OK), NaN rows in ``out``.
+    ``status`` and ``info`` with no row: not recorded (a caller that needs neither allocates neither)."""
     n, m, bad = p.shape[0], ref.shape[0], 0
+    record = status.shape[0] == n
     for i in prange(n):
-        s, a, b = _ik_core(p[i], g, ref[i if m > 1 else i - i], tol, out[i])
-        status[i], info[i, 0], info[i, 1] = s, a, b
+        j = i if m > 1 else i - i
+        s, a, b, out[i, 0], out[i, 1], out[i, 2] = _ik_core(p[i, 0], p[i, 1], p[i, 2], g, ref[j, 0], ref[j, 1],
+                                                            ref[j, 2], tol)
+        if record:
+            status[i], info[i, 0], info[i, 1] = s, a, b
         bad += s != OK
     return bad

@@ -65,7 +65,8 @@ _CD, _SD = 50, 51  # cos, sin (phi_k - phi_l): the knee's offset angle (the hip 
 #: (_WHOLE, _NARROW: shorter than pi, _WIDE: from pi to 2 pi); the limits-first IK drops an abduction branch whose
 #: q1 lies off the arc before computing the angle (two cross products instead of an atan2).
 _ARC = 52
-_NPARAMS = 57
+_REF = 57  # q_ref (3): the default reference of Leg.ik / Leg.ik_all (a single call passes no reference array)
+_NPARAMS = 60
 _WHOLE, _NARROW, _WIDE = 0.0, 1.0, 2.0
 
 _TWO_PI = 2.0 * math.pi

@@ -26,13 +26,11 @@ import numpy.typing as npt
 
 from .._batch import check_flag, check_number
 from .._kernels import OK
-from ..legs._fk_kernels import _fk_k, _jacobian_k
-from ..legs._ik_kernels import _ik_all_k, _ik_k
-from ..legs.kinematics import Leg, _vector3
+from ..legs.kinematics import _FK, _IK, _IK_ALL, _IK_NEAR, _JACOBIAN, Leg, _vector3
 from . import constants as _constants
 from ._common import foot_z_of, leg_index, rows
 from .constants import *  # noqa: F403 - the quadruped's constants (LEGS, JOINT_LIMITS, X01, ...), re-exported
-from .constants import JOINT_LIMITS, LEGS, LIMIT_TOL
+from .constants import JOINT_LIMITS, LIMIT_TOL
 from .geometry import DEFAULT_GEOMETRY, Geometry
 from .measured import CACHE_SIZE, SEED_ORDER, legs
 from .textbook import textbook_frame, textbook_ik, textbook_to_joints
@@ -48,31 +46,34 @@ _LO, _HI = tuple(JOINT_LIMITS[:, 0].tolist()), tuple(JOINT_LIMITS[:, 1].tolist()
 _REVERSED = np.array((3, 2, 1, 0))
 #: Per leg, the rows of Leg.ik_all in seed 004's order (the left legs' is reversed: that array itself, a slice serves).
 _ORDER = {leg: _REVERSED if order == (3, 2, 1, 0) else np.array(order) for leg, order in SEED_ORDER.items()}
+#: The same order as the kernels' ``flip`` (seed row ``s`` holds Leg row ``s ^ flip``): the single call's kernel
+#: writes its rows in seed order (a slice or ``take`` of its answer would cost ~150 ns of a ~1 us call).
+_FLIP = {leg: order[0] for leg, order in SEED_ORDER.items()}  # (3, 2, 1, 0): 3, (1, 0, 3, 2): 1
 
 
 #: The default geometry's measured legs by name, once measured (the single calls' look-up: one dict access).
 _DEFAULT: dict[str, Leg] = {}
-#: Their kernels' arrays by leg name, ``(params, q_ref)``: the single-call fast paths below call the compiled
-#: kernels of :class:`~legkin.legs.Leg` directly (one Python call fewer: ~100-200 ns of a ~1 us call).
-_KERNEL_ARGS: dict[str, tuple[np.ndarray, np.ndarray]] = {}
-#: The same for other geometries, by ``(leg, foot_z)`` (as many as :func:`legs` keeps).
-_KERNEL_ARGS_OF: dict[tuple[str, float], tuple[np.ndarray, np.ndarray]] = {}
+#: Their kernels' arguments by leg name, ``(params, q_ref, flip)``: the single-call fast paths below call the
+#: compiled kernels of :class:`~legkin.legs.Leg` directly (one Python call fewer: ~100-200 ns of a ~1 us call).
+_KERNEL_ARGS: dict[str, tuple[np.ndarray, np.ndarray, int]] = {}
+#: The same for other geometries, by ``foot_z`` then leg name (as many as :func:`legs` keeps; two look-ups: no key
+#: tuple to build and hash).
+_KERNEL_ARGS_OF: dict[float, dict[str, tuple[np.ndarray, np.ndarray, int]]] = {}
 _F64, _S3, _ND = np.dtype(np.float64), (3,), np.ndarray
 
 
-def _kernel_args(leg: object, geometry: object) -> tuple[np.ndarray, np.ndarray] | None:
-    """The kernel arrays ``(params, q_ref)`` of ``leg`` for a :class:`Geometry` (measured on first use), or None
-    (a bad leg or geometry: the general path then raises its error)."""
-    if leg.__class__ is not str or leg not in LEGS or geometry.__class__ is not Geometry:
+def _kernel_args(leg: object, geometry: object) -> tuple[np.ndarray, np.ndarray, int] | None:
+    """The kernel arguments ``(params, q_ref, flip)`` of ``leg`` for a :class:`Geometry` (measured on first use), or
+    None (a bad leg or geometry: the general path then raises its error)."""
+    if geometry.__class__ is not Geometry:
         return None
-    key = (leg, geometry.foot_z)  # type: ignore[attr-defined]
-    found = _KERNEL_ARGS_OF.get(key)
+    found = _KERNEL_ARGS_OF.get(geometry.foot_z)  # type: ignore[attr-defined]
     if found is None:
-        one = legs(geometry)[leg]  # type: ignore[arg-type]
-        if len(_KERNEL_ARGS_OF) >= 4 * CACHE_SIZE:  # a sweep over foot_z: keep the memory bounded
+        if len(_KERNEL_ARGS_OF) >= CACHE_SIZE:  # a sweep over foot_z: keep the memory bounded
             _KERNEL_ARGS_OF.clear()
-        found = _KERNEL_ARGS_OF[key] = (one.params, one.q_ref.copy())
-    return found
+        found = _KERNEL_ARGS_OF[geometry.foot_z] = {  # type: ignore[attr-defined]
+            name: (one._g, one._ref, _FLIP[name]) for name, one in legs(geometry).items()}  # type: ignore[arg-type]
+    return found.get(leg) if leg.__class__ is str else None  # type: ignore[call-overload]
 
 
 def _leg(leg: object, geometry: Geometry | None) -> Leg:
@@ -84,7 +85,7 @@ def _leg(leg: object, geometry: Geometry | None) -> Leg:
     found = legs(geometry)
     if geometry is None:
         _DEFAULT.update(found)
-        _KERNEL_ARGS.update({name: (one.params, one.q_ref.copy()) for name, one in found.items()})
+        _KERNEL_ARGS.update({name: (one._g, one._ref, _FLIP[name]) for name, one in found.items()})
     try:
         return found[leg]  # type: ignore[index]
     except (KeyError, TypeError):
@@ -133,7 +134,7 @@ def fk(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
     """
     if return_mask is False and q.__class__ is _ND and q.shape == _S3 and q.dtype is _F64:
         args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
-        if args is not None and _fk_k(q, args[0], out := np.empty(3)) == OK:
+        if args is not None and _FK.call(q, args[0], out := np.empty(3)) == OK:
             return out
     x = _leg(leg, geometry).fk(q)
     return x if return_mask is False else _with_mask(x, 1, return_mask)
@@ -166,7 +167,7 @@ def jacobian(q: npt.ArrayLike, leg: str, *, geometry: Geometry | None = None,
     """
     if return_mask is False and q.__class__ is _ND and q.shape == _S3 and q.dtype is _F64:
         args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
-        if args is not None and _jacobian_k(q, args[0], out := np.empty((3, 3))) == OK:
+        if args is not None and _JACOBIAN.call(q, args[0], out := np.empty((3, 3))) == OK:
             return out
     x = _leg(leg, geometry).jacobian(q)
     return x if return_mask is False else _with_mask(x, 2, return_mask)
@@ -215,7 +216,7 @@ def ik(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = None, 
         args = ref = None
     if args is not None and ref is not None:
         out = np.empty(3)
-        if _ik_k(p, args[0], ref, out) == OK:
+        if (_IK.call(p, args[0], out) if q_near is None else _IK_NEAR.call(p, args[0], ref, out)) == OK:
             return out
     return _leg(leg, geometry).ik(target, q_near=q_near, return_mask=return_mask)  # type: ignore[no-any-return]
 
@@ -259,8 +260,8 @@ def ik_all(target: npt.ArrayLike, leg: str, *, q_near: npt.ArrayLike | None = No
         args = _KERNEL_ARGS.get(leg) if geometry is None and leg.__class__ is str else _kernel_args(leg, geometry)
         if args is not None:
             out = np.empty((4, 3))
-            if _ik_all_k(p, args[0], args[1], out) == OK:
-                return out[::-1] if _ORDER[leg] is _REVERSED else out.take(_ORDER[leg], axis=0)
+            if _IK_ALL.call(p, args[0], args[2], out) == OK:
+                return out
     found = _leg(leg, geometry)
     order = _ORDER[leg]
     if not (return_mask if return_mask is False or return_mask is True else _flag(return_mask)):

@@ -19,7 +19,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .._benchkit import SOLVE_TOL, Method, MethodResult, ModelBench, Score, missing, rotation_error, sizes
-from .bench import _LegFrame
+from ._benchframe import _LegFrame
 
 __all__ = ["build6", "CLIK_MAX_ITER", "CLIK_DAMPING"]
 

@@ -713,6 +713,27 @@ def test_tol_bounds_the_nearest_point_solution(erd):
         fl.ik(out, tol=-1.0)
 
 
+def test_an_exact_branch_beats_a_clamped_one():
+    """bolt's legs have h_X != 0, so their two abduction branches reach different sets: a target that one reaches
+    exactly can lie within the default tol (1e-7 m) outside the other's reach. That branch's nearest reachable
+    point (a straight knee, 9.2e-9 m off) was returned as a solution and picked by ``ik`` (``legkin check bolt
+    --random-seed 12 --samples 1000``); now only exact branches are, and every row reproduces the target."""
+    model = legs.load_erd("bolt")[0]
+    fr = legs.from_model(model)["FR"]
+    q = np.array([-2.1967784400339907, -8.031564439602102, 0.22872995395444917])
+    p = fr.fk(q)
+    sol, mask = fr.ik_all(p, return_mask=True)
+    assert np.linalg.norm(fr.fk(sol[mask]) - p, axis=-1).max() <= TOL
+    assert np.linalg.norm(fr.fk(fr.ik(p)) - p) <= TOL
+    rng = np.random.default_rng(5)
+    for leg in legs.from_model(model).values():
+        q = rng.uniform(leg.lower, leg.upper, (50_000, 3))
+        p = leg.fk(q)
+        sol, mask = leg.ik_all(p, return_mask=True)
+        assert np.linalg.norm(leg.fk(sol[mask]) - p[np.nonzero(mask)[0]], axis=-1).max() <= TOL
+        assert np.linalg.norm(leg.fk(leg.ik(p)) - p, axis=-1).max() <= TOL
+
+
 def test_quadruped_legs_named_by_hip_position_when_joint_names_share_no_prefix():
     """Joints named '0' ... '11' (no common prefix): the legs are FL, FR, RL, RR from the hips' signs of x and y."""
     model = pin.Model()

@@ -244,8 +244,9 @@ def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out, flip):
     ``q3 = s3 (beta - phi_l + phi_k)``, ``q2 = atan2(w) - atan2(k + Rot(s3 q3) l)``. Each branch is then
     polished on the exact forward map (:func:`_settle_k`) and each angle moved to its 2 pi representative
     nearest ``ref``. A target up to ``tol`` (m) outside the reachable set is solved at its nearest reachable point
-    (the clamped closed form, polished). Returns ``(status, miss, reason)``: on failure the miss (m) and its
-    reason.
+    (the clamped closed form, polished); a branch clamped onto its reach is dropped when the other abduction branch
+    reaches the target exactly (:func:`_drop_projected_k`). Returns ``(status, miss, reason)``: on failure the
+    miss (m) and its reason.
     """
     for b in range(4):
         out[b, 0] = out[b, 1] = out[b, 2] = _NAN
@@ -261,6 +262,7 @@ def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out, flip):
     found = 0
     pitched, far, clean_w = False, False, False  # the pitch-plane quantities computed (for one abduction branch)
     wx = wy = miss = c = acb = 0.0
+    written, projected, exact = 0, 0, False  # bits of the abduction branches written / clamped onto the reach
     for ia in range(2):
         u3, q1 = _abduction_k(g, ia, t, yz)
         if not pitched or g[_H] != 0.0:  # h_X = 0: |w|, so the knee, is the same on both abduction branches
@@ -285,9 +287,32 @@ def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out, flip):
             b = (2 * ia + ik) ^ flip
             out[b, 0], out[b, 1], out[b, 2] = _near_k(j1, r0), _near_k(j2, r1), _near_k(j3, r2)
             found += 1
+            written |= 1 << ia
+            if miss > g[_SLACK]:
+                projected |= 1 << ia
+            else:
+                exact = True
+    if exact and projected:  # an exact branch beats a clamped one (h_X != 0: the branches' reaches differ)
+        found -= _drop_projected_k(out, written & projected, flip)
     if found == 0:
         return _UNREACHABLE, best, why
     return OK, 0.0, 0.0
+
+
+@kernel
+def _drop_projected_k(out, bits, flip) -> int:
+    """NaN the rows of the abduction branches in ``bits`` (bit ``ia``): a target that one abduction branch reaches
+    exactly is not solved by the other's nearest reachable point (with ``h_X != 0`` their reaches differ, and a
+    target on one's boundary lies up to ``tol`` outside the other's). Returns the number of rows cleared."""
+    n = 0
+    for ia in range(2):
+        if bits & (1 << ia):
+            for ik in range(2):
+                b = (2 * ia + ik) ^ flip
+                if out[b, 0] == out[b, 0]:
+                    n += 1
+                out[b, 0] = out[b, 1] = out[b, 2] = _NAN
+    return n
 
 
 @kernel(inline=True)
@@ -461,7 +486,7 @@ def _ik_core(px, py, pz, g, r0, r1, r2, tol):
         return _BAD_INPUT, 0.0, 0.0, _NAN, _NAN, _NAN
     x, t, yz, cyl, clean_a = _target_k(px, py, pz, g)
     slack = g[_SLACK] - REACH_TOL + tol
-    best, c1, c2, c3, check, clean, inside = math.inf, 0.0, 0.0, 0.0, False, False, False
+    best, c1, c2, c3, check, clean, inside, clamped = math.inf, 0.0, 0.0, 0.0, False, False, False, False
     y0 = y1 = y2 = 0.0
     pitched, clean_w = False, False  # the pitch-plane quantities computed (for one abduction branch)
     wx = wy = miss = c = acb = 0.0
@@ -491,9 +516,12 @@ def _ik_core(px, py, pz, g, r0, r1, r2, tol):
             cost += (x1 - r1) ** 2
             if m1 <= CANDIDATE_SLACK and cost < best:
                 best, c1, c2, c3, y0, y1, y2 = cost, q1, q2, q3, x0, x1, x2
+                clamped = miss > g[_SLACK]
                 check = cyl > tol or miss > tol
                 clean = clean_a and clean_w and not check
                 inside = m0 == 0.0 and m1 == 0.0 and m2 == 0.0 and not (k0 or k1 or k2)
+    if clamped and g[_H] != 0.0:  # clamped onto its reach: the other abduction branch may reach exactly
+        return _ik_every_k(px, py, pz, g, r0, r1, r2, tol)
     if clean and inside:  # well-conditioned, strictly inside the limits: the representatives found are the answer
         return OK, 0.0, 0.0, y0, y1, y2
     if best == math.inf:  # no candidate: decided here when it is clear (_no_candidate_k), else the complete path

@@ -23,18 +23,34 @@ On the offset hip every quantity of one point is ``X_0 + X_c cos t + X_s sin t``
 (:func:`_off_prepare`) and the subproblems' roots are taken as cosine/sine pairs: a point costs one cosine, one sine
 and a few square roots for all 4 branches, no allocation.
 
-The search (:data:`SEARCH_GRID` points by structure): every sign change of ``r_b`` between two grid points is
-bracketed and refined by the Illinois method to 1e-15 rad; where ``|r_b|`` dips at a grid point without a sign
-change, Brent's minimisation finds the dip's extremum: two close roots are bracketed on its sides, a tangential root
-(``|r| <=`` :data:`TANGENT_TOL`) kept. Where a branch stops existing (a *fold*, where g1's knee nears full stretch
-and two branches meet; found by the Illinois method on the existence margin), the residual moves like
-``sqrt(|t - f|)``: the piece from the fold to the grid point is searched on :data:`_FOLD_CELLS` cells of
-quadratically growing width, with a dip at the fold. A bracket that holds a gap of its branch is split at the gap's
-folds; and where the margin peaks near zero between three grid points (an *island* where the branch exists, or a
-*hole* where it does not; the parabola through the three margins decides), Brent's method finds it and the pieces
-from its folds are searched.
+The search (:data:`SEARCH_GRID` points by structure). No root may be missed, so every cell between two grid
+points is *settled* by a bound, not by its end values alone. On a cell ``[a, b]`` of width ``w`` where
+``|r_b''| <= M``: the chord's slope ``(r(b) - r(a)) / w`` is ``r_b'`` somewhere, so ``|r(b) - r(a)| > M w^2`` keeps
+``r_b'`` from vanishing (one root if the signs differ, none if not), and ``min(|r(a)|, |r(b)|) > M w^2 / 8`` with
+equal signs leaves none (the chord minus the parabola of curvature ``M``). ``M`` is ``S`` =
+:data:`CURVATURE_SAFETY` times the larger second difference at the cell's ends, over ``w^2``: exact with ``S = 1``
+for a cubic, whose ``r''`` is linear (so largest at an end) and equals its centred second difference; with ``S``,
+``M`` bounds ``|r''|`` whenever ``w^2 |r''''| <= 24 (S - 1) / (2 S + 3) max(|r''(a)|, |r''(b)|)`` on the cell
+(3.4 for ``S = 2``: ``r''`` strays from its chord by ``<= w^2 |r''''| / 8``, the second difference from ``r''`` by
+``<= w^2 |r''''| / 12``). A cell the bound does not settle is halved, each half's ``M`` the larger of the parent's
+and ``S`` times its own second difference, down to :data:`_MIN_CELL`. That catches what values alone miss: three
+roots of a branch within one or two cells (g1, a pose near a cusp of its solutions), two roots in a cell of equal
+signs. Sign changes are refined by the Illinois method to 1e-15 rad.
+
+Where a branch stops existing (a *fold*, where g1's knee nears full stretch and two branches meet; found by the
+Illinois method on the existence margin), the residual moves like ``sqrt(|t - f|)``, whose derivatives have no
+bound; in ``u`` with ``t = f + (t_g - f) u^2`` it is smooth, so the piece from the fold to the grid point ``t_g``
+beyond the next is searched as above on :data:`_FOLD_CELLS` cells equally spaced in ``u`` (the fold itself a
+candidate where the residual nearly vanishes there). Islands (the branch exists between grid points only) and holes
+(it stops existing between them) are found where the existence margin's parabola through three grid points comes
+near zero, by Brent's minimisation of the margin, and searched from their folds.
 Every candidate is then polished on the exact forward map and kept only if it reproduces the target
 (:mod:`._ik6_kernels`).
+
+The bound rests on that condition on the residual's fourth derivative, which the search does not verify: it is a
+bound checked by measurement, not a proof for every target. ``python scripts/legs6_completeness.py`` (docs/legs.md):
+the sampled configuration among ``ik_all``'s rows on every random in-limit sample (10^6 per leg of g1, 4x10^5 per
+leg of alexander), where the values alone missed about 1 in 10^5 on g1.
 """
 
 from __future__ import annotations
@@ -49,15 +65,14 @@ from ._sixdof_layout import _GRID, _HIP, _KIND, TANGENT_TOL, THREE_PARALLEL
 from .subproblems import cross, dot, rot, rot_cs, sp1, sp2, sp3
 
 _REFINE_STEPS = 100
-#: The golden-section search of a dip stops at this width (rad): a tangential root's residual is then off by
-#: ~|r''| _DIP_WIDTH^2 / 8, far below :data:`TANGENT_TOL`, and two roots on its sides are bracketed.
+#: Brent's minimisation of an existence margin (an island's peak, a hole's dip) stops at this width (rad).
 _DIP_WIDTH = 1e-8
-#: Cells of the search from a fold to the next grid point (widths growing quadratically, as the sqrt(t - f) of a fold).
+#: Cells of the search from a fold to the grid point beyond the next (equal in u, t = f + span u^2: widths in t growing
+#: quadratically, as the sqrt(t - f) of a fold).
 _FOLD_CELLS = 6
 _NB = 4  # branches at most
-#: A cell's residual is taken to curve at most this many times as much as the second differences at the cell's ends
-#: say (:func:`_cell`): exact for a cubic (its curvature is linear, so largest at an end), the margin covering the
-#: higher terms.
+#: A cell's residual is taken to curve at most this many times as much as the second differences at its ends say
+#: (:func:`_cell`; the module docstring gives the condition on the fourth derivative that makes it a bound).
 CURVATURE_SAFETY = 2.0
 #: A bisection stops at this width (the searched variable's units; rad on the grid): a sign change there is one root
 #: (two roots this close are the same solution to the polish), a residual within TANGENT_TOL a tangential root.

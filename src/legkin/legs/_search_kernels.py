@@ -49,7 +49,7 @@ Every candidate is then polished on the exact forward map and kept only if it re
 
 The bound rests on that condition on the residual's fourth derivative, which the search does not verify: it is a
 bound checked by measurement, not a proof for every target. ``python scripts/legs6_completeness.py`` (docs/legs.md):
-the sampled configuration among ``ik_all``'s rows on every random in-limit sample (10^6 per leg of g1, 4x10^5 per
+the sampled configuration among ``ik_all``'s rows on every random in-limit sample (10^6 per leg of g1, 6x10^5 per
 leg of alexander), where the values alone missed about 1 in 10^5 on g1.
 """
 

@@ -19,8 +19,10 @@ from ._sixdof_layout import (
     _KIND,
     _LO6,
     _NSOLS,
+    _QREF,
     _UNREACHABLE,
     HIP_SPHERICAL,
+    IK_TOL,
     LIMIT_SLACK6,
 )
 
@@ -37,7 +39,7 @@ def _candidates(tg, g, cand) -> int:
     return 0
 
 
-@kernel(entry=True)
+@kernel
 def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
     """Every solution (rows of ``out`` (K, 6), NaN rows for absent ones) of the foot pose ``tg`` (16 floats): the
     candidates of the leg's structure (closed form or search), each polished (:func:`_polish6`) and kept if it
@@ -105,7 +107,7 @@ def _clip_solution(tg, g, q, ref, tol, out, ws) -> bool:
     return False
 
 
-@kernel(entry=True)
+@kernel
 def _ik6_k(tg, g, ref, tol, out, info) -> int:
     """The solution inside the limits nearest ``ref`` (least sum of squared differences): the candidates are ranked
     by that cost first and polished in that order until one reproduces ``tg`` to ``tol`` (its angles then moved
@@ -176,6 +178,33 @@ def _polished_fallback(tg, g, ref, tol, cand, lim, n, best, out, info, ws) -> in
         return _UNREACHABLE
     info[0], info[1] = viol, nb
     return _JOINT_LIMIT
+
+
+@kernel
+def _one(t, g, out, solve_all) -> int:
+    """The single call's fast path of :meth:`Leg6.ik` (``solve_all`` False, ``out`` (6,)) and :meth:`Leg6.ik_all`
+    (``out`` (K, 6)): one pose ``t`` (4, 4) in any memory layout, the leg's ``q_ref`` and the default ``IK_TOL``;
+    ``_BAD_INPUT`` (the wrapper's full checks then say why) for a bad pose or a leg without an IK."""
+    if g[_KIND] == 0.0:
+        return _BAD_INPUT
+    tg, info = np.empty(16), np.empty(2)
+    for i in range(4):
+        for j in range(4):
+            tg[4 * i + j] = t[i, j]
+    ref = g[_QREF:_QREF + 6]
+    return _ik_all6_k(tg, g, ref, IK_TOL, out, info) if solve_all else _ik6_k(tg, g, ref, IK_TOL, out[0], info)
+
+
+@kernel(entry=True)
+def _ik6_one(t, g, out) -> int:
+    """:func:`_one` for :meth:`Leg6.ik`: ``out`` (1, 6)."""
+    return _one(t, g, out, False)
+
+
+@kernel(entry=True)
+def _ik_all6_one(t, g, out) -> int:
+    """:func:`_one` for :meth:`Leg6.ik_all`: ``out`` (K, 6)."""
+    return _one(t, g, out, True)
 
 
 @batch_kernel(rows="tg ref out status info", min_parallel=256)

@@ -23,18 +23,34 @@ On the offset hip every quantity of one point is ``X_0 + X_c cos t + X_s sin t``
 (:func:`_off_prepare`) and the subproblems' roots are taken as cosine/sine pairs: a point costs one cosine, one sine
 and a few square roots for all 4 branches, no allocation.
 
-The search (:data:`SEARCH_GRID` points by structure): every sign change of ``r_b`` between two grid points is
-bracketed and refined by the Illinois method to 1e-15 rad; where ``|r_b|`` dips at a grid point without a sign
-change, Brent's minimisation finds the dip's extremum: two close roots are bracketed on its sides, a tangential root
-(``|r| <=`` :data:`TANGENT_TOL`) kept. Where a branch stops existing (a *fold*, where g1's knee nears full stretch
-and two branches meet; found by the Illinois method on the existence margin), the residual moves like
-``sqrt(|t - f|)``: the piece from the fold to the grid point is searched on :data:`_FOLD_CELLS` cells of
-quadratically growing width, with a dip at the fold. A bracket that holds a gap of its branch is split at the gap's
-folds; and where the margin peaks near zero between three grid points (an *island* where the branch exists, or a
-*hole* where it does not; the parabola through the three margins decides), Brent's method finds it and the pieces
-from its folds are searched.
+The search (:data:`SEARCH_GRID` points by structure). No root may be missed, so every cell between two grid
+points is *settled* by a bound, not by its end values alone. On a cell ``[a, b]`` of width ``w`` where
+``|r_b''| <= M``: the chord's slope ``(r(b) - r(a)) / w`` is ``r_b'`` somewhere, so ``|r(b) - r(a)| > M w^2`` keeps
+``r_b'`` from vanishing (one root if the signs differ, none if not), and ``min(|r(a)|, |r(b)|) > M w^2 / 8`` with
+equal signs leaves none (the chord minus the parabola of curvature ``M``). ``M`` is ``S`` =
+:data:`CURVATURE_SAFETY` times the larger second difference at the cell's ends, over ``w^2``: exact with ``S = 1``
+for a cubic, whose ``r''`` is linear (so largest at an end) and equals its centred second difference; with ``S``,
+``M`` bounds ``|r''|`` whenever ``w^2 |r''''| <= 24 (S - 1) / (2 S + 3) max(|r''(a)|, |r''(b)|)`` on the cell
+(3.4 for ``S = 2``: ``r''`` strays from its chord by ``<= w^2 |r''''| / 8``, the second difference from ``r''`` by
+``<= w^2 |r''''| / 12``). A cell the bound does not settle is halved, each half's ``M`` the larger of the parent's
+and ``S`` times its own second difference, down to :data:`_MIN_CELL`. That catches what values alone miss: three
+roots of a branch within one or two cells (g1, a pose near a cusp of its solutions), two roots in a cell of equal
+signs. Sign changes are refined by the Illinois method to 1e-15 rad.
+
+Where a branch stops existing (a *fold*, where g1's knee nears full stretch and two branches meet; found by the
+Illinois method on the existence margin), the residual moves like ``sqrt(|t - f|)``, whose derivatives have no
+bound; in ``u`` with ``t = f + (t_g - f) u^2`` it is smooth, so the piece from the fold to the grid point ``t_g``
+beyond the next is searched as above on :data:`_FOLD_CELLS` cells equally spaced in ``u`` (the fold itself a
+candidate where the residual nearly vanishes there). Islands (the branch exists between grid points only) and holes
+(it stops existing between them) are found where the existence margin's parabola through three grid points comes
+near zero, by Brent's minimisation of the margin, and searched from their folds.
 Every candidate is then polished on the exact forward map and kept only if it reproduces the target
 (:mod:`._ik6_kernels`).
+
+The bound rests on that condition on the residual's fourth derivative, which the search does not verify: it is a
+bound checked by measurement, not a proof for every target. ``python scripts/legs6_completeness.py`` (docs/legs.md):
+the sampled configuration among ``ik_all``'s rows on every random in-limit sample (10^6 per leg of g1, 6x10^5 per
+leg of alexander), where the values alone missed about 1 in 10^5 on g1.
 """
 
 from __future__ import annotations
@@ -49,12 +65,19 @@ from ._sixdof_layout import _GRID, _HIP, _KIND, TANGENT_TOL, THREE_PARALLEL
 from .subproblems import cross, dot, rot, rot_cs, sp1, sp2, sp3
 
 _REFINE_STEPS = 100
-#: The golden-section search of a dip stops at this width (rad): a tangential root's residual is then off by
-#: ~|r''| _DIP_WIDTH^2 / 8, far below :data:`TANGENT_TOL`, and two roots on its sides are bracketed.
+#: Brent's minimisation of an existence margin (an island's peak, a hole's dip) stops at this width (rad).
 _DIP_WIDTH = 1e-8
-#: Cells of the search from a fold to the next grid point (widths growing quadratically, as the sqrt(t - f) of a fold).
+#: Cells of the search from a fold to the grid point beyond the next (equal in u, t = f + span u^2: widths in t growing
+#: quadratically, as the sqrt(t - f) of a fold).
 _FOLD_CELLS = 6
 _NB = 4  # branches at most
+#: A cell's residual is taken to curve at most this many times as much as the second differences at its ends say
+#: (:func:`_cell`; the module docstring gives the condition on the fourth derivative that makes it a bound).
+CURVATURE_SAFETY = 2.0
+#: A bisection stops at this width (the searched variable's units; rad on the grid): a sign change there is one root
+#: (two roots this close are the same solution to the polish), a residual within TANGENT_TOL a tangential root.
+_MIN_CELL = 1e-10
+_STACK = 64  # cells waiting on :func:`_cell`'s stack at most
 
 
 @kernel
@@ -397,17 +420,14 @@ def _parabola_step(x, w, v, fx, fw, fv):
 
 @kernel
 def _dip_f(t, sg, b, gr, gt, g, ws) -> float:
-    """``sg r_b(t)`` (``sg = +-1``), or ``-margin_b(t)`` for ``sg = 0``, ``margin_b(t)`` for ``sg = 2``."""
-    if sg == 0.0 or sg == 2.0:
-        return (sg - 1.0) * _margin(t, b, gr, gt, g, ws)
-    return sg * _eval1(t, b, gr, gt, g, ws)[1]
+    """``sg margin_b(t)`` (``sg = +-1``): the function whose minimum :func:`_dip_minimum` seeks."""
+    return sg * _margin(t, b, gr, gt, g, ws)
 
 
 @kernel
 def _dip_minimum(lo, hi, sg, b, gr, gt, g, ws):
     """``(t, f)``: the minimum of ``f`` (:func:`_dip_f`) on ``[lo, hi]`` by Brent's method (parabolic steps
-    safeguarded by golden sections), to :data:`_DIP_WIDTH`; it stops early where ``f`` goes negative (a sign change
-    of ``r_b``, or a point where the branch exists)."""
+    safeguarded by golden sections), to :data:`_DIP_WIDTH`; it stops early where ``f`` goes negative."""
     gold = 0.5 * (3.0 - math.sqrt(5.0))
     x = w = v = lo + gold * (hi - lo)
     fx = fw = fv = _dip_f(x, sg, b, gr, gt, g, ws)
@@ -437,66 +457,95 @@ def _dip_minimum(lo, hi, sg, b, gr, gt, g, ws):
 
 
 @kernel
-def _dip(t0, t2, r1, b, gr, gt, g, ws, cand, n) -> int:
-    """``r_b`` dips toward zero between ``t0`` and ``t2`` without a sign change (``r1``: a value of that sign): the
-    minimum of ``sign(r1) r_b`` (:func:`_dip_minimum`); two roots bracketed on its sides if it crosses zero, a
-    tangential root if within :data:`TANGENT_TOL` of it."""
-    tm, fm = _dip_minimum(t0, t2, 1.0 if r1 > 0.0 else -1.0, b, gr, gt, g, ws)
-    okm, rm = _eval1(tm, b, gr, gt, g, ws)
-    if not okm:
-        return n
-    if fm < 0.0:
-        r0, r2 = _eval1(t0, b, gr, gt, g, ws)[1], _eval1(t2, b, gr, gt, g, ws)[1]
-        n = _root(t0, tm, r0, rm, b, gr, gt, g, ws, cand, n)
-        return _root(tm, t2, rm, r2, b, gr, gt, g, ws, cand, n)
-    return _rows(tm, b, gr, gt, g, ws, cand, n) if abs(rm) <= TANGENT_TOL else n
+def _second(ra, rm, rb) -> float:
+    """``|ra - 2 rm + rb|``: the second difference of three equally spaced values (NaN if one is NaN)."""
+    return abs(ra - 2.0 * rm + rb)
 
 
 @kernel
-def _cell(t, prev_t, prev2_t, b, r, was_r, was_r2, gr, gt, g, ws, cand, n) -> int:
-    """The search between the points ``prev_t`` and ``t`` (the branch exists at both, residuals ``was_r``, ``r``;
-    ``was_r2`` at ``prev2_t``, NaN if none): a sign change is refined, a dip of ``|r_b|`` at ``prev_t`` searched."""
-    if (r > 0.0) != (was_r > 0.0) or r == 0.0:
-        return _root(prev_t, t, was_r, r, b, gr, gt, g, ws, cand, n)
-    if (was_r2 > 0.0) == (r > 0.0) and abs(was_r) < abs(was_r2) and abs(was_r) <= abs(r):
-        return _dip(min(prev2_t, t), max(prev2_t, t), was_r, b, gr, gt, g, ws, cand, n)
+def _verdict(ra, rb, w, m2) -> int:
+    """What ``|r''| <= m2`` on a cell of width ``w`` with end values ``ra``, ``rb`` proves: 0 no root, 1 exactly one
+    root, -1 nothing. The chord's slope ``s = (rb - ra) / w`` is ``r'`` somewhere in the cell, so ``|s| > m2 w``
+    keeps ``r' != 0`` throughout (``r`` monotone); with equal signs, ``r >= min(|ra|, |rb|) - m2 w^2 / 8`` on the
+    cell (the chord minus the parabola of curvature ``m2``)."""
+    mono = abs(rb - ra) > m2 * w * w
+    if (ra > 0.0) == (rb > 0.0) and ra != 0.0 and rb != 0.0:
+        return 0 if mono or min(abs(ra), abs(rb)) > 0.125 * m2 * w * w else -1
+    return 1 if mono else -1
+
+
+@kernel
+def _cell(ua, ub, ra, rb, m2, base, span, quad, b, gr, gt, g, ws, cand, n) -> int:
+    """Every root of ``r_b`` on the cell ``[t(ua), t(ub)]`` (the branch exists at both ends, residuals ``ra``,
+    ``rb``), ``t(u) = base + span u`` (``quad``: ``base + span u^2``, the piece next to a fold, where ``r_b`` is
+    smooth in ``u``); ``m2``: the bound taken for ``|d^2 r_b / du^2|`` on the cell (NaN: none).
+
+    A cell is settled when :func:`_verdict` proves it holds no root or exactly one (refined by :func:`_root`); else
+    it is halved, the bound raised to :data:`CURVATURE_SAFETY` times the curvature that the midpoint's second
+    difference shows if larger, and both halves examined in turn (a stack in ``ws``). Halves narrower than
+    :data:`_MIN_CELL` keep a sign change as one root and a residual within :data:`TANGENT_TOL` of zero as a tangential
+    root. A midpoint where the branch does not exist ends the cell's search (a hole: :func:`_hole` searches it)."""
+    st, top = ws[_NCO:], 1
+    st[0], st[1], st[2], st[3], st[4] = ua, ub, ra, rb, m2
+    while top > 0:
+        top -= 1
+        k = 5 * top
+        ua, ub, ra, rb, m2 = st[k], st[k + 1], st[k + 2], st[k + 3], st[k + 4]
+        w = ub - ua
+        v = _verdict(ra, rb, w, m2) if m2 == m2 else -1
+        if v == 0:
+            continue
+        ta, tb = base + span * (ua * ua if quad else ua), base + span * (ub * ub if quad else ub)
+        if v == 1 or w <= _MIN_CELL or top >= _STACK - 2:
+            if (ra > 0.0) != (rb > 0.0) or ra == 0.0 or rb == 0.0:
+                n = _root(ta, tb, ra, rb, b, gr, gt, g, ws, cand, n)
+            elif min(abs(ra), abs(rb)) <= TANGENT_TOL:
+                n = _rows(ta if abs(ra) <= abs(rb) else tb, b, gr, gt, g, ws, cand, n)
+            continue
+        um = 0.5 * (ua + ub)
+        okm, rm = _eval1(base + span * (um * um if quad else um), b, gr, gt, g, ws)
+        if not okm:
+            continue
+        mm = CURVATURE_SAFETY * _second(ra, rm, rb) / (0.25 * w * w)
+        mm = max(mm, m2) if m2 == m2 else mm
+        st[k], st[k + 1], st[k + 2], st[k + 3], st[k + 4] = um, ub, rm, rb, mm
+        st[k + 5], st[k + 6], st[k + 7], st[k + 8], st[k + 9] = ua, um, ra, rm, mm
+        top += 2
     return n
 
 
 @kernel
-def _from_fold(good, good_r, bad, b, gr, gt, g, ws, cand, n):
-    """The piece from the fold between ``good`` (the branch exists, residual ``good_r``) and ``bad`` (it does not) to
-    ``good``, where the residual moves like ``sqrt(|t - f|)``: :data:`_FOLD_CELLS` cells of quadratically growing
-    width, a dip at the fold, the fold itself where the residual nearly vanishes there. Returns ``(n, t, r)``: the
-    last point before ``good`` and its residual."""
-    x0 = _fold(good, bad, b, gr, gt, g, ws)
-    r0, x1, r1 = _eval1(x0, b, gr, gt, g, ws)[1], math.nan, math.nan
-    if abs(r0) <= TANGENT_TOL:  # a root at the fold (a stretched knee), or a target just beyond it: the polish decides
-        n = _rows(x0, b, gr, gt, g, ws, cand, n)
-    for j in range(1, _FOLD_CELLS + 1):
-        x = x0 + (good - x0) * (j / _FOLD_CELLS) ** 2 if j < _FOLD_CELLS else good
-        okx, rx = _eval1(x, b, gr, gt, g, ws) if j < _FOLD_CELLS else (True, good_r)
-        if not okx:  # another fold between the two: left to the polish of its neighbours
-            return n, math.nan, math.nan
-        if j == 1 and (rx > 0.0) == (r0 > 0.0) and abs(r0) <= abs(rx):  # |r_b| least at the fold: a dip there?
-            n = _dip(min(x0, x), max(x0, x), r0, b, gr, gt, g, ws, cand, n)
-        n = _cell(x, x0, x1, b, rx, r0, r1, gr, gt, g, ws, cand, n)
-        x1, r1, x0, r0 = x0, r0, x, rx
-    return n, x1, r1
+def _bound(r, j, w) -> float:
+    """The curvature bound of the cell ``[j, j + 1]`` of the equally spaced values ``r`` (``w`` apart; NaN where the
+    branch does not exist): :data:`CURVATURE_SAFETY` times the larger second difference centred on its ends, over
+    ``w^2``; NaN if neither exists."""
+    d = -1.0
+    if j >= 1 and r[j - 1] == r[j - 1]:
+        d = _second(r[j - 1], r[j], r[j + 1])
+    if j + 2 < r.shape[0] and r[j + 2] == r[j + 2]:
+        d = max(d, _second(r[j], r[j + 1], r[j + 2]))
+    return CURVATURE_SAFETY * d / (w * w) if d >= 0.0 else math.nan
 
 
 @kernel
-def _step(t, prev_t, step, b, ok, r, was_ok, was_r, was_r2, gr, gt, g, ws, cand, n) -> int:
-    """The search between grid points ``prev_t`` and ``t`` on branch ``b``; where the branch ends between them, the
-    piece from the fold (:func:`_from_fold`) and a dip at the grid point next to it."""
-    if ok and was_ok:
-        return _cell(t, prev_t, prev_t - step, b, r, was_r, was_r2, gr, gt, g, ws, cand, n)
-    good, bad, good_r = (t, prev_t, r) if ok else (prev_t, t, was_r)
-    n, x1, r1 = _from_fold(good, good_r, bad, b, gr, gt, g, ws, cand, n)
-    far = good + (good - bad)  # the grid has no value before good
-    okf, rf = _eval1(far, b, gr, gt, g, ws)
-    if x1 == x1 and okf and (rf > 0.0) == (good_r > 0.0) and rf != 0.0:
-        return _cell(far, good, x1, b, rf, good_r, r1, gr, gt, g, ws, cand, n)
+def _from_fold(good, good_r, bad, b, gr, gt, g, ws, cand, n) -> int:
+    """The piece from the fold between ``good`` (the branch exists, residual ``good_r``) and ``bad`` (it does not) to
+    ``good``. There ``r_b`` moves like ``sqrt(|t - f|)``, smooth in ``u`` with ``t = f + (good - f) u^2``: the
+    values at :data:`_FOLD_CELLS` + 1 equally spaced ``u`` and :func:`_cell` on each cell; the fold itself is a
+    candidate where the residual nearly vanishes there."""
+    x0 = _fold(good, bad, b, gr, gt, g, ws)
+    span, rs = good - x0, ws[_NCO + 5 * _STACK:_NCO + 5 * _STACK + _FOLD_CELLS + 1]
+    rs[0], rs[_FOLD_CELLS] = _eval1(x0, b, gr, gt, g, ws)[1], good_r
+    if abs(rs[0]) <= TANGENT_TOL:  # a root at the fold (a stretched knee), or a target just beyond it
+        n = _rows(x0, b, gr, gt, g, ws, cand, n)
+    for j in range(1, _FOLD_CELLS):
+        ok, rs[j] = _eval1(x0 + span * (j / _FOLD_CELLS) ** 2, b, gr, gt, g, ws)
+        if not ok:  # another fold between the two: left to the polish of its neighbours
+            return n
+    for j in range(_FOLD_CELLS):
+        m2 = _bound(rs, j, 1.0 / _FOLD_CELLS)
+        n = _cell(j / _FOLD_CELLS, (j + 1) / _FOLD_CELLS, rs[j], rs[j + 1], m2, x0, span, True, b, gr, gt, g, ws,
+                  cand, n)
     return n
 
 
@@ -505,12 +554,12 @@ def _island(lo, hi, b, gr, gt, g, ws, cand, n) -> int:
     """The branch does not exist at the grid points ``lo``, ``(lo + hi) / 2``, ``hi`` but its margin peaks near zero
     between them: where the peak is positive (the branch exists on an island between two folds), both halves of the
     island are searched from their folds (:func:`_from_fold`)."""
-    x, f = _dip_minimum(lo, hi, 0.0, b, gr, gt, g, ws)
+    x, f = _dip_minimum(lo, hi, -1.0, b, gr, gt, g, ws)
     if not f < 0.0:
         return n
     rx = _eval1(x, b, gr, gt, g, ws)[1]
-    n = _from_fold(x, rx, lo, b, gr, gt, g, ws, cand, n)[0]
-    return _from_fold(x, rx, hi, b, gr, gt, g, ws, cand, n)[0]
+    n = _from_fold(x, rx, lo, b, gr, gt, g, ws, cand, n)
+    return _from_fold(x, rx, hi, b, gr, gt, g, ws, cand, n)
 
 
 @kernel
@@ -518,13 +567,13 @@ def _hole(lo, hi, b, gr, gt, g, ws, cand, n) -> int:
     """The branch exists at the grid points ``lo``, ``(lo + hi) / 2``, ``hi`` but its margin dips near zero between
     them: where the dip is negative (a gap between two folds), the pieces from each fold to the grid points on its
     side are searched (:func:`_from_fold`)."""
-    x, f = _dip_minimum(lo, hi, 2.0, b, gr, gt, g, ws)
+    x, f = _dip_minimum(lo, hi, 1.0, b, gr, gt, g, ws)
     if not f < 0.0:
         return n
     mid = 0.5 * (lo + hi)
     for good in (lo, mid, hi):
         if good != x:
-            n = _from_fold(good, _eval1(good, b, gr, gt, g, ws)[1], x, b, gr, gt, g, ws, cand, n)[0]
+            n = _from_fold(good, _eval1(good, b, gr, gt, g, ws)[1], x, b, gr, gt, g, ws, cand, n)
     return n
 
 
@@ -539,37 +588,62 @@ def _peak(m2, m1, m0) -> bool:
 
 
 @kernel
+def _grid_cell(i, b, t0, h, mg, rg, gr, gt, g, ws, cand, n) -> int:
+    """The search of branch ``b`` around grid point ``i`` (at ``t0``; margins ``mg``, residuals ``rg`` of the grid,
+    NaN residuals where the branch does not exist): an island or a hole centred there, then the cell
+    ``[t0, t0 + h]``: :func:`_cell` where the branch exists at both ends and at their outer neighbours; where it
+    ends in the cell, the piece from the fold to the grid point beyond the next (:func:`_from_fold`: the
+    ``sqrt`` of the fold reaches into the next cell too, which is then left to it)."""
+    m0, m1, mp = mg[i], mg[i + 1], mg[i - 1]
+    if _peak(mp, m0, m1):
+        n = _island(t0 - h, t0 + h, b, gr, gt, g, ws, cand, n)
+    elif m0 >= 0.0 and mp >= 0.0 and m1 >= 0.0 and _peak(-mp, -m0, -m1):
+        n = _hole(t0 - h, t0 + h, b, gr, gt, g, ws, cand, n)
+    if m0 >= 0.0 and m1 >= 0.0:
+        if mp < 0.0 or mg[i + 2] < 0.0:
+            return n
+        m2 = _bound(rg, i, h)
+        v = _verdict(rg[i], rg[i + 1], h, m2) if m2 == m2 else -1
+        if v == 1:
+            return _root(t0, t0 + h, rg[i], rg[i + 1], b, gr, gt, g, ws, cand, n)
+        return n if v == 0 else _cell(t0, t0 + h, rg[i], rg[i + 1], m2, 0.0, 1.0, False, b, gr, gt, g, ws, cand, n)
+    if m0 >= 0.0:
+        far = mp >= 0.0
+        return _from_fold(t0 - h if far else t0, rg[i - 1] if far else rg[i], t0 + h, b, gr, gt, g, ws, cand, n)
+    if m1 >= 0.0:
+        far = mg[i + 2] >= 0.0
+        return _from_fold(t0 + 2.0 * h if far else t0 + h, rg[i + 2] if far else rg[i + 1], t0, b, gr, gt, g, ws,
+                          cand, n)
+    return n
+
+
+@kernel
 def _search_candidates(tg, g, cand) -> int:
-    """The candidate rows (``cand`` (K, 6)) of the target ``tg`` (16 floats); returns how many are filled."""
+    """The candidate rows (``cand`` (K, 6)) of the target ``tg`` (16 floats); returns how many are filled. The grid
+    has one point more on each side of the turn ``[-pi, pi]``, for the second differences at its ends."""
     gr = np.empty((3, 3))
     gt = _target_motion(tg, g, gr)
-    ws = np.empty(_NCO)
+    ws = np.empty(_NCO + 5 * _STACK + _FOLD_CELLS + 1)
     if g[_KIND] != THREE_PARALLEL:
         _off_prepare(gr, gt, g, ws)
-    cur = np.empty((2, _NB))  # existence margin, residual at t
-    prev = np.empty((4, _NB))  # margin, residual at the previous grid point, residual one before (NaN: none), margin
     grid = int(g[_GRID])
-    step = 2.0 * math.pi / grid
-    prev_t = -math.pi
-    _eval(prev_t, gr, gt, g, ws, prev[0], prev[1])
-    for b in range(_NB):
-        prev[2, b], prev[3, b] = math.nan, math.nan
-    n = 0
-    for i in range(1, grid + 1):
-        t = -math.pi + i * step
-        _eval(t, gr, gt, g, ws, cur[0], cur[1])
+    h = 2.0 * math.pi / grid
+    vals = np.empty((2 * _NB, grid + 3))  # margins, then residuals (NaN where the branch does not exist)
+    for i in range(grid + 3):
+        _eval(-math.pi + (i - 1) * h, gr, gt, g, ws, vals[:_NB, i], vals[_NB:, i])
         for b in range(_NB):
-            ok, r, was_ok, was_r = cur[0, b] >= 0.0, cur[1, b], prev[0, b] >= 0.0, prev[1, b]
-            if not (ok or was_ok):
-                if _peak(prev[3, b], prev[0, b], cur[0, b]):
-                    n = _island(prev_t - step, t, b, gr, gt, g, ws, cand, n)
-            else:
-                if ok and was_ok and _peak(-prev[3, b], -prev[0, b], -cur[0, b]):
-                    n = _hole(prev_t - step, t, b, gr, gt, g, ws, cand, n)
-                if not (ok and was_ok and (r > 0.0) == (was_r > 0.0) and r != 0.0 and not (
-                        abs(was_r) < abs(prev[2, b]) and abs(was_r) <= abs(r))):  # else nothing between them
-                    n = _step(t, prev_t, step, b, ok, r, was_ok, was_r, prev[2, b], gr, gt, g, ws, cand, n)
-            prev[2, b] = prev[1, b] if (ok and was_ok) else math.nan
-            prev[3, b], prev[0, b], prev[1, b] = prev[0, b], cur[0, b], r
-        prev_t = t
+            if vals[b, i] < 0.0:
+                vals[_NB + b, i] = math.nan
+    n = 0
+    for b in range(_NB):
+        mg, rg = vals[b], vals[_NB + b]
+        for i in range(1, grid + 1):
+            if (mg[i - 1] >= 0.0 and mg[i] >= 0.0 and mg[i + 1] >= 0.0 and mg[i + 2] >= 0.0
+                    and not _peak(-mg[i - 1], -mg[i], -mg[i + 1])):
+                m2 = _bound(rg, i, h)  # the common cell, settled here when it holds no root
+                if m2 == m2 and _verdict(rg[i], rg[i + 1], h, m2) == 0:
+                    continue
+            elif mg[i] < 0.0 and mg[i + 1] < 0.0 and not _peak(mg[i - 1], mg[i], mg[i + 1]):
+                continue
+            n = _grid_cell(i, b, -math.pi + (i - 1) * h, h, mg, rg, gr, gt, g, ws, cand, n)
     return n

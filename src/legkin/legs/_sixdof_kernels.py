@@ -26,7 +26,7 @@ from ._sixdof_layout import (
     POLISH_DAMPING6,
     POLISH_STEPS6,
 )
-from .subproblems import cross, dot, rot, rot_cs, sp1, sp2, sp3
+from .subproblems import cross, dot, rot_cs, sp1, sp2_cs, sp3
 
 _NAN = math.nan
 
@@ -190,11 +190,13 @@ def _polish6(tg, g, q, ws, fixed=0) -> float:
     joints of the bit mask ``fixed`` do not move (their Jacobian columns are zeroed). ``ws``: a work array of at least
     32 rows of 6. Returns the error of the final ``q``: the larger of its position error (m) and its rotation error
     (rad)."""
-    jac, a, aw, ow = ws[0:6], ws[6:12], ws[12:18, 0:3], ws[18:24, 0:3]
-    rm, p, e, b, dq, qn = ws[24:27, 0:3], ws[27, 0:3], ws[28], ws[29], ws[30], ws[31]
+    aw, ow, rm, p, e = ws[12:18, 0:3], ws[18:24, 0:3], ws[24:27, 0:3], ws[27, 0:3], ws[28]
     _pose6(q, g, rm, p, aw, ow)
     err = _pose_error(tg, rm, p, e)
     split = _split_error(e)
+    if err <= POLISH_BELOW6:  # the closed form's usual case: no work space for the steps
+        return split
+    jac, a, b, dq, qn = ws[0:6], ws[6:12], ws[29], ws[30], ws[31]
     lam2 = POLISH_DAMPING6 * POLISH_DAMPING6
     for _ in range(POLISH_STEPS6):
         if err <= POLISH_BELOW6:
@@ -281,19 +283,19 @@ def _hip_candidates(tg, g, cand) -> int:
         c4, s4 = math.cos(q4), -math.sin(q4)  # R(a_4, -q_4)
         e = rot_cs(a4, c4, s4, (c[0] - o4[0], c[1] - o4[1], c[2] - o4[2]))
         ea = (e[0] + o4[0] - an[0], e[1] + o4[1] - an[1], e[2] + o4[2] - an[2])
-        _, t5a, t6a, t5b, t6b, _ = sp2(ea, da, a5, a6)
+        _, p5a, p6a, p5b, p6b, _ = sp2_cs(ea, da, a5, a6)  # (cos, sin) of -q_5 and of q_6
         r4a3, r4v = rot_cs(a4, c4, s4, a3), rot_cs(a4, c4, s4, v)
         for i56 in range(2):
-            q5, q6 = -(t5a if i56 == 0 else t5b), (t6a if i56 == 0 else t6b)
-            c5, s5, c6, s6 = math.cos(q5), -math.sin(q5), math.cos(q6), -math.sin(q6)
+            p5, p6 = (p5a, p6a) if i56 == 0 else (p5b, p6b)
             # R_h y = R_G R_6^T R_5^T R_4^T y
-            h3 = _mat_vec(gr, rot_cs(a6, c6, s6, rot_cs(a5, c5, s5, r4a3)))
-            hv = _mat_vec(gr, rot_cs(a6, c6, s6, rot_cs(a5, c5, s5, r4v)))
-            _, t1a, t2a, t1b, t2b, _ = sp2(h3, a3, a1, a2)
+            h3 = _mat_vec(gr, rot_cs(a6, p6[0], -p6[1], rot_cs(a5, p5[0], p5[1], r4a3)))
+            hv = _mat_vec(gr, rot_cs(a6, p6[0], -p6[1], rot_cs(a5, p5[0], p5[1], r4v)))
+            _, p1a, p2a, p1b, p2b, _ = sp2_cs(h3, a3, a1, a2)  # (cos, sin) of -q_1 and of q_2
+            q5, q6 = -math.atan2(p5[1], p5[0]), math.atan2(p6[1], p6[0])
             for i12 in range(2):
-                q1, q2 = -(t1a if i12 == 0 else t1b), (t2a if i12 == 0 else t2b)
-                q3 = sp1(v, rot(a2, -q2, rot(a1, -q1, hv)), a3)
-                cand[n, 0], cand[n, 1], cand[n, 2] = q1, q2, q3
+                p1, p2 = (p1a, p2a) if i12 == 0 else (p1b, p2b)
+                cand[n, 0], cand[n, 1] = -math.atan2(p1[1], p1[0]), math.atan2(p2[1], p2[0])
+                cand[n, 2] = sp1(v, rot_cs(a2, p2[0], -p2[1], rot_cs(a1, p1[0], p1[1], hv)), a3)
                 cand[n, 3], cand[n, 4], cand[n, 5] = q4, q5, q6
                 n += 1
     return n

@@ -27,12 +27,12 @@ POLISH_BELOW6 = 1e-13
 #: one-dimensional search of three parallel axes keeps at most 16 (a 6R chain has at most 16).
 _NSOL = 8
 _NSOL_SEARCH = 16
-#: Grid of the one-dimensional search by structure (points over a full turn of the searched joint): every sign change
-#: of the residual between two grid points is bracketed, then refined (see :mod:`._search_kernels`). g1 (offset hip):
-#: 90 points found the sampled configuration on 159,999 of 160,000 random in-limit samples (8 seeds x 2 legs x 10^4;
-#: the one miss a pose 2e-4 rad from a fold, where four roots lie within 0.04 rad at a residual of 3e-5), 60 points
-#: also missed 1, 45 missed 1-6 per 2x10^4 (docs/legs.md); alexander keeps 360.
-SEARCH_GRID = {"6R-three-parallel": 360, "6R-offset-hip": 90}
+#: Grid of the one-dimensional search by structure (points over a full turn of the searched joint): each cell between
+#: two grid points is settled by a curvature bound or bisected (see :mod:`._search_kernels`), so the grid sets the
+#: speed more than the completeness. g1 (offset hip): 60 points (42 us a target; 90 took 50 us; the sampled
+#: configuration among ik_all's rows on every one of 10^6 random in-limit samples per leg at 60 points, docs/legs.md);
+#: alexander keeps 360.
+SEARCH_GRID = {"6R-three-parallel": 360, "6R-offset-hip": 60}
 #: A dip of the search residual to within this (m) of zero without a sign change is kept as a tangential root (the
 #: polish then decides).
 TANGENT_TOL = 1e-9
@@ -52,4 +52,5 @@ _LO6, _HI6 = 54, 60  # the URDF limits (6 each)
 _KIND = 66  # the structure code
 _NSOLS = 67  # the rows of ik_all
 _GRID = 68  # the grid points of the one-dimensional search (0: none)
-_NP6 = 69
+_QREF = 69  # the default reference q_ref (6): the single call's fast path reads it here
+_NP6 = 75

@@ -9,7 +9,7 @@ if any, at the neutral configuration: the world frame is then the root frame). R
 * for legs with an IK (``6R-spherical-hip``, ``6R-three-parallel``): ``IK round trip`` (max entry of Pinocchio's foot at
   ``Leg6.ik(T)`` minus ``T``; unsolved or outside the limits counts as infinite), ``IK all solutions``
   (the same for every row of ``ik_all``), ``sampled q among ik_all`` (rad: the distance, mod 2 pi, from the sampled
-  configuration to the nearest row).
+  configuration to the nearest row; scaled by ``sigma_min / SIGMA_REF`` near a singular pose).
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ import numpy as np
 from .._checkkit import CheckResult, compare
 from ._reference import pinocchio_poses
 
-__all__ = ["rows6", "TOL6", "TOL_AMONG"]
+__all__ = ["rows6", "TOL6", "TOL_AMONG", "SIGMA_REF"]
 
 #: Tolerance of the FK, Jacobian and round-trip rows (m, rad; measured <= 4e-15 on talos, romeo, icub,
 #: simple_humanoid, alexander, g1).
@@ -27,6 +27,11 @@ TOL6 = 1e-12
 #: The sampled configuration is among ik_all's rows to this (rad). Measured <= 2e-11 on 10^4 samples per leg (the
 #: conditioning of the knee near full stretch: a pose error of 1e-15 moves the angles by ~1e-15 / sin(knee)).
 TOL_AMONG = 1e-9
+#: Where the foot Jacobian's least singular value ``sigma_min`` at the sampled configuration is below this, the
+#: row's distance is scaled by ``sigma_min / SIGMA_REF``: a pose reproduced to ~1e-12 fixes the joints only to
+#: ``1e-12 / sigma_min`` (two solutions merge at a singular pose; g1: 2 of 1.2x10^6 samples, sigma_min 2e-7 and 2e-6,
+#: the sampled q 1.1e-9 and 7e-9 rad from a row), so the row passes within ``TOL_AMONG SIGMA_REF / sigma_min``.
+SIGMA_REF = 1e-3
 
 
 def _with(model, legs: dict, qleg: np.ndarray) -> np.ndarray:
@@ -56,7 +61,11 @@ def _ik_rows(model, legs: dict, qleg: np.ndarray, poses: np.ndarray) -> list[Che
         ok[:, k] &= np.asarray(leg.within_limits(np.nan_to_num(q_ik[:, k])))
         q_all[:, k, :leg.n_solutions], mask[:, k, :leg.n_solutions] = leg.ik_all(poses[:, k], return_mask=True)
         gap = np.abs(np.angle(np.exp(1j * (q_all[:, k] - qleg[:, k, None])))).max(axis=-1)
-        among.append(np.nanmin(np.where(mask[:, k], gap, np.inf), axis=-1))
+        gap = np.nanmin(np.where(mask[:, k], gap, np.inf), axis=-1)
+        far = gap > TOL_AMONG  # near a singular pose the pose fixes the joints to ~1e-12 / sigma_min only
+        sigma = np.linalg.svd(leg.jacobian(qleg[far, k]), compute_uv=False)[:, -1] if far.any() else 1.0
+        gap[far] *= np.minimum(1.0, sigma / SIGMA_REF)
+        among.append(gap)
     back, _ = pinocchio_poses(model, legs, _with(model, legs, np.where(ok[..., None], q_ik, 0.0)), False)
     err = np.where(ok, np.abs(back - poses).max(axis=(-1, -2)), np.inf)[:, closed]
     errs = []

@@ -46,7 +46,7 @@ from .. import _batch
 from .._batch import as_input, check_flag, check_number, finish, in_chunks
 from .._kernels import OK, as_rows
 from ..errors import InvalidInputError, JointLimitError, LegStructureError, UnreachableError
-from ._ik6_kernels import _ik6_batch, _ik6_k, _ik_all6_batch, _ik_all6_k
+from ._ik6_kernels import _ik6_batch, _ik6_one, _ik_all6_batch, _ik_all6_one
 from ._sixdof_kernels import _fk6_batch, _fk6_k, _jacobian6_batch, _jacobian6_k
 from ._sixdof_layout import (
     _ANK,
@@ -64,6 +64,7 @@ from ._sixdof_layout import (
     _NSOL_SEARCH,
     _NSOLS,
     _OR,
+    _QREF,
     AXIS_TOL,
     HIP_SPHERICAL,
     IK_TOL,
@@ -228,6 +229,7 @@ class Leg6:
         g[_GRID] = SEARCH_GRID.get(structure, 0)
         finite = np.isfinite(lo) & np.isfinite(hi)
         mid = np.where(finite, 0.5 * (np.where(finite, lo, 0.0) + np.where(finite, hi, 0.0)), np.clip(0.0, lo, hi))
+        g[_QREF:_QREF + 6] = mid
         return cls(
             name=str(name), joint_names=tuple(str(j) for j in joint_names), foot_frame=str(foot_frame),
             lower=_frozen(lo), upper=_frozen(hi), axes=_frozen(a), origins=_frozen(o), foot_pose=_frozen(m0),
@@ -320,24 +322,14 @@ class Leg6:
             arr = np.broadcast_to(arr, batch + _T44)
         return as_rows(arr, 16), ref, batch, len(batch) == 0, tol
 
-    def _single(self, kernel: Any, shape: tuple[int, ...], target: Any) -> np.ndarray | None:
-        """The fast path of :meth:`ik` and :meth:`ik_all` for one float64 pose with the default options: the
-        kernel's answer of ``shape``, or None when ``target`` is not such a pose or the kernel saw bad input (the
-        full checks then run and say why).
-
-        Raises:
-            UnreachableError, JointLimitError: the pose has no answer (:meth:`_error`).
-        """
-        if not (target.__class__ is np.ndarray and target.shape == _T44 and target.dtype is _F64
-                and self.params[_KIND] != 0.0):
+    def _single(self, kernel: Any, rows: int, target: Any) -> np.ndarray | None:
+        """The fast path of :meth:`ik` (``rows`` 1) and :meth:`ik_all` (``rows`` K) for one float64 pose with the
+        default options: the kernel's answer ``(rows, 6)``, or None when ``target`` is not such a pose or the
+        kernel refused it (bad input, no answer, a leg without an IK: the full path then runs and says why)."""
+        if not (target.__class__ is np.ndarray and target.shape == _T44 and target.dtype is _F64):
             return None
-        out, info = np.empty(shape), np.zeros(2)
-        st = kernel(target.reshape(16), self.params, self.q_ref, IK_TOL, out, info)
-        if st == OK:
-            return out
-        if st != _BAD_INPUT:
-            raise self._error(st, info, target, IK_TOL)
-        return None
+        out = np.empty((rows, 6))
+        return out if kernel(target, self.params, out) == OK else None
 
     @staticmethod
     def _bad_poses(status: np.ndarray, rows: np.ndarray) -> None:
@@ -399,7 +391,7 @@ class Leg6:
             InvalidInputError, InvalidArgumentError: bad ``target`` / ``q_near`` / ``tol`` / ``return_mask``.
         """
         if q_near is None and tol is IK_TOL and return_mask is False:  # a single float64 pose: the kernel directly
-            fast = self._single(_ik_all6_k, (self.n_solutions, 6), target)
+            fast = self._single(_ik_all6_one, self.n_solutions, target)
             if fast is not None:
                 return fast
         rows, ref, batch, single, tol = self._prepare(target, q_near, tol)
@@ -433,9 +425,9 @@ class Leg6:
             LegStructureError, InvalidInputError, InvalidArgumentError: as :meth:`ik_all`.
         """
         if q_near is None and tol is IK_TOL and return_mask is False:  # a single float64 pose: the kernel directly
-            fast = self._single(_ik6_k, _Q6, target)
+            fast = self._single(_ik6_one, 1, target)
             if fast is not None:
-                return fast
+                return fast[0]
         rows, ref, batch, single, tol = self._prepare(target, q_near, tol)
         flag = check_flag(return_mask, "return_mask")
         out, status, info = self._solve(_ik6_batch, _Q6, rows, ref, tol)

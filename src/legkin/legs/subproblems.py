@@ -24,7 +24,7 @@ import math
 
 from .._kernels import kernel
 
-__all__ = ["sp1", "sp2", "sp3", "sp4", "rot", "rot_cs", "dot", "cross"]
+__all__ = ["sp1", "sp1_cs", "sp2", "sp2_cs", "sp3", "sp4", "rot", "rot_cs", "dot", "cross"]
 
 
 @kernel
@@ -57,11 +57,27 @@ def rot_cs(k, c, s, p):
 
 
 @kernel
+def _sp1_parts(p1, p2, k):
+    """``(k . (p1 x p2), p1 . p2 - (k . p1)(k . p2))``: the sine and cosine of SP1's angle, each times the product
+    of the projections' lengths."""
+    kp1, kp2 = dot(k, p1), dot(k, p2)
+    return dot(k, cross(p1, p2)), dot(p1, p2) - kp1 * kp2
+
+
+@kernel
 def sp1(p1, p2, k) -> float:
     """Subproblem 1: the angle ``t`` with ``R(k, t) p1 = p2`` (least squares: the angle between the projections of
     ``p1`` and ``p2`` on the plane normal to ``k``), ``t = atan2(k . (p1 x p2), p1 . p2 - (k . p1)(k . p2))``."""
-    kp1, kp2 = dot(k, p1), dot(k, p2)
-    return math.atan2(dot(k, cross(p1, p2)), dot(p1, p2) - kp1 * kp2)
+    sn, cs = _sp1_parts(p1, p2, k)
+    return math.atan2(sn, cs)
+
+
+@kernel
+def sp1_cs(p1, p2, k):
+    """:func:`sp1`'s angle as ``(cos t, sin t)`` (no trigonometry; ``(1, 0)`` where a projection vanishes)."""
+    sn, cs = _sp1_parts(p1, p2, k)
+    r = math.sqrt(sn * sn + cs * cs)
+    return (cs / r, sn / r) if r > 0.0 else (1.0, 0.0)
 
 
 @kernel
@@ -105,8 +121,9 @@ def sp3(p1, p2, k, d):
 
 
 @kernel
-def sp2(p1, p2, k1, k2):
-    """Subproblem 2: ``(t1, t2)`` with ``R(k1, t1) p1 = R(k2, t2) p2`` (``k1`` not parallel to ``k2``).
+def sp2_cs(p1, p2, k1, k2):
+    """Subproblem 2: ``(t1, t2)`` with ``R(k1, t1) p1 = R(k2, t2) p2`` (``k1`` not parallel to ``k2``), each angle as
+    its ``(cos, sin)`` pair (:func:`sp1_cs`).
 
     Solved on the directions ``u_i = p_i / |p_i|`` (exact when ``|p1| = |p2|``, else the directions align and
     ``miss`` reports ``| |p1| - |p2| |``): both sides are the unit vector ``x`` where the cone of ``u1`` about ``k1``
@@ -116,8 +133,9 @@ def sp2(p1, p2, k1, k2):
     ``t1 = SP1(u1 -> x)`` about ``k1`` and ``t2 = SP1(u2 -> x)`` about ``k2``.
 
     Returns:
-        ``(n, t1_a, t2_a, t1_b, t2_b, miss)``: ``n`` = 2 (``c = -+ sqrt``), 0 when the cones do not meet
-        (``c = 0``: the least-squares pair, ``miss`` = ``sqrt(-c^2 (1 - g^2))`` > 0, in units of ``|x|``).
+        ``(n, (c1, s1)_a, (c2, s2)_a, (c1, s1)_b, (c2, s2)_b, miss)``: ``n`` = 2 (``c = -+ sqrt``), 0 when the cones
+        do not meet (``c = 0``: the least-squares pair, ``miss`` = ``sqrt(-c^2 (1 - g^2))`` > 0, in units of
+        ``|x|``).
     """
     n1, n2 = math.sqrt(dot(p1, p1)), math.sqrt(dot(p2, p2))
     u1 = (p1[0] / n1, p1[1] / n1, p1[2] / n1)
@@ -135,4 +153,16 @@ def sp2(p1, p2, k1, k2):
     c = math.sqrt(c2)
     xa = (a * k1[0] + b * k2[0] - c * n[0], a * k1[1] + b * k2[1] - c * n[1], a * k1[2] + b * k2[2] - c * n[2])
     xb = (a * k1[0] + b * k2[0] + c * n[0], a * k1[1] + b * k2[1] + c * n[1], a * k1[2] + b * k2[2] + c * n[2])
-    return count, sp1(u1, xa, k1), sp1(u2, xa, k2), sp1(u1, xb, k1), sp1(u2, xb, k2), miss
+    return count, sp1_cs(u1, xa, k1), sp1_cs(u2, xa, k2), sp1_cs(u1, xb, k1), sp1_cs(u2, xb, k2), miss
+
+
+@kernel
+def sp2(p1, p2, k1, k2):
+    """Subproblem 2 (:func:`sp2_cs`) with the angles.
+
+    Returns:
+        ``(n, t1_a, t2_a, t1_b, t2_b, miss)`` as :func:`sp2_cs`.
+    """
+    n, c1a, c2a, c1b, c2b, miss = sp2_cs(p1, p2, k1, k2)
+    return (n, math.atan2(c1a[1], c1a[0]), math.atan2(c2a[1], c2a[0]), math.atan2(c1b[1], c1b[0]),
+            math.atan2(c2b[1], c2b[0]), miss)

@@ -40,6 +40,15 @@ class _Pose(_LegFrame):
         return np.maximum(pos, rotation_error(targets[:, :3, :3], got[:, :3, :3]))
 
 
+def _nearest_inside(rows: np.ndarray, lo: np.ndarray, hi: np.ndarray, ref: np.ndarray) -> np.ndarray:
+    """The row of joint solutions ``rows`` (K, 6) (NaN rows ignored), each angle moved to its 2 pi representative
+    nearest ``ref``, that lies inside ``[lo, hi]`` nearest ``ref`` (rad); NaN if none does."""
+    shifted = rows + 2 * np.pi * np.round((ref - rows) / (2 * np.pi))
+    cost = np.where(np.all((shifted >= lo) & (shifted <= hi), axis=-1), np.sum((shifted - ref) ** 2, axis=-1), np.inf)
+    k = int(np.argmin(np.nan_to_num(cost, nan=np.inf)))
+    return shifted[k] if np.isfinite(cost[k]) else np.full(rows.shape[-1], np.nan)
+
+
 def _legkin(leg, targets: np.ndarray, pose: _Pose, n_batch: int, n_single: int) -> list[Method]:
     from ..errors import LegkinError
 
@@ -48,23 +57,29 @@ def _legkin(leg, targets: np.ndarray, pose: _Pose, n_batch: int, n_single: int) 
     leg.ik_all(targets[0])
 
     def single(fn: Callable) -> Callable:
-        def run(t):
-            out = np.full((len(t), 6), np.nan)
+        def run(t):  # timed: the calls alone (a refused target gives None)
+            out: list[np.ndarray | None] = []
             for k in range(len(t)):
                 try:
-                    res = fn(t[k])
+                    out.append(fn(t[k]))
                 except LegkinError:
-                    continue
-                out[k] = res if res.ndim == 1 else res[np.isfinite(res[:, 0])][0]
+                    out.append(None)
             return out
         return run
 
+    def score(t, sols) -> Score:  # untimed: ik's answer, or ik_all's solution inside the limits nearest q_ref
+        q = np.full((len(sols), 6), np.nan)
+        for k, sol in enumerate(sols):
+            if sol is not None:
+                q[k] = sol if sol.ndim == 1 else _nearest_inside(sol, leg.lower, leg.upper, leg.q_ref)
+        return pose.score(t[:len(sols)], q)
+
     return [
         Method(f"legkin Leg6.ik batch ({leg.structure}; {n_batch} at once)", targets, leg.ik, pose.score, repeats=3),
-        Method("legkin Leg6.ik single calls (Python loop)", targets, single(leg.ik), pose.score,
+        Method("legkin Leg6.ik single calls (Python loop)", targets, single(leg.ik), score,
                max_targets=n_single, repeats=3),
-        Method("legkin Leg6.ik_all single calls (every solution)", targets, single(leg.ik_all), pose.score,
-               max_targets=n_single, repeats=3),
+        Method("legkin Leg6.ik_all single calls (every solution; the nearest in-limit one picked untimed)", targets,
+               single(leg.ik_all), score, max_targets=n_single, repeats=3),
     ]
 
 
@@ -93,12 +108,9 @@ def _eaik(leg, targets: np.ndarray, pose: _Pose, n_single: int) -> Method:
     def score(t, sols) -> Score:  # untimed: the non-least-squares solution inside the limits nearest mid-limit
         q = np.full((len(sols), 6), np.nan)
         for k, sol in enumerate(sols):
-            best = np.inf
-            for qs, ls in zip(sol.Q, sol.is_LS):
-                qs = qs + 2 * np.pi * np.round((ref - qs) / (2 * np.pi))
-                cost = float(np.sum((qs - ref) ** 2))
-                if not ls and np.all((qs >= lo) & (qs <= hi)) and cost < best:
-                    best, q[k] = cost, qs
+            exact = [qs for qs, ls in zip(sol.Q, sol.is_LS) if not ls]
+            if exact:
+                q[k] = _nearest_inside(np.array(exact), lo, hi, ref)
         return pose.score(t[:len(sols)], q)
 
     return Method(name, targets, run, score, max_targets=n_single, repeats=3)

@@ -244,3 +244,35 @@ def test_tyre_point_batch_reuses_the_pieces_of_equal_theta_bit_for_bit():
     batch = ty.tyre_point(theta, beta, s, w)
     single = np.array([ty.tyre_point(float(t), float(b), float(x), float(y)) for t, b, x, y in zip(theta, beta, s, w)])
     np.testing.assert_array_equal(batch, single)
+
+
+def test_stance_ik_all_finds_the_roots_next_to_a_fold():
+    """The check sweep (issue 25): seed 14, 10^4 samples, leg FR at (theta, beta, gamma) = (2.3103, -2.9923, -1.1215),
+    its contact on the tip cap about H_R: theta is 5e-4 rad from the fold of |H|^2(theta) (its minimum, at 2.3108),
+    where the curve crosses the level and comes back between two grid nodes of one sign, and stance_ik found no
+    solution. Now the roots on both sides of a fold are found: that sample, and samples of theta within two grid
+    cells of each fold of the five |c|^2 rows, are among stance_ik_all's solutions, to the inverse's conditioning
+    (the check row's measure)."""
+    q0 = np.array([2.3103307936437836, -2.9922927397940575, -1.1214610495917927])
+    allq = sk.stance_ik_all(gd.ground_contact(q0, "FR").point, "FR")
+    assert np.abs(allq - q0).max(-1).min() < 1e-9, allq
+    th, tab, runs, nrun = sk._centre_table(GEO)
+    folds = np.unique(np.concatenate([th[runs[k, 1 : nrun[k] - 1]] for k in range(5)]))
+    assert len(folds) >= 1, folds  # one: the minimum of |H|^2
+    rng = np.random.default_rng(3)
+    n = 200
+    cell = th[1] - th[0]
+    theta = np.repeat(folds, n) + rng.uniform(-2 * cell, 2 * cell, n * len(folds))
+    q = np.stack([theta, rng.uniform(-np.pi, np.pi, theta.size), rng.uniform(-1.4, 1.4, theta.size)], -1)
+    far = []
+    for leg in ("FL", "FR"):
+        allq = sk.stance_ik_all(gd.ground_contact(q, leg).point, leg)
+        d = allq - q[:, None, :]
+        d[..., 1:] = np.pi - np.mod(np.pi - d[..., 1:], 2 * np.pi)
+        dist = np.min(np.where(np.isnan(d[..., 0]), np.inf, np.abs(d).max(-1)), axis=1)
+        # the check row's measure: the q distance x sigma_min of the contact point's derivative (m)
+        scaled = dist * tc._contact_sigma_min(q, leg, R_T)
+        assert np.all(scaled <= tc.TOL), (leg, np.flatnonzero(~(scaled <= tc.TOL)))
+        far.append(dist.max())
+    # next to the fold the inverse is ill-conditioned: a solution reproducing the target can be > 1e-9 rad away
+    assert max(far) > 1e-9, far

@@ -561,3 +561,29 @@ def test_tripod_jacobian_rows_hold_to_their_conditioning_bound():
     assert np.all(err <= checks.AMP_CONSTANT * eps * amp), (err / (eps * amp)).max()
     # the bound explains the sample that failed: a large amplification (cond(G) ~ 1543), not a wrong formula
     assert amp[-1] > 10 * np.median(amp), (amp[-1], np.median(amp))
+
+
+def test_tripod_fk_round_trip_holds_to_its_conditioning_bound():
+    """The check sweep (issue 25): "[alpha=pi/4] fk(ik(u)) round trip, platform rotation" reached 1.41e-12 against a
+    fixed 1e-12 at seed 19, 10^5 samples, at a pose near a forward singularity (1 / sigma_min(A_u) = 261). The row
+    now holds each sample to eps x amplification x FK_CONSTANT (scripts/tripod_conditioning_sweep.py --row fk
+    measured the constant over 20 seeds x 10^3..10^5 samples); that sample, with 300 random ones, is within it."""
+    import math
+
+    import numpy as np
+
+    from legkin import tripod as at
+    from legkin.tripod import checks
+    from legkin.tripod.configuration import sample_workspace
+
+    geo = at.Geometry(alpha=math.pi / 4)
+    ay, az = sample_workspace(300, np.random.default_rng(19), geo)
+    ay, az = np.append(ay, -0.0028632618673902765), np.append(az, 2.356265716541423)
+    q = at.ik_joints(np.stack([ay, az], axis=-1), geometry=geo)
+    far = 1 + np.cos(ay) * np.cos(az) > checks.NEAR_FLIP
+    err, amp, inc, inc_amp = checks.fk_round_trip_errors(geo, q, ay, az, far)
+    eps = np.finfo(float).eps
+    assert np.all(err <= checks.FK_CONSTANT * eps * amp), (err / (eps * amp)).max()
+    assert np.all(inc[far] <= checks.INCONSISTENCY_CONSTANT * eps * inc_amp[far])
+    # the bound explains the sample that failed: a large amplification, not a wrong fk
+    assert err[-1] > 1e-12 and amp[-1] > 50 * np.median(amp), (err[-1], amp[-1], np.median(amp))

@@ -858,3 +858,17 @@ def test_roll_and_step_fixed_base(roll_clip):
     from legkin.clips import available
 
     assert "roll_and_step" in available("wheel_leg")
+
+
+def test_damped_ik_starts_at_a_root_of_the_in_plane_radius():
+    """The check sweep (issue 25): seed 17, 10^4 samples, the damped method left a target made by fk from in-limit
+    joints unsolved (leg RL, theta = 157.1 deg): the in-plane radius has a root there and a second one just beyond
+    THETA_MAX, the start (the grid's local minimum of the residual, at the last node) sat between them and the
+    iteration stalled on the bound; the next starts reached the other out-of-plane branch (gamma = -2.01, outside
+    the limits: not solved, JointLimitError). The starts now begin at the secant roots of the cells where the
+    residual changes sign: solved in 4 iterations."""
+    q0 = np.array([2.7426983317136155, -0.7491319630514184, -0.4931611265510177])
+    kw = {"alpha": -1.877257342710617, "w": -0.00457124034971999}
+    target = wl.fk(q0, "RL", **kw)
+    q, info = wl.ik(target, "RL", method="damped", return_info=True, **kw)
+    assert np.abs(q - q0).max() < 1e-9 and info.iterations <= 10, (q, info.iterations)

@@ -244,3 +244,67 @@ def test_tyre_point_batch_reuses_the_pieces_of_equal_theta_bit_for_bit():
     batch = ty.tyre_point(theta, beta, s, w)
     single = np.array([ty.tyre_point(float(t), float(b), float(x), float(y)) for t, b, x, y in zip(theta, beta, s, w)])
     np.testing.assert_array_equal(batch, single)
+
+
+def test_stance_ik_all_finds_the_roots_next_to_a_fold():
+    """The check sweep (issue 25): seed 14, 10^4 samples, leg FR at (theta, beta, gamma) = (2.3103, -2.9923, -1.1215),
+    its contact on the tip cap about H_R: theta is 5e-4 rad from the fold of |H|^2(theta) (its minimum, at 2.3108),
+    where the curve crosses the level and comes back between two grid nodes of one sign, and stance_ik found no
+    solution. Now the roots on both sides of a fold are found: that sample, and samples of theta within two grid
+    cells of each fold of the five |c|^2 rows, are among stance_ik_all's solutions, to the inverse's conditioning
+    (the check row's measure)."""
+    q0 = np.array([2.3103307936437836, -2.9922927397940575, -1.1214610495917927])
+    allq = sk.stance_ik_all(gd.ground_contact(q0, "FR").point, "FR")
+    assert np.abs(allq - q0).max(-1).min() < 1e-9, allq
+    th, tab, runs, nrun = sk._centre_table(GEO)
+    folds = np.unique(np.concatenate([th[runs[k, 1 : nrun[k] - 1]] for k in range(5)]))
+    assert len(folds) >= 1, folds  # one: the minimum of |H|^2
+    rng = np.random.default_rng(3)
+    n = 200
+    cell = th[1] - th[0]
+    theta = np.repeat(folds, n) + rng.uniform(-2 * cell, 2 * cell, n * len(folds))
+    q = np.stack([theta, rng.uniform(-np.pi, np.pi, theta.size), rng.uniform(-1.4, 1.4, theta.size)], -1)
+    far = []
+    for leg in ("FL", "FR"):
+        allq = sk.stance_ik_all(gd.ground_contact(q, leg).point, leg)
+        d = allq - q[:, None, :]
+        d[..., 1:] = np.pi - np.mod(np.pi - d[..., 1:], 2 * np.pi)
+        dist = np.min(np.where(np.isnan(d[..., 0]), np.inf, np.abs(d).max(-1)), axis=1)
+        # the check row's measure: the q distance x sigma_min of the contact point's derivative (m)
+        scaled = dist * tc._contact_sigma_min(q, leg, R_T)
+        assert np.all(scaled <= tc.TOL), (leg, np.flatnonzero(~(scaled <= tc.TOL)))
+        far.append(dist.max())
+    # next to the fold the inverse is ill-conditioned: a solution reproducing the target can be > 1e-9 rad away
+    assert max(far) > 1e-9, far
+
+
+def test_difference_rows_stay_on_one_smooth_branch():
+    """The check sweep (issue 25) failed two central-difference rows at 10^5 samples, by stencils that are not
+    smooth: the support height across a switch of the lowest point (9.0e-3 against 1e-8 at gamma = 5.5e-7, the
+    tyre edge switching at gamma = 0: seed 2; a jump between the tip caps, 6.9e-2; a jump from lower_L to upper_L,
+    2.0e-2), and the contact point with theta 1.5e-7 rad above THETA_MIN (the stencil clipped off-centre: 3.7e-8,
+    seed 2). Those stencils are now one-sided on the centre's branch (second order); the derivatives match."""
+    from legkin import wheel_leg as wl
+    from legkin.wheel_leg import checks as wc
+    from legkin.wheel_leg._differences import derivative
+
+    q = np.array([[2.5789600468405016, 1.0836373151802983, 5.510506475570054e-07],
+                  [1.6660385160682967, -3.1415925257589272, 0.020420628913310868],
+                  [1.3960195269973472, 0.8349840502419519, -0.20486316276301308]])
+    for leg, qi, c in (("RL", q[0], 2), ("FR", q[1], 1), ("RR", q[2], 1)):
+        def height(x, rows, leg=leg):
+            g = gd.ground_contact(x, leg)
+            return g.point[:, 2:], tc._smooth_branch(g)
+
+        gc = gd.ground_contact(qi[None], leg)
+        d, one_sided = derivative(height, qi[None], c, tc.FD_STEP, -np.inf, np.inf, height(qi[None], None))
+        assert one_sided[0], (leg, qi)  # the central stencil crosses a switch
+        assert abs(d[0, 0] - gc.jacobian[0, 2, c]) <= tc.TOL_FD, (leg, d[0, 0], gc.jacobian[0, 2, c])
+    q3 = np.array([[0.29670612319213113, -1.8369875173680323, 0.48246826710999324]])
+    kw = {"alpha": np.array([-2.3000814363123685]), "w": np.array([1.0189088797893375e-05])}
+
+    def contact(x, rows):
+        return wl.fk(x, "FL", **kw), None
+
+    d, one_sided = derivative(contact, q3, 0, wc.FD_STEP, wl.THETA_MIN, wl.THETA_MAX, contact(q3, None))
+    assert one_sided[0] and np.abs(d[0] - wl.jacobian(q3, "FL", **kw)[0, :, 0]).max() <= wc.TOL_FD

@@ -54,9 +54,25 @@ TOL_GAIN = 1e-15
 SOLVE_SAMPLES = 200
 #: Near the platform singularity 1 + c_y c_z = 0 (tilt -> pi) fk and ik are ill-conditioned: the orientation
 #: error of fk(ik(u)) grows like 1e-16 / (1 + c_y c_z) (measured 3.8e-10 at 1 + c_y c_z = 7e-7, alpha = pi/4);
-#: samples with 1 + c_y c_z <= NEAR_FLIP get rows of their own with TOL_FLIP, valid down to 1 + c_y c_z ~ 1e-7.
+#: samples with 1 + c_y c_z <= NEAR_FLIP get rows of their own (the ik rows with TOL_FLIP, valid down to
+#: 1 + c_y c_z ~ 1e-7; the fk rows with FK_CONSTANT).
 NEAR_FLIP = 1e-2
 TOL_FLIP = 1e-8
+#: fk(ik(u)) round trip: fk solves ik(x) = u by Gauss-Newton, so its answer is off by the solve's gain
+#: |A_u^+| = 1 / sigma_min(A_u) times the rounding of the residual ik(x) - u, ~eps (|u| + |A_u| |x|) with |u|,
+#: |x| <= pi; near the flip ik and platform_rotation themselves lose accuracy like eps / (1 + c_y c_z) (measured
+#: 3.8e-10 at 1 + c_y c_z = 7e-7). The row reports the rotation error / (eps x amplification), amplification
+#: = (1 + 1 / sigma_min(A_u)) (1 + sigma_max(A_u)) + 1 / (1 + c_y c_z), against FK_CONSTANT. A fixed 1e-12 failed
+#: by chance: 1.41e-12 at alpha = pi/4, seed 19, 10^5 samples, where det M = 8e-5, 1 / sigma_min = 261 and
+#: sigma_max = 1.5 (error / (eps x amplification) = 9.7 there). scripts/tripod_conditioning_sweep.py --row fk
+#: measured the ratio over 20 seeds x 10^3, 10^4, 10^5 samples at each alpha: largest 10.6 (pi/3), 12.1 (pi/4),
+#: 7.8 (pi/2) far from the flip, 0.84 near it (pi/4); FK_CONSTANT keeps a margin of 2.5.
+FK_CONSTANT = 30.0
+#: The inconsistency |ik(fk(u)) - u| of consistent motors is the rounding of ik's motors at fk's answer,
+#: ~eps (1 + |A_u|) (|A_u| = sigma_max reaches ~500 near a leg's boundary, where a fixed 1e-12 keeps a margin of
+#: only ~4); the row reports inconsistency / (eps (1 + sigma_max(A_u))) against INCONSISTENCY_CONSTANT (measured
+#: as FK_CONSTANT: largest 2.4, 2.2, 2.6 at pi/3, pi/4, pi/2; a margin of 3).
+INCONSISTENCY_CONSTANT = 8.0
 SOLVE_TOL = 1e-14
 
 
@@ -244,26 +260,50 @@ def _jacobian_rows(robot, geo: at.Geometry, alpha: float, pre: str, q: np.ndarra
     return rows
 
 
-def _fk_rows(geo: at.Geometry, pre: str, q: np.ndarray, ay: np.ndarray, az: np.ndarray,
-             far: np.ndarray) -> list[CheckResult]:
-    """fk(ik(u)) round trip and the inconsistency of consistent motors."""
-    rows: list[CheckResult] = []
+def fk_round_trip_errors(geo: at.Geometry, q: np.ndarray, ay: np.ndarray, az: np.ndarray,
+                         far: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Per sample, the platform rotation error of ``fk(ik(u))`` and its amplification bound (:data:`FK_CONSTANT`),
+    the inconsistency of the consistent motors and its amplification (:data:`INCONSISTENCY_CONSTANT`).
+
+    Args:
+        geo: the geometry.
+        q: (n, 12) joint configurations of the orientations (from :func:`legkin.tripod.ik_joints`).
+        ay: (n,) alpha_y (rad).
+        az: (n,) alpha_z (rad).
+        far: (n,) the samples with 1 + c_y c_z > :data:`NEAR_FLIP` (the others may be inconsistent up to 1e-6 rad).
+
+    Returns:
+        ``(error, amplification, inconsistency, inconsistency_amplification)``, four (n,) arrays: the rotation
+        angle (rad, NaN where fk failed) and the inconsistency (rad), and their amplifications (dimensionless).
+    """
     # near the flip the motors' rounding noise is amplified (|A_u| ~ 1 / (1 + c_y c_z)): measured
     # inconsistency up to 5e-9 rad there, so those samples accept up to 1e-6 (the default is 1e-9)
     u, u_ok, u_info = at.fk(q[:, list(MOTOR_COLUMNS)], geometry=geo, return_mask=True, return_info=True,
                             max_inconsistency=1e-6)
     inconsistency = u_info.inconsistency
     u_ok[far & (inconsistency > 1e-9)] = False
-    fk_rot = _rot_err(at.platform_rotation(np.nan_to_num(u[:, 0]), np.nan_to_num(u[:, 1])),
-                      at.platform_rotation(ay, az))
-    fk_rot[~u_ok] = np.nan  # a failure counts against the row
-    rows.append(compare(pre + f"fk(ik(u)) round trip, platform rotation (rad) (1 + c_y c_z > {NEAR_FLIP:g})",
-                        fk_rot[far], TOL))
-    if (~far).any():
-        rows.append(compare(pre + f"fk(ik(u)) round trip, platform rotation (rad) (1 + c_y c_z <= {NEAR_FLIP:g})",
-                            fk_rot[~far], TOL_FLIP))
-    rows.append(compare(pre + f"fk(ik(u)) inconsistency of consistent motors (rad) (1 + c_y c_z > {NEAR_FLIP:g})",
-                        inconsistency[far], TOL))
+    error = _rot_err(at.platform_rotation(np.nan_to_num(u[:, 0]), np.nan_to_num(u[:, 1])),
+                     at.platform_rotation(ay, az))
+    error[~u_ok] = np.nan  # a failure counts against the row
+    sv = np.linalg.svd(at.jacobian(np.stack([ay, az], axis=-1), geometry=geo), compute_uv=False)
+    amp = (1.0 + 1.0 / sv[:, -1]) * (1.0 + sv[:, 0]) + 1.0 / (1.0 + np.cos(ay) * np.cos(az))
+    return error, amp, inconsistency, 1.0 + sv[:, 0]
+
+
+def _fk_rows(geo: at.Geometry, pre: str, q: np.ndarray, ay: np.ndarray, az: np.ndarray,
+             far: np.ndarray) -> list[CheckResult]:
+    """fk(ik(u)) round trip and the inconsistency of consistent motors, each per sample against its conditioning
+    bound (:data:`FK_CONSTANT`, :data:`INCONSISTENCY_CONSTANT`)."""
+    rows: list[CheckResult] = []
+    error, amp, inconsistency, inc_amp = fk_round_trip_errors(geo, q, ay, az, far)
+    eps = float(np.finfo(float).eps)
+    for sel, tag_ in ((far, f"1 + c_y c_z > {NEAR_FLIP:g}"), (~far, f"1 + c_y c_z <= {NEAR_FLIP:g}")):
+        if sel.any():
+            rows.append(compare(pre + f"fk(ik(u)) round trip, platform rotation / (eps x amplification) ({tag_})",
+                                error[sel] / (eps * amp[sel]), FK_CONSTANT))
+    rows.append(compare(pre + "fk(ik(u)) inconsistency of consistent motors / (eps x (1 + |A_u|)) "
+                        f"(1 + c_y c_z > {NEAR_FLIP:g})", inconsistency[far] / (eps * inc_amp[far]),
+                        INCONSISTENCY_CONSTANT))
     return rows
 
 

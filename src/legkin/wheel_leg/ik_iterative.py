@@ -46,10 +46,13 @@ def _k_starts(tgt, upper, right, e, a, seed, K, KC, o0, o1, o2, s, grid, table, 
     Out of the plane (exact): in {M} before the ABAD rotation the contact point is ``(a, y_L, -+x_L)``,
     ``a = d_wheel + s w``; ``Rz(gamma)`` keeps the coordinate along z_M (``x_L = -(target - o)_x``) and the
     distance from that axis, so ``y_L = branch sqrt(x_M^2 + y_M^2 - a^2)`` (clipped at 0) and gamma is the
-    angle from ``(a, y_L)`` to ``(x_M, y_M)``. In the plane: the local minima over the 64-node theta grid of
-    ``| |z(theta, alpha)| - |x_L + i y_L| |`` (:func:`~legkin.wheel_leg.ik_radial._arc_table`: several theta
-    can give the same radius) by increasing residual, then the other nodes in grid order; theta is kept half
-    a cell inside its domain and beta rotates ``z`` onto the target.
+    angle from ``(a, y_L)`` to ``(x_M, y_M)``. In the plane, on the 64-node theta grid, the signed residual
+    ``|z(theta, alpha)| - |x_L + i y_L|`` (:func:`~legkin.wheel_leg.ik_radial._arc_table`: several theta can give
+    the same radius): first the cells where it changes sign (each holds a root of the in-plane radius), started at
+    the secant root, by increasing residual of the cell's better node; then the local minima of its magnitude
+    outside those cells, by increasing residual; then the other nodes in grid order. theta is kept half a cell
+    inside its domain and beta rotates ``z`` onto the target. (The local minima alone missed a root next to a
+    second one beyond the domain: the start sat between them and the iteration stalled on the bound, issue 25.)
     """
     d0, d1, d2 = tgt[0] - o0, tgt[1] - o1, tgt[2] - o2
     m = complex(s * d1, d2)
@@ -61,32 +64,46 @@ def _k_starts(tgt, upper, right, e, a, seed, K, KC, o0, o1, o2, s, grid, table, 
     nodes = grid.shape[0]
     ee = e.real * e.real + e.imag * e.imag
     base = 0 if upper else 4
-    res = np.empty(nodes)
+    sd = np.empty(nodes)
     for k in range(nodes):
         f = table[base, k] + ee * table[base + 1, k] + 2.0 * e.real * table[base + 2, k] - 2.0 * e.imag * table[
             base + 3, k]
-        res[k] = abs(math.sqrt(max(f, 0.0)) - r)
-    used = np.zeros(nodes, dtype=np.bool_)
+        sd[k] = math.sqrt(max(f, 0.0)) - r
+    key, theta = _k_start_keys(sd, grid)
     for c in range(count):
-        best = -1
-        for k in range(nodes):  # the unused local minimum of smallest residual (first on ties)
-            if used[k]:
-                continue
-            local = (k == 0 or res[k] <= res[k - 1]) and (k == nodes - 1 or res[k] <= res[k + 1])
-            if local and (best < 0 or res[k] < res[best]):
+        best = 0
+        for k in range(1, nodes):  # the smallest key left (first on ties)
+            if key[k] < key[best]:
                 best = k
-        if best < 0:  # no local minimum left: the next node in grid order
-            for k in range(nodes):
-                if not used[k]:
-                    best = k
-                    break
-        used[best] = True
-        z, _dz = _k_plane(grid[best], upper, right, e, seed, K, KC, False, True)
+        key[best] = math.inf
+        z, _dz = _k_plane(theta[best], upper, right, e, seed, K, KC, False, True)
         zk = 1j * z  # exp(i (beta + pi/2)) at beta = 0
         ratio = t / zk
-        starts[c, 0] = _k_clip(grid[best], THETA_MIN + _START_MARGIN, THETA_MAX - _START_MARGIN)
+        starts[c, 0] = _k_clip(theta[best], THETA_MIN + _START_MARGIN, THETA_MAX - _START_MARGIN)
         starts[c, 1] = math.atan2(ratio.imag, ratio.real)
         starts[c, 2] = gamma
+
+
+@kernel(inline=True)
+def _k_start_keys(sd, grid):
+    """The order of the starts (:func:`_k_starts`) from the signed residual ``sd`` on the grid: per node a key
+    (smaller first) and a theta. A cell [k, k + 1] where sd changes sign puts its secant root on its better node
+    (key: that node's residual - 2, first), a local minimum of |sd| elsewhere its node (key: its residual, next),
+    every other node its own (key: 1 + its index / nodes, last; the residuals are below 1 m)."""
+    nodes = grid.shape[0]
+    key = np.empty(nodes)
+    theta = grid.copy()
+    for k in range(nodes):
+        res = abs(sd[k])
+        local = (k == 0 or res <= abs(sd[k - 1])) and (k == nodes - 1 or res <= abs(sd[k + 1]))
+        key[k] = res if local else 1.0 + k / nodes
+    for k in range(nodes - 1):
+        if (sd[k] < 0.0) != (sd[k + 1] < 0.0):
+            j, o = (k, k + 1) if abs(sd[k]) <= abs(sd[k + 1]) else (k + 1, k)
+            theta[j] = grid[k] + sd[k] / (sd[k] - sd[k + 1]) * (grid[k + 1] - grid[k])
+            key[j] = abs(sd[j]) - 2.0
+            key[o] = max(key[o], 1.0 + o / nodes)  # not again as a local minimum
+    return key, theta
 
 
 @kernel

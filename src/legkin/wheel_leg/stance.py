@@ -15,12 +15,17 @@ How every solution is found (:func:`_k_stance_all`, one target):
   [17, 160] deg (:func:`_centre_table`). Each sign change of ``|c|^2 - |Z|^2`` on the grid is bracketed and
   solved by Newton's method safeguarded by bisection (the theta-derivative of the closed form) to full
   precision (an ill-conditioned root, near wheel mode: by plain bisection); a grid end with
-  ``| |c|^2 - |Z|^2 | <= 1e-15`` is a root too. beta follows from the angle of ``Z_k / c_k``;
+  ``| |c|^2 - |Z|^2 | <= 1e-15`` is a root too. Next to a fold of a row (an interior extremum of its grid values,
+  a boundary of its monotone runs) the curve can cross the level and come back between two nodes that do not
+  change sign: where the level is that close to the fold's node (:func:`_k_fold_roots`), the true extremum is
+  found (bisection on the sign of the theta-derivative) and the two roots on either side of it solved, or the
+  extremum itself taken where it touches the level to 1e-15. beta follows from the angle of ``Z_k / c_k``;
 * each candidate is kept only if ``ground_contact`` at it reproduces the target to :data:`VERIFY_TOL` (the
   circle must really carry the lowest point), then sorted by (|gamma|, theta) (stable) and de-duplicated
   (max-norm 1e-9, angles wrapped; the first is kept).
 
-Roots where |c_k|^2 touches the level without crossing it inside one grid cell (a fold) can be missed.
+A root is missed only where one grid cell holds more than one extremum of a row (none does: the rows are smooth
+and their folds 100s of cells apart).
 """
 
 from __future__ import annotations
@@ -166,6 +171,62 @@ def _k_bisect(row, z2, lo, hi, flo, K, KC):
 
 
 @kernel(inline=True)
+def _k_solve_cell(row, z2, lo, hi, flo, fhi, K, KC):
+    """The root of ``|c_row(theta)|^2 - z2`` bracketed by [lo, hi] (values flo, fhi of opposite signs): Newton
+    (:func:`_k_root`), or plain bisection (:func:`_k_bisect`) where the root is ill-conditioned."""
+    x, df = _k_root(row, z2, lo, hi, flo, fhi, K, KC)
+    if not abs(df) >= _ILL * z2:
+        x = _k_bisect(row, z2, lo, hi, flo, K, KC)
+    return x
+
+
+@kernel
+def _k_extremum(row, lo, hi, K, KC):
+    """The extremum of ``|c_row(theta)|^2`` in [lo, hi] (the theta-derivative changes sign there; else the middle)
+    by bisection on the derivative's sign: (theta, |c_row|^2 there)."""
+    c, dc = _k_centre(lo, row, K, KC)
+    neg_lo = (c.conjugate() * dc).real < 0.0
+    for _ in range(_BISECT):
+        mid = 0.5 * (lo + hi)
+        c, dc = _k_centre(mid, row, K, KC)
+        if ((c.conjugate() * dc).real < 0.0) == neg_lo:
+            lo = mid
+        else:
+            hi = mid
+    x = 0.5 * (lo + hi)
+    c, dc = _k_centre(x, row, K, KC)
+    return x, abs(c) ** 2
+
+
+@kernel(inline=True)
+def _k_fold_roots(row, z2, TH, TAB, RUNS, NRUN, K, KC, roots, m):
+    """Append to ``roots[row]`` (m so far) the roots next to each interior fold of the row (node b, a boundary of
+    its monotone runs) that the nodes b - 1, b, b + 1 do not bracket: where the level is within the neighbours'
+    differences of the fold's node (a parabola through the nodes dips below its lowest node by at most a quarter
+    of them), the extremum between b - 1 and b + 1 decides: beyond the level, a root on each side of it; at the
+    level (to 1e-15, a double root), the extremum itself. Returns the new count."""
+    for q in range(1, NRUN[row] - 1):
+        b = RUNS[row, q]
+        f0, f1, f2 = TAB[row, b - 1] - z2, TAB[row, b] - z2, TAB[row, b + 1] - z2
+        if (f0 < 0.0) != (f1 < 0.0) or (f2 < 0.0) != (f1 < 0.0):
+            continue  # a sign change in a cell next to the fold: bracketed by the scan of the runs
+        if abs(f1) > max(abs(f0 - f1), abs(f2 - f1)):
+            continue  # the curve cannot reach the level between these nodes
+        x, fx = _k_extremum(row, TH[b - 1], TH[b + 1], K, KC)
+        fx -= z2
+        if abs(fx) <= 1e-15:
+            if m < _CAP_ROOTS:
+                roots[row, m] = x
+            m += 1
+        elif (fx < 0.0) != (f1 < 0.0):
+            for lo, hi, flo, fhi in ((TH[b - 1], x, f0, fx), (x, TH[b + 1], fx, f2)):
+                if m < _CAP_ROOTS:
+                    roots[row, m] = _k_solve_cell(row, z2, lo, hi, flo, fhi, K, KC)
+                m += 1
+    return m
+
+
+@kernel(inline=True)
 def _k_arc_low(c, p1, p2, d, R):
     """Lowest height ``Re(conj(p) d)`` over the arc of radius R about c from p1 to p2 (counter-clockwise)."""
     a1 = math.atan2((p1 - c).imag, (p1 - c).real)
@@ -239,12 +300,9 @@ def _k_branch(t, n, yl, gamma, Zb, u, TH, TAB, RUNS, NRUN, K, KC, gargs, rho_big
                 else:
                     b = mid
             if m < _CAP_ROOTS:
-                x, df = _k_root(row, z2, TH[a], TH[b], TAB[row, a] - z2, TAB[row, b] - z2, K, KC)
-                if not abs(df) >= _ILL * z2:
-                    x = _k_bisect(row, z2, TH[a], TH[b], TAB[row, a] - z2, K, KC)
-                roots[row, m] = x
+                roots[row, m] = _k_solve_cell(row, z2, TH[a], TH[b], TAB[row, a] - z2, TAB[row, b] - z2, K, KC)
             m += 1
-        nroot[row] = m
+        nroot[row] = _k_fold_roots(row, z2, TH, TAB, RUNS, NRUN, K, KC, roots, m)
     for k in range(9):
         row = _C_ROW[k]
         rho_k = rho_big if _ROW_BIG[row] else rho_small

@@ -12,6 +12,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .._checkkit import CheckResult, compare, per_sample
+from ._differences import derivative
 from .configuration import configuration
 from .frames import leg_frame_to_robot
 from .geometry import ABAD_LIMIT, LEGS, THETA0, THETA_MAX, THETA_MIN, Geometry
@@ -29,6 +30,12 @@ LAB_R = (0.019, 0.01)
 BRUTE_SAMPLES, BRUTE_S = 400, 4000
 PIN_SAMPLES = 300
 IK_SAMPLES = 1000
+#: The stance IK's completeness row scales the distance (rad) from the sampled q to the nearest solution by the
+#: smallest singular value of the contact point's derivative (m/rad; central differences with this step): near a
+#: fold the inverse is ill-conditioned, and a solution that reproduces the target to ~1e-16 m can be ~1e-9 rad from
+#: the sampled q (theta 7e-7 rad from the fold of |H|^2, where sigma_min = 5e-8 m/rad). The differences' rounding,
+#: ~eps |p| / h ~ 1e-9 m/rad, is below the sigma_min that matters.
+SIGMA_STEP = 1e-7
 
 
 class LabContact(NamedTuple):
@@ -241,21 +248,35 @@ def _wheel_rows(rng: np.random.Generator, geo: Geometry, r: float) -> list[Check
     ]
 
 
+def _smooth_branch(gc: Any) -> np.ndarray:
+    """The smooth branch of the support height at each ground contact: the lowest point's piece and tyre edge (w
+    -T/2, 0, T/2); where either switches, the height has a kink (:mod:`legkin.wheel_leg._differences`)."""
+    return np.asarray(gc.piece * 3 + np.sign(gc.w).astype(np.int64) + 1)
+
+
 def _envelope_row(rng: np.random.Generator, geo: Geometry, r: float, n: int) -> CheckResult:
     q = np.stack([rng.uniform(THETA_MIN + 1e-5, THETA_MAX - 1e-5, n), rng.uniform(-np.pi, np.pi, n),
                   rng.uniform(-1.2, 1.2, n)], -1)
     err = np.zeros(n)
+    one_sided = np.zeros(n, dtype=bool)
     for k, leg in enumerate(LEGS):
-        m = np.arange(n) % 4 == k
+        m = np.flatnonzero(np.arange(n) % 4 == k)
+
+        def height(x: np.ndarray, rows: np.ndarray, leg: str = leg) -> tuple[np.ndarray, np.ndarray]:
+            gc = ground_contact(x, leg, r=r, geometry=geo)
+            return gc.point[:, 2:], _smooth_branch(gc)
+
         gc = ground_contact(q[m], leg, r=r, geometry=geo)
         for c in range(3):
-            dq = np.zeros(3)
-            dq[c] = FD_STEP
-            hp = ground_contact(q[m] + dq, leg, r=r, geometry=geo).point[:, 2]
-            hm = ground_contact(q[m] - dq, leg, r=r, geometry=geo).point[:, 2]
-            err[m] = np.maximum(err[m], np.abs((hp - hm) / (2 * FD_STEP) - gc.jacobian[:, 2, c]))
-    return compare(f"support height derivative (central differences, h = {FD_STEP:g}) = n . material Jacobian "
-                   "(envelope theorem; the rolling does not change the height)", err, TOL_FD)
+            lower, upper = (THETA_MIN, THETA_MAX) if c == 0 else (-np.inf, np.inf)
+            d, fitted = derivative(height, q[m], c, FD_STEP, lower, upper, (gc.point[:, 2:], _smooth_branch(gc)))
+            err[m] = np.maximum(err[m], np.abs(d[:, 0] - gc.jacobian[:, 2, c]))
+            one_sided[m] |= fitted
+    left = ~np.isfinite(err)
+    return compare(f"support height derivative (central differences, h = {FD_STEP:g}; {one_sided.sum()} across a "
+                   f"switch of the lowest piece or tyre edge: one-sided, second order, {left.sum()} left out) "
+                   "= n . material Jacobian (envelope theorem; the rolling does not change the height)",
+                   err[~left], TOL_FD)
 
 
 def _pinocchio_rows(rng: np.random.Generator, r: float) -> list[CheckResult]:
@@ -336,6 +357,23 @@ def _lab_rows(rng: np.random.Generator, n: int) -> list[CheckResult]:
     return rows
 
 
+def _contact_sigma_min(q: np.ndarray, leg: str, r: float) -> np.ndarray:
+    """sigma_min of d(ground contact point) / d(theta, beta, gamma) at each q (n, 3) (m/rad), by central differences
+    (h = :data:`SIGMA_STEP`, theta kept in its limits): the contact point slides over the tyre, so the material-point
+    Jacobian is not its derivative. Near a fold of the stance IK (theta at an extremum of a support circle's
+    centre distance |c(theta)|) sigma_min -> 0 and the inverse is ill-conditioned."""
+    jac = np.empty((len(q), 3, 3))
+    lim_lo, lim_hi = [THETA_MIN, -9.0, -9.0], [THETA_MAX, 9.0, 9.0]
+    for c in range(3):
+        hi, lo = q.copy(), q.copy()
+        hi[:, c] += SIGMA_STEP
+        lo[:, c] -= SIGMA_STEP
+        hi, lo = np.clip(hi, lim_lo, lim_hi), np.clip(lo, lim_lo, lim_hi)
+        diff = ground_contact(hi, leg, r=r).point - ground_contact(lo, leg, r=r).point
+        jac[:, :, c] = diff / (hi[:, c] - lo[:, c])[:, None]
+    return np.linalg.svd(jac, compute_uv=False)[:, -1]
+
+
 def _ik_rows(rng: np.random.Generator, r: float, n: int) -> list[CheckResult]:
     q = np.stack([rng.uniform(THETA_MIN, THETA_MAX, n), rng.uniform(-np.pi, np.pi, n),
                   rng.uniform(-ABAD_LIMIT * 0.9, ABAD_LIMIT * 0.9, n)], -1)
@@ -351,13 +389,14 @@ def _ik_rows(rng: np.random.Generator, r: float, n: int) -> list[CheckResult]:
         allq = stance_ik_all(target, leg, r=r)
         d = allq - q[m][:, None, :]
         d[..., 1:] = np.pi - np.mod(np.pi - d[..., 1:], 2 * np.pi)
-        found[m] = np.nanmin(np.abs(d).max(-1), axis=1)
+        found[m] = np.min(np.where(np.isnan(d[..., 0]), np.inf, np.abs(d).max(-1)), axis=1)
+        found[m] *= _contact_sigma_min(q[m], leg, r)
         nsol[m] = np.isfinite(allq[..., 0]).sum(-1)
     return [
         compare(f"stance_ik round trip: ground_contact(stance_ik(target)) = target, {np.isfinite(err).sum()}/{n} "
                 f"solved (targets = ground contacts of in-limit q, 4 legs)", err, TOL),
-        compare(f"stance_ik_all: the sampled q among the solutions (max-norm rad; {nsol.min()}-{nsol.max()} "
-                "solutions per target)", found, 1e-9),
+        compare(f"stance_ik_all: the sampled q among the solutions ({nsol.min()}-{nsol.max()} solutions per target; "
+                "q distance, max-norm rad, x sigma_min(d contact / dq), m)", found, TOL),
     ]
 
 

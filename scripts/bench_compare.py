@@ -22,26 +22,49 @@ from __future__ import annotations
 
 import argparse
 import json
+import statistics
 import sys
 from typing import Any
 
 
-def ratios(path: str) -> dict[tuple[str, str], float]:
+def pooled_yardsticks(data: dict[str, Any]) -> dict[tuple[str, str], float]:
+    """The median over a run's models of each yardstick's time per call (s), by (key, label): the same call only
+    (``solve_loops`` is another call on each model).
+
+    A run times the same Pinocchio call (``quadruped_fk``) once per model; on a shared 2-core machine even its CPU
+    time moves by ~10 % between those timings (586 vs 522 ns in one run), and with it every ratio of the model it
+    was timed for. The median of the run's timings is the steadier yardstick.
+    """
+    times: dict[tuple[str, str], list[float]] = {}
+    for m in data["models"].values():
+        for key, y in ((m.get("single_calls") or {}).get("yardsticks") or {}).items():
+            times.setdefault((key, y["label"]), []).append(float(y["time_per_call_s"]))
+    return {key: statistics.median(t) for key, t in times.items()}
+
+
+def ratios(path: str, pooled: bool = False) -> dict[tuple[str, str], float]:
     """Every ratio of a bench JSON file by (model, row name).
 
     Args:
         path: a file written by ``legkin bench --json``.
+        pooled: divide single calls by the run's median yardstick (:func:`pooled_yardsticks`), not their model's.
 
     Returns:
         ``{(model, "single: NAME") or (model, "method: NAME"): ratio}``, dimensionless.
     """
     with open(path, encoding="utf-8") as f:
         data: dict[str, Any] = json.load(f)
+    sticks = pooled_yardsticks(data)
     out: dict[tuple[str, str], float] = {}
     for model, m in data["models"].items():
         single = m.get("single_calls") or {}
+        labels = {key: y["label"] for key, y in (single.get("yardsticks") or {}).items()}
         for row in single.get("rows", []):
-            out[(model, f"single: {row['name']}")] = float(row["ratio"])
+            ratio = float(row["ratio"])
+            stick = (row.get("yardstick"), labels.get(row.get("yardstick")))
+            if pooled and row.get("time_per_call_s") and stick in sticks:
+                ratio = float(row["time_per_call_s"]) / sticks[stick]
+            out[(model, f"single: {row['name']}")] = ratio
         yard = [y["time_per_call_s"] for y in single.get("yardsticks", {}).values() if y["number"] >= 1000]
         if not yard:
             continue
@@ -58,8 +81,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("before")
     ap.add_argument("after")
     ap.add_argument("--slack", type=float, default=0.10, help="run-to-run spread allowed (default 0.10)")
+    ap.add_argument("--pooled", action="store_true", help="single calls over the run's median yardstick")
     args = ap.parse_args(argv)
-    old, new = ratios(args.before), ratios(args.after)
+    old, new = ratios(args.before, args.pooled), ratios(args.after, args.pooled)
     worse = 0
     print(f"{'model':12s} {'row':78s} {'before':>9s} {'after':>9s} {'after/before':>12s}")
     for key in sorted(set(old) & set(new)):

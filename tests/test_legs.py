@@ -734,6 +734,19 @@ def test_an_exact_branch_beats_a_clamped_one():
         assert np.linalg.norm(leg.fk(leg.ik(p)) - p, axis=-1).max() <= TOL
 
 
+def test_polish_converges_next_to_the_abduction_singularity():
+    """hyq's rf foot next to its HAA cylinder (``r ~ d``: the Jacobian's least singular value 6.8e-9, below the polish's
+    damping 1e-7): with a fixed damping the steps left 2.4e-12 m (``legkin check hyq --random-seed 16 --samples
+    100000``); the Levenberg-Marquardt damping reaches the target to machine precision on every branch."""
+    rf = legs.from_model(legs.load_erd("hyq")[0])["rf"]
+    q = np.array([-0.9957433163743001, -0.7818827155056822, -2.0389794853692838])
+    p = rf.fk(q)
+    assert np.linalg.svd(rf.jacobian(q), compute_uv=False).min() < 1e-7  # the case: sigma_min below the damping
+    sol, mask = rf.ik_all(p, return_mask=True)
+    assert mask.sum() >= 2
+    assert np.linalg.norm(rf.fk(sol[mask]) - p, axis=-1).max() <= TOL
+
+
 def test_quadruped_legs_named_by_hip_position_when_joint_names_share_no_prefix():
     """Joints named '0' ... '11' (no common prefix): the legs are FL, FR, RL, RR from the hips' signs of x and y."""
     model = pin.Model()

@@ -33,7 +33,7 @@ CANDIDATE_SLACK = LIMIT_SLACK + 1e-6
 #: than CANDIDATE_SLACK, so that the exact test on the angle, not the rounding of a cross product, decides there.
 ARC_SLACK = CANDIDATE_SLACK + 1e-6
 #: Damped Newton steps (at most) polishing each closed-form branch on the exact forward map (see _polish_k).
-POLISH_STEPS = 8
+POLISH_STEPS = 24
 #: Damping (m) of the polishing steps: bounds a step to ~|e| / (2 lambda) rad near a singularity.
 POLISH_DAMPING = 1e-7
 #: On a leg with the exact ideal structure (:data:`_IDEAL`), a closed-form branch is returned unpolished (no

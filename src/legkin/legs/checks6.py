@@ -82,7 +82,7 @@ def _ik_rows(model, legs: dict, qleg: np.ndarray, poses: np.ndarray) -> list[Che
                 f"solved in limits)", err, TOL6),
         compare(f"{n_closed} feet: IK all solutions, Pinocchio FK of ik_all(T) ({int(mask.sum())} solutions)",
                 np.concatenate(errs), TOL6),
-        compare(f"{n_closed} feet: the sampled q among ik_all(T) (joint gap x sigma_min(J), m)", np.concatenate(among),
+        compare(f"{n_closed} feet: the sampled q among ik_all(T) (q distance x sigma_min(J), m)", np.concatenate(among),
                 C_AMONG * TOL6),
     ]
 

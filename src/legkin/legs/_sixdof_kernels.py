@@ -184,48 +184,68 @@ def _split_error(e) -> float:
 
 
 @kernel
-def _polish6(tg, g, q, ws, fixed=0) -> float:
-    """Damped Newton steps ``dq = (J^T J + lambda^2 I)^-1 J^T e`` on the exact forward map (at most
-    :data:`POLISH_STEPS6`, each kept only if it reduces ``|e|``) while ``|e|`` exceeds :data:`POLISH_BELOW6`; the
-    joints of the bit mask ``fixed`` do not move (their Jacobian columns are zeroed). ``ws``: a work array of at least
-    32 rows of 6. Returns the error of the final ``q``: the larger of its position error (m) and its rotation error
-    (rad)."""
+def _newton_step6(tg, g, q, ws, fixed) -> float:
+    """One damped Newton correction ``dq = (J^T J + lambda^2 I)^-1 J^T e`` at ``q`` into ``ws[30]`` (``e`` in
+    ``ws[28]``, the pose error at ``q``), the joints of the bit mask ``fixed`` held (their Jacobian columns zeroed);
+    returns ``|dq|`` (rad), or -1 if the normal matrix is not positive definite."""
     aw, ow, rm, p, e = ws[12:18, 0:3], ws[18:24, 0:3], ws[24:27, 0:3], ws[27, 0:3], ws[28]
+    jac, a, b, dq = ws[0:6], ws[6:12], ws[29], ws[30]
+    _jac6(q, g, jac, rm, p, aw, ow)
+    for c in range(6):
+        if fixed >> c & 1:
+            for i in range(6):
+                jac[i, c] = 0.0
+    lam2 = POLISH_DAMPING6 * POLISH_DAMPING6
+    for i in range(6):
+        b[i] = 0.0
+        for k in range(6):
+            b[i] += jac[k, i] * e[k]
+        for c in range(6):
+            s = lam2 if i == c else 0.0
+            for k in range(6):
+                s += jac[k, i] * jac[k, c]
+            a[i, c] = s
+    if not _solve6(a, b, dq):
+        return -1.0
+    return math.sqrt(dq[0] ** 2 + dq[1] ** 2 + dq[2] ** 2 + dq[3] ** 2 + dq[4] ** 2 + dq[5] ** 2)
+
+
+@kernel
+def _polish6(tg, g, q, ws, fixed=0) -> float:
+    """Damped Newton steps (:func:`_newton_step6`) on the exact forward map while ``|e|`` exceeds
+    :data:`POLISH_BELOW6`, at most :data:`POLISH_STEPS6`, as long as the corrections shrink (``|dq|`` less than the
+    previous step's: Deuflhard's natural monotonicity test, affine invariant). A step may raise ``|e|``: near a
+    singular pose (least singular value ``sigma`` of ``J``) the closed form can land ``~1e-5`` rad off along the
+    near-null direction with ``|e| ~ 1e-11``, where the first full step overshoots the residual (10x) but lands
+    ``1e-9`` rad from the root and the next one at ``|e| ~ 1e-16`` (talos, ``sigma = 1.7e-7``); a test on ``|e|``
+    stopped there. ``q`` ends at the iterate of least ``|e|``. ``ws``: a work array of at least 32 rows of 6.
+    Returns the error of the final ``q``: the larger of its position error (m) and its rotation error (rad)."""
+    aw, ow, rm, p, e, dq, qb = ws[12:18, 0:3], ws[18:24, 0:3], ws[24:27, 0:3], ws[27, 0:3], ws[28], ws[30], ws[31]
     _pose6(q, g, rm, p, aw, ow)
     err = _pose_error(tg, rm, p, e)
-    split = _split_error(e)
+    best, split = err, _split_error(e)
     if err <= POLISH_BELOW6:  # the closed form's usual case: no work space for the steps
         return split
-    jac, a, b, dq, qn = ws[0:6], ws[6:12], ws[29], ws[30], ws[31]
-    lam2 = POLISH_DAMPING6 * POLISH_DAMPING6
+    for i in range(6):
+        qb[i] = q[i]
+    last = math.inf
     for _ in range(POLISH_STEPS6):
         if err <= POLISH_BELOW6:
             break
-        _jac6(q, g, jac, rm, p, aw, ow)
-        for c in range(6):
-            if fixed >> c & 1:
-                for i in range(6):
-                    jac[i, c] = 0.0
-        for i in range(6):
-            b[i] = 0.0
-            for k in range(6):
-                b[i] += jac[k, i] * e[k]
-            for c in range(6):
-                s = lam2 if i == c else 0.0
-                for k in range(6):
-                    s += jac[k, i] * jac[k, c]
-                a[i, c] = s
-        if not _solve6(a, b, dq):
+        size = _newton_step6(tg, g, q, ws, fixed)
+        if not 0.0 <= size < last:  # not a descent any more: no root near, or the rounding floor
             break
+        last = size
         for i in range(6):
-            qn[i] = q[i] + dq[i]
-        _pose6(qn, g, rm, p, aw, ow)
-        new = _pose_error(tg, rm, p, e)
-        if not new < err:
-            break
-        err, split = new, _split_error(e)
-        for i in range(6):
-            q[i] = qn[i]
+            q[i] += dq[i]
+        _pose6(q, g, rm, p, aw, ow)
+        err = _pose_error(tg, rm, p, e)
+        if err < best:
+            best, split = err, _split_error(e)
+            for i in range(6):
+                qb[i] = q[i]
+    for i in range(6):
+        q[i] = qb[i]
     return split
 
 

@@ -59,9 +59,11 @@ def rot_cs(k, c, s, p):
 @kernel
 def _sp1_parts(p1, p2, k):
     """``(k . (p1 x p2), p1 . p2 - (k . p1)(k . p2))``: the sine and cosine of SP1's angle, each times the product
-    of the projections' lengths."""
-    kp1, kp2 = dot(k, p1), dot(k, p2)
-    return dot(k, cross(p1, p2)), dot(p1, p2) - kp1 * kp2
+    of the projections' lengths; computed as ``(k . (w1 x w2), w1 . w2)`` with ``w_i = k x p_i`` (the projections
+    turned by 90 degrees): for ``p_i`` within ``beta`` of ``k`` both parts are ``~beta^2``, and the direct formulas
+    (differences of O(1) terms) lost them entirely below ``beta ~ 1e-8``."""
+    w1, w2 = cross(k, p1), cross(k, p2)
+    return dot(k, cross(w1, w2)), dot(w1, w2)
 
 
 @kernel
@@ -129,8 +131,12 @@ def sp2_cs(p1, p2, k1, k2):
     ``miss`` reports ``| |p1| - |p2| |``): both sides are the unit vector ``x`` where the cone of ``u1`` about ``k1``
     meets the cone of ``u2`` about ``k2``, ``x = a k1 + b k2 + c (k1 x k2)`` with ``k1 . x = k1 . u1``,
     ``k2 . x = k2 . u2`` (so, with ``g = k1 . k2``, ``a = (k1.u1 - g k2.u2) / (1 - g^2)``,
-    ``b = (k2.u2 - g k1.u1) / (1 - g^2)``) and ``|x| = 1`` (``c^2 (1 - g^2) = 1 - a^2 - b^2 - 2 a b g``); then
-    ``t1 = SP1(u1 -> x)`` about ``k1`` and ``t2 = SP1(u2 -> x)`` about ``k2``.
+    ``b = (k2.u2 - g k1.u1) / (1 - g^2)``) and ``|x| = 1``; then ``t1 = SP1(u1 -> x)`` about ``k1`` and
+    ``t2 = SP1(u2 -> x)`` about ``k2``. ``|x| = 1`` gives ``c^2 (1 - g^2) = 1 - a^2 - b^2 - 2 a b g``, i.e.
+    ``c^2 (1 - g^2)^2 = |k1 x k2|^2 |k2 x u2|^2 - (k1.u1 - g k2.u2)^2`` (or the same with 1 and 2 swapped), computed
+    on the narrower cone's ``|k x u|`` from its cross product: ``1 - a^2 - b^2 ...`` cancels to nothing when a cone is
+    narrow (``u2`` within ``beta`` of ``k2``: ``c ~ beta`` came out with an absolute error ``1e-16 / beta``, a leg's
+    foot off by ``1e-16 / beta`` m near the pose where the hip centre lies on the ankle roll axis).
 
     Returns:
         ``(n, (c1, s1)_a, (c2, s2)_a, (c1, s1)_b, (c2, s2)_b, miss)``: ``n`` = 2 (``c = -+ sqrt``), 0 when the cones
@@ -141,12 +147,14 @@ def sp2_cs(p1, p2, k1, k2):
     u1 = (p1[0] / n1, p1[1] / n1, p1[2] / n1)
     u2 = (p2[0] / n2, p2[1] / n2, p2[2] / n2)
     g = dot(k1, k2)
-    s2 = 1.0 - g * g
+    n = cross(k1, k2)
+    s2 = dot(n, n)  # 1 - g^2
     ku1, ku2 = dot(k1, u1), dot(k2, u2)
     a = (ku1 - g * ku2) / s2
     b = (ku2 - g * ku1) / s2
-    n = cross(k1, k2)
-    c2 = (1.0 - a * a - b * b - 2.0 * a * b * g) / s2
+    w1, w2 = cross(k1, u1), cross(k2, u2)
+    r1, r2 = dot(w1, w1), dot(w2, w2)  # 1 - (k.u)^2 of each cone, from the cross product
+    c2 = (s2 * r2 - (ku1 - g * ku2) ** 2 if r2 <= r1 else s2 * r1 - (ku2 - g * ku1) ** 2) / (s2 * s2)
     miss, count = abs(n1 - n2), 2
     if c2 < 0.0:
         miss, c2, count = max(miss, math.sqrt(-c2 * s2)), 0.0, 0

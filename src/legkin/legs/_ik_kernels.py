@@ -271,7 +271,7 @@ def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out, flip):
     found = 0
     pitched, far, clean_w = False, False, False  # the pitch-plane quantities computed (for one abduction branch)
     wx = wy = miss = c = acb = 0.0
-    written, projected, exact = 0, 0, False  # bits of the abduction branches written / clamped onto the reach
+    projected, exact = 0, False  # bits of the abduction branches written clamped onto their reach; one exact
     for ia in range(2):
         u3, q1 = _abduction_k(g, ia, t, yz)
         if not pitched or g[_H] != 0.0:  # h_X = 0: |w|, so the knee, is the same on both abduction branches
@@ -296,13 +296,12 @@ def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out, flip):
             b = (2 * ia + ik) ^ flip
             out[b, 0], out[b, 1], out[b, 2] = _near_k(j1, r0), _near_k(j2, r1), _near_k(j3, r2)
             found += 1
-            written |= 1 << ia
             if miss > g[_SLACK]:
                 projected |= 1 << ia
             else:
                 exact = True
     if exact and projected:  # an exact branch beats a clamped one (h_X != 0: the branches' reaches differ)
-        found -= _drop_projected_k(out, written & projected, flip)
+        found -= _drop_projected_k(out, projected, flip)
     if found == 0:
         return _UNREACHABLE, best, why
     return OK, 0.0, 0.0

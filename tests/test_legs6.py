@@ -493,11 +493,12 @@ def test_squat_keeps_the_soles_on_the_floor(name, deep):
     assert all(leg.within_limits(qs[:, list(leg.idx_q)]).all() for leg in robot.geometry.values())
 
 
-@pytest.mark.xfail(strict=True, reason="open: g1's search misses this solution (docs/legs.md, 'Open')")
-def test_g1_search_misses(humanoids):
-    """g1's left leg at ``legkin check g1 --random-seed 7 --samples 100000`` (sample 83926): ik and ik_all of its
-    pose miss the sampled configuration (the nearest row 1.47 rad away, sigma_min 0.019, not near a singular pose).
-    Found by ``scripts/check_sweep.py`` at 10^5 samples (seeds 10, 15, 16, 19 fail the same way)."""
+def test_g1_seventeenth_candidate_is_kept(humanoids):
+    """g1's left leg at ``legkin check g1 --random-seed 7 --samples 100000`` (sample 83926): its pose has 16
+    solutions, and the search finds one of them twice (two candidates 1e-10 apart that polish to one row), so a list
+    of 16 candidates lost the 17th candidate, the sampled configuration (the nearest row was 1.47 rad away,
+    sigma_min 0.019). Found by ``scripts/check_sweep.py`` at 10^5 samples (seeds 10, 15, 16, 19 failed too). The
+    candidates now have room for twice K, and a row polished onto an earlier one is dropped."""
     model, found = humanoids["g1"]
     leg = found["left"]
     q = np.array([2.5902614147125917, 0.0353202021090927, 0.021342084094692737, 2.8377100853976733,
@@ -506,3 +507,6 @@ def test_g1_search_misses(humanoids):
     q_all, mask = leg.ik_all(pose[0], return_mask=True)
     gap = np.where(mask, np.abs(np.angle(np.exp(1j * (q_all - q)))).max(axis=-1), np.inf).min()
     assert gap * np.linalg.svd(leg.jacobian(q), compute_uv=False)[-1] <= 3e-12
+    rows = q_all[mask]
+    apart = np.abs(np.angle(np.exp(1j * (rows[:, None] - rows[None])))).max(axis=-1)
+    assert (apart[~np.eye(len(rows), dtype=bool)] > 1e-9).all()  # no solution listed twice

@@ -9,7 +9,7 @@ import math
 import numpy as np
 
 from .._kernels import OK, batch_kernel, kernel
-from ._ik_kernels import _in_limits_k, _near_k
+from ._ik_kernels import _TWO_PI, _in_limits_k, _near_k
 from ._search_kernels import _search_candidates
 from ._sixdof_kernels import _hip_candidates, _polish6, _valid_pose
 from ._sixdof_layout import (
@@ -39,32 +39,59 @@ def _candidates(tg, g, cand) -> int:
     return 0
 
 
+#: The candidate rows a search may hold: twice the K rows of ``ik_all``. A root can be found twice (by two cells, or
+#: as two roots of a near-tangent pair that polish to one solution), and a list of K candidates once lost the 17th,
+#: a distinct solution (g1, ``legkin check g1 --random-seed 7 --samples 100000``).
+_CAND_ROWS = 2
+#: Two polished rows closer than this in every angle (rad, modulo 2 pi) are one solution: the polish lands within
+#: ~1e-15 rad of a solution, and two distinct solutions this close make the same pose to far below ``IK_TOL``.
+_SAME_ROW = 1e-9
+
+
+@kernel
+def _listed(out, m, q) -> bool:
+    """Whether ``q`` (6,) is one of the rows ``out[:m]`` to :data:`_SAME_ROW` in every angle, modulo 2 pi."""
+    for i in range(m):
+        same = True
+        for j in range(6):
+            d = abs(out[i, j] - q[j]) % _TWO_PI
+            same = same and min(d, _TWO_PI - d) <= _SAME_ROW
+        if same:
+            return True
+    return False
+
+
 @kernel
 def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
     """Every solution (rows of ``out`` (K, 6), NaN rows for absent ones) of the foot pose ``tg`` (16 floats): the
     candidates of the leg's structure (closed form or search), each polished (:func:`_polish6`) and kept if it
-    reproduces ``tg`` to ``tol``, each angle moved to its 2 pi representative nearest ``ref``. ``info[0]``: on
-    failure the least residual."""
+    reproduces ``tg`` to ``tol``, each angle moved to its 2 pi representative nearest ``ref``. The closed form's
+    rows keep their branch order; the search's are packed, a row polished onto an earlier one dropped
+    (:func:`_listed`). ``info[0]``: on failure the least residual."""
     k = out.shape[0]
     for b in range(k):
         for j in range(6):
             out[b, j] = _NAN
     if not _valid_pose(tg):
         return _BAD_INPUT
-    ws = np.empty((33 + k, 6))  # rows 0-31: the polish's work space, 32: the polished row, then the candidates
+    ws = np.empty((33 + _CAND_ROWS * k, 6))  # rows 0-31: the polish's work space, 32: the polished row, candidates
     cand, qb = ws[33:], ws[32]
     n = _candidates(tg, g, cand)
+    packed = g[_KIND] != HIP_SPHERICAL
     best, found = math.inf, 0
     for b in range(n):
         for j in range(6):
             qb[j] = cand[b, j]
         res = _polish6(tg, g, qb, ws)
-        if res <= tol:
-            for j in range(6):
-                out[b, j] = _near_k(qb[j], ref[j])
-            found += 1
-        elif res < best:
-            best = res
+        if not res <= tol:
+            best = min(best, res)
+            continue
+        if packed and (found >= k or _listed(out, found, qb)):
+            continue
+        row = found if packed else b
+        for j in range(6):
+            out[row, j] = _near_k(qb[j], ref[j])
+        found += 1
     if found == 0:
         info[0], info[1] = best, 0.0
         return _UNREACHABLE
@@ -117,7 +144,7 @@ def _ik6_k(tg, g, ref, tol, out, info) -> int:
         out[j] = _NAN
     if not _valid_pose(tg):
         return _BAD_INPUT
-    k = int(g[_NSOLS])
+    k = _CAND_ROWS * int(g[_NSOLS])
     ws = np.empty((33 + 2 * k, 6))  # polish work space, polished row, candidates, their in-limit representatives
     cand, lim, qb = ws[33:33 + k], ws[33 + k:], ws[32]
     n = _candidates(tg, g, cand)

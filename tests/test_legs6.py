@@ -17,6 +17,7 @@ from legkin.errors import (
     LegStructureError,
     UnreachableError,
 )
+from legkin.legs.checks6 import C_AMONG, TOL6
 from legkin.legs.sixdof import Leg6
 
 # The erd robots with legs: URDF relative to example-robot-data's robots/, expected structure and foot frames.
@@ -491,6 +492,40 @@ def test_squat_keeps_the_soles_on_the_floor(name, deep):
     assert abs(soles[0, :, 2, 3].min()) <= 1e-12  # the lowest sole on the floor
     assert qs[0, 2] - qs[:, 2].min() == pytest.approx(depth, rel=1e-3)
     assert all(leg.within_limits(qs[:, list(leg.idx_q)]).all() for leg in robot.geometry.values())
+
+
+#: g1 configurations near its singular poses (``sigma_min`` 2e-5 to 2e-4) whose solution the search missed, from
+#: ``scripts/check_sweep.py g1 --sizes 100000`` (seed, leg, sample): a pair of roots 1e-3 to 1e-2 rad apart in one
+#: cell of equal signs, next to a fold, settled as empty by the curvature bound (docs/legs.md: ``DOUBT``).
+G1_NEAR_SINGULAR = {
+    "seed10-right-52108": ("right", [-0.4708061459872095, -2.6792596632099066, -0.08803088448631424,
+                                     2.5658381763361047, 0.3586799140289244, -0.12171823946636393]),
+    "seed15-left-77844": ("left", [1.0359140685471755, -0.44394727450113936, -0.12678564108442636,
+                                   2.732228581934333, 0.2935541820372122, -0.06130810766009231]),
+    "seed16-right-48801": ("right", [-1.4930337583698596, -1.6539886248438063, -0.01513341255087086,
+                                     2.784339035106442, 0.26776232440908776, -0.00558007000458272]),
+    "seed19-left-54107": ("left", [-0.06180974889635049, 2.8375129912270967, 0.14080683878461864,
+                                   2.4090013945978104, 0.4341763716595738, 0.16126967674642362]),
+    "seed19-left-98538": ("left", [-1.0622088788833608, 2.598281362685622, 0.28145932803413576,
+                                   2.3737128383516586, 0.4510226309844406, -0.08442099868805683]),
+    "seed19-right-56788": ("right", [2.544362993695828, -1.7474332779590753, 1.9854445967387608,
+                                     0.20996556862923282, -0.5215367570965774, 0.2216784969569356]),
+}
+
+
+@pytest.mark.parametrize("case", list(G1_NEAR_SINGULAR))
+def test_g1_near_singular_solutions_are_found(humanoids, case):
+    """Each configuration's pose: ``ik`` solves it, and the configuration is among ``ik_all``'s rows by the check's
+    criterion (``gap * sigma_min <= C_AMONG * TOL6``; each was 2e-6 to 2e-4 before ``DOUBT``)."""
+    model, found = humanoids["g1"]
+    side, q = G1_NEAR_SINGULAR[case]
+    leg, q = found[side], np.array(q)
+    pose, _ = _pin_feet(model, leg, q[None])
+    q_all, mask = leg.ik_all(pose[0], return_mask=True)
+    gap = np.where(mask, np.abs(np.angle(np.exp(1j * (q_all - q)))).max(axis=-1), np.inf).min()
+    assert gap * np.linalg.svd(leg.jacobian(q), compute_uv=False)[-1] <= C_AMONG * TOL6
+    back, _ = _pin_feet(model, leg, leg.ik(pose[0])[None])
+    assert np.abs(back[0] - pose[0]).max() <= TOL6
 
 
 def test_g1_seventeenth_candidate_is_kept(humanoids):

@@ -32,7 +32,9 @@ equal signs leaves none (the chord minus the parabola of curvature ``M``). ``M``
 for a cubic, whose ``r''`` is linear (so largest at an end) and equals its centred second difference; with ``S``,
 ``M`` bounds ``|r''|`` whenever ``w^2 |r''''| <= 24 (S - 1) / (2 S + 3) max(|r''(a)|, |r''(b)|)`` on the cell
 (3.4 for ``S = 2``: ``r''`` strays from its chord by ``<= w^2 |r''''| / 8``, the second difference from ``r''`` by
-``<= w^2 |r''''| / 12``). A cell the bound does not settle is halved, each half's ``M`` the larger of the parent's
+``<= w^2 |r''''| / 12``). A cell is concluded empty only with :data:`DOUBT` times that bound: near g1's singular
+poses a pair of roots 1e-3 to 1e-2 rad apart sits next to a fold, where the residual curves far more than its
+second differences at the cell's ends say. A cell the bound does not settle is halved, each half's ``M`` the larger of the parent's
 and ``S`` times its own second difference, down to :data:`_MIN_CELL`. That catches what values alone miss: three
 roots of a branch within one or two cells (g1, a pose near a cusp of its solutions), two roots in a cell of equal
 signs. Sign changes are refined by the Illinois method to 1e-15 rad.
@@ -48,7 +50,7 @@ Every candidate is then polished on the exact forward map and kept only if it re
 (:mod:`._ik6_kernels`).
 
 The bound rests on that condition on the residual's fourth derivative, which the search does not verify: it is a
-bound checked by measurement, not a proof for every target. ``python scripts/legs6_completeness.py`` (docs/legs.md):
+bound checked by measurement (with :data:`DOUBT` as a margin), not a proof for every target. ``python scripts/legs6_completeness.py`` (docs/legs.md):
 the sampled configuration among ``ik_all``'s rows on every random in-limit sample (10^6 per leg of g1, 6x10^5 per
 leg of alexander), where the values alone missed about 1 in 10^5 on g1.
 """

@@ -229,8 +229,8 @@ def _pitch_k(g, x1, u3, t2):
     c = (w2 - kn * kn - ln * ln) / (2.0 * kn * ln)
     c = 1.0 if c > 1.0 else (-1.0 if c < -1.0 else c)
     sb = math.sqrt((1.0 - c) * (1.0 + c))
-    return wx, wy, (far if far > near else near), far > near, (c, sb), _atan2_k(sb, c), wn >= WELL_CONDITIONED * (
-        kn + ln)
+    clean = wn >= WELL_CONDITIONED * (kn + ln)
+    return wx, wy, (far if far > near else near), far > near, (c, sb), _atan2_k(sb, c), clean
 
 
 @kernel

@@ -54,6 +54,24 @@ from ._layout import (
 )
 
 _LAM2_MAX = POLISH_DAMPING * POLISH_DAMPING
+_HALF_PI = 0.5 * math.pi
+
+
+@kernel(inline=True)
+def _atan2_k(y, x):
+    """``atan2(y, x)`` (rad, in ``[-pi, pi]``) from one ``atan`` of a ratio of magnitude <= 1: ``atan(y / x)``, plus
+    ``+-pi`` (the sign of ``y``) when ``x < 0``, or ``+-pi/2 - atan(x / y)`` when ``|y| > |x|``. glibc's ``atan2``
+    costs ~17 ns, its ``atan`` on [-1, 1] ~4 ns and a division ~1 ns: the closed-form IK's three angles (q1, q2
+    and the knee's ``beta``) took half of a batch ``ik``'s time. Within 1-2 ulp of ``math.atan2`` (the ratio's
+    rounding, then the sum with the rounded ``pi`` or ``pi/2``); signed zeros, infinities and NaN as
+    ``math.atan2`` (``x`` zero or infinite and ``|y| <= |x|``: ``math.atan2`` itself)."""
+    ax, ay = abs(x), abs(y)
+    if ay <= ax:
+        if not 0.0 < ax < math.inf:
+            return math.atan2(y, x)
+        a = math.atan(y / x)
+        return a + math.copysign(math.pi, y) if x < 0.0 else a
+    return math.copysign(_HALF_PI, y) - math.atan(x / y)
 
 
 @kernel
@@ -146,19 +164,21 @@ def _settle_k(px, py, pz, g, q0, q1, q2):
 
 @kernel
 def _target_k(px, py, pz, g):
-    """The target in the abduction frame: ``x1 = p'.e1``, ``t = sqrt(y^2 + z^2 - d^2)`` (0 inside the cylinder),
-    ``y``, ``z``, ``cyl = |d| - r`` (> 0: inside the abduction cylinder), with ``p' = p - o1``, and
-    whether the leg has the exact ideal structure with ``t >= WELL_CONDITIONED r`` (away from the abduction
-    singularity: see :data:`WELL_CONDITIONED`)."""
+    """The target in the abduction frame: ``x1 = p'.e1``, ``t = sqrt(t2)`` and ``t2 = max(y^2 + z^2 - d^2, 0)``
+    (0 inside the cylinder), ``(y, z)``, ``cyl = |d| - r`` (> 0: inside the abduction cylinder), with ``p' = p -
+    o1``, and whether the leg has the exact ideal structure with ``t >= WELL_CONDITIONED r`` (away from the
+    abduction singularity: see :data:`WELL_CONDITIONED`). ``t2`` from ``r^2`` directly, not from ``r`` (``r``
+    is off the path to the angles: one square root fewer in a row's chain of dependent operations)."""
     px, py, pz = px - g[_O], py - g[_O + 1], pz - g[_O + 2]
     x1 = px * g[_E1] + py * g[_E1 + 1] + pz * g[_E1 + 2]
     y = px * g[_E2] + py * g[_E2 + 1] + pz * g[_E2 + 2]
     z = px * g[_E3] + py * g[_E3 + 1] + pz * g[_E3 + 2]
     ad = abs(g[_D])
-    r = math.sqrt(y * y + z * z)  # (hypot costs ~7x a sqrt; no overflow at leg scales)
-    disc = (r - ad) * (r + ad)
-    t = math.sqrt(disc) if disc > 0.0 else 0.0
-    return x1, t, (y, z), ad - r, g[_IDEAL] > 0.0 and t >= WELL_CONDITIONED * r
+    r2 = y * y + z * z
+    r = math.sqrt(r2)  # (hypot costs ~7x a sqrt; no overflow at leg scales)
+    t2 = max(r2 - ad * ad, 0.0)
+    t = math.sqrt(t2)
+    return x1, t, t2, (y, z), ad - r, g[_IDEAL] > 0.0 and t >= WELL_CONDITIONED * r
 
 
 @kernel(inline=True)
@@ -175,7 +195,7 @@ def _abduction_vec_k(g, ia, t, yz):
 def _abduction_k(g, ia, t, yz):
     """Abduction branch ``ia``: ``u3`` and ``q1`` (one ``atan2`` of :func:`_abduction_vec_k`'s vector)."""
     u3, c, s = _abduction_vec_k(g, ia, t, yz)
-    return u3, math.atan2(s, c)
+    return u3, _atan2_k(s, c)
 
 
 @kernel(inline=True)
@@ -193,19 +213,24 @@ def _on_arc_k(g, c, s) -> bool:
 
 
 @kernel
-def _pitch_k(g, x1, u3):
+def _pitch_k(g, x1, u3, t2):
     """The pitch-plane vector ``w = (u3, x1) - h``, its miss of the knee's reach ``max(|w| - |k| - |l|,
     | |k| - |l| | - |w|)`` (m, <= 0 inside), whether it is beyond full stretch, the knee's
-    ``c = cos beta = (|w|^2 - |k|^2 - |l|^2) / (2 |k||l|)`` (clipped to [-1, 1]) and ``acos c``, and whether
-    ``|w| >= WELL_CONDITIONED (|k| + |l|)`` (away from the knee's fold)."""
+    ``cs = (cos beta, |sin beta|)`` with ``cos beta = (|w|^2 - |k|^2 - |l|^2) / (2 |k||l|)`` (clipped to [-1, 1])
+    and ``acos(cos beta) = atan2(|sin beta|, cos beta)``, and whether ``|w| >= WELL_CONDITIONED (|k| + |l|)``
+    (away from the knee's fold). With ``h_X = 0``, ``|w|^2 = t2 + w_Y^2`` (``u3^2 = t2``: no square root between
+    the target and ``cos beta``)."""
     kn, ln = g[_KN], g[_LN]
     wx, wy = u3 - g[_H], x1 - g[_H + 1]
-    wn = math.sqrt(wx * wx + wy * wy)
+    w2 = (t2 if g[_H] == 0.0 else wx * wx) + wy * wy
+    wn = math.sqrt(w2)
     far = wn - (kn + ln)
     near = abs(kn - ln) - wn
-    c = (wn * wn - kn * kn - ln * ln) / (2.0 * kn * ln)
+    c = (w2 - kn * kn - ln * ln) / (2.0 * kn * ln)
     c = 1.0 if c > 1.0 else (-1.0 if c < -1.0 else c)
-    return wx, wy, (far if far > near else near), far > near, c, math.acos(c), wn >= WELL_CONDITIONED * (kn + ln)
+    sb = math.sqrt((1.0 - c) * (1.0 + c))
+    clean = wn >= WELL_CONDITIONED * (kn + ln)
+    return wx, wy, (far if far > near else near), far > near, (c, sb), _atan2_k(sb, c), clean
 
 
 @kernel
@@ -216,19 +241,18 @@ def _knee_k(g, ik, acb):
 
 
 @kernel
-def _hip_k(g, ik, wx, wy, c):
+def _hip_k(g, ik, wx, wy, cs):
     """Hip pitch of knee branch ``ik``: ``q2 = atan2(w) - atan2(v)`` (one ``atan2``: the angle from ``v`` to ``w``)
-    with ``v = k + Rot(a) l``; ``cos a`` and
-    ``sin a`` from ``cos beta = c``, ``sin beta = s_k sqrt(1 - c^2)`` and the stored ``cos, sin (phi_k - phi_l)``
-    (no trigonometric call)."""
-    sb = math.sqrt(max(0.0, (1.0 - c) * (1.0 + c)))
+    with ``v = k + Rot(a) l``; ``cos a`` and ``sin a`` from ``cs = (cos beta, |sin beta|)`` of :func:`_pitch_k`
+    (``sin beta`` of sign ``s_k``) and the stored ``cos, sin (phi_k - phi_l)`` (no trigonometric call)."""
+    c, sb = cs
     if ik == 0:
         sb = -sb
     ca = c * g[_CD] - sb * g[_SD]
     sa = sb * g[_CD] + c * g[_SD]
     vx = g[_K] + ca * g[_L] - sa * g[_L + 1]
     vy = g[_K + 1] + sa * g[_L] + ca * g[_L + 1]
-    return math.atan2(vx * wy - vy * wx, vx * wx + vy * wy)
+    return _atan2_k(vx * wy - vy * wx, vx * wx + vy * wy)
 
 
 @kernel
@@ -261,7 +285,7 @@ def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out, flip):
         out[b, 0] = out[b, 1] = out[b, 2] = _NAN
     if not (_finite_k(px, py, pz) and _finite_k(r0, r1, r2)):
         return _BAD_INPUT, 0.0, 0.0
-    x, t, yz, cyl, clean_a = _target_k(px, py, pz, g)
+    x, t, t2, yz, cyl, clean_a = _target_k(px, py, pz, g)
     slack = g[_SLACK] - REACH_TOL + tol  # the ideal structure's deviation bound, plus tol
     if cyl > slack:
         return _UNREACHABLE, cyl, _IN_CYLINDER
@@ -270,12 +294,13 @@ def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out, flip):
         best, why = cyl, _IN_CYLINDER
     found = 0
     pitched, far, clean_w = False, False, False  # the pitch-plane quantities computed (for one abduction branch)
-    wx = wy = miss = c = acb = 0.0
+    wx = wy = miss = acb = 0.0
+    cs = (0.0, 0.0)
     projected, exact = 0, False  # bits of the abduction branches written clamped onto their reach; one exact
     for ia in range(2):
         u3, q1 = _abduction_k(g, ia, t, yz)
         if not pitched or g[_H] != 0.0:  # h_X = 0: |w|, so the knee, is the same on both abduction branches
-            wx, wy, miss, far, c, acb, clean_w = _pitch_k(g, x, u3)
+            wx, wy, miss, far, cs, acb, clean_w = _pitch_k(g, x, u3, t2)
             pitched = True
         wx = u3 - g[_H]
         reason = _TOO_FAR if far else _TOO_NEAR
@@ -286,7 +311,7 @@ def _ik_all_core(px, py, pz, g, r0, r1, r2, tol, out, flip):
         # within the slack of the ideal structure's boundary: kept only if the exact foot error is <= tol
         check = cyl > tol or miss > tol
         for ik in range(2):
-            j1, j2, j3 = q1, _hip_k(g, ik, wx, wy, c), _knee_k(g, ik, acb)
+            j1, j2, j3 = q1, _hip_k(g, ik, wx, wy, cs), _knee_k(g, ik, acb)
             if not (clean_a and clean_w and not check):  # (a call with arrays costs their reference counts)
                 j1, j2, j3, res = _settle_k(px, py, pz, g, j1, j2, j3)
                 if check and res > tol:  # clamped onto the ideal structure's boundary, and missing the target
@@ -444,7 +469,7 @@ def _ik_every_k(px, py, pz, g, r0, r1, r2, tol):
 
 
 @kernel
-def _no_candidate_k(g, x, t, cyl, tol, slack, clean_a):
+def _no_candidate_k(g, x, t, t2, cyl, tol, slack, clean_a):
     """The verdict on a target none of whose branches is a candidate of the limits-first :func:`_ik_core`, when it
     is beyond doubt (a workspace study's common case; otherwise ``(OK, 0, 0)``: the complete path decides):
 
@@ -463,7 +488,7 @@ def _no_candidate_k(g, x, t, cyl, tol, slack, clean_a):
         best, why = cyl, _IN_CYLINDER
     clean = clean_a and cyl <= tol
     for ia in range(1 if g[_H] == 0.0 else 2):  # h_X = 0: the knee's miss is the same on both abduction branches
-        _wx, _wy, miss, far, _c, _acb, clean_w = _pitch_k(g, x, t if ia == 1 else -t)
+        _wx, _wy, miss, far, _cs, _acb, clean_w = _pitch_k(g, x, t if ia == 1 else -t, t2)
         clean = clean and clean_w and miss <= tol
         if not miss > slack:
             best = -1.0  # this branch is within the reach: not out of reach
@@ -492,23 +517,24 @@ def _ik_core(px, py, pz, g, r0, r1, r2, tol):
     q2, q3)`` as :func:`_ik_every_k`."""
     if not (_finite_k(px, py, pz) and _finite_k(r0, r1, r2)):
         return _BAD_INPUT, 0.0, 0.0, _NAN, _NAN, _NAN
-    x, t, yz, cyl, clean_a = _target_k(px, py, pz, g)
+    x, t, t2, yz, cyl, clean_a = _target_k(px, py, pz, g)
     slack = g[_SLACK] - REACH_TOL + tol
     best, c1, c2, c3, check, clean, inside, clamped = math.inf, 0.0, 0.0, 0.0, False, False, False, False
     y0 = y1 = y2 = 0.0
     pitched, clean_w = False, False  # the pitch-plane quantities computed (for one abduction branch)
-    wx = wy = miss = c = acb = 0.0
+    wx = wy = miss = acb = 0.0
+    cs = (0.0, 0.0)
     for ia in range(2 if cyl <= slack else 0):
         u3, vc, vs = _abduction_vec_k(g, ia, t, yz)
         if not _on_arc_k(g, vc, vs):  # q1 off the limits (by more than ARC_SLACK): no atan2
             continue
-        q1 = math.atan2(vs, vc)
+        q1 = _atan2_k(vs, vc)
         x0, m0, k0 = _within_k(q1, r0, g[_LO], g[_HI], CANDIDATE_SLACK)
         cost0 = (x0 - r0) ** 2
         if m0 > CANDIDATE_SLACK or not cost0 < best:
             continue
         if not pitched or g[_H] != 0.0:  # h_X = 0: |w|, so the knee, is the same on both abduction branches
-            wx, wy, miss, far, c, acb, clean_w = _pitch_k(g, x, u3)
+            wx, wy, miss, far, cs, acb, clean_w = _pitch_k(g, x, u3, t2)
             pitched = True
         wx = u3 - g[_H]
         if miss > slack:
@@ -519,7 +545,7 @@ def _ik_core(px, py, pz, g, r0, r1, r2, tol):
             cost = cost0 + (x2 - r2) ** 2
             if m2 > CANDIDATE_SLACK or not cost < best:
                 continue
-            q2 = _hip_k(g, ik, wx, wy, c)
+            q2 = _hip_k(g, ik, wx, wy, cs)
             x1, m1, k1 = _within_k(q2, r1, g[_LO + 1], g[_HI + 1], CANDIDATE_SLACK)
             cost += (x1 - r1) ** 2
             if m1 <= CANDIDATE_SLACK and cost < best:
@@ -533,7 +559,7 @@ def _ik_core(px, py, pz, g, r0, r1, r2, tol):
     if clean and inside:  # well-conditioned, strictly inside the limits: the representatives found are the answer
         return OK, 0.0, 0.0, y0, y1, y2
     if best == math.inf:  # no candidate: decided here when it is clear (_no_candidate_k), else the complete path
-        status, i0, i1 = _no_candidate_k(g, x, t, cyl, tol, slack, clean_a)
+        status, i0, i1 = _no_candidate_k(g, x, t, t2, cyl, tol, slack, clean_a)
         if status != OK:
             return status, i0, i1, _NAN, _NAN, _NAN
     else:

@@ -11,7 +11,7 @@ import numpy as np
 from .._kernels import OK, batch_kernel, kernel
 from ._ik_kernels import _TWO_PI, _in_limits_k, _near_k
 from ._search_kernels import _search_candidates
-from ._sixdof_kernels import _hip_candidates, _polish6, _valid_pose
+from ._sixdof_kernels import _checked6, _hip_candidates, _polish6, _valid_pose
 from ._sixdof_layout import (
     _BAD_INPUT,
     _HI6,
@@ -29,16 +29,6 @@ from ._sixdof_layout import (
 _NAN = math.nan
 
 
-@kernel
-def _candidates(tg, g, cand) -> int:
-    """The candidate rows of the leg's structure (closed form or search) in ``cand``; returns how many."""
-    if g[_KIND] == HIP_SPHERICAL:
-        return _hip_candidates(tg, g, cand)
-    if g[_KIND] != 0.0:
-        return _search_candidates(tg, g, cand)
-    return 0
-
-
 #: The candidate rows a search may hold: twice the K rows of ``ik_all``. A root can be found twice (by two cells, or
 #: as two roots of a near-tangent pair that polish to one solution), and a list of K candidates once lost the 17th,
 #: a distinct solution (g1, ``legkin check g1 --random-seed 7 --samples 100000``).
@@ -46,6 +36,47 @@ _CAND_ROWS = 2
 #: Two polished rows closer than this in every angle (rad, modulo 2 pi) are one solution: the polish lands within
 #: ~1e-15 rad of a solution, and two distinct solutions this close make the same pose to far below ``IK_TOL``.
 _SAME_ROW = 1e-9
+
+
+@kernel
+def _work6(g, extra):
+    """The work arrays of :func:`_ik6_k` and :func:`_ik_all6_k` for the leg ``g``, allocated once per batch (not once
+    per target): ``(work, cost)``, ``work`` (36 + 4 k, 6) (:func:`_views`) and ``cost`` (k + ``extra``,), ``k`` =
+    :data:`_CAND_ROWS` times the rows of ``ik_all``."""
+    k = _CAND_ROWS * int(g[_NSOLS])
+    return np.empty((36 + 4 * k, 6)), np.empty(k + extra)
+
+
+@kernel(inline=True)
+def _views(work, g):
+    """The parts of ``work`` (:func:`_work6`; slices, no copy): the polish's work space and polished row ``ws``
+    (33, 6), a (3, 6) work array, the candidate rows ``cand`` (k, 6), their in-limit representatives ``lim``
+    (k, 6) and their cosines and sines ``cs`` (2 k, 6: row ``2 b`` the cosines of row ``b``, ``2 b + 1`` its
+    sines)."""
+    k = _CAND_ROWS * int(g[_NSOLS])
+    return work[:33], work[33:36], work[36:36 + k], work[36 + k:36 + 2 * k], work[36 + 2 * k:36 + 4 * k]
+
+
+@kernel
+def _candidates(tg, g, ref, work, cost) -> int:
+    """Every candidate row of the leg's structure into ``cand`` of :func:`_views` (the closed form's also with their
+    cosines and sines: :func:`_hip_candidates`); returns how many."""
+    _, gr, cand, _, cs = _views(work, g)
+    if g[_KIND] == HIP_SPHERICAL:
+        return _hip_candidates(tg, g, ref, False, cand, cs, cost, gr)
+    if g[_KIND] != 0.0:
+        return _search_candidates(tg, g, cand)
+    return 0
+
+
+@kernel(inline=True)
+def _verified(tg, g, q, b, ws, cs) -> float:
+    """The error of candidate ``b`` (its row ``q``; ``ws``, ``cs``: :func:`_views`): :func:`_checked6` for the
+    closed form (no trigonometry when it lands, as usual, at ~1e-15), :func:`_polish6` for the search's; ``q`` may
+    be polished in place."""
+    if g[_KIND] == HIP_SPHERICAL:
+        return _checked6(tg, g, q, cs[2 * b], cs[2 * b + 1], ws)
+    return _polish6(tg, g, q, ws)
 
 
 @kernel
@@ -62,27 +93,27 @@ def _listed(out, m, q) -> bool:
 
 
 @kernel
-def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
+def _ik_all6_k(tg, g, ref, tol, out, info, work, cost) -> int:
     """Every solution (rows of ``out`` (K, 6), NaN rows for absent ones) of the foot pose ``tg`` (16 floats): the
-    candidates of the leg's structure (closed form or search), each polished (:func:`_polish6`) and kept if it
-    reproduces ``tg`` to ``tol``, each angle moved to its 2 pi representative nearest ``ref``. The closed form's
-    rows keep their branch order; the search's are packed, a row polished onto an earlier one dropped
-    (:func:`_listed`). ``info[0]``: on failure the least residual."""
+    candidates of the leg's structure (closed form or search), each checked or polished (:func:`_verified`) and
+    kept if it reproduces ``tg`` to ``tol``, each angle moved to its 2 pi representative nearest ``ref``. The closed
+    form's rows keep their branch order; the search's are packed, a row polished onto an earlier one dropped
+    (:func:`_listed`). ``info[0]``: on failure the least residual. ``work``, ``cost``: :func:`_work6`."""
     k = out.shape[0]
     for b in range(k):
         for j in range(6):
             out[b, j] = _NAN
     if not _valid_pose(tg):
         return _BAD_INPUT
-    ws = np.empty((33 + _CAND_ROWS * k, 6))  # rows 0-31: the polish's work space, 32: the polished row, candidates
-    cand, qb = ws[33:], ws[32]
-    n = _candidates(tg, g, cand)
+    ws, _, cand, _, cs = _views(work, g)
+    qb = ws[32]
+    n = _candidates(tg, g, ref, work, cost)
     packed = g[_KIND] != HIP_SPHERICAL
     best, found = math.inf, 0
     for b in range(n):
         for j in range(6):
             qb[j] = cand[b, j]
-        res = _polish6(tg, g, qb, ws)
+        res = _verified(tg, g, qb, b, ws, cs)
         if not res <= tol:
             best = min(best, res)
             continue
@@ -134,24 +165,38 @@ def _clip_solution(tg, g, q, ref, tol, out, ws) -> bool:
     return False
 
 
+@kernel(inline=True)
+def _ranked(tg, g, ref, work, cost) -> int:
+    """The candidates inside the limits, for :func:`_ik6_k`: their representatives inside the limits nearest
+    ``ref`` in ``lim`` of :func:`_views` and their costs ``|q - ref|^2`` in ``cost`` (inf for a candidate outside
+    them); returns the count of rows. The closed form builds only the branches inside the limits (their rows go
+    straight to ``lim``); the search's candidates all go to ``cand``, each moved inside the limits
+    (:func:`_limited`)."""
+    _, gr, cand, lim, cs = _views(work, g)
+    if g[_KIND] == HIP_SPHERICAL:
+        return _hip_candidates(tg, g, ref, True, lim, cs, cost, gr)
+    n = _candidates(tg, g, ref, work, cost)
+    for b in range(n):
+        c, inside = _limited(cand[b], ref, g, lim[b])
+        cost[b] = c if inside else math.inf
+    return n
+
+
 @kernel
-def _ik6_k(tg, g, ref, tol, out, info) -> int:
-    """The solution inside the limits nearest ``ref`` (least sum of squared differences): the candidates are ranked
-    by that cost first and polished in that order until one reproduces ``tg`` to ``tol`` (its angles then moved
-    inside the limits again), so a single answer costs one polish, not one per candidate. ``info``: the least
-    residual, or the least limit violation (rad) and the count of solutions."""
+def _ik6_k(tg, g, ref, tol, out, info, work, cost) -> int:
+    """The solution inside the limits nearest ``ref`` (least sum of squared differences): the candidates inside the
+    limits (:func:`_ranked`) are checked or polished (:func:`_verified`) in the order of that cost until one
+    reproduces ``tg`` to ``tol`` (its angles then moved inside the limits again), so a single answer costs one
+    check, not one per candidate; when none does, :func:`_polished_fallback` on every candidate. ``info``: the
+    least residual, or the least limit violation (rad) and the count of solutions. ``work``, ``cost``:
+    :func:`_work6`."""
     for j in range(6):
         out[j] = _NAN
     if not _valid_pose(tg):
         return _BAD_INPUT
-    k = _CAND_ROWS * int(g[_NSOLS])
-    ws = np.empty((33 + 2 * k, 6))  # polish work space, polished row, candidates, their in-limit representatives
-    cand, lim, qb = ws[33:33 + k], ws[33 + k:], ws[32]
-    n = _candidates(tg, g, cand)
-    cost = np.empty(k)
-    for b in range(n):
-        c, inside = _limited(cand[b], ref, g, lim[b])
-        cost[b] = c if inside else math.inf
+    ws, _, _, lim, cs = _views(work, g)
+    qb = ws[32]
+    n = _ranked(tg, g, ref, work, cost)
     best = math.inf
     for _ in range(n):  # the in-limit candidates, cheapest first
         i = int(np.argmin(cost[:n]))
@@ -160,7 +205,7 @@ def _ik6_k(tg, g, ref, tol, out, info) -> int:
         cost[i] = math.inf
         for j in range(6):
             qb[j] = lim[i, j]
-        res = _polish6(tg, g, qb, ws)
+        res = _verified(tg, g, qb, i, ws, cs)
         if res <= tol:
             c, inside = _limited(qb, ref, g, out)
             if inside:
@@ -168,16 +213,20 @@ def _ik6_k(tg, g, ref, tol, out, info) -> int:
             for j in range(6):
                 out[j] = _NAN
         best = min(best, res)
-    return _polished_fallback(tg, g, ref, tol, cand, lim, n, best, out, info, ws)
+    return _polished_fallback(tg, g, ref, tol, n, best, out, info, work, cost)
 
 
 @kernel
-def _polished_fallback(tg, g, ref, tol, cand, lim, n, best, out, info, ws) -> int:
-    """:func:`_ik6_k` when no in-limit candidate polished to a solution: every candidate polished first, then moved
-    inside the limits (a candidate outside them can polish to an in-limit solution near a stretched knee; one a hair
-    outside, up to :data:`LIMIT_SLACK6`, is clipped onto them, :func:`_clip_solution`); the in-limit solution nearest
-    ``ref`` wins. Else ``info``: the least limit violation (rad) and the count of solutions, or the least residual."""
+def _polished_fallback(tg, g, ref, tol, n, best, out, info, work, cost) -> int:
+    """:func:`_ik6_k` when no in-limit candidate polished to a solution: every candidate (the closed form's built
+    again, all of them; the search's ``n`` as they are) polished first, then moved inside the limits (a candidate
+    outside them can polish to an in-limit solution near a stretched knee; one a hair outside, up to
+    :data:`LIMIT_SLACK6`, is clipped onto them, :func:`_clip_solution`); the in-limit solution nearest ``ref``
+    wins. Else ``info``: the least limit violation (rad) and the count of solutions, or the least residual."""
+    ws, _, cand, lim, _ = _views(work, g)
     qb = ws[32]
+    if g[_KIND] == HIP_SPHERICAL:
+        n = _candidates(tg, g, ref, work, cost)
     viol, nb, best_in = math.inf, 0, math.inf
     for b in range(n):
         for j in range(6):
@@ -214,12 +263,15 @@ def _one(t, g, out, solve_all) -> int:
     ``_BAD_INPUT`` (the wrapper's full checks then say why) for a bad pose or a leg without an IK."""
     if g[_KIND] == 0.0:
         return _BAD_INPUT
-    tg, info = np.empty(16), np.empty(2)
+    work, cost = _work6(g, 18)
+    tg, info = cost[-18:-2], cost[-2:]
     for i in range(4):
         for j in range(4):
             tg[4 * i + j] = t[i, j]
     ref = g[_QREF:_QREF + 6]
-    return _ik_all6_k(tg, g, ref, IK_TOL, out, info) if solve_all else _ik6_k(tg, g, ref, IK_TOL, out[0], info)
+    if solve_all:
+        return _ik_all6_k(tg, g, ref, IK_TOL, out, info, work, cost)
+    return _ik6_k(tg, g, ref, IK_TOL, out[0], info, work, cost)
 
 
 @kernel(entry=True)
@@ -237,12 +289,14 @@ def _ik_all6_one(t, g, out) -> int:
 @batch_kernel(rows="tg ref out status info", min_parallel=256)
 def _ik_all6_batch(tg, g, ref, tol, out, status, info) -> None:
     n, m = tg.shape[0], ref.shape[0]
+    work, cost = _work6(g, 0)
     for i in range(n):
-        status[i] = _ik_all6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])
+        status[i] = _ik_all6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i], work, cost)
 
 
 @batch_kernel(rows="tg ref out status info", min_parallel=256)
 def _ik6_batch(tg, g, ref, tol, out, status, info) -> None:
     n, m = tg.shape[0], ref.shape[0]
+    work, cost = _work6(g, 0)
     for i in range(n):
-        status[i] = _ik6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])
+        status[i] = _ik6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i], work, cost)

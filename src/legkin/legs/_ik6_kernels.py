@@ -75,7 +75,7 @@ def _verified(tg, g, q, b, ws, cs) -> float:
     closed form (no trigonometry when it lands, as usual, at ~1e-15), :func:`_polish6` for the search's; ``q`` may
     be polished in place."""
     if g[_KIND] == HIP_SPHERICAL:
-        return _checked6(tg, g, q, cs[2 * b], cs[2 * b + 1], ws)
+        return _checked6(tg, g, q, cs, b, ws)
     return _polish6(tg, g, q, ws)
 
 
@@ -182,7 +182,7 @@ def _ranked(tg, g, ref, work, cost) -> int:
     return n
 
 
-@kernel
+@kernel(inline=True)
 def _ik6_k(tg, g, ref, tol, out, info, work, cost) -> int:
     """The solution inside the limits nearest ``ref`` (least sum of squared differences): the candidates inside the
     limits (:func:`_ranked`) are checked or polished (:func:`_verified`) in the order of that cost until one
@@ -199,7 +199,10 @@ def _ik6_k(tg, g, ref, tol, out, info, work, cost) -> int:
     n = _ranked(tg, g, ref, work, cost)
     best = math.inf
     for _ in range(n):  # the in-limit candidates, cheapest first
-        i = int(np.argmin(cost[:n]))
+        i = 0
+        for b in range(1, n):
+            if cost[b] < cost[i]:
+                i = b
         if cost[i] == math.inf:
             break
         cost[i] = math.inf

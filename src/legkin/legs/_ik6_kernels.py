@@ -11,7 +11,7 @@ import numpy as np
 from .._kernels import OK, batch_kernel, kernel
 from ._ik_kernels import _TWO_PI, _in_limits_k, _near_k
 from ._search_kernels import _search_candidates
-from ._sixdof_kernels import _checked6, _hip_candidates, _polish6, _valid_pose
+from ._sixdof_kernels import _hip_candidates, _polish6, _valid_pose
 from ._sixdof_layout import (
     _BAD_INPUT,
     _HI6,
@@ -24,6 +24,7 @@ from ._sixdof_layout import (
     HIP_SPHERICAL,
     IK_TOL,
     LIMIT_SLACK6,
+    POLISH_BELOW6,
 )
 
 _NAN = math.nan
@@ -41,42 +42,34 @@ _SAME_ROW = 1e-9
 @kernel
 def _work6(g, extra):
     """The work arrays of :func:`_ik6_k` and :func:`_ik_all6_k` for the leg ``g``, allocated once per batch (not once
-    per target): ``(work, cost)``, ``work`` (36 + 4 k, 6) (:func:`_views`) and ``cost`` (k + ``extra``,), ``k`` =
-    :data:`_CAND_ROWS` times the rows of ``ik_all``."""
+    per target): ``(work, cost)``, ``work`` (36 + 2 k, 6) (:func:`_views`) and ``cost`` (2 k + ``extra``,): the
+    candidates' costs, then their errors (:func:`_candidates`); ``k`` = :data:`_CAND_ROWS` times the rows of
+    ``ik_all``."""
     k = _CAND_ROWS * int(g[_NSOLS])
-    return np.empty((36 + 4 * k, 6)), np.empty(k + extra)
+    return np.empty((36 + 2 * k, 6)), np.empty(2 * k + extra)
 
 
 @kernel(inline=True)
-def _views(work, g):
-    """The parts of ``work`` (:func:`_work6`; slices, no copy): the polish's work space and polished row ``ws``
-    (33, 6), a (3, 6) work array, the candidate rows ``cand`` (k, 6), their in-limit representatives ``lim``
-    (k, 6) and their cosines and sines ``cs`` (2 k, 6: row ``2 b`` the cosines of row ``b``, ``2 b + 1`` its
-    sines)."""
+def _views(work, cost, g):
+    """The parts of ``work`` and ``cost`` (:func:`_work6`; slices, no copy): the polish's work space and polished
+    row ``ws`` (33, 6), a (3, 6) work array, the candidate rows ``cand`` (k, 6), their in-limit representatives
+    ``lim`` (k, 6), their costs (k,) and their errors ``resid`` (k,)."""
     k = _CAND_ROWS * int(g[_NSOLS])
-    return work[:33], work[33:36], work[36:36 + k], work[36 + k:36 + 2 * k], work[36 + 2 * k:36 + 4 * k]
+    return work[:33], work[33:36], work[36:36 + k], work[36 + k:36 + 2 * k], cost[:k], cost[k:2 * k]
 
 
 @kernel
 def _candidates(tg, g, ref, work, cost) -> int:
-    """Every candidate row of the leg's structure into ``cand`` of :func:`_views` (the closed form's also with their
-    cosines and sines: :func:`_hip_candidates`); returns how many."""
-    _, gr, cand, _, cs = _views(work, g)
+    """Every candidate row of the leg's structure into ``cand`` of :func:`_views`, its error in ``resid`` (the
+    closed form's from its subproblems' cosines and sines, :func:`_hip_candidates`; inf for the search's, which
+    are all polished); returns how many."""
+    _, gr, cand, _, costs, resid = _views(work, cost, g)
     if g[_KIND] == HIP_SPHERICAL:
-        return _hip_candidates(tg, g, ref, False, cand, cs, cost, gr)
-    if g[_KIND] != 0.0:
-        return _search_candidates(tg, g, cand)
-    return 0
-
-
-@kernel(inline=True)
-def _verified(tg, g, q, b, ws, cs) -> float:
-    """The error of candidate ``b`` (its row ``q``; ``ws``, ``cs``: :func:`_views`): :func:`_checked6` for the
-    closed form (no trigonometry when it lands, as usual, at ~1e-15), :func:`_polish6` for the search's; ``q`` may
-    be polished in place."""
-    if g[_KIND] == HIP_SPHERICAL:
-        return _checked6(tg, g, q, cs, b, ws)
-    return _polish6(tg, g, q, ws)
+        return _hip_candidates(tg, g, ref, False, cand, costs, resid, gr)
+    n = _search_candidates(tg, g, cand) if g[_KIND] != 0.0 else 0
+    for b in range(n):
+        resid[b] = math.inf
+    return n
 
 
 @kernel
@@ -95,7 +88,7 @@ def _listed(out, m, q) -> bool:
 @kernel
 def _ik_all6_k(tg, g, ref, tol, out, info, work, cost) -> int:
     """Every solution (rows of ``out`` (K, 6), NaN rows for absent ones) of the foot pose ``tg`` (16 floats): the
-    candidates of the leg's structure (closed form or search), each checked or polished (:func:`_verified`) and
+    candidates of the leg's structure (closed form or search), each checked (:func:`_candidates`) or polished and
     kept if it reproduces ``tg`` to ``tol``, each angle moved to its 2 pi representative nearest ``ref``. The closed
     form's rows keep their branch order; the search's are packed, a row polished onto an earlier one dropped
     (:func:`_listed`). ``info[0]``: on failure the least residual. ``work``, ``cost``: :func:`_work6`."""
@@ -105,7 +98,7 @@ def _ik_all6_k(tg, g, ref, tol, out, info, work, cost) -> int:
             out[b, j] = _NAN
     if not _valid_pose(tg):
         return _BAD_INPUT
-    ws, _, cand, _, cs = _views(work, g)
+    ws, _, cand, _, _, resid = _views(work, cost, g)
     qb = ws[32]
     n = _candidates(tg, g, ref, work, cost)
     packed = g[_KIND] != HIP_SPHERICAL
@@ -113,7 +106,7 @@ def _ik_all6_k(tg, g, ref, tol, out, info, work, cost) -> int:
     for b in range(n):
         for j in range(6):
             qb[j] = cand[b, j]
-        res = _verified(tg, g, qb, b, ws, cs)
+        res = resid[b] if resid[b] <= POLISH_BELOW6 else _polish6(tg, g, qb, ws)
         if not res <= tol:
             best = min(best, res)
             continue
@@ -172,20 +165,20 @@ def _ranked(tg, g, ref, work, cost) -> int:
     them); returns the count of rows. The closed form builds only the branches inside the limits (their rows go
     straight to ``lim``); the search's candidates all go to ``cand``, each moved inside the limits
     (:func:`_limited`)."""
-    _, gr, cand, lim, cs = _views(work, g)
+    _, gr, cand, lim, costs, resid = _views(work, cost, g)
     if g[_KIND] == HIP_SPHERICAL:
-        return _hip_candidates(tg, g, ref, True, lim, cs, cost, gr)
+        return _hip_candidates(tg, g, ref, True, lim, costs, resid, gr)
     n = _candidates(tg, g, ref, work, cost)
     for b in range(n):
         c, inside = _limited(cand[b], ref, g, lim[b])
-        cost[b] = c if inside else math.inf
+        costs[b] = c if inside else math.inf
     return n
 
 
 @kernel(inline=True)
 def _ik6_k(tg, g, ref, tol, out, info, work, cost) -> int:
     """The solution inside the limits nearest ``ref`` (least sum of squared differences): the candidates inside the
-    limits (:func:`_ranked`) are checked or polished (:func:`_verified`) in the order of that cost until one
+    limits (:func:`_ranked`) are checked or polished in the order of that cost until one
     reproduces ``tg`` to ``tol`` (its angles then moved inside the limits again), so a single answer costs one
     check, not one per candidate; when none does, :func:`_polished_fallback` on every candidate. ``info``: the
     least residual, or the least limit violation (rad) and the count of solutions. ``work``, ``cost``:
@@ -194,21 +187,21 @@ def _ik6_k(tg, g, ref, tol, out, info, work, cost) -> int:
         out[j] = _NAN
     if not _valid_pose(tg):
         return _BAD_INPUT
-    ws, _, _, lim, cs = _views(work, g)
+    ws, _, _, lim, costs, resid = _views(work, cost, g)
     qb = ws[32]
     n = _ranked(tg, g, ref, work, cost)
     best = math.inf
     for _ in range(n):  # the in-limit candidates, cheapest first
         i = 0
         for b in range(1, n):
-            if cost[b] < cost[i]:
+            if costs[b] < costs[i]:
                 i = b
-        if cost[i] == math.inf:
+        if costs[i] == math.inf:
             break
-        cost[i] = math.inf
+        costs[i] = math.inf
         for j in range(6):
             qb[j] = lim[i, j]
-        res = _verified(tg, g, qb, i, ws, cs)
+        res = resid[i] if resid[i] <= POLISH_BELOW6 else _polish6(tg, g, qb, ws)
         if res <= tol:
             c, inside = _limited(qb, ref, g, out)
             if inside:
@@ -226,7 +219,7 @@ def _polished_fallback(tg, g, ref, tol, n, best, out, info, work, cost) -> int:
     outside them can polish to an in-limit solution near a stretched knee; one a hair outside, up to
     :data:`LIMIT_SLACK6`, is clipped onto them, :func:`_clip_solution`); the in-limit solution nearest ``ref``
     wins. Else ``info``: the least limit violation (rad) and the count of solutions, or the least residual."""
-    ws, _, cand, lim, _ = _views(work, g)
+    ws, _, cand, lim, _, _ = _views(work, cost, g)
     qb = ws[32]
     if g[_KIND] == HIP_SPHERICAL:
         n = _candidates(tg, g, ref, work, cost)

@@ -51,7 +51,7 @@ def _pose6(q, g, rot_out, pos_out, axes_w, orig_w) -> None:
     r, t = _pose6_cs(
         (math.cos(q[0]), math.cos(q[1]), math.cos(q[2]), math.cos(q[3]), math.cos(q[4]), math.cos(q[5])),
         (math.sin(q[0]), math.sin(q[1]), math.sin(q[2]), math.sin(q[3]), math.sin(q[4]), math.sin(q[5])),
-        g, axes_w, orig_w, True)
+        _geometry(g), axes_w, orig_w)
     for i in range(3):
         pos_out[i] = t[i]
         for c in range(3):
@@ -75,23 +75,34 @@ def _times_joint(r, t, a, o, c, s):
 
 
 @kernel(inline=True)
-def _pose6_cs(cq, sq, g, axes_w, orig_w, joints):
-    """``T(q)`` (:func:`_pose6`) from the cosines ``cq`` and sines ``sq`` (6-tuples) of the joint angles, as tuples
-    ``(R, p)`` (``R`` row-major, 9): no trigonometry (a closed-form candidate comes with them), no array but the
-    joints' axes ``axes_w`` and points ``orig_w``, written only if ``joints``."""
+def _geometry(g):
+    """The leg's axes and joint origins (6-tuples of 3-tuples) and ``M_0`` (12: rotation row-major, position) from
+    its geometry array ``g``, as tuples."""
+    axes = (_axis(g, 0), _axis(g, 1), _axis(g, 2), _axis(g, 3), _axis(g, 4), _axis(g, 5))
+    origins = (_origin(g, 0), _origin(g, 1), _origin(g, 2), _origin(g, 3), _origin(g, 4), _origin(g, 5))
+    m0 = (g[_M0], g[_M0 + 1], g[_M0 + 2], g[_M0 + 3], g[_M0 + 4], g[_M0 + 5], g[_M0 + 6], g[_M0 + 7], g[_M0 + 8],
+          g[_M0 + 9], g[_M0 + 10], g[_M0 + 11])
+    return axes, origins, m0
+
+
+@kernel(inline=True)
+def _pose6_cs(cq, sq, geo, axes_w, orig_w):
+    """``T(q)`` (:func:`_pose6`) from the cosines ``cq`` and sines ``sq`` (6-tuples) of the joint angles and the
+    leg's :func:`_geometry` ``geo``, as tuples ``(R, p)`` (``R`` row-major, 9): no trigonometry (a closed-form
+    candidate comes with them), no array but the joints' axes ``axes_w`` and points ``orig_w`` (None: not
+    written)."""
     r, t = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0), (0.0, 0.0, 0.0)
     for j in range(6):
-        a = (g[_AX + 3 * j], g[_AX + 3 * j + 1], g[_AX + 3 * j + 2])
-        o = (g[_OR + 3 * j], g[_OR + 3 * j + 1], g[_OR + 3 * j + 2])
-        if joints:  # the joint's axis and a point of it, in the root frame at q
+        a, o = geo[0][j], geo[1][j]
+        if axes_w is not None:  # the joint's axis and a point of it, in the root frame at q
             for i in range(3):
                 axes_w[j, i] = r[3 * i] * a[0] + r[3 * i + 1] * a[1] + r[3 * i + 2] * a[2]
                 orig_w[j, i] = r[3 * i] * o[0] + r[3 * i + 1] * o[1] + r[3 * i + 2] * o[2] + t[i]
         r, t = _times_joint(r, t, a, o, cq[j], sq[j])
-    m = (g[_M0], g[_M0 + 1], g[_M0 + 2], g[_M0 + 3], g[_M0 + 4], g[_M0 + 5], g[_M0 + 6], g[_M0 + 7], g[_M0 + 8])
-    return _mat_mat(r, m), (t[0] + r[0] * g[_M0 + 9] + r[1] * g[_M0 + 10] + r[2] * g[_M0 + 11],
-                            t[1] + r[3] * g[_M0 + 9] + r[4] * g[_M0 + 10] + r[5] * g[_M0 + 11],
-                            t[2] + r[6] * g[_M0 + 9] + r[7] * g[_M0 + 10] + r[8] * g[_M0 + 11])
+    m = geo[2]
+    return _mat_mat(r, m), (t[0] + r[0] * m[9] + r[1] * m[10] + r[2] * m[11],
+                            t[1] + r[3] * m[9] + r[4] * m[10] + r[5] * m[11],
+                            t[2] + r[6] * m[9] + r[7] * m[10] + r[8] * m[11])
 
 
 @kernel(inline=True)
@@ -183,21 +194,19 @@ def _pose_error(tg, rm, p, e) -> float:
 
 
 @kernel(inline=True)
-def _checked6(tg, g, q, cs, b, ws) -> float:
-    """The error of a closed-form candidate ``q`` whose joints' cosines and sines are rows ``2 b`` and ``2 b + 1`` of
-    ``cs``: the forward map from those (:func:`_pose6_cs`, no trigonometry), and when it reproduces ``tg`` to
-    :data:`POLISH_BELOW6` (the closed form's usual case, ~1e-15) the larger of its position error (m) and ``sin``
-    of its rotation error (rad; equal to it there); else :func:`_polish6` on ``q`` (from ``q``'s own angles).
-    ``ws``: the polish's work space."""
-    c, s = 2 * b, 2 * b + 1
-    r, p = _pose6_cs((cs[c, 0], cs[c, 1], cs[c, 2], cs[c, 3], cs[c, 4], cs[c, 5]),
-                     (cs[s, 0], cs[s, 1], cs[s, 2], cs[s, 3], cs[s, 4], cs[s, 5]), g, ws, ws, False)
-    v, cos = _rot_gap(tg, r)
-    pos2 = (tg[3] - p[0]) ** 2 + (tg[7] - p[1]) ** 2 + (tg[11] - p[2]) ** 2
+def _gap6(tt, geo, cq, sq) -> float:
+    """The error of a closed-form candidate whose joints' cosines and sines are ``cq`` and ``sq`` (6-tuples), for the
+    target ``tt`` (16-tuple) and the leg's :func:`_geometry` ``geo``: the forward map from those
+    (:func:`_pose6_cs`: no trigonometry, no array), and when it reproduces the target to :data:`POLISH_BELOW6`
+    (the closed form's usual case, ~1e-15) the larger of its position error (m) and ``sin`` of its rotation error
+    (rad; equal to it there), else inf (the caller then polishes the candidate, :func:`_polish6`)."""
+    r, p = _pose6_cs(cq, sq, geo, None, None)
+    v, cos = _rot_gap(tt, r)
+    pos2 = (tt[3] - p[0]) ** 2 + (tt[7] - p[1]) ** 2 + (tt[11] - p[2]) ** 2
     rot2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2]
     if cos > 0.0 and pos2 + rot2 <= POLISH_BELOW6 * POLISH_BELOW6:
         return math.sqrt(max(pos2, rot2))
-    return _polish6(tg, g, q, ws)
+    return math.inf
 
 
 @kernel
@@ -367,29 +376,31 @@ def _sp2_branch(sol, i, j, lim, prune):
 def _hip_setup(tg, g, ref, gr):
     """What :func:`_hip_candidates` reads of the target ``tg`` and the leg ``g``, as tuples (no array is touched
     in its branches: each array a helper receives costs atomic reference counts): ``R_G`` (row-major 9-tuple),
-    ``d - a``, ``c - o_4``, ``a - o_4``, the axes, ``o_4``, the unit ``v`` normal to ``a_3`` and ``a_2``, and
-    ``(lower, upper, ref)``."""
+    ``d - a``, ``c - o_4``, ``a - o_4``, the leg's :func:`_geometry`, the unit ``v`` normal to ``a_3`` and ``a_2``,
+    ``(lower, upper, ref)`` and the target (16-tuple)."""
     gt = _target_motion(tg, g, gr)
     rg = (gr[0, 0], gr[0, 1], gr[0, 2], gr[1, 0], gr[1, 1], gr[1, 2], gr[2, 0], gr[2, 1], gr[2, 2])
     c = (g[_HIP], g[_HIP + 1], g[_HIP + 2])
     an = (g[_ANK], g[_ANK + 1], g[_ANK + 2])
     d = _mat_t_vec(gr, (c[0] - gt[0], c[1] - gt[1], c[2] - gt[2]))
-    axes = (_axis(g, 0), _axis(g, 1), _axis(g, 2), _axis(g, 3), _axis(g, 4), _axis(g, 5))
-    o4 = _origin(g, 3)
-    v = cross(axes[2], axes[1])
+    geo = _geometry(g)
+    o4 = geo[1][3]
+    v = cross(geo[0][2], geo[0][1])
     nv = math.sqrt(dot(v, v))
     lo = (g[_LO6], g[_LO6 + 1], g[_LO6 + 2], g[_LO6 + 3], g[_LO6 + 4], g[_LO6 + 5])
     hi = (g[_HI6], g[_HI6 + 1], g[_HI6 + 2], g[_HI6 + 3], g[_HI6 + 4], g[_HI6 + 5])
     return (rg, (d[0] - an[0], d[1] - an[1], d[2] - an[2]), (c[0] - o4[0], c[1] - o4[1], c[2] - o4[2]),
-            (an[0] - o4[0], an[1] - o4[1], an[2] - o4[2]), axes, o4, (v[0] / nv, v[1] / nv, v[2] / nv),
-            (lo, hi, (ref[0], ref[1], ref[2], ref[3], ref[4], ref[5])))
+            (an[0] - o4[0], an[1] - o4[1], an[2] - o4[2]), geo, (v[0] / nv, v[1] / nv, v[2] / nv),
+            (lo, hi, (ref[0], ref[1], ref[2], ref[3], ref[4], ref[5])),
+            (tg[0], tg[1], tg[2], tg[3], tg[4], tg[5], tg[6], tg[7], tg[8], tg[9], tg[10], tg[11], 0.0, 0.0, 0.0, 1.0))
 
 
 @kernel
-def _hip_candidates(tg, g, ref, prune, cand, cs, cost, gr) -> int:
+def _hip_candidates(tg, g, ref, prune, cand, cost, resid, gr) -> int:
     """The closed-form solutions (rows of ``cand`` (8, 6)) of a leg whose hip axes 1-3 meet at the hip centre
     ``c`` and whose ankle axes 5, 6 meet at the ankle centre ``a``; returns how many rows are filled. Each row's
-    cosines and sines go to ``cs`` (16, 6) (rows ``2 n``, ``2 n + 1``; :func:`_checked6`). Every branch (rows in
+    error goes to ``resid`` (:func:`_gap6`: a forward map from the subproblems' cosines and sines, inf above
+    :data:`POLISH_BELOW6`: the row then needs the polish). Every branch (rows in
     the branch order of ``ik_all``), or with ``prune`` only those inside the limits (:func:`_kept`): each angle at
     its representative inside them nearest ``ref``, a branch dropped at its first joint without one (a knee root
     bent the wrong way: its four rows never built), and ``|q - ref|^2`` in ``cost``. ``gr``: a (3, >= 3) work
@@ -401,7 +412,8 @@ def _hip_candidates(tg, g, ref, prune, cand, cs, cost, gr) -> int:
     SP1 ``R(a_3, q_3) v = R_2^T R_1^T R_h v`` (``v`` normal to ``a_3``) gives ``q_3`` (:func:`_hip_branch`).
     Branches that the subproblems find absent are filled with their least-squares angles (the check and the
     residual decide)."""
-    rg, da, co, ao, ax, o4, v, lim = _hip_setup(tg, g, ref, gr)
+    rg, da, co, ao, geo, v, lim, tt = _hip_setup(tg, g, ref, gr)
+    ax = geo[0]
     a4, a5, a6 = ax[3], ax[4], ax[5]
     _, t4a, t4b, _ = sp3(co, ao, a4, math.sqrt(dot(da, da)))
     n = 0
@@ -430,8 +442,8 @@ def _hip_candidates(tg, g, ref, prune, cand, cs, cost, gr) -> int:
                 cq = (cs123[0], cs123[2], cs123[4], c4, p5[0], p6[0])
                 sq = (cs123[1], cs123[3], cs123[5], -s4, -p5[1], p6[1])
                 for j in range(6):
-                    cand[n, j], cs[2 * n, j], cs[2 * n + 1, j] = row[j], cq[j], sq[j]
-                cost[n] = k4 + k56 + k123
+                    cand[n, j] = row[j]
+                cost[n], resid[n] = k4 + k56 + k123, _gap6(tt, geo, cq, sq)
                 n += 1
     return n
 

@@ -34,12 +34,12 @@ from .subproblems import cross, dot, rot_cs, sp1_cs, sp2_cs, sp3
 _NAN = math.nan
 
 
-@kernel(inline=True)
+@kernel
 def _axis(g, j):
     return g[_AX + 3 * j], g[_AX + 3 * j + 1], g[_AX + 3 * j + 2]
 
 
-@kernel(inline=True)
+@kernel
 def _origin(g, j):
     return g[_OR + 3 * j], g[_OR + 3 * j + 1], g[_OR + 3 * j + 2]
 
@@ -74,7 +74,7 @@ def _times_joint(r, t, a, o, c, s):
                t[2] + r[6] * d[0] + r[7] * d[1] + r[8] * d[2])
 
 
-@kernel(inline=True)
+@kernel
 def _geometry(g):
     """The leg's axes and joint origins (6-tuples of 3-tuples) and ``M_0`` (12: rotation row-major, position) from
     its geometry array ``g``, as tuples."""
@@ -105,7 +105,7 @@ def _pose6_cs(cq, sq, geo, axes_w, orig_w):
                             t[2] + r[6] * m[9] + r[7] * m[10] + r[8] * m[11])
 
 
-@kernel(inline=True)
+@kernel
 def _mat_mat(a, b):
     """``a b`` of two row-major 9-tuples."""
     return (a[0] * b[0] + a[1] * b[3] + a[2] * b[6], a[0] * b[1] + a[1] * b[4] + a[2] * b[7],
@@ -163,7 +163,7 @@ def _jacobian6_k(q, g, out) -> int:
     return OK
 
 
-@kernel(inline=True)
+@kernel
 def _rot_gap(tg, r):
     """``(v, c)`` of ``R_target R^T`` (the target's rotation in ``tg`` (16), ``R`` = ``r``, a row-major 9-tuple):
     its axial part ``v`` = ``sin(t) u`` (a 3-tuple) and ``c = cos t``, for the rotation by ``t`` about ``u``
@@ -309,26 +309,26 @@ def _polish6(tg, g, q, ws, fixed=0) -> float:
     return split
 
 
-@kernel(inline=True)
+@kernel
 def _mat_vec(m, v):
     """``m v`` for a (3, 3) array ``m``."""
     return _m9_vec((m[0, 0], m[0, 1], m[0, 2], m[1, 0], m[1, 1], m[1, 2], m[2, 0], m[2, 1], m[2, 2]), v)
 
 
-@kernel(inline=True)
+@kernel
 def _mat_t_vec(m, v):
     """``m^T v`` for a (3, 3) array ``m``."""
     return _m9_vec((m[0, 0], m[1, 0], m[2, 0], m[0, 1], m[1, 1], m[2, 1], m[0, 2], m[1, 2], m[2, 2]), v)
 
 
-@kernel(inline=True)
+@kernel
 def _m9_vec(m, v):
     """``m v`` for a row-major 9-tuple ``m``."""
     return (m[0] * v[0] + m[1] * v[1] + m[2] * v[2], m[3] * v[0] + m[4] * v[1] + m[5] * v[2],
             m[6] * v[0] + m[7] * v[1] + m[8] * v[2])
 
 
-@kernel(inline=True)
+@kernel
 def _target_motion(tg, g, gr):
     """``G = T M_0^-1`` of the target ``T`` (16 floats): its rotation into ``gr`` (3, 3), its translation returned."""
     for i in range(3):
@@ -448,7 +448,7 @@ def _hip_candidates(tg, g, ref, prune, cand, cost, resid, gr) -> int:
     return n
 
 
-@kernel(inline=True)
+@kernel
 def _hip_branch(s12, i12, hv, v, ax, lim, prune):
     """Hip branch ``i12`` of :func:`_hip_candidates` (step iii; ``s12`` the answer of its SP2, ``R_h v = hv``):
     ``(kept, (q_1, q_2, q_3), (cos, sin) of each, cost)``."""

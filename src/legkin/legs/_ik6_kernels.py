@@ -201,7 +201,12 @@ def _ik6_k(tg, g, ref, tol, out, info, work, cost) -> int:
         costs[i] = math.inf
         for j in range(6):
             qb[j] = lim[i, j]
-        res = resid[i] if resid[i] <= POLISH_BELOW6 else _polish6(tg, g, qb, ws)
+        checked = resid[i] <= POLISH_BELOW6
+        res = resid[i] if checked else _polish6(tg, g, qb, ws)
+        if res <= tol and checked:  # the row as built: its angles are inside the limits already
+            for j in range(6):
+                out[j] = qb[j]
+            return OK
         if res <= tol:
             c, inside = _limited(qb, ref, g, out)
             if inside:

@@ -1,6 +1,7 @@
 """The inverse kinematics kernels of a 6-DOF leg (:mod:`legkin.legs.sixdof`): every solution (the closed form's or
-the one-dimensional search's candidates, each polished on the exact forward map and kept if it reproduces the
-target), and the solution inside the limits nearest a reference; scalar and batch."""
+the one-dimensional search's candidates, each checked on the exact forward map, polished where that misses 1e-13,
+and kept if it reproduces the target), and the solution inside the limits nearest a reference (the closed form
+builds only its branches inside the limits); scalar and batch, a batch allocating its work arrays once."""
 
 from __future__ import annotations
 

@@ -58,7 +58,7 @@ def _pose6(q, g, rot_out, pos_out, axes_w, orig_w) -> None:
             rot_out[i, c] = r[3 * i + c]
 
 
-@kernel(inline=True)
+@kernel
 def _times_joint(r, t, a, o, c, s):
     """``(r, t) E_j = (r m, t + r o - (r m) o)`` with ``m = R(a, q_j)`` (``c``, ``s``: its cosine and sine), ``o`` a
     point of the axis ``a``; ``r`` a row-major 9-tuple, ``t`` a 3-tuple."""

@@ -403,6 +403,46 @@ def test_q_near_picks_the_solution_and_joint_limit_error(talos_left):
             leg.ik(leg.fk(bad))
 
 
+def _in_limit_rows(leg, q_all, mask, near):
+    """Each row of ``q_all`` (n, K, 6) with each angle at its 2 pi representative inside the limits nearest ``near``
+    (n, 6), the cost ``|x - near|^2`` of each row (inf when an angle has none) and how far (rad) each row lies
+    outside the limits at least."""
+    x = q_all[..., None] + 2.0 * np.pi * np.arange(-1, 2)  # (n, K, 6, 3)
+    lo, hi = leg.lower[:, None], leg.upper[:, None]
+    out = np.maximum(np.maximum(lo - x, x - hi), 0.0).min(-1).max(-1)
+    d = np.where((x >= lo) & (x <= hi), np.abs(x - near[:, None, :, None]), np.inf)
+    rep = np.take_along_axis(x, d.argmin(-1)[..., None], -1)[..., 0]
+    cost = np.where(np.isfinite(d.min(-1)).all(-1) & mask, ((rep - near[:, None]) ** 2).sum(-1), np.inf)
+    return rep, cost, np.where(mask, out, np.inf)
+
+
+@pytest.mark.parametrize("name", ["talos", "romeo", "icub", "simple_humanoid"])
+def test_ik_is_the_in_limit_row_of_ik_all_nearest_q_near(humanoids, name):
+    """``ik`` builds only the closed form's branches inside the limits (a branch dropped at its first joint outside)
+    and checks the cheapest first: its answer is the row of ``ik_all`` moved inside the limits nearest ``q_near``
+    (least sum of squares), on 600 targets per leg (half from joints inside the limits, half from up to 0.5 rad
+    outside them), with ``q_near`` random inside them; a target whose every row lies 1e-3 rad or more outside the
+    limits is refused."""
+    _, found = humanoids[name]
+    rng = np.random.default_rng(11)
+    for leg in found.values():
+        wide = np.repeat([[0.0], [0.5]], 300, axis=0)  # half from joints inside the limits, half from up to 0.5 out
+        qs = rng.uniform(leg.lower - wide, leg.upper + wide, (600, 6))
+        near = rng.uniform(leg.lower, leg.upper, (600, 6))
+        poses = leg.fk(qs)
+        q, ok = leg.ik(poses, q_near=near, return_mask=True)
+        q_all, mask = leg.ik_all(poses, return_mask=True)
+        rep, cost, out = _in_limit_rows(leg, q_all, mask, near)
+        two = np.sort(cost, axis=-1)[:, :2]
+        clear = np.isfinite(two[:, 0]) & ~(two[:, 1] <= two[:, 0] + 1e-6)  # one nearest row, not a tie
+        far = mask.any(-1) & (out >= 1e-3).all(-1)
+        assert clear.sum() >= 250 and far.sum() >= 100, (clear.sum(), far.sum())  # measured >= 300, >= 276
+        best = rep[np.arange(len(q)), cost.argmin(-1)]
+        assert ok[clear].all()
+        np.testing.assert_allclose(q[clear], best[clear], atol=1e-9)
+        assert not ok[far].any()
+
+
 def test_tol_solves_a_pose_just_out_of_reach(talos_left):
     """The default tol (IK_TOL = 1e-7) solves a pose 5e-8 beyond full stretch at its nearest pose, refuses one 1e-6
     beyond; a tighter tol refuses the first, a looser one solves the second."""

@@ -1,6 +1,7 @@
 """The inverse kinematics kernels of a 6-DOF leg (:mod:`legkin.legs.sixdof`): every solution (the closed form's or
-the one-dimensional search's candidates, each polished on the exact forward map and kept if it reproduces the
-target), and the solution inside the limits nearest a reference; scalar and batch."""
+the one-dimensional search's candidates, each checked on the exact forward map, polished where that misses 1e-13,
+and kept if it reproduces the target), and the solution inside the limits nearest a reference (the closed form
+builds only its branches inside the limits); scalar and batch, a batch allocating its work arrays once."""
 
 from __future__ import annotations
 
@@ -24,19 +25,10 @@ from ._sixdof_layout import (
     HIP_SPHERICAL,
     IK_TOL,
     LIMIT_SLACK6,
+    POLISH_BELOW6,
 )
 
 _NAN = math.nan
-
-
-@kernel
-def _candidates(tg, g, cand) -> int:
-    """The candidate rows of the leg's structure (closed form or search) in ``cand``; returns how many."""
-    if g[_KIND] == HIP_SPHERICAL:
-        return _hip_candidates(tg, g, cand)
-    if g[_KIND] != 0.0:
-        return _search_candidates(tg, g, cand)
-    return 0
 
 
 #: The candidate rows a search may hold: twice the K rows of ``ik_all``. A root can be found twice (by two cells, or
@@ -46,6 +38,39 @@ _CAND_ROWS = 2
 #: Two polished rows closer than this in every angle (rad, modulo 2 pi) are one solution: the polish lands within
 #: ~1e-15 rad of a solution, and two distinct solutions this close make the same pose to far below ``IK_TOL``.
 _SAME_ROW = 1e-9
+
+
+@kernel
+def _work6(g, extra):
+    """The work arrays of :func:`_ik6_k` and :func:`_ik_all6_k` for the leg ``g``, allocated once per batch (not once
+    per target): ``(work, cost)``, ``work`` (36 + 2 k, 6) (:func:`_views`) and ``cost`` (2 k + ``extra``,): the
+    candidates' costs, then their errors (:func:`_candidates`); ``k`` = :data:`_CAND_ROWS` times the rows of
+    ``ik_all``."""
+    k = _CAND_ROWS * int(g[_NSOLS])
+    return np.empty((36 + 2 * k, 6)), np.empty(2 * k + extra)
+
+
+@kernel(inline=True)
+def _views(work, cost, g):
+    """The parts of ``work`` and ``cost`` (:func:`_work6`; slices, no copy): the polish's work space and polished
+    row ``ws`` (33, 6), a (3, 6) work array, the candidate rows ``cand`` (k, 6), their in-limit representatives
+    ``lim`` (k, 6), their costs (k,) and their errors ``resid`` (k,)."""
+    k = _CAND_ROWS * int(g[_NSOLS])
+    return work[:33], work[33:36], work[36:36 + k], work[36 + k:36 + 2 * k], cost[:k], cost[k:2 * k]
+
+
+@kernel
+def _candidates(tg, g, ref, work, cost) -> int:
+    """Every candidate row of the leg's structure into ``cand`` of :func:`_views`, its error in ``resid`` (the
+    closed form's from its subproblems' cosines and sines, :func:`_hip_candidates`; inf for the search's, which
+    are all polished); returns how many."""
+    _, gr, cand, _, costs, resid = _views(work, cost, g)
+    if g[_KIND] == HIP_SPHERICAL:
+        return _hip_candidates(tg, g, ref, False, cand, costs, resid, gr)
+    n = _search_candidates(tg, g, cand) if g[_KIND] != 0.0 else 0
+    for b in range(n):
+        resid[b] = math.inf
+    return n
 
 
 @kernel
@@ -62,27 +87,27 @@ def _listed(out, m, q) -> bool:
 
 
 @kernel
-def _ik_all6_k(tg, g, ref, tol, out, info) -> int:
+def _ik_all6_k(tg, g, ref, tol, out, info, work, cost) -> int:
     """Every solution (rows of ``out`` (K, 6), NaN rows for absent ones) of the foot pose ``tg`` (16 floats): the
-    candidates of the leg's structure (closed form or search), each polished (:func:`_polish6`) and kept if it
-    reproduces ``tg`` to ``tol``, each angle moved to its 2 pi representative nearest ``ref``. The closed form's
-    rows keep their branch order; the search's are packed, a row polished onto an earlier one dropped
-    (:func:`_listed`). ``info[0]``: on failure the least residual."""
+    candidates of the leg's structure (closed form or search), each checked (:func:`_candidates`) or polished and
+    kept if it reproduces ``tg`` to ``tol``, each angle moved to its 2 pi representative nearest ``ref``. The closed
+    form's rows keep their branch order; the search's are packed, a row polished onto an earlier one dropped
+    (:func:`_listed`). ``info[0]``: on failure the least residual. ``work``, ``cost``: :func:`_work6`."""
     k = out.shape[0]
     for b in range(k):
         for j in range(6):
             out[b, j] = _NAN
     if not _valid_pose(tg):
         return _BAD_INPUT
-    ws = np.empty((33 + _CAND_ROWS * k, 6))  # rows 0-31: the polish's work space, 32: the polished row, candidates
-    cand, qb = ws[33:], ws[32]
-    n = _candidates(tg, g, cand)
+    ws, _, cand, _, _, resid = _views(work, cost, g)
+    qb = ws[32]
+    n = _candidates(tg, g, ref, work, cost)
     packed = g[_KIND] != HIP_SPHERICAL
     best, found = math.inf, 0
     for b in range(n):
         for j in range(6):
             qb[j] = cand[b, j]
-        res = _polish6(tg, g, qb, ws)
+        res = resid[b] if resid[b] <= POLISH_BELOW6 else _polish6(tg, g, qb, ws)
         if not res <= tol:
             best = min(best, res)
             continue
@@ -134,33 +159,55 @@ def _clip_solution(tg, g, q, ref, tol, out, ws) -> bool:
     return False
 
 
-@kernel
-def _ik6_k(tg, g, ref, tol, out, info) -> int:
-    """The solution inside the limits nearest ``ref`` (least sum of squared differences): the candidates are ranked
-    by that cost first and polished in that order until one reproduces ``tg`` to ``tol`` (its angles then moved
-    inside the limits again), so a single answer costs one polish, not one per candidate. ``info``: the least
-    residual, or the least limit violation (rad) and the count of solutions."""
+@kernel(inline=True)
+def _ranked(tg, g, ref, work, cost) -> int:
+    """The candidates inside the limits, for :func:`_ik6_k`: their representatives inside the limits nearest
+    ``ref`` in ``lim`` of :func:`_views` and their costs ``|q - ref|^2`` in ``cost`` (inf for a candidate outside
+    them); returns the count of rows. The closed form builds only the branches inside the limits (their rows go
+    straight to ``lim``); the search's candidates all go to ``cand``, each moved inside the limits
+    (:func:`_limited`)."""
+    _, gr, cand, lim, costs, resid = _views(work, cost, g)
+    if g[_KIND] == HIP_SPHERICAL:
+        return _hip_candidates(tg, g, ref, True, lim, costs, resid, gr)
+    n = _candidates(tg, g, ref, work, cost)
+    for b in range(n):
+        c, inside = _limited(cand[b], ref, g, lim[b])
+        costs[b] = c if inside else math.inf
+    return n
+
+
+@kernel(inline=True)
+def _ik6_k(tg, g, ref, tol, out, info, work, cost) -> int:
+    """The solution inside the limits nearest ``ref`` (least sum of squared differences): the candidates inside the
+    limits (:func:`_ranked`) are checked or polished in the order of that cost until one
+    reproduces ``tg`` to ``tol`` (its angles then moved inside the limits again), so a single answer costs one
+    check, not one per candidate; when none does, :func:`_polished_fallback` on every candidate. ``info``: the
+    least residual, or the least limit violation (rad) and the count of solutions. ``work``, ``cost``:
+    :func:`_work6`."""
     for j in range(6):
         out[j] = _NAN
     if not _valid_pose(tg):
         return _BAD_INPUT
-    k = _CAND_ROWS * int(g[_NSOLS])
-    ws = np.empty((33 + 2 * k, 6))  # polish work space, polished row, candidates, their in-limit representatives
-    cand, lim, qb = ws[33:33 + k], ws[33 + k:], ws[32]
-    n = _candidates(tg, g, cand)
-    cost = np.empty(k)
-    for b in range(n):
-        c, inside = _limited(cand[b], ref, g, lim[b])
-        cost[b] = c if inside else math.inf
+    ws, _, _, lim, costs, resid = _views(work, cost, g)
+    qb = ws[32]
+    n = _ranked(tg, g, ref, work, cost)
     best = math.inf
     for _ in range(n):  # the in-limit candidates, cheapest first
-        i = int(np.argmin(cost[:n]))
-        if cost[i] == math.inf:
+        i = 0
+        for b in range(1, n):
+            if costs[b] < costs[i]:
+                i = b
+        if costs[i] == math.inf:
             break
-        cost[i] = math.inf
+        costs[i] = math.inf
         for j in range(6):
             qb[j] = lim[i, j]
-        res = _polish6(tg, g, qb, ws)
+        checked = resid[i] <= POLISH_BELOW6
+        res = resid[i] if checked else _polish6(tg, g, qb, ws)
+        if res <= tol and checked:  # the row as built: its angles are inside the limits already
+            for j in range(6):
+                out[j] = qb[j]
+            return OK
         if res <= tol:
             c, inside = _limited(qb, ref, g, out)
             if inside:
@@ -168,16 +215,20 @@ def _ik6_k(tg, g, ref, tol, out, info) -> int:
             for j in range(6):
                 out[j] = _NAN
         best = min(best, res)
-    return _polished_fallback(tg, g, ref, tol, cand, lim, n, best, out, info, ws)
+    return _polished_fallback(tg, g, ref, tol, n, best, out, info, work, cost)
 
 
 @kernel
-def _polished_fallback(tg, g, ref, tol, cand, lim, n, best, out, info, ws) -> int:
-    """:func:`_ik6_k` when no in-limit candidate polished to a solution: every candidate polished first, then moved
-    inside the limits (a candidate outside them can polish to an in-limit solution near a stretched knee; one a hair
-    outside, up to :data:`LIMIT_SLACK6`, is clipped onto them, :func:`_clip_solution`); the in-limit solution nearest
-    ``ref`` wins. Else ``info``: the least limit violation (rad) and the count of solutions, or the least residual."""
+def _polished_fallback(tg, g, ref, tol, n, best, out, info, work, cost) -> int:
+    """:func:`_ik6_k` when no in-limit candidate polished to a solution: every candidate (the closed form's built
+    again, all of them; the search's ``n`` as they are) polished first, then moved inside the limits (a candidate
+    outside them can polish to an in-limit solution near a stretched knee; one a hair outside, up to
+    :data:`LIMIT_SLACK6`, is clipped onto them, :func:`_clip_solution`); the in-limit solution nearest ``ref``
+    wins. Else ``info``: the least limit violation (rad) and the count of solutions, or the least residual."""
+    ws, _, cand, lim, _, _ = _views(work, cost, g)
     qb = ws[32]
+    if g[_KIND] == HIP_SPHERICAL:
+        n = _candidates(tg, g, ref, work, cost)
     viol, nb, best_in = math.inf, 0, math.inf
     for b in range(n):
         for j in range(6):
@@ -214,12 +265,15 @@ def _one(t, g, out, solve_all) -> int:
     ``_BAD_INPUT`` (the wrapper's full checks then say why) for a bad pose or a leg without an IK."""
     if g[_KIND] == 0.0:
         return _BAD_INPUT
-    tg, info = np.empty(16), np.empty(2)
+    work, cost = _work6(g, 18)
+    tg, info = cost[-18:-2], cost[-2:]
     for i in range(4):
         for j in range(4):
             tg[4 * i + j] = t[i, j]
     ref = g[_QREF:_QREF + 6]
-    return _ik_all6_k(tg, g, ref, IK_TOL, out, info) if solve_all else _ik6_k(tg, g, ref, IK_TOL, out[0], info)
+    if solve_all:
+        return _ik_all6_k(tg, g, ref, IK_TOL, out, info, work, cost)
+    return _ik6_k(tg, g, ref, IK_TOL, out[0], info, work, cost)
 
 
 @kernel(entry=True)
@@ -237,12 +291,14 @@ def _ik_all6_one(t, g, out) -> int:
 @batch_kernel(rows="tg ref out status info", min_parallel=256)
 def _ik_all6_batch(tg, g, ref, tol, out, status, info) -> None:
     n, m = tg.shape[0], ref.shape[0]
+    work, cost = _work6(g, 0)
     for i in range(n):
-        status[i] = _ik_all6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])
+        status[i] = _ik_all6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i], work, cost)
 
 
 @batch_kernel(rows="tg ref out status info", min_parallel=256)
 def _ik6_batch(tg, g, ref, tol, out, status, info) -> None:
     n, m = tg.shape[0], ref.shape[0]
+    work, cost = _work6(g, 0)
     for i in range(n):
-        status[i] = _ik6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i])
+        status[i] = _ik6_k(tg[i], g, ref[i if m > 1 else i - i], tol, out[i], info[i], work, cost)

@@ -26,7 +26,8 @@ forward map is the product of exponentials (what Pinocchio computes, with the me
 * ``"6R-general"``: any other 6R chain: ``fk`` and ``jacobian`` only; :meth:`Leg6.ik` raises
   :class:`~legkin.errors.LegStructureError`.
 
-Every answer is polished and kept only if it reproduces the target to ``tol`` (default :data:`IK_TOL` = 1e-7:
+Every answer is checked on the forward map (polished by Newton steps where it misses 1e-13) and kept only if it
+reproduces the target to ``tol`` (default :data:`IK_TOL` = 1e-7:
 position error <= ``tol`` m and rotation error <= ``tol`` rad, above what float32 rounding does to a pose, see
 ``legs.kinematics.IK_TOL``; pass ``tol=1e-9`` for a tighter check); a target within ``tol`` of the
 reachable set is solved at its nearest reachable pose (the polish's least-squares limit). Single/batch contract

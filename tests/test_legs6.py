@@ -568,6 +568,24 @@ def test_g1_near_singular_solutions_are_found(humanoids, case):
     assert np.abs(back[0] - pose[0]).max() <= TOL6
 
 
+def test_an_approximate_row_is_dropped_when_the_pose_is_reached_exactly(humanoids):
+    """alexander's left leg at ``legkin check alexander --random-seed 17 --samples 100000`` (sample 52919): beside
+    its two exact solutions, the search's stretched-knee candidate polishes to a least-squares point of its branch
+    (knee 1e-16 rad, ``sigma_min`` 5e-17) that reproduces the pose to 7.7e-9 only, within ``IK_TOL``. The pose is
+    reached exactly, so that row is not a solution: ``ik_all`` lists only rows that reproduce it to ``TOL6``, and
+    the sampled configuration is among them (the check's "IK all solutions" row failed at 7.7e-9)."""
+    model, found = humanoids["alexander"]
+    leg = found["LEFT"]
+    q = np.array([0.13357090545303052, 0.01863643929939512, -0.9046069022273362, 1.0630389338814212,
+                  -0.00654516423748386, -0.2550224657563013])
+    pose, _ = _pin_feet(model, leg, q[None])
+    q_all, mask = leg.ik_all(pose[0], return_mask=True)
+    back, _ = _pin_feet(model, leg, q_all[mask])
+    assert np.abs(back - pose[0]).max() <= TOL6
+    gap = np.where(mask, np.abs(np.angle(np.exp(1j * (q_all - q)))).max(axis=-1), np.inf).min()
+    assert gap * np.linalg.svd(leg.jacobian(q), compute_uv=False)[-1] <= C_AMONG * TOL6
+
+
 def test_g1_seventeenth_candidate_is_kept(humanoids):
     """g1's left leg at ``legkin check g1 --random-seed 7 --samples 100000`` (sample 83926): its pose has 16
     solutions, and the search finds one of them twice (two candidates 1e-10 apart that polish to one row), so a list

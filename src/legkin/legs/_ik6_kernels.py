@@ -38,6 +38,11 @@ _CAND_ROWS = 2
 #: Two polished rows closer than this in every angle (rad, modulo 2 pi) are one solution: the polish lands within
 #: ~1e-15 rad of a solution, and two distinct solutions this close make the same pose to far below ``IK_TOL``.
 _SAME_ROW = 1e-9
+#: A row reproducing the pose to no better than this (``_polish6``'s residual: m and rad) while another reproduces
+#: it to this is a least-squares point of its branch, not a solution, and is dropped (``tol`` keeps a target within
+#: it of the reachable set solvable, not a pose already reached). Exact rows land at <= 1e-13 (the sweep's worst,
+#: g1); alexander's stretched-knee row (``--random-seed 17 --samples 100000``) reached 7.7e-9.
+EXACT6 = 1e-10
 
 
 @kernel
@@ -92,18 +97,19 @@ def _ik_all6_k(tg, g, ref, tol, out, info, work, cost) -> int:
     candidates of the leg's structure (closed form or search), each checked (:func:`_candidates`) or polished and
     kept if it reproduces ``tg`` to ``tol``, each angle moved to its 2 pi representative nearest ``ref``. The closed
     form's rows keep their branch order; the search's are packed, a row polished onto an earlier one dropped
-    (:func:`_listed`). ``info[0]``: on failure the least residual. ``work``, ``cost``: :func:`_work6`."""
+    (:func:`_listed`). Where a row reproduces ``tg`` to :data:`EXACT6`, the rows that do not are dropped.
+    ``info[0]``: on failure the least residual. ``work``, ``cost``: :func:`_work6`."""
     k = out.shape[0]
     for b in range(k):
         for j in range(6):
             out[b, j] = _NAN
     if not _valid_pose(tg):
         return _BAD_INPUT
-    ws, _, cand, _, _, resid = _views(work, cost, g)
+    ws, _, cand, _, kept, resid = _views(work, cost, g)
     qb = ws[32]
     n = _candidates(tg, g, ref, work, cost)
     packed = g[_KIND] != HIP_SPHERICAL
-    best, found = math.inf, 0
+    best, found, least = math.inf, 0, math.inf
     for b in range(n):
         for j in range(6):
             qb[j] = cand[b, j]
@@ -116,11 +122,33 @@ def _ik_all6_k(tg, g, ref, tol, out, info, work, cost) -> int:
         row = found if packed else b
         for j in range(6):
             out[row, j] = _near_k(qb[j], ref[j])
+        kept[row], least = res, min(least, res)
         found += 1
     if found == 0:
         info[0], info[1] = best, 0.0
         return _UNREACHABLE
+    if least <= EXACT6:
+        _drop_inexact(out, kept, found if packed else n, packed)
     return OK
+
+
+@kernel
+def _drop_inexact(out, res, m, packed) -> None:
+    """Drop the rows of ``out[:m]`` whose residual ``res`` exceeds :data:`EXACT6` (NaN rows; ``packed``: the rows
+    after them move up)."""
+    w = 0
+    for i in range(m):
+        if out[i, 0] != out[i, 0]:
+            continue
+        keep = res[i] <= EXACT6
+        target = w if packed else i
+        for j in range(6):
+            out[target, j] = out[i, j] if keep else _NAN
+        w += 1 if keep else 0
+    if packed:
+        for i in range(w, m):
+            for j in range(6):
+                out[i, j] = _NAN
 
 
 @kernel
@@ -181,7 +209,8 @@ def _ik6_k(tg, g, ref, tol, out, info, work, cost) -> int:
     """The solution inside the limits nearest ``ref`` (least sum of squared differences): the candidates inside the
     limits (:func:`_ranked`) are checked or polished in the order of that cost until one
     reproduces ``tg`` to ``tol`` (its angles then moved inside the limits again), so a single answer costs one
-    check, not one per candidate; when none does, :func:`_polished_fallback` on every candidate. ``info``: the
+    check, not one per candidate (a row reproducing ``tg`` to ``tol`` but not to :data:`EXACT6` only when no later
+    one does); when none does, :func:`_polished_fallback` on every candidate. ``info``: the
     least residual, or the least limit violation (rad) and the count of solutions. ``work``, ``cost``:
     :func:`_work6`."""
     for j in range(6):
@@ -191,7 +220,7 @@ def _ik6_k(tg, g, ref, tol, out, info, work, cost) -> int:
     ws, _, _, lim, costs, resid = _views(work, cost, g)
     qb = ws[32]
     n = _ranked(tg, g, ref, work, cost)
-    best = math.inf
+    best, inexact = math.inf, -1
     for _ in range(n):  # the in-limit candidates, cheapest first
         i = 0
         for b in range(1, n):
@@ -210,11 +239,18 @@ def _ik6_k(tg, g, ref, tol, out, info, work, cost) -> int:
             return OK
         if res <= tol:
             c, inside = _limited(qb, ref, g, out)
-            if inside:
+            if inside and res <= EXACT6:
                 return OK
+            inexact = i if inside and inexact < 0 else inexact  # kept unless an exact row follows (EXACT6)
             for j in range(6):
                 out[j] = _NAN
         best = min(best, res)
+    if inexact >= 0:
+        for j in range(6):
+            qb[j] = lim[inexact, j]
+        _polish6(tg, g, qb, ws)
+        _limited(qb, ref, g, out)
+        return OK
     return _polished_fallback(tg, g, ref, tol, n, best, out, info, work, cost)
 
 

@@ -23,21 +23,20 @@ On the offset hip every quantity of one point is ``X_0 + X_c cos t + X_s sin t``
 (:func:`_off_prepare`) and the subproblems' roots are taken as cosine/sine pairs: a point costs one cosine, one sine
 and a few square roots for all 4 branches, no allocation.
 
-The search (:data:`SEARCH_GRID` points by structure). No root may be missed, so every cell between two grid
-points is *settled* by a bound, not by its end values alone. On a cell ``[a, b]`` of width ``w`` where
-``|r_b''| <= M``: the chord's slope ``(r(b) - r(a)) / w`` is ``r_b'`` somewhere, so ``|r(b) - r(a)| > M w^2`` keeps
-``r_b'`` from vanishing (one root if the signs differ, none if not), and ``min(|r(a)|, |r(b)|) > M w^2 / 8`` with
-equal signs leaves none (the chord minus the parabola of curvature ``M``). ``M`` is ``S`` =
-:data:`CURVATURE_SAFETY` times the larger second difference at the cell's ends, over ``w^2``: exact with ``S = 1``
-for a cubic, whose ``r''`` is linear (so largest at an end) and equals its centred second difference; with ``S``,
-``M`` bounds ``|r''|`` whenever ``w^2 |r''''| <= 24 (S - 1) / (2 S + 3) max(|r''(a)|, |r''(b)|)`` on the cell
-(3.4 for ``S = 2``: ``r''`` strays from its chord by ``<= w^2 |r''''| / 8``, the second difference from ``r''`` by
-``<= w^2 |r''''| / 12``). A cell is concluded empty only with :data:`DOUBT` times that bound: near g1's singular
-poses a pair of roots 1e-3 to 1e-2 rad apart sits next to a fold, where the residual curves far more than its
-second differences at the cell's ends say. A cell the bound does not settle is halved, each half's ``M`` the larger of the parent's
-and ``S`` times its own second difference, down to :data:`_MIN_CELL`. That catches what values alone miss: three
-roots of a branch within one or two cells (g1, a pose near a cusp of its solutions), two roots in a cell of equal
-signs. Sign changes are refined by the Illinois method to 1e-15 rad.
+The search (:data:`SEARCH_GRID` points by structure). No root may be missed, so every cell between two grid points is
+*settled* by a bound, not by its end values alone. On a cell ``[a, b]`` of width ``w`` where ``|r_b''| <= M``: the
+chord's slope ``(r(b) - r(a)) / w`` is ``r_b'`` somewhere, so ``|r(b) - r(a)| > M w^2`` keeps ``r_b'`` from vanishing
+(one root if the signs differ, none if not), and ``min(|r(a)|, |r(b)|) > M w^2 / 8`` with equal signs leaves none (the
+chord minus the parabola of curvature ``M``). ``M`` is ``S`` = :data:`CURVATURE_SAFETY` times the larger second
+difference at the cell's ends, over ``w^2``: exact with ``S = 1`` for a cubic, whose ``r''`` is linear (so largest at an
+end) and equals its centred second difference; with ``S``, ``M`` bounds ``|r''|`` whenever ``w^2 |r''''| <= 24 (S - 1) /
+(2 S + 3) max(|r''(a)|, |r''(b)|)`` on the cell (3.4 for ``S = 2``: ``r''`` strays from its chord by ``<= w^2 |r''''| /
+8``, the second difference from ``r''`` by ``<= w^2 |r''''| / 12``). A cell is concluded empty only with :data:`DOUBT`
+times that bound: near g1's singular poses a pair of roots 1e-3 to 1e-2 rad apart sits next to a fold, where the
+residual curves far more than its second differences at the cell's ends say. A cell the bound does not settle is halved,
+each half's ``M`` the larger of the parent's and ``S`` times its own second difference, down to :data:`_MIN_CELL`. That
+catches what values alone miss: three roots of a branch within one or two cells (g1, a pose near a cusp of its
+solutions), two roots in a cell of equal signs. Sign changes are refined by the Illinois method to 1e-15 rad.
 
 Where a branch stops existing (a *fold*, where g1's knee nears full stretch and two branches meet; found by the
 Illinois method on the existence margin), the residual moves like ``sqrt(|t - f|)``, whose derivatives have no
@@ -49,11 +48,11 @@ near zero, by Brent's minimisation of the margin, and searched from their folds.
 Every candidate is then polished on the exact forward map and kept only if it reproduces the target
 (:mod:`._ik6_kernels`).
 
-The bound rests on that condition on the residual's fourth derivative, which the search does not verify: it is a
-bound checked by measurement (with :data:`DOUBT` as a margin), not a proof for every target. ``python scripts/legs6_completeness.py`` (docs/legs.md):
-the sampled configuration among ``ik_all``'s rows on every random in-limit sample (10^6 per leg of g1, 6x10^5 per
-leg of alexander), where the values alone missed about 1 in 10^5 on g1.
-"""
+The bound rests on that condition on the residual's fourth derivative, which the search does not verify: it is a bound
+checked by measurement (with :data:`DOUBT` as a margin), not a proof for every target. ``python
+scripts/legs6_completeness.py`` (docs/legs.md): the sampled configuration among ``ik_all``'s rows on every random
+in-limit sample (10^6 per leg of g1, 6x10^5 per leg of alexander), where the values alone missed about 1 in 10^5
+on g1; ``python scripts/check_sweep.py g1 alexander``: every check row for seeds 0-19 at up to 10^5 samples."""
 
 from __future__ import annotations
 

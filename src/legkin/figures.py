@@ -50,7 +50,9 @@ def error_histograms(model: str, rows, outdir: Path) -> Path:
     fig.tight_layout()
     path = outdir / f"check_{model}.png"
     fig.savefig(path, dpi=90)
-    fig.clf()
+    import matplotlib.pyplot as plt
+
+    plt.close(fig)  # pyplot keeps every figure it made until closed (a warning past 20)
     return path
 
 

@@ -175,7 +175,7 @@ def textbook_to_joints(theta: npt.ArrayLike, leg: str, *, geometry: Geometry | N
     """
     fz = 0.0 if geometry is None else foot_z_of(geometry)
     leg_index(leg)
-    beta = math.atan2(fz, X34)
+    beta = math.atan2(fz, X34) if fz else 0.0  # atan2(0, X34) is 0: no call for the default geometry
     arr = rows(theta, "theta")
     if arr.ndim == 1:
         out = np.empty(3)

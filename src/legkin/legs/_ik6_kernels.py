@@ -10,7 +10,8 @@ import math
 import numpy as np
 
 from .._kernels import OK, batch_kernel, kernel
-from ._ik_kernels import _TWO_PI, _in_limits_k, _near_k
+from .._rotations import wrap_k
+from ._ik_kernels import _in_limits_k, _near_k
 from ._search_kernels import _search_candidates
 from ._sixdof_kernels import _hip_candidates, _polish6, _valid_pose
 from ._sixdof_layout import (
@@ -84,8 +85,7 @@ def _listed(out, m, q) -> bool:
     for i in range(m):
         same = True
         for j in range(6):
-            d = abs(out[i, j] - q[j]) % _TWO_PI
-            same = same and min(d, _TWO_PI - d) <= _SAME_ROW
+            same = same and abs(wrap_k(out[i, j] - q[j])) <= _SAME_ROW
         if same:
             return True
     return False
